@@ -1,0 +1,140 @@
+//! Contract 2 of `docs/architecture.md`: every traversal reports what it does to an
+//! [`Observer`]. The CPU path passes [`NoObserver`], which compiles away; statistics use
+//! [`CountingObserver`]; the simulator records macro-operations.
+
+/// The kind of a dual-split tree node (the pipeline's derived 2-bit "node type").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum DstNodeKind {
+    /// Splitting node: two planes on one axis, two children.
+    Split,
+    /// Single-axis carving node: a slab on one axis, one child.
+    SingleCarve,
+    /// Dual-axis carving node: one plane on each of two axes, one child.
+    DualCarve,
+    /// Leaf word.
+    Leaf,
+}
+
+/// One step of a traversal kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NodeStep {
+    /// A BVH internal node: `arity` slots, `valid` non-empty children whose boxes were
+    /// tested, `hits` of them intersected (and then sorted by entry distance).
+    Bvh {
+        /// Node width (2, 4, 8).
+        arity: u8,
+        /// Children actually present (empty slots hold degenerate boxes).
+        valid: u8,
+        /// Children whose box the ray intersects.
+        hits: u8,
+    },
+    /// A dual-split tree node step: the node's kind and the pipeline's return code
+    /// (0 miss, 1 one child, 2 both children, 3 leaf; Lin et al. 2020, §3).
+    Dst {
+        /// Node kind.
+        kind: DstNodeKind,
+        /// Return code 0–3.
+        code: u8,
+        /// For a carving node acting as a leaf (L bit set).
+        carving_leaf: bool,
+    },
+    /// A leaf (BVH leaf or DST triangle run) about to be intersected.
+    Leaf {
+        /// Triangles in the run.
+        count: u32,
+    },
+}
+
+/// Told what a traversal kernel does, in order.
+pub trait Observer {
+    /// The kernel reads `bytes` contiguous bytes at byte address `addr` of the structure's
+    /// memory image (node words, triangle-index entries, triangle vertices).
+    #[inline(always)]
+    fn fetch(&mut self, _addr: u64, _bytes: u32) {}
+    /// A node step.
+    #[inline(always)]
+    fn step(&mut self, _step: NodeStep) {}
+    /// A ray–triangle test of triangle `prim`; `hit` when it was accepted.
+    #[inline(always)]
+    fn triangle_test(&mut self, _prim: u32, _hit: bool) {}
+    /// A traversal-stack push.
+    #[inline(always)]
+    fn push(&mut self) {}
+    /// A traversal-stack pop (including entries discarded after the pop).
+    #[inline(always)]
+    fn pop(&mut self) {}
+}
+
+/// The observer that observes nothing.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoObserver;
+impl Observer for NoObserver {}
+
+/// Per-ray counters: nodes visited, planes/boxes tested, triangles tested, bytes fetched.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct CountingObserver {
+    /// Internal node steps (BVH nodes, DST splitting and carving nodes).
+    pub nodes: u64,
+    /// Leaves entered.
+    pub leaves: u64,
+    /// Ray–box tests (BVH) — one per valid child box.
+    pub box_tests: u64,
+    /// Ray–plane tests (DST: two per internal node step).
+    pub plane_tests: u64,
+    /// Ray–triangle tests.
+    pub triangle_tests: u64,
+    /// Bytes fetched from the memory image.
+    pub bytes: u64,
+    /// Stack pushes.
+    pub pushes: u64,
+    /// DST steps by pipeline return code 0–3.
+    pub dst_codes: [u64; 4],
+}
+
+impl Observer for CountingObserver {
+    #[inline]
+    fn fetch(&mut self, _addr: u64, bytes: u32) {
+        self.bytes += bytes as u64;
+    }
+    #[inline]
+    fn step(&mut self, step: NodeStep) {
+        match step {
+            NodeStep::Bvh { valid, .. } => {
+                self.nodes += 1;
+                self.box_tests += valid as u64;
+            }
+            NodeStep::Dst { kind, code, .. } => {
+                if kind != DstNodeKind::Leaf {
+                    self.nodes += 1;
+                    self.plane_tests += 2;
+                }
+                self.dst_codes[code as usize & 3] += 1;
+            }
+            NodeStep::Leaf { .. } => self.leaves += 1,
+        }
+    }
+    #[inline]
+    fn triangle_test(&mut self, _prim: u32, _hit: bool) {
+        self.triangle_tests += 1;
+    }
+    #[inline]
+    fn push(&mut self) {
+        self.pushes += 1;
+    }
+}
+
+impl CountingObserver {
+    /// Adds another counter set into this one.
+    pub fn add(&mut self, o: &CountingObserver) {
+        self.nodes += o.nodes;
+        self.leaves += o.leaves;
+        self.box_tests += o.box_tests;
+        self.plane_tests += o.plane_tests;
+        self.triangle_tests += o.triangle_tests;
+        self.bytes += o.bytes;
+        self.pushes += o.pushes;
+        for i in 0..4 {
+            self.dst_codes[i] += o.dst_codes[i];
+        }
+    }
+}

@@ -1,0 +1,8 @@
+//! One module per subcommand.
+pub mod bench;
+pub mod check;
+pub mod info;
+pub mod render;
+pub mod report;
+pub mod simulate;
+pub mod stats;

@@ -1,0 +1,57 @@
+//! The `dualsplit` command line. Each subcommand lives in `cmd/<name>.rs` with its own
+//! arguments; this file only parses and dispatches.
+
+mod cmd;
+mod progress;
+
+use clap::{Parser, Subcommand};
+
+/// dualsplit: dual-split trees, BVHs and a TRaX-style hardware simulator.
+#[derive(Parser)]
+#[command(name = "dualsplit", version, about, long_about = None)]
+struct Cli {
+    /// Hide progress bars.
+    #[arg(long, short, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Load a scene and print its triangles, bounds and load statistics.
+    Info(cmd::info::Args),
+    /// Build every structure and print sizes, node counts and build times (Table 3).
+    Stats(cmd::stats::Args),
+    /// Validate every structure and check per-ray equivalence against BVH2.
+    Check(cmd::check::Args),
+    /// Render an image with a workload on a structure.
+    Render(cmd::render::Args),
+    /// Measure traversal throughput (Mrays/s) per structure and ray type.
+    Bench(cmd::bench::Args),
+    /// Simulate a frame on the TRaX-style many-core model.
+    Simulate(cmd::simulate::Args),
+    /// Regenerate the paper's tables and figures.
+    Report(cmd::report::Args),
+}
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    let ctx = progress::Ctx::new(cli.quiet);
+    let result = match cli.command {
+        Command::Info(a) => cmd::info::run(a, &ctx),
+        Command::Stats(a) => cmd::stats::run(a, &ctx),
+        Command::Check(a) => cmd::check::run(a, &ctx),
+        Command::Render(a) => cmd::render::run(a, &ctx),
+        Command::Bench(a) => cmd::bench::run(a, &ctx),
+        Command::Simulate(a) => cmd::simulate::run(a, &ctx),
+        Command::Report(a) => cmd::report::run(a, &ctx),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,36 @@
+/// A closest-hit result: the ray parameter and the triangle id (index into the scene's
+/// triangle array), plus the barycentric coordinates of the hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter of the hit point.
+    pub t: f32,
+    /// Triangle id.
+    pub prim: u32,
+    /// Barycentric u (weight of vertex 1).
+    pub u: f32,
+    /// Barycentric v (weight of vertex 2).
+    pub v: f32,
+}
+
+impl Hit {
+    /// The total order used by every closest-hit traversal: smaller `t` wins, equal `t` goes
+    /// to the smaller triangle id. Using it everywhere makes results independent of the
+    /// order in which a structure visits its leaves.
+    #[inline]
+    pub fn closer_than(&self, t: f32, prim: u32) -> bool {
+        self.t < t || (self.t == t && self.prim < prim)
+    }
+}
+
+/// The far bound used for culling nodes against the current best hit `best_t` (or the ray's
+/// `t_max` for shadow rays): `best_t` widened by a relative 2^-12.
+///
+/// Slab distances and triangle distances are computed with different arithmetic, so a
+/// triangle hit at `t` can sit one or two ulps before the computed entry of the box that
+/// holds it. Culling at exactly `best_t` could then skip a leaf holding an equal-`t` hit with a
+/// smaller id (a ray through a shared edge), and two structures would disagree. The margin
+/// costs a negligible amount of extra work and keeps all structures bit-identical.
+#[inline]
+pub fn cull_limit(best_t: f32) -> f32 {
+    best_t + best_t.abs() * (1.0 / 4096.0) + f32::MIN_POSITIVE
+}

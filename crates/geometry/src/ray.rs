@@ -1,0 +1,138 @@
+use glam::Vec3;
+
+/// A ray `origin + t * dir` valid for `t` in `[t_min, t_max]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Origin.
+    pub origin: Vec3,
+    /// Direction (need not be normalised).
+    pub dir: Vec3,
+    /// Lower end of the valid interval.
+    pub t_min: f32,
+    /// Upper end of the valid interval.
+    pub t_max: f32,
+}
+
+impl Ray {
+    /// A ray valid on `[0, ∞)`.
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        Self {
+            origin,
+            dir,
+            t_min: 0.0,
+            t_max: f32::INFINITY,
+        }
+    }
+
+    /// A ray valid on `[t_min, t_max]`.
+    pub fn segment(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
+        Self {
+            origin,
+            dir,
+            t_min,
+            t_max,
+        }
+    }
+
+    /// The point at parameter `t`.
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+
+    /// Per-ray constants used by the slab and triangle tests.
+    pub fn precompute(&self) -> RayPre {
+        RayPre::new(self)
+    }
+}
+
+/// Per-ray precomputed values: the IEEE reciprocal direction (±∞ for zero components), the
+/// direction signs, and the shear constants of the watertight triangle test.
+#[derive(Clone, Copy, Debug)]
+pub struct RayPre {
+    /// The ray itself.
+    pub ray: Ray,
+    /// `1 / dir`, component-wise; ±∞ where a component is ±0.
+    pub inv_dir: Vec3,
+    /// `inv_dir[a] < 0` (or `-0.0` direction): the ray travels toward −a.
+    pub neg: [bool; 3],
+    /// Watertight test: the axis where `|dir|` is largest (kz) and the two others (kx, ky).
+    pub k: [usize; 3],
+    /// Watertight test shear constants `Sx, Sy, Sz`.
+    pub shear: Vec3,
+}
+
+impl RayPre {
+    /// Computes the constants for `ray`.
+    pub fn new(ray: &Ray) -> Self {
+        let d = ray.dir;
+        let inv_dir = Vec3::ONE / d;
+        let neg = [
+            d.x.is_sign_negative(),
+            d.y.is_sign_negative(),
+            d.z.is_sign_negative(),
+        ];
+        let a = d.abs();
+        let kz = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let shear = Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+        Self {
+            ray: *ray,
+            inv_dir,
+            neg,
+            k: [kx, ky, kz],
+            shear,
+        }
+    }
+
+    /// Ray parameter where the ray meets the plane `x[axis] = p`: `(p - o[axis]) * inv[axis]`.
+    /// NaN when the ray lies in the plane (see the crate's robustness rules).
+    #[inline(always)]
+    pub fn plane_t(&self, axis: usize, p: f32) -> f32 {
+        (p - self.ray.origin[axis]) * self.inv_dir[axis]
+    }
+
+    /// Slab test of a box against `[t_lo, t_hi]`: the clipped interval `(entry, exit)`, which
+    /// is non-empty (`entry <= exit`) when the ray meets the box. Near and far planes are
+    /// chosen by the ray's direction signs (not by swapping distances), so the degenerate
+    /// box [`crate::Aabb::DEGENERATE`] (`min = +∞, max = -∞`) never hits, and NaN plane
+    /// distances are ignored (closed slabs).
+    #[inline(always)]
+    pub fn slab(&self, min: Vec3, max: Vec3, t_lo: f32, t_hi: f32) -> (f32, f32) {
+        let o = self.ray.origin;
+        let inv = self.inv_dir;
+        let (nx, fx) = if self.neg[0] {
+            (max.x, min.x)
+        } else {
+            (min.x, max.x)
+        };
+        let (ny, fy) = if self.neg[1] {
+            (max.y, min.y)
+        } else {
+            (min.y, max.y)
+        };
+        let (nz, fz) = if self.neg[2] {
+            (max.z, min.z)
+        } else {
+            (min.z, max.z)
+        };
+        let entry = t_lo
+            .max((nx - o.x) * inv.x)
+            .max((ny - o.y) * inv.y)
+            .max((nz - o.z) * inv.z);
+        let exit = t_hi
+            .min((fx - o.x) * inv.x)
+            .min((fy - o.y) * inv.y)
+            .min((fz - o.z) * inv.z);
+        (entry, exit)
+    }
+}

@@ -1,0 +1,1 @@
+//! `dualsplit report`: the paper's tables and figures, regenerated.

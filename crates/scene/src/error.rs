@@ -1,0 +1,44 @@
+use std::path::PathBuf;
+
+/// Everything that can go wrong while loading or generating a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be opened or read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The file's contents are malformed.
+    #[error("{path}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line, where the format has lines.
+        line: Option<u64>,
+        /// What is wrong.
+        message: String,
+    },
+    /// The extension is not one of `.obj`, `.ply`, `.gltf`, `.glb` (optionally `.gz`).
+    #[error("{path}: unknown scene format (expected .obj, .ply, .obj.gz, .ply.gz, .gltf or .glb)")]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+    },
+    /// No triangle is left after loading.
+    #[error("{spec}: the scene has no triangles")]
+    Empty {
+        /// The spec.
+        spec: String,
+    },
+    /// A builtin name or parameter is wrong.
+    #[error("builtin scene `{spec}`: {message}")]
+    Builtin {
+        /// The spec after `builtin:`.
+        spec: String,
+        /// What is wrong.
+        message: String,
+    },
+}

@@ -1,0 +1,119 @@
+//! Scenes for dualsplit: triangle soups with a camera and a light.
+//!
+//! A scene is addressed by a *spec*: a file path (`.obj`, `.ply`, either also `.gz`, `.gltf`,
+//! `.glb`) or `builtin:NAME?key=value&...` (see [`builtin`]). [`load`] resolves a spec into a
+//! [`Scene`].
+//!
+//! ```no_run
+//! let scene = dualsplit_scene::load("builtin:cornell").unwrap();
+//! assert!(scene.triangles.len() > 0);
+//! ```
+//!
+//! ## Degenerate and non-finite triangles
+//!
+//! One rule everywhere: triangles with a non-finite coordinate (NaN or ±∞) are **dropped**
+//! at load time and counted in [`LoadStats::non_finite`]; zero-area triangles are **kept**
+//! (they are real input, never hit by the watertight test, and they keep triangle ids equal
+//! to face indices of the file) and counted in [`LoadStats::degenerate`]. A scene with no
+//! triangle left is an error ([`SceneError::Empty`]).
+
+pub mod builtin;
+mod camera;
+mod error;
+pub mod load;
+
+pub use camera::{Camera, Light};
+pub use error::SceneError;
+
+use dualsplit_geometry::{Aabb, Triangle};
+
+/// Counts gathered while loading.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct LoadStats {
+    /// Triangles in the source (after triangulating polygons), before dropping.
+    pub source_triangles: u64,
+    /// Zero-area triangles (kept).
+    pub degenerate: u64,
+    /// Triangles with a NaN or infinite coordinate (dropped).
+    pub non_finite: u64,
+    /// Polygons with more than three vertices that were fan-triangulated.
+    pub polygons_triangulated: u64,
+}
+
+/// A loaded scene: the triangle soup, its bounds, and a default camera and light.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// A short display name (file stem or builtin name).
+    pub name: String,
+    /// The spec the scene was loaded from.
+    pub spec: String,
+    /// The triangles; a triangle's id is its index here.
+    pub triangles: Vec<Triangle>,
+    /// Bounds of all triangles.
+    pub bounds: Aabb,
+    /// Default camera (fit to bounds, or a preset for known scenes).
+    pub camera: Camera,
+    /// Default light.
+    pub light: Light,
+    /// What loading found.
+    pub stats: LoadStats,
+}
+
+impl Scene {
+    /// Builds a scene from triangles, dropping non-finite ones (counted), counting degenerate
+    /// ones, and fitting a default camera and light to the bounds.
+    pub fn from_triangles(
+        name: impl Into<String>,
+        spec: impl Into<String>,
+        triangles: Vec<Triangle>,
+        mut stats: LoadStats,
+    ) -> Result<Self, SceneError> {
+        let spec = spec.into();
+        stats.source_triangles = stats.source_triangles.max(triangles.len() as u64);
+        let before = triangles.len();
+        let triangles: Vec<Triangle> = triangles.into_iter().filter(|t| t.is_finite()).collect();
+        stats.non_finite += (before - triangles.len()) as u64;
+        stats.degenerate = triangles.iter().filter(|t| t.is_degenerate()).count() as u64;
+        if triangles.is_empty() {
+            return Err(SceneError::Empty { spec });
+        }
+        let bounds = triangles
+            .iter()
+            .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+        let camera = Camera::fit(&bounds);
+        let light = Light::fit(&bounds);
+        Ok(Self {
+            name: name.into(),
+            spec,
+            triangles,
+            bounds,
+            camera,
+            light,
+            stats,
+        })
+    }
+
+    /// A 64-bit content hash of the triangle data (for result caches).
+    pub fn content_hash(&self) -> String {
+        use sha2::{Digest, Sha256};
+        let mut h = Sha256::new();
+        for t in &self.triangles {
+            for p in &t.v {
+                h.update(p.x.to_le_bytes());
+                h.update(p.y.to_le_bytes());
+                h.update(p.z.to_le_bytes());
+            }
+        }
+        let d = h.finalize();
+        d[..8].iter().map(|b| format!("{b:02x}")).collect()
+    }
+}
+
+/// Loads a scene from a spec: a file path or `builtin:NAME?params`.
+pub fn load(spec: &str) -> Result<Scene, SceneError> {
+    if let Some(rest) = spec.strip_prefix("builtin:") {
+        builtin::generate(rest)
+    } else {
+        load::load_file(std::path::Path::new(spec))
+    }
+}

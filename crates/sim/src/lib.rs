@@ -1,0 +1,1 @@
+//! A TRaX-style many-core simulator with the dual-split pipeline.
