@@ -58,7 +58,7 @@ impl Progress for NoProgress {
 }
 
 /// The simulator entry point, injectable so tests can count and fake simulations.
-pub type SimulateFn = dyn Fn(
+pub type SimulateFn<'a> = dyn Fn(
         &Scene,
         &Structures,
         SimAccel,
@@ -66,7 +66,8 @@ pub type SimulateFn = dyn Fn(
         &SimConfig,
         &(dyn Fn(u64, u64) + Sync),
     ) -> Result<SimResult, String>
-    + Sync;
+    + Sync
+    + 'a;
 
 /// The real simulator ([`dualsplit_sim::simulate`]), errors as "simulator unavailable: …".
 pub fn real_simulator(
@@ -96,7 +97,7 @@ pub struct Producer<'a> {
     cache: Cache,
     settings: ReportSettings,
     progress: &'a dyn Progress,
-    simulate: &'a SimulateFn,
+    simulate: &'a SimulateFn<'a>,
     computed: AtomicU64,
 }
 
@@ -106,7 +107,7 @@ impl<'a> Producer<'a> {
         cache: Cache,
         settings: ReportSettings,
         progress: &'a dyn Progress,
-        simulate: &'a SimulateFn,
+        simulate: &'a SimulateFn<'a>,
     ) -> Self {
         Self {
             cache,
