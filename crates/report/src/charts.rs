@@ -125,6 +125,8 @@ pub fn fig78(
                         String::new()
                     }
                 })
+                .y_label_formatter(&|y| format!("{y:.0}%"))
+                .light_line_style(WHITE.mix(0.0))
                 .y_desc(format!("{} (% of BVH2)", metric_kind.label()))
                 .axis_desc_style(("sans-serif", 12))
                 .draw()
@@ -172,6 +174,9 @@ fn fps_panel(
         .map_err(|e| err(e.to_string()))?;
     chart
         .configure_mesh()
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .y_label_formatter(&|y| crate::tables::fmt_num(*y))
+        .light_line_style(WHITE.mix(0.0))
         .x_desc("TMs")
         .y_desc("frames per second")
         .axis_desc_style(("sans-serif", 12))
@@ -194,7 +199,7 @@ fn fps_panel(
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
+        .position(SeriesLabelPosition::LowerRight)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK.mix(0.3))
         .label_font(("sans-serif", 11))

@@ -181,7 +181,12 @@ fn page_loads_in_headless_chromium() {
     let url = format!("file://{}", index.display());
 
     let dom = chromium(&bin, &dir.join("profile1"), &["--dump-dom".into()], &url);
-    let mut ids = vec!["table3".to_string(), "cpu-build".into(), "cpu-mrays".into(), "renders".into()];
+    let mut ids = vec![
+        "table3".to_string(),
+        "cpu-build".into(),
+        "cpu-mrays".into(),
+        "renders".into(),
+    ];
     for (i, s) in data.scenes.iter().enumerate() {
         let sid = dualsplit_report::tables::scene_id(i, s);
         ids.push(format!("table4-{sid}"));
@@ -204,10 +209,15 @@ fn page_loads_in_headless_chromium() {
     chromium(
         &bin,
         &dir.join("profile2"),
-        &[format!("--screenshot={}", shot.display()), "--window-size=1280,4000".into()],
+        &[
+            format!("--screenshot={}", shot.display()),
+            "--window-size=1280,4000".into(),
+        ],
         &url,
     );
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&shot).expect("screenshot written")));
+    let decoder = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(&shot).expect("screenshot written"),
+    ));
     let mut reader = decoder.read_info().unwrap();
     let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut buf).unwrap();
@@ -220,10 +230,14 @@ fn page_loads_in_headless_chromium() {
     let mean = luma.iter().sum::<f64>() / luma.len() as f64;
     let var = luma.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / luma.len() as f64;
     let inked = luma.iter().filter(|&&l| l < 200.0).count() as f64 / luma.len() as f64;
-    assert!(var > 100.0, "screenshot looks blank: luminance variance {var}");
+    assert!(
+        var > 100.0,
+        "screenshot looks blank: luminance variance {var}"
+    );
     assert!(inked > 0.01, "screenshot has almost no ink: {inked}");
     if let Ok(keep) = std::env::var("DUALSPLIT_KEEP_SCREENSHOT") {
-        std::fs::copy(&shot, keep).unwrap();
+        std::fs::copy(&shot, &keep).unwrap();
+        std::fs::copy(&index, format!("{keep}.html")).unwrap();
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

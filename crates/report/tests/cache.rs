@@ -24,7 +24,10 @@ fn settings(width: u32) -> ReportSettings {
 fn second_run_computes_nothing() {
     let dir = std::env::temp_dir().join(format!("dualsplit-report-cache-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let scenes = [random_scene("hairball-test", 40, 1), random_scene("other", 30, 2)];
+    let scenes = [
+        random_scene("hairball-test", 40, 1),
+        random_scene("other", 30, 2),
+    ];
     let calls = AtomicU64::new(0);
     let sim = |a: &_, b: &_, c, d: &_, e: &_, f: &(dyn Fn(u64, u64) + Sync)| {
         calls.fetch_add(1, Ordering::Relaxed);
@@ -46,7 +49,10 @@ fn second_run_computes_nothing() {
         assert_eq!(a.sim.len(), b.sim.len());
         for (x, y) in a.sim.iter().zip(&b.sim) {
             assert_eq!((x.accel, x.workload, x.tms), (y.accel, y.workload, y.tms));
-            assert_eq!(x.result.as_ref().unwrap().cycles, y.result.as_ref().unwrap().cycles);
+            assert_eq!(
+                x.result.as_ref().unwrap().cycles,
+                y.result.as_ref().unwrap().cycles
+            );
         }
         assert_eq!(a.render_png_base64, b.render_png_base64);
     }
@@ -70,7 +76,10 @@ fn simulator_errors_are_reported_not_cached() {
     let p = Producer::new(Cache::new(&dir), settings(4), &NoProgress, &sim);
     let data = p.run(&scenes, vec![]).unwrap();
     assert_eq!(p.computed(), 2, "CPU and render pieces only");
-    assert_eq!(data.sim_error(), Some("simulator unavailable: not implemented"));
+    assert_eq!(
+        data.sim_error(),
+        Some("simulator unavailable: not implemented")
+    );
     let out = dir.join("out");
     dualsplit_report::write_report(&data, &out).unwrap();
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();

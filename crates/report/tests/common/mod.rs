@@ -11,12 +11,30 @@ use dualsplit_sim::{EnergySplit, SimAccel, SimConfig, SimResult};
 pub fn random_scene(name: &str, n: usize, seed: u64) -> Scene {
     let mut rng = Pcg32::new(seed, 7);
     let mut tris = vec![
-        Triangle::new(Vec3::new(-2.0, 0.0, -2.0), Vec3::new(2.0, 0.0, 2.0), Vec3::new(2.0, 0.0, -2.0)),
-        Triangle::new(Vec3::new(-2.0, 0.0, -2.0), Vec3::new(-2.0, 0.0, 2.0), Vec3::new(2.0, 0.0, 2.0)),
+        Triangle::new(
+            Vec3::new(-2.0, 0.0, -2.0),
+            Vec3::new(2.0, 0.0, 2.0),
+            Vec3::new(2.0, 0.0, -2.0),
+        ),
+        Triangle::new(
+            Vec3::new(-2.0, 0.0, -2.0),
+            Vec3::new(-2.0, 0.0, 2.0),
+            Vec3::new(2.0, 0.0, 2.0),
+        ),
     ];
     for _ in 0..n {
-        let c = Vec3::new(rng.range_f32(-1.0, 1.0), rng.range_f32(0.1, 1.5), rng.range_f32(-1.0, 1.0));
-        let mut p = || c + Vec3::new(rng.range_f32(-0.2, 0.2), rng.range_f32(-0.2, 0.2), rng.range_f32(-0.2, 0.2));
+        let c = Vec3::new(
+            rng.range_f32(-1.0, 1.0),
+            rng.range_f32(0.1, 1.5),
+            rng.range_f32(-1.0, 1.0),
+        );
+        let mut p = || {
+            c + Vec3::new(
+                rng.range_f32(-0.2, 0.2),
+                rng.range_f32(-0.2, 0.2),
+                rng.range_f32(-0.2, 0.2),
+            )
+        };
         tris.push(Triangle::new(p(), p(), p()));
     }
     Scene::from_triangles(name, format!("test:{name}"), tris, LoadStats::default()).unwrap()
@@ -25,7 +43,11 @@ pub fn random_scene(name: &str, n: usize, seed: u64) -> Scene {
 /// A deterministic fake simulated frame: DST fastest, wide BVHs slower, scaling sublinear.
 pub fn fake_result(accel: SimAccel, workload: Workload, tms: u32, seed: u32) -> SimResult {
     let i = SimAccel::ALL.iter().position(|&a| a == accel).unwrap() as f64;
-    let base = if workload == Workload::Path { 20.0 } else { 5.0 } + f64::from(seed);
+    let base = if workload == Workload::Path {
+        20.0
+    } else {
+        5.0
+    } + f64::from(seed);
     let factor = [1.0, 0.9, 1.1, 0.95, 1.3, 1.1, 1.2, 0.75][i as usize];
     let scale = (64.0 / f64::from(tms)).powf(0.8);
     let frame_ms = base * factor * scale;
