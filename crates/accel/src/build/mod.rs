@@ -180,7 +180,8 @@ impl Bvh2 {
         };
         let (bounds, cbounds) = range_bounds(&ctx, &ids);
         let tmp = build_range(&ctx, &mut ids, 0, bounds, cbounds, 0);
-        let mut nodes = Vec::with_capacity(prim_bounds.len() * 2 / cfg.max_leaf_size.max(1) as usize + 1);
+        let mut nodes =
+            Vec::with_capacity(prim_bounds.len() * 2 / cfg.max_leaf_size.max(1) as usize + 1);
         nodes.push(Bvh2Node {
             bounds: Aabb::EMPTY,
             first: 0,
