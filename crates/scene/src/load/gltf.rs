@@ -78,7 +78,17 @@ fn load_buffer(
                 .parent()
                 .unwrap_or(Path::new("."))
                 .join(uri.replace("%20", " "));
-            std::fs::read(&file).map_err(|source| SceneError::Io { path: file, source })?
+            std::fs::read(&file).map_err(|e| {
+                parse_error(
+                    path,
+                    None,
+                    format!(
+                        "buffer {}: cannot read {}: {e}",
+                        buffer.index(),
+                        file.display()
+                    ),
+                )
+            })?
         }
     };
     if data.len() < buffer.length() {

@@ -33,10 +33,11 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, SceneError> {
     let header = parser
         .read_header(&mut reader)
         .map_err(|e| ply_error(path, &e))?;
-    let header_lines = reader.line() as u64;
+    // ply-rs-bw's reader is now on the first body line (1-based).
+    let first_body_line = reader.line() as u64;
     let schema = schema(path, &header)?;
     match header.encoding {
-        Encoding::Ascii => parse_ascii(path, &parser, reader, &header, &schema, header_lines),
+        Encoding::Ascii => parse_ascii(path, &parser, reader, &header, &schema, first_body_line),
         Encoding::BinaryLittleEndian => {
             parse_binary(path, reader.into_inner(), &header, &schema, false)
         }
@@ -167,13 +168,13 @@ fn parse_ascii(
     mut reader: Reader<&[u8]>,
     header: &Header,
     schema: &Schema,
-    header_lines: u64,
+    first_body_line: u64,
 ) -> Result<Mesh, SceneError> {
     let mut positions = Vec::new();
     let mut faces = Vec::new();
     let mut stats = LoadStats::default();
-    // The first body line is `header_lines + 1`; each element record takes one line.
-    let mut first_line = header_lines + 1;
+    // Each element record takes one line.
+    let mut first_line = first_body_line;
     for (name, def) in &header.elements {
         let elems = parser
             .read_payload_for_element(&mut reader, def, header)
