@@ -11,8 +11,10 @@ use serde::{Serialize, de::DeserializeOwned};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
-/// Bump when the meaning or layout of a cached value changes.
-pub const SCHEMA: u32 = 1;
+/// Bump when the meaning or layout of a cached value changes, or when the simulator's model
+/// changes in a way that changes its results (all crates share one version number, so the
+/// crate version alone does not tell).
+pub const SCHEMA: u32 = 2;
 
 /// Crate version plus [`SCHEMA`]: part of every cache key.
 pub const CODE_VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+schema");

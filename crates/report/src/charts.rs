@@ -81,15 +81,15 @@ pub fn fig78(
             let mut bars = Vec::new();
             for (i, a) in SimAccel::ALL.iter().enumerate() {
                 let x = i as f64;
-                if let (Some(r), Some(b)) = (s.sim(*a, workload, tms), base) {
-                    if b > 0.0 {
-                        bars.push((
-                            x - 0.38,
-                            x,
-                            100.0 * metric(r, metric_kind) / b,
-                            color(*a).filled(),
-                        ));
-                    }
+                if let (Some(r), Some(b)) = (s.sim(*a, workload, tms), base)
+                    && b > 0.0
+                {
+                    bars.push((
+                        x - 0.38,
+                        x,
+                        100.0 * metric(r, metric_kind) / b,
+                        color(*a).filled(),
+                    ));
                 }
                 if let Some(m) = &s.paper {
                     let v = paper::table45(workload, metric_kind, *a, m.scene)

@@ -80,12 +80,22 @@ pub struct SceneReport {
 pub struct CpuData {
     /// Structure sizes (Table 3).
     pub sizes: Vec<StructureSize>,
-    /// Host time to build the SAH BVH2 alone (ms).
-    pub bvh2_build_ms: f64,
+    /// Host time of each construction step as the accel crate reports it: BVH2 build,
+    /// BVH4/BVH8 collapse, DST conversion (ms).
+    pub build_ms: Vec<BuildTime>,
     /// Host time to build every structure (BVH2, collapses, DST conversion) (ms).
     pub all_structures_ms: f64,
     /// Traversal throughput per structure and ray kind.
     pub throughput: Vec<Throughput>,
+}
+
+/// Host time of one construction step.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BuildTime {
+    /// Structure name (`bvh2`, `bvh4`, `bvh8`, `dst`).
+    pub structure: String,
+    /// Wall time in ms.
+    pub ms: f64,
 }
 
 /// One structure's size.

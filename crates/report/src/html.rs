@@ -93,7 +93,7 @@ pub fn index_html(data: &ReportData) -> Result<String, ReportError> {
     let mut h = String::new();
     h.push_str("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">");
     h.push_str("<title>dualsplit report — Hardware-Accelerated Dual-Split Trees</title>");
-    let _ = write!(h, "<style>{CSS}</style></head><body>\n");
+    let _ = writeln!(h, "<style>{CSS}</style></head><body>");
     h.push_str("<h1>Hardware-Accelerated Dual-Split Trees, regenerated</h1>\n");
     let st = &data.settings;
     let _ = writeln!(

@@ -14,12 +14,13 @@
 use crate::ReportError;
 use crate::cache::{CODE_VERSION, Cache, CacheKey, SCHEMA};
 use crate::data::{
-    CpuData, ReportData, ReportSettings, SceneReport, SimRun, Skipped, StructureSize, Throughput,
+    BuildTime, CpuData, ReportData, ReportSettings, SceneReport, SimRun, Skipped, StructureSize,
+    Throughput,
 };
 use crate::paper::{PaperMatch, PaperScene, PaperValues};
 use base64::Engine;
-use dualsplit_accel::{AccelKind, BuildConfig, Bvh2, NoObserver, Structures};
-use dualsplit_geometry::{Aabb, Hit};
+use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
+use dualsplit_geometry::Hit;
 use dualsplit_render::{PixelJob, RayKind, RayQuery, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::Scene;
 use dualsplit_sim::{SimAccel, SimConfig, SimResult};
@@ -199,7 +200,13 @@ impl<'a> Producer<'a> {
                 &format!("cpu_res={}", self.settings.cpu_res),
                 (self.settings.cpu_res, self.settings.cpu_res),
             );
-            cpu.push(self.cached(&key, || Ok(cpu_data(scene, self.settings.cpu_res)))?);
+            // Incomplete CPU data (a structure the accel crate does not build yet) is not
+            // cached, so it is measured again once the structure exists.
+            cpu.push(self.cached(
+                &key,
+                || Ok(cpu_data(scene, self.settings.cpu_res)),
+                |c: &CpuData| c.sizes.iter().all(|s| s.bytes.is_ok()),
+            )?);
             self.progress.advance(1);
             let key = CacheKey::new(
                 "render",
@@ -209,7 +216,7 @@ impl<'a> Producer<'a> {
                 &format!("spp={RENDER_SPP}"),
                 (RENDER_RES, RENDER_RES),
             );
-            renders.push(self.cached(&key, || render_png_base64(scene, get(i)))?);
+            renders.push(self.cached(&key, || render_png_base64(scene, get(i)), |_| true)?);
             self.progress.advance(1);
         }
         self.progress.end();
@@ -275,10 +282,10 @@ impl<'a> Producer<'a> {
                             .advance(pixels.saturating_sub(last.load(Ordering::Relaxed)));
                         if let Ok(r) = &result {
                             self.computed.fetch_add(1, Ordering::Relaxed);
-                            if let Err(e) = self.cache.put(&job.key, r) {
-                                if let Ok(mut w) = write_error.lock() {
-                                    w.get_or_insert(e);
-                                }
+                            if let Err(e) = self.cache.put(&job.key, r)
+                                && let Ok(mut w) = write_error.lock()
+                            {
+                                w.get_or_insert(e);
                             }
                         }
                         if let Ok(mut d) = done.lock() {
@@ -336,29 +343,39 @@ impl<'a> Producer<'a> {
         &self,
         key: &CacheKey,
         compute: impl FnOnce() -> Result<T, ReportError>,
+        keep: impl FnOnce(&T) -> bool,
     ) -> Result<T, ReportError> {
         if let Some(v) = self.cache.get(key) {
             return Ok(v);
         }
         let v = compute()?;
         self.computed.fetch_add(1, Ordering::Relaxed);
-        self.cache.put(key, &v)?;
+        if keep(&v) {
+            self.cache.put(key, &v)?;
+        }
         Ok(v)
     }
 }
 
 /// Bytes of structure `kind`: nodes plus triangle-index lists (Table 3's sizes; triangle
-/// data is shared by all structures and not counted).
-///
-/// Only BVH2 is known from the current `Structures` API (52-byte nodes, Lin et al. 2020,
-/// §4.1, plus 4 bytes per index); the other structures report why they are unknown until
-/// their memory images are exposed.
+/// data is shared by all structures and not counted), from `Structures::stats`. Both DST
+/// variants share one image (`dst`). A structure the accel crate does not build yet reports
+/// why instead of a number.
 pub fn structure_bytes(structures: &Structures, kind: AccelKind) -> Result<u64, String> {
+    let name = stats_name(kind);
+    structures
+        .stats()
+        .into_iter()
+        .find(|s| s.name == name)
+        .map(|s| s.bytes_total)
+        .ok_or_else(|| format!("the accel crate does not build `{name}` yet"))
+}
+
+/// The name `Structures::stats` uses for `kind`.
+fn stats_name(kind: AccelKind) -> &'static str {
     match kind {
-        AccelKind::Bvh2 => {
-            Ok(structures.bvh2.nodes.len() as u64 * 52 + structures.bvh2.prim_ids.len() as u64 * 4)
-        }
-        _ => Err("not exposed by the accel crate yet".into()),
+        AccelKind::DstSw | AccelKind::Dst => "dst",
+        k => k.name(),
     }
 }
 
@@ -409,14 +426,17 @@ fn ray_set(scene: &Scene, structures: &Structures, res: u32) -> Vec<Traced> {
 /// structure and ray kind, each structure checked ray by ray against BVH2 before it is
 /// timed.
 pub fn cpu_data(scene: &Scene, cpu_res: u32) -> CpuData {
-    let boxes: Vec<Aabb> = scene.triangles.iter().map(|t| t.bounds()).collect();
-    let t0 = Instant::now();
-    let bvh2 = Bvh2::build(&boxes, &BuildConfig::high_quality());
-    let bvh2_build_ms = t0.elapsed().as_secs_f64() * 1e3;
-    drop(bvh2);
     let t0 = Instant::now();
     let structures = Structures::build(&scene.triangles, &BuildConfig::high_quality());
     let all_structures_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let build_ms = structures
+        .stats()
+        .into_iter()
+        .map(|s| BuildTime {
+            structure: s.name,
+            ms: s.build_ms,
+        })
+        .collect();
     let sizes = AccelKind::ALL
         .iter()
         .map(|&kind| StructureSize {
@@ -439,7 +459,7 @@ pub fn cpu_data(scene: &Scene, cpu_res: u32) -> CpuData {
     }
     CpuData {
         sizes,
-        bvh2_build_ms,
+        build_ms,
         all_structures_ms,
         throughput,
     }
@@ -451,6 +471,11 @@ fn time_set(
     ray_kind: RayKind,
     set: &[&Traced],
 ) -> Result<f64, String> {
+    if kind != AccelKind::Bvh2 && stats_name(kind) != kind.name() {
+        // A DST variant: timed only once the accel crate builds a DST (until then it
+        // dispatches to BVH2, and timing it would report BVH2 under DST's name).
+        structure_bytes(structures, kind)?;
+    }
     if set.is_empty() {
         return Err("no rays of this kind".into());
     }

@@ -177,18 +177,18 @@ pub fn table6(data: &ReportData) -> String {
             r(d.energy.dram_j, b.energy.dram_j),
             r(d.energy.caches_j, b.energy.caches_j)
         );
-        if let Some(m) = s.paper.filter(|m| m.scene.table67_index().is_some()) {
-            if let (Some(pb), Some(pd)) = (
+        if let Some(m) = s.paper.filter(|m| m.scene.table67_index().is_some())
+            && let (Some(pb), Some(pd)) = (
                 paper::table6(SimAccel::Bvh2, m.scene),
                 paper::table6(SimAccel::Dst, m.scene),
-            ) {
-                line.push_str(&format!(
-                    " (paper, {}: {} and {})",
-                    m.scene.label(),
-                    r(pd[0], pb[0]),
-                    r(pd[1], pb[1])
-                ));
-            }
+            )
+        {
+            line.push_str(&format!(
+                " (paper, {}: {} and {})",
+                m.scene.label(),
+                r(pd[0], pb[0]),
+                r(pd[1], pb[1])
+            ));
         }
         line.push('.');
         out.push(line);
@@ -261,10 +261,10 @@ pub fn cpu(data: &ReportData) -> String {
                     .find(|t| t.kind == k && t.ray_kind == rk)
                     .and_then(|t| t.mrays_per_s.as_ref().ok().copied())
             };
-            if let (Some(b), Some(d)) = (get(AccelKind::Bvh2), get(AccelKind::DstSw)) {
-                if b > 0.0 {
-                    ratios.push(d / b);
-                }
+            if let (Some(b), Some(d)) = (get(AccelKind::Bvh2), get(AccelKind::DstSw))
+                && b > 0.0
+            {
+                ratios.push(d / b);
             }
         }
     }

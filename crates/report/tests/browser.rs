@@ -12,7 +12,7 @@ use common::fake_result;
 use dualsplit_accel::AccelKind;
 use dualsplit_render::{RayKind, Workload};
 use dualsplit_report::data::{
-    CpuData, ReportData, ReportSettings, SceneReport, SimRun, StructureSize, Throughput,
+    BuildTime, CpuData, ReportData, ReportSettings, SceneReport, SimRun, StructureSize, Throughput,
 };
 use dualsplit_report::paper::{PaperMatch, PaperValues};
 use dualsplit_report::produce::encode_png;
@@ -79,7 +79,13 @@ fn synthetic_scene(name: &str, spec: &str, seed: u32, tms: &[u32]) -> SceneRepor
         paper: PaperMatch::for_scene(name, spec),
         cpu: CpuData {
             sizes,
-            bvh2_build_ms: 12.0,
+            build_ms: ["bvh2", "bvh4", "bvh8", "dst"]
+                .iter()
+                .map(|n| BuildTime {
+                    structure: n.to_string(),
+                    ms: 3.0,
+                })
+                .collect(),
             all_structures_ms: 20.0,
             throughput,
         },

@@ -9,6 +9,14 @@ use dualsplit_report::data::ReportSettings;
 use dualsplit_report::{Cache, NoProgress, Producer};
 use std::sync::atomic::{AtomicU64, Ordering};
 
+/// Scenes whose CPU piece is incomplete (and therefore not cached).
+fn incomplete_cpu(data: &dualsplit_report::ReportData) -> u64 {
+    data.scenes
+        .iter()
+        .filter(|s| s.cpu.sizes.iter().any(|z| z.bytes.is_err()))
+        .count() as u64
+}
+
 fn settings(width: u32) -> ReportSettings {
     ReportSettings {
         width,
@@ -41,9 +49,16 @@ fn second_run_computes_nothing() {
     assert_eq!(calls.load(Ordering::Relaxed), expect_sims);
     assert_eq!(p.computed(), expect_sims + 4);
 
+    // CPU pieces that lack a structure the accel crate does not build yet are not cached
+    // (so they are measured once it exists); everything else must come from the cache.
+    let incomplete = incomplete_cpu(&first);
     let p = Producer::new(Cache::new(&dir), settings(4), &NoProgress, &sim);
     let second = p.run(&scenes, vec![]).unwrap();
-    assert_eq!(p.computed(), 0, "nothing changed, nothing computed");
+    assert_eq!(
+        p.computed(),
+        incomplete,
+        "nothing changed, nothing computed"
+    );
     assert_eq!(calls.load(Ordering::Relaxed), expect_sims);
     for (a, b) in first.scenes.iter().zip(&second.scenes) {
         assert_eq!(a.sim.len(), b.sim.len());
@@ -61,7 +76,7 @@ fn second_run_computes_nothing() {
     // depend on it).
     let p = Producer::new(Cache::new(&dir), settings(8), &NoProgress, &sim);
     p.run(&scenes, vec![]).unwrap();
-    assert_eq!(p.computed(), expect_sims);
+    assert_eq!(p.computed(), expect_sims + incomplete);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -88,6 +103,6 @@ fn simulator_errors_are_reported_not_cached() {
     // Nothing simulated was cached, so the next run tries again.
     let p = Producer::new(Cache::new(&dir), settings(4), &NoProgress, &sim);
     p.run(&scenes, vec![]).unwrap();
-    assert_eq!(p.computed(), 0);
+    assert_eq!(p.computed(), incomplete_cpu(&data));
     std::fs::remove_dir_all(&dir).unwrap();
 }
