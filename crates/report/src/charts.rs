@@ -41,6 +41,12 @@ pub fn color(a: SimAccel) -> RGBColor {
     }
 }
 
+/// An axis tick: at most three decimals, trailing zeros dropped.
+fn tick(v: f64) -> String {
+    let s = format!("{v:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 fn chart_err(chart: &str) -> impl Fn(String) -> ReportError + '_ {
     move |message| ReportError::Chart {
         chart: chart.to_string(),
@@ -175,7 +181,7 @@ fn fps_panel(
     chart
         .configure_mesh()
         .x_label_formatter(&|x| format!("{x:.0}"))
-        .y_label_formatter(&|y| crate::tables::fmt_num(*y))
+        .y_label_formatter(&|y| tick(*y))
         .light_line_style(WHITE.mix(0.0))
         .x_desc("TMs")
         .y_desc("frames per second")
@@ -190,21 +196,29 @@ fn fps_panel(
         };
         chart
             .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
-            .map_err(|e| err(e.to_string()))?
-            .label(a.label())
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], c.stroke_width(2)));
+            .map_err(|e| err(e.to_string()))?;
         chart
             .draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))
             .map_err(|e| err(e.to_string()))?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.3))
-        .label_font(("sans-serif", 11))
-        .draw()
+    Ok(())
+}
+
+/// The configurations' colour key, drawn beside the panels so it never covers a line.
+fn legend(
+    area: &DrawingArea<SVGBackend, plotters::coord::Shift>,
+    err: &dyn Fn(String) -> ReportError,
+) -> Result<(), ReportError> {
+    for (i, a) in SimAccel::ALL.iter().enumerate() {
+        let y = 40 + 20 * i as i32;
+        area.draw(&PathElement::new(
+            [(6, y), (30, y)],
+            color(*a).stroke_width(3),
+        ))
         .map_err(|e| err(e.to_string()))?;
+        area.draw(&Text::new(a.label(), (36, y - 7), ("sans-serif", 13)))
+            .map_err(|e| err(e.to_string()))?;
+    }
     Ok(())
 }
 
@@ -237,7 +251,9 @@ pub fn fig9(data: &ReportData, s: &SceneReport) -> Result<Option<String>, Report
     {
         let root = SVGBackend::with_string(&mut svg, (900, 340)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
-        let (left, right) = root.split_horizontally(if pm.is_some() { 450 } else { 900 });
+        let (panels, key) = root.split_horizontally(800);
+        legend(&key, &err)?;
+        let (left, right) = panels.split_horizontally(if pm.is_some() { 400 } else { 800 });
         fps_panel(
             &left,
             &format!("{} (ours)", s.name),

@@ -228,12 +228,21 @@ pub fn table7(data: &ReportData) -> String {
                     "; the paper's {} from 32 to 128: BVH2 {pb:.2}×, DST {pd:.2}×",
                     m.scene.label()
                 ));
-                let ours_dst_scales_better = d > b;
-                let paper_dst_scales_better = pd > pb;
-                line.push_str(if ours_dst_scales_better == paper_dst_scales_better {
-                    " — the same ordering"
-                } else {
-                    " — a different ordering"
+                // DST scales better (1), alike within 2% (0) or worse (-1).
+                let class = |d: f64, b: f64| {
+                    if d > b * 1.02 {
+                        1
+                    } else if d < b / 1.02 {
+                        -1
+                    } else {
+                        0
+                    }
+                };
+                line.push_str(match (class(d, b), class(pd, pb)) {
+                    (x, y) if x == y => " — the same picture",
+                    (1, _) => " — here DST scales better, unlike in the paper",
+                    (-1, _) => " — here DST scales worse than BVH2, unlike in the paper",
+                    _ => " — here both scale alike, unlike in the paper",
                 });
             }
         }
