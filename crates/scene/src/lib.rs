@@ -78,16 +78,27 @@ impl Scene {
     ) -> Result<Self, SceneError> {
         let spec = spec.into();
         stats.source_triangles = stats.source_triangles.max(triangles.len() as u64);
+        // Parallel passes (millions of triangles for the big scenes); order is kept and the
+        // bounds are exact min/max, so the result does not depend on the thread count.
+        use rayon::prelude::*;
         let before = triangles.len();
-        let triangles: Vec<Triangle> = triangles.into_iter().filter(|t| t.is_finite()).collect();
+        let triangles: Vec<Triangle> = if triangles.par_iter().all(|t| t.is_finite()) {
+            triangles
+        } else {
+            triangles
+                .into_par_iter()
+                .filter(|t| t.is_finite())
+                .collect()
+        };
         stats.non_finite += (before - triangles.len()) as u64;
-        stats.degenerate = triangles.iter().filter(|t| t.is_degenerate()).count() as u64;
+        stats.degenerate = triangles.par_iter().filter(|t| t.is_degenerate()).count() as u64;
         if triangles.is_empty() {
             return Err(SceneError::Empty { spec });
         }
         let bounds = triangles
-            .iter()
-            .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+            .par_iter()
+            .map(|t| t.bounds())
+            .reduce(|| Aabb::EMPTY, Aabb::union);
         let camera = Camera::fit(&bounds);
         let light = Light::fit(&bounds);
         Ok(Self {
