@@ -150,10 +150,10 @@ fn preset_view(stem: &str) -> Option<View> {
         },
         // The dragon inside its box, seen through the open +z side.
         "dragon_box" => View {
-            target: [0.5, 0.3, 0.4],
+            target: [0.5, 0.28, 0.45],
             eye: None,
             dir: Vec3::new(0.12, 0.15, 1.0),
-            zoom: 0.85,
+            zoom: 0.7,
             fov: 45.0,
         },
         // Inside the courtyard from its west end, looking down the arcades.
@@ -166,8 +166,8 @@ fn preset_view(stem: &str) -> Option<View> {
         },
         // The row of dragons on the courtyard floor, seen diagonally from a corner.
         "dragon_sponza" => View {
-            target: [0.58, 0.1, 0.47],
-            eye: Some([0.12, 0.25, 0.78]),
+            target: [0.45, 0.11, 0.5],
+            eye: Some([0.1, 0.27, 0.385]),
             dir: Vec3::X,
             zoom: 1.0,
             fov: 55.0,
@@ -185,7 +185,7 @@ impl Camera {
             target: [0.5, 0.5, 0.5],
             eye: None,
             dir: Vec3::new(0.35, 0.35, 1.0),
-            zoom: 0.9,
+            zoom: 1.0,
             fov: 45.0,
         }
         .camera(b)

@@ -227,7 +227,6 @@ impl AtriumParams {
         }
         // Vases along the courtyard's axis.
         let vase = [
-            (0.0, 0.0),
             (0.35, 0.0),
             (0.45, 0.15),
             (0.6, 0.5),
