@@ -265,6 +265,17 @@ impl<'a> Producer<'a> {
                     loop {
                         let job = queue.lock().map(|mut q| q.pop_front()).ok().flatten();
                         let Some(job) = job else { break };
+                        // Until the accel crate builds a DST it dispatches DST to BVH2, and a
+                        // "DST" simulation would be BVH2's: report that instead of simulating.
+                        if matches!(job.accel, SimAccel::Dst | SimAccel::DstSw)
+                            && let Err(e) = structure_bytes(get(job.scene), AccelKind::Dst)
+                        {
+                            self.progress.advance(pixels);
+                            if let Ok(mut d) = done.lock() {
+                                d.push((job, Err(format!("not simulated: {e}"))));
+                            }
+                            continue;
+                        }
                         let last = AtomicU64::new(0);
                         let report = |d: u64, _t: u64| {
                             let prev = last.swap(d, Ordering::Relaxed);

@@ -91,16 +91,15 @@ pub fn table45(data: &ReportData, workload: Workload) -> String {
     let mut ours = [Vec::new(), Vec::new(), Vec::new()];
     let mut fastest = Vec::new();
     for s in &data.scenes {
-        let (Some(b), Some(d)) = (
+        if let (Some(b), Some(d)) = (
             s.sim(SimAccel::Bvh2, workload, tms),
             s.sim(SimAccel::Dst, workload, tms),
-        ) else {
-            continue;
-        };
-        for (i, m) in Metric::ALL.iter().enumerate() {
-            let bv = metric(b, *m);
-            if bv > 0.0 {
-                ours[i].push(metric(d, *m) / bv);
+        ) {
+            for (i, m) in Metric::ALL.iter().enumerate() {
+                let bv = metric(b, *m);
+                if bv > 0.0 {
+                    ours[i].push(metric(d, *m) / bv);
+                }
             }
         }
         let best = SimAccel::ALL
@@ -110,6 +109,13 @@ pub fn table45(data: &ReportData, workload: Workload) -> String {
         if let Some((a, _)) = best {
             fastest.push(format!("{} on {}", a.label(), s.name));
         }
+    }
+    if ours[0].is_empty() && !fastest.is_empty() {
+        return format!(
+            "DST: {}. Fastest configuration: {}.",
+            data.sim_error().unwrap_or("no results"),
+            fastest.join(", ")
+        );
     }
     if ours[0].is_empty() {
         return match data.sim_error() {
