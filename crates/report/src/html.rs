@@ -25,7 +25,7 @@ td:first-child,th:first-child{text-align:left}td.paper,th.paper{background:#f3f3
 caption{text-align:left;font-weight:bold;padding:4px 0}.summary{background:#eef5ff;padding:8px 12px;border-left:4px solid #58a}\
 .note{color:#666;font-size:13px;margin:2px 0}.warn{background:#fff3e0;border-left:4px solid #e90;padding:8px 12px}\
 .renders{display:flex;flex-wrap:wrap;gap:16px}.renders figure{margin:0;text-align:center;font-size:13px}\
-.renders img{image-rendering:pixelated;width:240px;height:240px;border:1px solid #ccc}\
+.renders img{width:256px;height:256px;border:1px solid #ccc}\
 .chart svg{max-width:100%;height:auto}.meta{color:#555;font-size:14px}";
 
 /// Formats one table as HTML.

@@ -37,9 +37,10 @@ pub const FULL_RES: u32 = 1024;
 pub const DEFAULT_TMS: [u32; 3] = [32, 64, 128];
 /// Square resolution of the CPU ray sets (path workload rays).
 pub const CPU_RES: u32 = 64;
-/// Simulated rays per second of wall time on this 2-core machine, two simulations side by
-/// side; used only for the `--full` up-front estimate.
-pub const SIM_RAYS_PER_SECOND: f64 = 150_000.0;
+/// Simulated rays per second of wall time on a 2-core machine, two simulations side by side;
+/// used only for the `--full` up-front estimate. Measured: about 38K simulated rays per CPU
+/// second (release build, `lin2020` config, the default builtins at 64×64).
+pub const SIM_RAYS_PER_SECOND: f64 = 40_000.0;
 
 /// Arguments of `dualsplit report`.
 #[derive(clap::Args)]
