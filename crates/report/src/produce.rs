@@ -482,7 +482,7 @@ fn time_set(
     ray_kind: RayKind,
     set: &[&Traced],
 ) -> Result<f64, String> {
-    if kind != AccelKind::Bvh2 && stats_name(kind) != kind.name() {
+    if matches!(kind, AccelKind::DstSw | AccelKind::Dst) {
         // A DST variant: timed only once the accel crate builds a DST (until then it
         // dispatches to BVH2, and timing it would report BVH2 under DST's name).
         structure_bytes(structures, kind)?;

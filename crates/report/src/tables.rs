@@ -509,7 +509,13 @@ pub fn cpu(data: &ReportData) -> Section {
                         match &t.mrays_per_s {
                             Ok(v) => cells.push(Cell::num(*v)),
                             Err(e) => {
-                                notes.push(format!("{} {} {rk:?}: {e}", s.name, k.name()));
+                                // A structure that is not built says so once; a
+                                // disagreement with BVH2 names its scene.
+                                notes.push(if e.contains("disagrees") {
+                                    format!("{}: {e}", s.name)
+                                } else {
+                                    format!("{}: {e}", k.name())
+                                });
                                 cells.push(Cell::none());
                             }
                         }
@@ -522,6 +528,8 @@ pub fn cpu(data: &ReportData) -> Section {
             rows.push(row);
         }
     }
+    notes.sort();
+    notes.dedup();
     Section {
         id: "cpu".into(),
         title: "CPU — build times and traversal throughput (host, this machine)".into(),
