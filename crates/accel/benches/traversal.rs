@@ -58,12 +58,27 @@ fn data(scene: &str) -> &'static Data {
     })
 }
 
-const SCENES: [&str; 2] = ["dragon_box", "sponza_dabrovic"];
-const KINDS: [&str; 5] = ["bvh2", "bvh4", "bvh8", "dst-sw", "dst"];
+/// `scene/kind` cases.
+const CASES: [&str; 10] = [
+    "dragon_box/bvh2",
+    "dragon_box/bvh4",
+    "dragon_box/bvh8",
+    "dragon_box/dst-sw",
+    "dragon_box/dst",
+    "sponza_dabrovic/bvh2",
+    "sponza_dabrovic/bvh4",
+    "sponza_dabrovic/bvh8",
+    "sponza_dabrovic/dst-sw",
+    "sponza_dabrovic/dst",
+];
 
-fn closest(bencher: divan::Bencher, scene: &str, kind: &str, which: fn(&Data) -> &Vec<Ray>) {
-    let d = data(scene);
-    let kind = AccelKind::parse(kind).unwrap();
+fn case(c: &str) -> (&'static Data, AccelKind) {
+    let (scene, kind) = c.split_once('/').unwrap();
+    (data(scene), AccelKind::parse(kind).unwrap())
+}
+
+fn closest(bencher: divan::Bencher, c: &str, which: fn(&Data) -> &Vec<Ray>) {
+    let (d, kind) = case(c);
     bencher.bench(|| {
         let mut n = 0u32;
         for ray in which(d) {
@@ -73,20 +88,19 @@ fn closest(bencher: divan::Bencher, scene: &str, kind: &str, which: fn(&Data) ->
     });
 }
 
-#[divan::bench(args = KINDS, consts = [0, 1], sample_count = 10)]
-fn primary<const SCENE: usize>(bencher: divan::Bencher, kind: &str) {
-    closest(bencher, SCENES[SCENE], kind, |d| &d.primary);
+#[divan::bench(args = CASES, sample_count = 10)]
+fn primary(bencher: divan::Bencher, c: &str) {
+    closest(bencher, c, |d| &d.primary);
 }
 
-#[divan::bench(args = KINDS, consts = [0, 1], sample_count = 10)]
-fn diffuse<const SCENE: usize>(bencher: divan::Bencher, kind: &str) {
-    closest(bencher, SCENES[SCENE], kind, |d| &d.diffuse);
+#[divan::bench(args = CASES, sample_count = 10)]
+fn diffuse(bencher: divan::Bencher, c: &str) {
+    closest(bencher, c, |d| &d.diffuse);
 }
 
-#[divan::bench(args = KINDS, consts = [0, 1], sample_count = 10)]
-fn shadow<const SCENE: usize>(bencher: divan::Bencher, kind: &str) {
-    let d = data(SCENES[SCENE]);
-    let kind = AccelKind::parse(kind).unwrap();
+#[divan::bench(args = CASES, sample_count = 10)]
+fn shadow(bencher: divan::Bencher, c: &str) {
+    let (d, kind) = case(c);
     bencher.bench(|| {
         let mut n = 0u32;
         for ray in &d.shadow {
