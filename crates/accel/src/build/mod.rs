@@ -166,9 +166,23 @@ impl Box3 {
     }
 }
 
-struct Ctx<'a> {
-    pb: &'a [Box3],
-    cent: &'a [Vec3A],
+/// A primitive reference: its box and id, moved with the partition so that every range is
+/// contiguous in memory (the centroid is recomputed as `(min + max) / 2`, the same value as
+/// [`Aabb::center`]).
+#[derive(Clone, Copy, Debug)]
+struct PrimRef {
+    b: Box3,
+    id: u32,
+}
+
+impl PrimRef {
+    #[inline(always)]
+    fn c(&self) -> Vec3A {
+        (self.b.min + self.b.max) * 0.5
+    }
+}
+
+struct Ctx {
     cfg: BuildConfig,
     bins: usize,
 }
@@ -209,15 +223,17 @@ enum How {
 impl Bvh2 {
     /// Builds a BVH2 over primitive boxes (one per triangle; ids are indices).
     pub fn build(prim_bounds: &[Aabb], cfg: &BuildConfig) -> Self {
-        let boxes: Vec<Box3> = prim_bounds
+        let mut refs: Vec<PrimRef> = prim_bounds
             .iter()
-            .map(|b| Box3 {
-                min: b.min.into(),
-                max: b.max.into(),
+            .enumerate()
+            .map(|(i, b)| PrimRef {
+                b: Box3 {
+                    min: b.min.into(),
+                    max: b.max.into(),
+                },
+                id: i as u32,
             })
             .collect();
-        let centroids: Vec<Vec3A> = prim_bounds.iter().map(|b| b.center().into()).collect();
-        let mut ids: Vec<u32> = (0..prim_bounds.len() as u32).collect();
         if prim_bounds.is_empty() {
             return Self {
                 nodes: vec![Bvh2Node {
@@ -226,18 +242,16 @@ impl Bvh2 {
                     count: 0,
                     right: 0,
                 }],
-                prim_ids: ids,
+                prim_ids: Vec::new(),
                 sah_cost: 0.0,
             };
         }
         let ctx = Ctx {
-            pb: &boxes,
-            cent: &centroids,
             cfg: *cfg,
             bins: cfg.bins.clamp(2, 256) as usize,
         };
-        let (bounds, cbounds) = range_bounds(&ctx, &ids);
-        let tmp = build_range(&ctx, &mut ids, 0, (bounds, cbounds), 0);
+        let (bounds, cbounds) = range_bounds(&ctx, &refs);
+        let tmp = build_range(&ctx, &mut refs, 0, (bounds, cbounds), 0);
         let mut nodes =
             Vec::with_capacity(prim_bounds.len() * 2 / cfg.max_leaf_size.max(1) as usize + 1);
         nodes.push(Bvh2Node {
@@ -249,7 +263,7 @@ impl Bvh2 {
         flatten(&tmp, 0, &mut nodes);
         let mut bvh = Self {
             nodes,
-            prim_ids: ids,
+            prim_ids: refs.iter().map(|r| r.id).collect(),
             sah_cost: 0.0,
         };
         bvh.sah_cost = bvh.compute_sah(cfg);
@@ -319,10 +333,8 @@ fn flatten(t: &Tmp, idx: usize, nodes: &mut Vec<Bvh2Node>) {
     }
 }
 
-fn range_bounds(ctx: &Ctx, ids: &[u32]) -> (Box3, Box3) {
-    let f = |(b, c): (Box3, Box3), &i: &u32| {
-        (b.union(ctx.pb[i as usize]), c.grow(ctx.cent[i as usize]))
-    };
+fn range_bounds(ctx: &Ctx, ids: &[PrimRef]) -> (Box3, Box3) {
+    let f = |(b, c): (Box3, Box3), i: &PrimRef| (b.union(i.b), c.grow(i.c()));
     if ids.len() as u32 > ctx.cfg.parallel_threshold * 16 {
         use rayon::prelude::*;
         ids.par_chunks(16 * 1024)
@@ -343,13 +355,13 @@ fn bin_of(c: f32, lo: f32, scale: f32, bins: usize) -> usize {
 }
 
 /// Bins `ids` on all three axes: `bins[axis * B + b]`.
-fn bin_range(ctx: &Ctx, ids: &[u32], lo: Vec3A, scale: Vec3A) -> Vec<Bin> {
+fn bin_range(ctx: &Ctx, ids: &[PrimRef], lo: Vec3A, scale: Vec3A) -> Vec<Bin> {
     let nb = ctx.bins;
-    let work = |chunk: &[u32]| {
+    let work = |chunk: &[PrimRef]| {
         let mut bins = vec![EMPTY_BIN; 3 * nb];
-        for &i in chunk {
-            let c = ctx.cent[i as usize];
-            let b = ctx.pb[i as usize];
+        for i in chunk {
+            let c = i.c();
+            let b = i.b;
             let k = ((c - lo) * scale).to_array();
             for (axis, &k) in k.iter().enumerate() {
                 let bin = &mut bins[axis * nb + (k as usize).min(nb - 1)];
@@ -379,7 +391,7 @@ fn bin_range(ctx: &Ctx, ids: &[u32], lo: Vec3A, scale: Vec3A) -> Vec<Bin> {
 }
 
 /// Best binned split, or `None` when every centroid coincides.
-fn binned_split(ctx: &Ctx, ids: &[u32], cbounds: Box3) -> Option<(Split, Vec3A, Vec3A)> {
+fn binned_split(ctx: &Ctx, ids: &[PrimRef], cbounds: Box3) -> Option<(Split, Vec3A, Vec3A)> {
     let nb = ctx.bins;
     let lo = cbounds.min;
     let ext = cbounds.max - cbounds.min;
@@ -436,7 +448,7 @@ fn binned_split(ctx: &Ctx, ids: &[u32], cbounds: Box3) -> Option<(Split, Vec3A, 
 
 /// Full SAH sweep over the centroids sorted on each axis (ties by id); leaves `ids` sorted
 /// on the best axis. `None` when every centroid coincides.
-fn sweep_split(ctx: &Ctx, ids: &mut [u32], cbounds: Box3) -> Option<Split> {
+fn sweep_split(ctx: &Ctx, ids: &mut [PrimRef], cbounds: Box3) -> Option<Split> {
     let n = ids.len();
     let ext = cbounds.max - cbounds.min;
     let mut right_area = [0f32; SWEEP_MAX];
@@ -445,15 +457,15 @@ fn sweep_split(ctx: &Ctx, ids: &mut [u32], cbounds: Box3) -> Option<Split> {
         if ext[axis] <= 0.0 {
             continue;
         }
-        sort_on(ctx, ids, axis);
+        sort_on(ids, axis);
         let mut acc = Box3::EMPTY;
         for k in (1..n).rev() {
-            acc = acc.union(ctx.pb[ids[k] as usize]);
+            acc = acc.union(ids[k].b);
             right_area[k] = acc.half_area();
         }
         let mut left = Box3::EMPTY;
         for k in 0..n - 1 {
-            left = left.union(ctx.pb[ids[k] as usize]);
+            left = left.union(ids[k].b);
             let cost = left.half_area() * (k + 1) as f32 + right_area[k + 1] * (n - k - 1) as f32;
             if best.is_none_or(|b| cost < b.0) {
                 best = Some((cost, axis, k + 1));
@@ -461,7 +473,7 @@ fn sweep_split(ctx: &Ctx, ids: &mut [u32], cbounds: Box3) -> Option<Split> {
         }
     }
     let (cost, axis, mid) = best?;
-    sort_on(ctx, ids, axis);
+    sort_on(ids, axis);
     let left = range_bounds(ctx, &ids[..mid]);
     let right = range_bounds(ctx, &ids[mid..]);
     Some(Split {
@@ -472,17 +484,17 @@ fn sweep_split(ctx: &Ctx, ids: &mut [u32], cbounds: Box3) -> Option<Split> {
     })
 }
 
-fn sort_on(ctx: &Ctx, ids: &mut [u32], axis: usize) {
-    ids.sort_unstable_by(|&a, &b| {
-        let (ca, cb) = (ctx.cent[a as usize][axis], ctx.cent[b as usize][axis]);
-        ca.total_cmp(&cb).then(a.cmp(&b))
+fn sort_on(ids: &mut [PrimRef], axis: usize) {
+    ids.sort_unstable_by(|a, b| {
+        let (ca, cb) = (a.c()[axis], b.c()[axis]);
+        ca.total_cmp(&cb).then(a.id.cmp(&b.id))
     });
 }
 
-fn partition(ids: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
+fn partition(ids: &mut [PrimRef], pred: impl Fn(&PrimRef) -> bool) -> usize {
     let mut i = 0;
     for j in 0..ids.len() {
-        if pred(ids[j]) {
+        if pred(&ids[j]) {
             ids.swap(i, j);
             i += 1;
         }
@@ -492,7 +504,7 @@ fn partition(ids: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
 
 fn build_range(
     ctx: &Ctx,
-    ids: &mut [u32],
+    ids: &mut [PrimRef],
     offset: u32,
     (bounds, cbounds): (Box3, Box3),
     depth: u32,
@@ -525,7 +537,7 @@ fn build_range(
             let mid = match s.how {
                 How::Sorted { mid } => mid,
                 How::Bin { axis, bin } => partition(ids, |i| {
-                    bin_of(ctx.cent[i as usize][axis], lo[axis], scale[axis], ctx.bins) < bin
+                    bin_of(i.c()[axis], lo[axis], scale[axis], ctx.bins) < bin
                 }),
             };
             (mid, s.left, s.right)
@@ -538,9 +550,9 @@ fn build_range(
             // widest centroid axis, ties broken by id, so the result is deterministic.
             let axis = cbounds.aabb().largest_axis();
             let mid = n / 2;
-            ids.select_nth_unstable_by(mid, |&a, &b| {
-                let (ca, cb) = (ctx.cent[a as usize][axis], ctx.cent[b as usize][axis]);
-                ca.total_cmp(&cb).then(a.cmp(&b))
+            ids.select_nth_unstable_by(mid, |a, b| {
+                let (ca, cb) = (a.c()[axis], b.c()[axis]);
+                ca.total_cmp(&cb).then(a.id.cmp(&b.id))
             });
             (
                 mid,
