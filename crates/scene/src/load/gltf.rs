@@ -186,7 +186,7 @@ fn emit(
         }
         None => (0..positions.len()).collect(),
     };
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         return Err(err(format!(
             "{} indices, not a multiple of 3",
             indices.len()

@@ -413,7 +413,7 @@ fn parse_binary(
     let mut stats = LoadStats::default();
     for (name, def) in &header.elements {
         let (min_size, fixed) = record_size(def);
-        let need = def.count.checked_mul(min_size).unwrap_or(usize::MAX);
+        let need = def.count.saturating_mul(min_size);
         if need > cur.remaining() {
             return Err(truncated(path, def, cur.remaining(), need));
         }
