@@ -662,20 +662,14 @@ fn read_triangles_fast(
         };
         i as usize
     };
-    let triangles: Option<Vec<Triangle>> = bytes
+    let n = positions.len();
+    let in_range = |r: &[u8]| decode(r, 1) < n && decode(r, 5) < n && decode(r, 9) < n;
+    if !bytes
         .par_chunks_exact(REC)
         .with_min_len(1 << 14)
-        .map(|r| {
-            Some(Triangle::new(
-                *positions.get(decode(r, 1))?,
-                *positions.get(decode(r, 5))?,
-                *positions.get(decode(r, 9))?,
-            ))
-        })
-        .collect();
-    let Some(triangles) = triangles else {
+        .all(in_range)
+    {
         // Find the first bad index for the message.
-        let n = positions.len();
         for (i, r) in bytes.chunks_exact(REC).enumerate() {
             if let Some(bad) = [1, 5, 9]
                 .map(|k| decode(r, k))
@@ -691,7 +685,20 @@ fn read_triangles_fast(
             }
         }
         return Err(parse_error(path, None, "vertex index out of range"));
-    };
+    }
+    // Every index was checked above, so the indexing below cannot fail; an indexed parallel
+    // iterator collects straight into the output vector.
+    let triangles: Vec<Triangle> = bytes
+        .par_chunks_exact(REC)
+        .with_min_len(1 << 14)
+        .map(|r| {
+            Triangle::new(
+                positions[decode(r, 1)],
+                positions[decode(r, 5)],
+                positions[decode(r, 9)],
+            )
+        })
+        .collect();
     cur.pos += bytes.len();
     Ok(Some(triangles))
 }
