@@ -27,7 +27,7 @@ mod camera;
 mod error;
 pub mod load;
 
-pub use camera::{Camera, Light};
+pub use camera::{Camera, CameraError, Light, parse_vec3};
 pub use error::SceneError;
 
 use dualsplit_geometry::{Aabb, Triangle};
@@ -147,6 +147,23 @@ pub fn load(spec: &str) -> Result<Scene, SceneError> {
     if let Some(rest) = spec.strip_prefix("builtin:") {
         builtin::generate(rest)
     } else {
-        load::load_file(std::path::Path::new(spec))
+        let path = std::path::Path::new(spec);
+        let mut scene = load::load_file(path)?;
+        let stem = file_stem(path);
+        scene.camera = Camera::preset_for(stem, &scene.bounds);
+        scene.light = Light::preset_for(stem, &scene.bounds);
+        Ok(scene)
     }
+}
+
+/// The file name without its scene extensions (`.ply`, `.obj`, `.gz`, ...): the key of the
+/// camera and light presets (`dragon_box.ply.gz` → `dragon_box`).
+pub fn file_stem(path: &std::path::Path) -> &str {
+    let mut name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    for ext in [".gz", ".obj", ".ply", ".gltf", ".glb"] {
+        if let Some(s) = name.strip_suffix(ext) {
+            name = s;
+        }
+    }
+    name
 }
