@@ -88,29 +88,29 @@ impl Mesh {
             let b = path[(i + 1).min(path.len() - 1)];
             (b - a).normalize_or(Vec3::Y)
         };
-        let mut t = tangent(0);
+        self.tris.reserve(2 * sides * (path.len() - 1));
+        let t = tangent(0);
         let (mut n, _) = t.any_orthonormal_pair();
-        let ring = |c: Vec3, t: Vec3, n: Vec3, r: f32| -> Vec<Vec3> {
+        let ring = |out: &mut Vec<Vec3>, c: Vec3, t: Vec3, n: Vec3, r: f32| {
             let b = t.cross(n);
-            (0..sides)
-                .map(|k| {
-                    let a = std::f32::consts::TAU * k as f32 / sides as f32;
-                    c + (n * a.cos() + b * a.sin()) * r
-                })
-                .collect()
+            out.clear();
+            out.extend((0..sides).map(|k| {
+                let a = std::f32::consts::TAU * k as f32 / sides as f32;
+                c + (n * a.cos() + b * a.sin()) * r
+            }));
         };
-        let mut prev = ring(path[0], t, n, radius(0));
+        let (mut prev, mut cur) = (Vec::with_capacity(sides), Vec::with_capacity(sides));
+        ring(&mut prev, path[0], t, n, radius(0));
         for (i, &c) in path.iter().enumerate().skip(1) {
-            let t2 = tangent(i);
+            let t = tangent(i);
             // Parallel transport: remove the new tangent's component from the old normal.
-            n = (n - t2 * n.dot(t2)).normalize_or(t2.any_orthonormal_pair().0);
-            t = t2;
-            let cur = ring(c, t, n, radius(i));
+            n = (n - t * n.dot(t)).normalize_or(t.any_orthonormal_pair().0);
+            ring(&mut cur, c, t, n, radius(i));
             for k in 0..sides {
                 let k1 = (k + 1) % sides;
                 self.quad(prev[k], prev[k1], cur[k1], cur[k]);
             }
-            prev = cur;
+            std::mem::swap(&mut prev, &mut cur);
         }
     }
 
