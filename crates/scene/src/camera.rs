@@ -174,8 +174,8 @@ fn preset_view(stem: &str) -> Option<View> {
         },
         // The row of dragons on the courtyard floor, seen diagonally from a corner.
         "dragon_sponza" => View {
-            target: [0.5, 0.11, 0.47],
-            eye: Some([0.1, 0.34, 0.56]),
+            target: [0.5, 0.11, 0.487],
+            eye: Some([0.155, 0.248, 0.577]),
             dir: Vec3::X,
             zoom: 1.0,
             fov: 55.0,
