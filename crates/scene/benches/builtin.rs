@@ -23,3 +23,9 @@ fn generate_default(name: &str) -> usize {
     assert!(n.abs_diff(want) * 20 <= want, "{name}: {n} triangles");
     n
 }
+
+/// The hairball's triangles alone, without `Scene::from_triangles`.
+#[divan::bench(sample_count = 5, sample_size = 1)]
+fn hairball_triangles_only() -> usize {
+    builtin::HairballParams::default().triangles().len()
+}
