@@ -158,3 +158,28 @@ pub(crate) fn split_evenly(total: usize, parts: usize) -> impl Iterator<Item = u
     let extra = total % parts.max(1);
     (0..parts).map(move |i| base + usize::from(i < extra))
 }
+
+/// Generates objects in parallel straight into their slots of one output array: object `i`
+/// has exactly `counts[i]` triangles and lands after objects `0..i`, whatever the thread
+/// count, so the result is deterministic.
+pub(crate) fn par_objects(counts: &[usize], make: impl Fn(usize) -> Mesh + Sync) -> Vec<Triangle> {
+    use rayon::prelude::*;
+    let mut out = vec![Triangle::default(); counts.iter().sum()];
+    let mut slots = Vec::with_capacity(counts.len());
+    let mut rest = out.as_mut_slice();
+    for &n in counts {
+        let (slot, tail) = std::mem::take(&mut rest).split_at_mut(n);
+        slots.push(slot);
+        rest = tail;
+    }
+    slots.into_par_iter().enumerate().for_each(|(i, slot)| {
+        let m = make(i);
+        assert_eq!(
+            m.len(),
+            slot.len(),
+            "object {i} has the wrong triangle count"
+        );
+        slot.copy_from_slice(&m.tris);
+    });
+    out
+}
