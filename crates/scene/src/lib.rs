@@ -1,8 +1,9 @@
 //! Scenes for dualsplit: triangle soups with a camera and a light.
 //!
 //! A scene is addressed by a *spec*: a file path (`.obj`, `.ply`, either also `.gz`, `.gltf`,
-//! `.glb`) or `builtin:NAME?key=value&...` (see [`builtin`]). [`load`] resolves a spec into a
-//! [`Scene`].
+//! `.glb`) or `builtin:NAME?key=value&...` (see [`builtin`]). [`load()`] resolves a spec into a
+//! [`Scene`]. Builtins come with their own camera and light; files get the preset of their
+//! stem ([`Camera::preset_for`], see `docs/scenes.md`) or a fit to their bounds.
 //!
 //! ```no_run
 //! let scene = dualsplit_scene::load("builtin:cornell").unwrap();
