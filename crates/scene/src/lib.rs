@@ -1,7 +1,7 @@
 //! Scenes for dualsplit: triangle soups with a camera and a light.
 //!
 //! A scene is addressed by a *spec*: a file path (`.obj`, `.ply`, either also `.gz`, `.gltf`,
-//! `.glb`) or `builtin:NAME?key=value&...` (see [`builtin`]). [`load`] resolves a spec into a
+//! `.glb`) or `builtin:NAME?key=value&...` (see [`builtin`]). [`load()`] resolves a spec into a
 //! [`Scene`].
 //!
 //! ```no_run
