@@ -2,7 +2,8 @@
 //!
 //! A scene is addressed by a *spec*: a file path (`.obj`, `.ply`, either also `.gz`, `.gltf`,
 //! `.glb`) or `builtin:NAME?key=value&...` (see [`builtin`]). [`load()`] resolves a spec into a
-//! [`Scene`].
+//! [`Scene`]. Builtins come with their own camera and light; files get the preset of their
+//! stem ([`Camera::preset_for`], see `docs/scenes.md`) or a fit to their bounds.
 //!
 //! ```no_run
 //! let scene = dualsplit_scene::load("builtin:cornell").unwrap();
