@@ -91,14 +91,11 @@ pub fn format_of(path: &Path) -> Result<(Format, bool), SceneError> {
 
 /// Loads a scene file, choosing the format by extension (see the module docs).
 ///
-/// The scene's name is the file name without its extensions; its spec is the path.
+/// The scene's name is [`file_stem`](crate::file_stem) (the file name without its scene
+/// extensions); its spec is the path.
 pub fn load_file(path: &Path) -> Result<Scene, SceneError> {
     let mesh = read_mesh(path)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let name = name.split('.').next().unwrap_or_default().to_string();
+    let name = crate::file_stem(path).to_string();
     Scene::from_triangles(
         name,
         path.to_string_lossy().into_owned(),
