@@ -148,7 +148,7 @@ impl<'a> Producer<'a> {
 
     /// The scenes that get the TM-scaling study: those standing for the paper's Crytek
     /// Sponza and Hairball (Table 7), or the first scene when none does.
-    fn scaling_scenes(scenes: &[Scene]) -> Vec<bool> {
+    pub fn scaling_scenes(scenes: &[Scene]) -> Vec<bool> {
         let wanted: Vec<bool> = scenes
             .iter()
             .map(|s| {

@@ -159,16 +159,25 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     if args.full {
         let pixels = f64::from(res) * f64::from(res);
-        // Up to 2 rays per pixel for casting and 12 for path tracing (see dualsplit-render);
-        // about half the path rays survive on average.
-        let rays_per_scene = 8.0 * pixels * 2.0 + 8.0 * pixels * 6.0;
-        let scaling = 2.0 * 8.0 * pixels * 6.0 * (tms.len().saturating_sub(1)) as f64;
-        let total = rays_per_scene * scenes.len() as f64 + scaling;
-        let hours = total / SIM_RAYS_PER_SECOND / 3600.0;
+        let scaling = Producer::scaling_scenes(&scenes)
+            .iter()
+            .filter(|&&b| b)
+            .count();
+        let extra_tms = tms.iter().filter(|&&t| t != base_tms).count();
+        // 8 configurations; up to 2 rays per pixel for casting and 12 for path tracing (see
+        // dualsplit-render), about 1.5 and 6 on average.
+        let frames = scenes.len() * 16 + scaling * extra_tms * 8;
+        let rays = 8.0 * pixels * (1.5 + 6.0) * scenes.len() as f64
+            + (scaling * extra_tms * 8) as f64 * pixels * 6.0;
+        let secs = rays / SIM_RAYS_PER_SECOND;
+        let when = if secs >= 3600.0 {
+            format!("{:.1} hours", secs / 3600.0)
+        } else {
+            format!("{:.0} minutes", (secs / 60.0).ceil())
+        };
         eprintln!(
-            "--full: {} scenes at {res}×{res}, {} simulated frames; roughly {hours:.1} hours on a 2-core machine (cached pieces are skipped)",
-            scenes.len(),
-            scenes.len() * 16 + 16 * (tms.len().saturating_sub(1)) * 2
+            "--full: {} scenes at {res}×{res}, {frames} simulated frames; roughly {when} on a 2-core machine (cached pieces are skipped)",
+            scenes.len()
         );
     }
 
