@@ -10,6 +10,7 @@
 //! [`Structures`] builds all of them from one scene and dispatches by [`AccelKind`].
 
 pub mod build;
+pub mod dst;
 pub mod image;
 pub mod observer;
 
