@@ -1,1 +1,143 @@
-fn main() {}
+//! CPU traversal speed: closest-hit (primary, diffuse) and any-hit (shadow) rays on shipped
+//! scenes, for the BVH2 traversal on `main` (the `Structures` reference), the DST software
+//! decoder (DST*) and the DST pipeline-function loop. Rays come from the renderer's
+//! path-tracing jobs (128² pixels, ≤ 16K rays per kind). Every ray is checked against the
+//! BVH2 before anything is timed.
+//!
+//! `cargo bench -p dualsplit-accel --bench dst_traversal`
+
+#[path = "../tests/dst_common/mod.rs"]
+mod dst_common;
+
+use divan::Bencher;
+use divan::counter::ItemsCount;
+use dualsplit_accel::dst::{Dst, DstConfig};
+use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_geometry::Ray;
+use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
+use dualsplit_scene::{LoadStats, Scene};
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
+
+const SCENES: [&str; 2] = ["bunny", "sponza_dabrovic"];
+const CASES: [&str; 6] = [
+    "bunny/primary",
+    "bunny/shadow",
+    "bunny/diffuse",
+    "sponza_dabrovic/primary",
+    "sponza_dabrovic/shadow",
+    "sponza_dabrovic/diffuse",
+];
+const SIDE: u32 = 128;
+const MAX_RAYS: usize = 16_384;
+
+struct Prepared {
+    reference: Structures,
+    dst: Dst,
+    rays: [Vec<Ray>; 3],
+}
+
+fn prepare(name: &str) -> Prepared {
+    let tris = dst_common::load_shipped(&format!("{name}.ply.gz"));
+    let scene = Scene::from_triangles(name, name, tris, LoadStats::default()).expect("scene");
+    let b = dst_common::build(&scene.triangles, &DstConfig::hardware());
+    let settings = RenderSettings::new(SIDE, SIDE, Workload::Path);
+    let mut rays: [Vec<Ray>; 3] = Default::default();
+    for y in 0..SIDE {
+        for x in 0..SIDE {
+            let mut job = PixelJob::new(&scene, &settings, x, y);
+            while let Some(q) = job.next_ray() {
+                let hit = b
+                    .reference
+                    .closest_hit(AccelKind::Bvh2, &q.ray, &mut NoObserver);
+                // Correctness before timing.
+                dst_common::check_ray(&b.dst, &q.ray, hit, name);
+                let list = &mut rays[q.kind as usize];
+                if list.len() < MAX_RAYS {
+                    list.push(q.ray);
+                }
+                job.submit(match q.kind {
+                    RayKind::Shadow => TraceResult::Occluded(hit.is_some()),
+                    _ => TraceResult::Closest(hit),
+                });
+            }
+        }
+    }
+    Prepared {
+        reference: b.reference,
+        dst: b.dst,
+        rays,
+    }
+}
+
+fn data(case: &str) -> (&'static Prepared, &'static [Ray], bool) {
+    static DATA: OnceLock<Mutex<HashMap<&'static str, &'static Prepared>>> = OnceLock::new();
+    let (scene, kind) = case.split_once('/').unwrap();
+    let scene = SCENES.into_iter().find(|s| *s == scene).unwrap();
+    let p = *DATA
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap()
+        .entry(scene)
+        .or_insert_with(|| Box::leak(Box::new(prepare(scene))));
+    let k = match kind {
+        "primary" => 0,
+        "shadow" => 1,
+        _ => 2,
+    };
+    (p, &p.rays[k], k == 1)
+}
+
+fn main() {
+    divan::main();
+}
+
+#[divan::bench(args = CASES)]
+fn bvh2(bencher: Bencher, case: &str) {
+    let (p, rays, shadow) = data(case);
+    bencher.counter(ItemsCount::new(rays.len())).bench(|| {
+        let mut n = 0u32;
+        for r in rays {
+            n += if shadow {
+                p.reference.any_hit(AccelKind::Bvh2, r, &mut NoObserver) as u32
+            } else {
+                p.reference
+                    .closest_hit(AccelKind::Bvh2, r, &mut NoObserver)
+                    .is_some() as u32
+            };
+        }
+        n
+    });
+}
+
+#[divan::bench(args = CASES)]
+fn dst_software(bencher: Bencher, case: &str) {
+    let (p, rays, shadow) = data(case);
+    bencher.counter(ItemsCount::new(rays.len())).bench(|| {
+        let mut n = 0u32;
+        for r in rays {
+            n += if shadow {
+                p.dst.any_hit(r, &mut NoObserver) as u32
+            } else {
+                p.dst.closest_hit(r, &mut NoObserver).is_some() as u32
+            };
+        }
+        n
+    });
+}
+
+#[divan::bench(args = CASES)]
+fn dst_pipeline(bencher: Bencher, case: &str) {
+    let (p, rays, shadow) = data(case);
+    bencher.counter(ItemsCount::new(rays.len())).bench(|| {
+        let mut n = 0u32;
+        for r in rays {
+            n += if shadow {
+                p.dst.any_hit_pipeline(r, &mut NoObserver) as u32
+            } else {
+                p.dst.closest_hit_pipeline(r, &mut NoObserver).is_some() as u32
+            };
+        }
+        n
+    });
+}

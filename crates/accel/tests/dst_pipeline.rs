@@ -10,6 +10,7 @@ use dualsplit_accel::dst::{AxisPair, Corner, DstConfig, HeaderOffset};
 use dualsplit_accel::{CountingObserver, DstNodeKind};
 use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3};
 use proptest::prelude::*;
+use std::cmp::Ordering;
 
 fn input(word: HeaderOffset, p0: f32, p1: f32, o: [f32; 3], d: [f32; 3]) -> PipelineInput {
     PipelineInput {
@@ -128,8 +129,8 @@ fn reference(i: &PipelineInput) -> (u8, u32, f32, f32, Option<(u32, f32)>) {
             } else {
                 (l, r, t(a, i.p0), t(a, i.p1))
             };
-            let near_hit = !(i.t_min > t1);
-            let far_hit = !(i.t_max < t2);
+            let near_hit = i.t_min.partial_cmp(&t1) != Some(Ordering::Greater);
+            let far_hit = i.t_max.partial_cmp(&t2) != Some(Ordering::Less);
             match (near_hit, far_hit) {
                 (true, true) => (
                     2,

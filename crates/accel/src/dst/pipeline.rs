@@ -92,6 +92,14 @@ pub fn mux<T: Copy>(s: bool, a: T, b: T) -> T {
     [b, a][s as usize]
 }
 
+/// The comparator `a ≤ b` with NaN counted as true: a NaN plane distance (the ray lies in
+/// the plane) never drops a child or culls a node.
+#[inline(always)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // the negated form is exactly the NaN rule
+pub fn le_or_nan(a: f32, b: f32) -> bool {
+    !(a > b)
+}
+
 /// One dual-split pipeline operation (Lin et al. 2020, §3, Fig. 6; Apps. A–C).
 #[inline(always)]
 pub fn step(i: &PipelineInput) -> PipelineOutput {
@@ -125,9 +133,9 @@ pub fn step(i: &PipelineInput) -> PipelineOutput {
     let corner = w.corner();
     let exit0 = mux(is_dual, neg0 == corner.first_lower, true);
     let exit1 = mux(is_dual, neg1 == corner.second_lower, false);
-    // ---- FPCMP: splitting-node child tests (NaN-permissive: written as !(a > b)) --------
-    let near_hit = !(i.t_min > t1);
-    let far_hit = !(i.t_max < t2);
+    // ---- FPCMP: splitting-node child tests (NaN-permissive) --------
+    let near_hit = le_or_nan(i.t_min, t1);
+    let far_hit = le_or_nan(t2, i.t_max);
     // A splitting node hit on one side only keeps the untouched bound of that side:
     // near-only → [t_min, min(t_max, t1)], far-only → [max(t_min, t2), t_max].
     let use_t1 = exit0 & !(is_split & !near_hit);
@@ -142,7 +150,7 @@ pub fn step(i: &PipelineInput) -> PipelineOutput {
         .max(mux(!exit0, t1, i.t_min))
         .max(mux(use_t2, t2, i.t_min));
     // ---- FPCMP: carving cull -------------------------------------------------------------
-    let carve_hit = !(t_min_out > t_max_out);
+    let carve_hit = le_or_nan(t_min_out, t_max_out);
     // ---- INTADD and offset muxes ---------------------------------------------------------
     let left = w.offset();
     let right = left.wrapping_add(field_b);
@@ -179,9 +187,7 @@ impl Dst {
         ray: &Ray,
         obs: &mut O,
     ) -> Option<Hit> {
-        let Some((mut tr, mut t_min, mut t_max)) = Tracer::start(self, ray) else {
-            return None;
-        };
+        let (mut tr, mut t_min, mut t_max) = Tracer::start(self, ray)?;
         let origin = tr.r.ray.origin.to_array();
         let inv_dir = tr.r.inv_dir.to_array();
         let mut node = 0u32;

@@ -11,6 +11,7 @@
 use super::Dst;
 use super::encode::RUN_END;
 use super::header::HeaderOffset;
+use super::pipeline::le_or_nan;
 use crate::image::MemoryImage;
 use crate::observer::{DstNodeKind, NodeStep, Observer};
 use dualsplit_geometry::{Hit, Ray, RayPre, Triangle, cull_limit};
@@ -185,7 +186,7 @@ impl<'a> Tracer<'a> {
         let limit = cull_limit(self.best_t);
         while let Some(e) = self.stack.pop() {
             obs.pop();
-            if !(e.t_min > limit) {
+            if le_or_nan(e.t_min, limit) {
                 return Some(Entry {
                     t_max: e.t_max.min(limit),
                     ..e
@@ -218,9 +219,7 @@ impl Dst {
 
     #[inline(always)]
     fn traverse<O: Observer, const ANY: bool>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        let Some((mut tr, mut t_min, mut t_max)) = Tracer::start(self, ray) else {
-            return None;
-        };
+        let (mut tr, mut t_min, mut t_max) = Tracer::start(self, ray)?;
         let mut node = 0u32;
         loop {
             let (w, p0, p1) = tr.fetch_node(node, obs);
@@ -241,8 +240,8 @@ impl Dst {
                     } else {
                         (left, right, tr.r.plane_t(a, p0), tr.r.plane_t(a, p1))
                     };
-                    let near_hit = !(t_min > t1);
-                    let far_hit = !(t_max < t2);
+                    let near_hit = le_or_nan(t_min, t1);
+                    let far_hit = le_or_nan(t2, t_max);
                     obs.step(dst_step(
                         DstNodeKind::Split,
                         near_hit as u8 + far_hit as u8,
@@ -298,7 +297,7 @@ impl Dst {
                         }
                         (lo, hi)
                     };
-                    let hit = !(lo > hi);
+                    let hit = le_or_nan(lo, hi);
                     let leaf = w.is_leaf_flag();
                     obs.step(dst_step(kind, hit as u8 * (1 + 2 * leaf as u8), leaf));
                     if hit {
@@ -314,10 +313,10 @@ impl Dst {
                     }
                 }
             };
-            if let Some(first) = run {
-                if let RunResult::Occluded = tr.test_run::<O, ANY>(first, obs) {
-                    return tr.best;
-                }
+            if let Some(first) = run
+                && let RunResult::Occluded = tr.test_run::<O, ANY>(first, obs)
+            {
+                return tr.best;
             }
             let Some(e) = tr.pop(obs) else {
                 return tr.best;
