@@ -4,9 +4,9 @@
 
 mod dst_common;
 
-use dst_common::{build, build_from, check_all, random_rays};
+use dst_common::{build, build_with, check_all, random_rays};
 use dualsplit_accel::dst::{DstConfig, Partitioning};
-use dualsplit_accel::{BuildConfig, Bvh2};
+use dualsplit_accel::BuildConfig;
 use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3};
 use proptest::prelude::*;
 
@@ -61,12 +61,11 @@ fn run_case(seed: u64, n: usize, shape: u32, leaf: u32) {
         max_leaf_size: leaf,
         ..BuildConfig::default()
     };
-    let bvh = Bvh2::build(&boxes, &bcfg);
     let mut rng = Pcg32::new(seed ^ 0x5eed, 11);
     let rays = random_rays(&mut rng, &tris, &scene_box, 60);
     let mut reference_misses = 0;
     for cfg in configs() {
-        let b = build_from(bvh.clone(), &tris, &cfg);
+        let b = build_with(&tris, &bcfg, &cfg);
         for ray in &rays {
             reference_misses += !check_all(&b, &tris, ray) as u32;
         }

@@ -16,18 +16,15 @@ pub struct Built {
 }
 
 pub fn build(tris: &[Triangle], cfg: &DstConfig) -> Built {
-    let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
-    let bvh = Bvh2::build(&boxes, &BuildConfig::default());
-    build_from(bvh, tris, cfg)
+    build_with(tris, &BuildConfig::default(), cfg)
 }
 
-pub fn build_from(bvh: Bvh2, tris: &[Triangle], cfg: &DstConfig) -> Built {
+/// Builds every structure with `bcfg`, then converts the DST from that same BVH2.
+pub fn build_with(tris: &[Triangle], bcfg: &BuildConfig, cfg: &DstConfig) -> Built {
+    let reference = Structures::try_build(tris, bcfg).expect("structures");
+    let bvh = reference.bvh2.clone();
     let dst = Dst::from_bvh2(&bvh, tris, cfg).expect("conversion");
     dst.validate(&bvh).expect("validate");
-    let reference = Structures {
-        triangles: tris.to_vec(),
-        bvh2: bvh.clone(),
-    };
     Built {
         bvh,
         dst,
