@@ -1,12 +1,10 @@
 //! Shared helpers of the DST tests: a brute-force oracle, the BVH2 reference, per-ray
-//! comparison of every DST traversal, random scene generators and a tiny reader for the
-//! shipped `*.ply.gz` meshes (fixed binary layout, see `shared/scenes/README.md`).
+//! comparison of every DST traversal, random scene generators and shipped-mesh loading.
 #![allow(dead_code)]
 
 use dualsplit_accel::dst::{Dst, DstConfig, Partitioning};
 use dualsplit_accel::{AccelKind, BuildConfig, Bvh2, NoObserver, Structures};
 use dualsplit_geometry::{Aabb, Hit, Pcg32, Ray, Triangle, Vec3};
-use std::io::Read;
 
 /// A BVH2 over `tris` (default build), its DST and the BVH2 reference traversal.
 pub struct Built {
@@ -182,48 +180,13 @@ pub fn random_rays(rng: &mut Pcg32, tris: &[Triangle], b: &Aabb, n: usize) -> Ve
     rays
 }
 
-/// Reads a shipped `*.ply.gz` (gzip of a binary little-endian PLY with float xyz vertices
-/// and `uchar uint` triangle lists).
+/// Loads a shipped mesh (`shared/scenes/NAME`) through the project's scene loader.
 pub fn load_shipped(name: &str) -> Vec<Triangle> {
     let path = format!(
         "{}/../../../shared/scenes/{name}",
         env!("CARGO_MANIFEST_DIR")
     );
-    let file = std::fs::File::open(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let mut data = Vec::new();
-    flate2::read::GzDecoder::new(std::io::BufReader::new(file))
-        .read_to_end(&mut data)
-        .expect("gunzip");
-    let end = b"end_header\n";
-    let hdr_len = data
-        .windows(end.len())
-        .position(|w| w == end)
-        .expect("PLY header")
-        + end.len();
-    let header = std::str::from_utf8(&data[..hdr_len]).expect("ascii header");
-    let count = |elem: &str| -> usize {
-        header
-            .lines()
-            .find_map(|l| l.strip_prefix(&format!("element {elem} ")))
-            .expect("element line")
-            .trim()
-            .parse()
-            .expect("count")
-    };
-    let (nv, nf) = (count("vertex"), count("face"));
-    let body = &data[hdr_len..];
-    let f32_at = |o: usize| f32::from_le_bytes(body[o..o + 4].try_into().unwrap());
-    let u32_at = |o: usize| u32::from_le_bytes(body[o..o + 4].try_into().unwrap());
-    let verts: Vec<Vec3> = (0..nv)
-        .map(|i| Vec3::new(f32_at(12 * i), f32_at(12 * i + 4), f32_at(12 * i + 8)))
-        .collect();
-    let fb = 12 * nv;
-    (0..nf)
-        .map(|i| {
-            let o = fb + 13 * i;
-            assert_eq!(body[o], 3, "triangles only");
-            let v = |k: usize| verts[u32_at(o + 1 + 4 * k) as usize];
-            Triangle::new(v(0), v(1), v(2))
-        })
-        .collect()
+    dualsplit_scene::load(&path)
+        .unwrap_or_else(|e| panic!("{path}: {e}"))
+        .triangles
 }
