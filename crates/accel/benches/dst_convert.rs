@@ -20,11 +20,17 @@ struct Input {
 fn input() -> &'static Input {
     static INPUT: OnceLock<Input> = OnceLock::new();
     INPUT.get_or_init(|| {
-        let tris = dst_common::load_shipped("dragon_box.ply.gz");
+        let tris = dst_common::load_shipped(&scene_name());
         let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
         let bvh = Bvh2::build(&boxes, &BuildConfig::default());
         Input { tris, boxes, bvh }
     })
+}
+
+/// The mesh: `dragon_box.ply.gz` unless `DST_BENCH_SCENE` names another shipped mesh (for
+/// quick callgrind runs on a small one).
+fn scene_name() -> String {
+    std::env::var("DST_BENCH_SCENE").unwrap_or_else(|_| "dragon_box.ply.gz".into())
 }
 
 fn main() {
@@ -35,7 +41,8 @@ fn main() {
         dst.validate(&i.bvh).expect("valid DST");
         let s = dst.stats();
         eprintln!(
-            "dragon_box {cfg:?}: {s:?}\n  DST {:.2} MiB = {:.1} % of BVH2 {:.2} MiB",
+            "{} {cfg:?}: {s:?}\n  DST {:.2} MiB = {:.1} % of BVH2 {:.2} MiB",
+            scene_name(),
             s.total_bytes as f64 / 1048576.0,
             s.percent_of_bvh2(),
             s.bvh2_bytes as f64 / 1048576.0

@@ -5,8 +5,8 @@
 mod dst_common;
 
 use dst_common::{build, build_with, check_all, random_rays};
-use dualsplit_accel::dst::{DstConfig, Partitioning};
 use dualsplit_accel::BuildConfig;
+use dualsplit_accel::dst::{DstConfig, Partitioning};
 use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3};
 use proptest::prelude::*;
 

@@ -9,8 +9,8 @@
 //! it node by node is exact, and the whole conversion is one O(1) step per BVH node.
 //!
 //! A carving chain covers the set F of faces where the incoming region differs from the
-//! target box (|F| ≤ 5 below a split). [`plan_chain`] solves it exactly by dynamic
-//! programming over the 2^|F| subsets of carved faces: a step carves one face or two (two on
+//! target box. [`ChainDp`] solves it exactly by dynamic programming over the 2^|F| subsets
+//! of carved faces (one DP per child prices all six split choices): a step carves one face or two (two on
 //! one axis = single-axis carving node, on two axes = dual-axis carving node); a lone face
 //! is carved by the cheaper node type with a ±∞ no-op partner plane.
 
@@ -69,15 +69,6 @@ fn face(b: &Aabb, f: usize) -> f32 {
         b.max[f >> 1]
     } else {
         b.min[f >> 1]
-    }
-}
-
-#[inline(always)]
-fn set_face(b: &mut Aabb, f: usize, v: f32) {
-    if f & 1 == 1 {
-        b.max[f >> 1] = v;
-    } else {
-        b.min[f >> 1] = v;
     }
 }
 
@@ -158,101 +149,154 @@ fn step_for(faces: &[usize], i: usize, j: Option<usize>, target: &Aabb, c: &DstC
     }
 }
 
-/// Cost and chain of the cheapest carving from `region` down to `target` (dst-spec §5.2).
+/// The exact chain DP of one child box against its parent's box (dst-spec §5.2).
 ///
-/// `leaf_tris` is `Some(n)` when the chain sits above a leaf of `n` triangles and
-/// similar partitioning is on: the chain may then stop early, paying `C_tri · n · SA` of the
-/// looser region instead. Costs are SAH-weighted by the area of the region in which each
-/// node is tested. `want_chain = false` skips reconstruction (cost only).
-pub(super) fn plan_chain(
-    region: &Aabb,
-    target: &Aabb,
-    costs: &DstCosts,
-    leaf_tris: Option<u32>,
-    want_chain: bool,
-) -> (f32, Chain) {
-    let mut faces = [0usize; 6];
-    let mut k = 0;
-    for f in 0..6 {
-        if face(region, f) != face(target, f) {
-            faces[k] = f;
-            k += 1;
-        }
-    }
-    // Triangle cost of the leaf below (similar partitioning only; identical bounds never
-    // stops early, and the leaf's cost is then the same for every choice).
-    let leaf_cost = |sa: f32| leaf_tris.map(|n| costs.triangle * n as f32 * sa);
-    if k == 0 {
-        return (leaf_cost(target.half_area()).unwrap_or(0.0), Chain::EMPTY);
-    }
-    let c_lone = costs.single_carve.min(costs.dual_carve);
-    let full = (1usize << k) - 1;
-    let mut sa = [0f32; 64];
-    for (s, slot) in sa.iter_mut().enumerate().take(full + 1) {
-        let mut b = *region;
-        for (i, &f) in faces[..k].iter().enumerate() {
-            if s >> i & 1 == 1 {
-                set_face(&mut b, f, face(target, f));
+/// States are subsets S of the faces F where the parent box differs from the child box; the
+/// region in state S is the parent box with the faces in S already at the child's values.
+/// `cost[S]` is the cheapest SAH cost of carving the rest. A split that carves face f of the
+/// child enters the chain in state {f}, so one DP per child prices all 6 split choices.
+pub(super) struct ChainDp {
+    faces: [usize; 6],
+    k: usize,
+    target: Aabb,
+    cost: [f32; 64],
+    choice: [u8; 64],
+    /// Leaf cost in the full state (similar partitioning), added to every result.
+    base: f32,
+}
+
+impl ChainDp {
+    /// Solves the DP from `region` (the parent box) down to `target` (the child box).
+    /// `leaf_tris` is `Some(n)` when the child is a leaf of `n` triangles and similar
+    /// partitioning is on: the chain may then stop early, paying `C_tri · n · SA` of the
+    /// looser region instead. Costs are SAH-weighted by the area of the region in which
+    /// each node is tested.
+    pub fn solve(region: &Aabb, target: &Aabb, costs: &DstCosts, leaf_tris: Option<u32>) -> Self {
+        let mut dp = ChainDp {
+            faces: [0; 6],
+            k: 0,
+            target: *target,
+            cost: [0.0; 64],
+            choice: [0; 64],
+            base: 0.0,
+        };
+        for f in 0..6 {
+            if face(region, f) != face(target, f) {
+                dp.faces[dp.k] = f;
+                dp.k += 1;
             }
         }
-        *slot = b.half_area();
-    }
-    // cost[s]: cheapest completion once the faces in `s` are carved (relative to the
-    // target: the full set costs nothing extra; similar mode may stop anywhere).
-    let base = leaf_cost(sa[full]).unwrap_or(0.0);
-    let mut cost = [0f32; 64];
-    let mut choice = [0u8; 64]; // the step taken from s (face mask); 0 = stop
-    cost[full] = 0.0;
-    for s in (0..full).rev() {
-        let stop = leaf_cost(sa[s]).map_or(f32::INFINITY, |c| c - base);
-        let mut best = (stop, 0u8);
-        let rem = full & !s;
+        let k = dp.k;
+        // Triangle cost of the leaf below (similar partitioning only; with identical bounds
+        // the leaf's cost is the same for every choice and never matters).
+        let leaf_cost = |sa: f32| leaf_tris.map(|n| costs.triangle * n as f32 * sa);
+        let full = (1usize << k) - 1;
+        // Region extent on each axis for each of the 4 carve states of its two faces
+        // (bit 0: min face carved, bit 1: max face carved).
+        let mut ext = [[0f32; 4]; 3];
+        for (a, e) in ext.iter_mut().enumerate() {
+            for (code, slot) in e.iter_mut().enumerate() {
+                let lo = if code & 1 == 1 {
+                    target.min[a]
+                } else {
+                    region.min[a]
+                };
+                let hi = if code & 2 == 2 {
+                    target.max[a]
+                } else {
+                    region.max[a]
+                };
+                *slot = (hi - lo).max(0.0);
+            }
+        }
+        // codes[s]: the carved faces of state s as a 6-bit mask (bit 2a + side).
+        let mut codes = [0u8; 64];
+        let mut sa = [0f32; 64];
+        for s in 0..=full {
+            if s > 0 {
+                codes[s] = codes[s & (s - 1)] | 1 << dp.faces[s.trailing_zeros() as usize];
+            }
+            let c = codes[s];
+            let (x, y, z) = (
+                ext[0][(c & 3) as usize],
+                ext[1][(c >> 2 & 3) as usize],
+                ext[2][(c >> 4 & 3) as usize],
+            );
+            sa[s] = x * y + y * z + z * x;
+        }
+        dp.base = leaf_cost(sa[full]).unwrap_or(0.0);
+        let c_lone = costs.single_carve.min(costs.dual_carve);
+        let mut pair = [[0f32; 6]; 6];
         for i in 0..k {
-            if rem >> i & 1 == 0 {
-                continue;
-            }
-            let c = c_lone * sa[s] + cost[s | 1 << i];
-            if c < best.0 {
-                best = (c, 1 << i);
-            }
             for j in i + 1..k {
-                if rem >> j & 1 == 0 {
-                    continue;
-                }
-                let node = if faces[i] >> 1 == faces[j] >> 1 {
+                pair[i][j] = if dp.faces[i] >> 1 == dp.faces[j] >> 1 {
                     costs.single_carve
                 } else {
                     costs.dual_carve
                 };
-                let c = node * sa[s] + cost[s | 1 << i | 1 << j];
-                if c < best.0 {
-                    best = (c, (1 << i | 1 << j) as u8);
-                }
             }
         }
-        cost[s] = best.0;
-        choice[s] = best.1;
+        for s in (0..full).rev() {
+            let stop = leaf_cost(sa[s]).map_or(f32::INFINITY, |c| c - dp.base);
+            let mut best = (stop, 0u8);
+            let mut rem_i = full & !s;
+            while rem_i != 0 {
+                let i = rem_i.trailing_zeros() as usize;
+                rem_i &= rem_i - 1;
+                let c = c_lone * sa[s] + dp.cost[s | 1 << i];
+                if c < best.0 {
+                    best = (c, 1 << i);
+                }
+                let mut rem_j = rem_i;
+                while rem_j != 0 {
+                    let j = rem_j.trailing_zeros() as usize;
+                    rem_j &= rem_j - 1;
+                    let c = pair[i][j] * sa[s] + dp.cost[s | 1 << i | 1 << j];
+                    if c < best.0 {
+                        best = (c, (1 << i | 1 << j) as u8);
+                    }
+                }
+            }
+            dp.cost[s] = best.0;
+            dp.choice[s] = best.1;
+        }
+        dp
     }
-    let total = cost[0] + base;
-    if !want_chain {
-        return (total, Chain::EMPTY);
+
+    /// The state entered when the split carves face `f` of the child (if it is one of F).
+    fn start(&self, carved_by_split: usize) -> usize {
+        self.faces[..self.k]
+            .iter()
+            .position(|&g| g == carved_by_split)
+            .map_or(0, |i| 1 << i)
     }
-    let mut chain = Chain::EMPTY;
-    let mut s = 0usize;
-    while s != full && choice[s] != 0 {
-        let t = choice[s] as usize;
-        let i = t.trailing_zeros() as usize;
-        let rest = t & !(1 << i);
-        let j = (rest != 0).then(|| rest.trailing_zeros() as usize);
-        chain.steps[chain.len as usize] = step_for(&faces[..k], i, j, target, costs);
-        chain.len += 1;
-        s |= t;
+
+    /// Cost of the chain when the split carves face `f`.
+    pub fn cost(&self, carved_by_split: usize) -> f32 {
+        self.cost[self.start(carved_by_split)] + self.base
     }
-    (total, chain)
+
+    /// The cheapest chain when the split carves face `f`, outermost node first.
+    pub fn chain(&self, carved_by_split: usize, costs: &DstCosts) -> Chain {
+        let full = (1usize << self.k) - 1;
+        let mut chain = Chain::EMPTY;
+        let mut s = self.start(carved_by_split);
+        while s != full && self.choice[s] != 0 {
+            let t = self.choice[s] as usize;
+            let i = t.trailing_zeros() as usize;
+            let rest = t & !(1 << i);
+            let j = (rest != 0).then(|| rest.trailing_zeros() as usize);
+            chain.steps[chain.len as usize] =
+                step_for(&self.faces[..self.k], i, j, &self.target, costs);
+            chain.len += 1;
+            s |= t;
+        }
+        chain
+    }
 }
 
 /// The split chosen for an internal BVH node: axis, which BVH child is the left (lower)
-/// child, and both children's incoming regions and carving chains.
+/// child, and both children's carving chains.
 pub(super) struct SplitPlan {
     pub axis: usize,
     pub left: u32,
@@ -266,6 +310,15 @@ fn leaf_tris(bvh: &Bvh2, n: u32, cfg: &DstConfig) -> Option<u32> {
     (cfg.partitioning == Partitioning::Similar && node.is_leaf()).then_some(node.count)
 }
 
+/// Face index of the max face on `axis` (carved for the left child by P0) and of the min
+/// face (carved for the right child by P1).
+const fn max_face(axis: usize) -> usize {
+    2 * axis + 1
+}
+const fn min_face(axis: usize) -> usize {
+    2 * axis
+}
+
 /// Chooses axis and child order of the splitting node for internal BVH node `n`, whose
 /// region is exactly its box: for each axis and order, the split plane carves the left
 /// child's max face and the right child's min face; the rest is left to the children's
@@ -275,43 +328,29 @@ pub(super) fn plan_split(bvh: &Bvh2, n: u32, cfg: &DstConfig) -> SplitPlan {
     let b = node.bounds;
     let [x, y] = node.children();
     let (bx, by) = (bvh.nodes[x as usize].bounds, bvh.nodes[y as usize].bounds);
-    let (lx, ly) = (leaf_tris(bvh, x, cfg), leaf_tris(bvh, y, cfg));
+    let dx = ChainDp::solve(&b, &bx, &cfg.costs, leaf_tris(bvh, x, cfg));
+    let dy = ChainDp::solve(&b, &by, &cfg.costs, leaf_tris(bvh, y, cfg));
     let mut best = (f32::INFINITY, 0usize, false);
     for axis in 0..3 {
         for swap in [false, true] {
-            let (lo, hi, llo, lhi) = if swap {
-                (by, bx, ly, lx)
-            } else {
-                (bx, by, lx, ly)
-            };
-            let mut rl = b;
-            rl.max[axis] = lo.max[axis];
-            let mut rr = b;
-            rr.min[axis] = hi.min[axis];
-            let c = plan_chain(&rl, &lo, &cfg.costs, llo, false).0
-                + plan_chain(&rr, &hi, &cfg.costs, lhi, false).0;
-            if c < best.0 || best.0.is_nan() && !c.is_nan() {
+            let (lo, hi) = if swap { (&dy, &dx) } else { (&dx, &dy) };
+            let c = lo.cost(max_face(axis)) + hi.cost(min_face(axis));
+            if c < best.0 {
                 best = (c, axis, swap);
             }
         }
     }
     let (_, axis, swap) = best;
-    let (left, right, lo, hi, llo, lhi) = if swap {
-        (y, x, by, bx, ly, lx)
+    let (left, right, lo, hi) = if swap {
+        (y, x, &dy, &dx)
     } else {
-        (x, y, bx, by, lx, ly)
+        (x, y, &dx, &dy)
     };
-    let mut left_region = b;
-    left_region.max[axis] = lo.max[axis];
-    let mut right_region = b;
-    right_region.min[axis] = hi.min[axis];
-    let left_chain = plan_chain(&left_region, &lo, &cfg.costs, llo, true).1;
-    let right_chain = plan_chain(&right_region, &hi, &cfg.costs, lhi, true).1;
     SplitPlan {
         axis,
         left,
         right,
-        left_chain,
-        right_chain,
+        left_chain: lo.chain(max_face(axis), &cfg.costs),
+        right_chain: hi.chain(min_face(axis), &cfg.costs),
     }
 }
