@@ -178,7 +178,11 @@ impl Dst {
             bvh,
             triangles: triangles.len(),
             cfg,
-            words: Vec::with_capacity(bvh.nodes.len() * 3),
+            // Room for the whole image, so appending the index list and triangles after
+            // the nodes never reallocates.
+            words: Vec::with_capacity(
+                bvh.nodes.len() * 3 + bvh.prim_ids.len() + triangles.len() * 9,
+            ),
             indices: Vec::with_capacity(bvh.prim_ids.len()),
             stats: DstStats::default(),
             visited: 0,
@@ -203,6 +207,7 @@ impl Dst {
         let n_nodes = enc.words.len();
         let n_idx = enc.indices.len();
         let mut words = enc.words;
+        words.reserve_exact(n_idx + triangles.len() * 9);
         words.extend_from_slice(&enc.indices);
         words.extend_from_slice(bytemuck::cast_slice::<Triangle, u32>(triangles));
         let image = MemoryImage {

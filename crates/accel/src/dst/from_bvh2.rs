@@ -210,6 +210,7 @@ impl ChainDp {
             }
         }
         // codes[s]: the carved faces of state s as a 6-bit mask (bit 2a + side).
+        let c_lone = costs.single_carve.min(costs.dual_carve);
         let mut codes = [0u8; 64];
         let mut sa = [0f32; 64];
         for s in 0..=full {
@@ -225,27 +226,40 @@ impl ChainDp {
             sa[s] = x * y + y * z + z * x;
         }
         dp.base = leaf_cost(sa[full]).unwrap_or(0.0);
-        let c_lone = costs.single_carve.min(costs.dual_carve);
+        // Pair costs, and for each face the partners whose pair node costs no more than a
+        // lone-face node: while such a partner remains, carving the face alone is dominated
+        // (the DP cost never grows when more faces are already carved), so it is skipped.
         let mut pair = [[0f32; 6]; 6];
+        let mut cheap_partner = [0usize; 6];
         for i in 0..k {
-            for j in i + 1..k {
-                pair[i][j] = if dp.faces[i] >> 1 == dp.faces[j] >> 1 {
+            for j in 0..k {
+                if i == j {
+                    continue;
+                }
+                let c = if dp.faces[i] >> 1 == dp.faces[j] >> 1 {
                     costs.single_carve
                 } else {
                     costs.dual_carve
                 };
+                pair[i][j] = c;
+                if c <= c_lone {
+                    cheap_partner[i] |= 1 << j;
+                }
             }
         }
         for s in (0..full).rev() {
             let stop = leaf_cost(sa[s]).map_or(f32::INFINITY, |c| c - dp.base);
             let mut best = (stop, 0u8);
-            let mut rem_i = full & !s;
+            let rem = full & !s;
+            let mut rem_i = rem;
             while rem_i != 0 {
                 let i = rem_i.trailing_zeros() as usize;
                 rem_i &= rem_i - 1;
-                let c = c_lone * sa[s] + dp.cost[s | 1 << i];
-                if c < best.0 {
-                    best = (c, 1 << i);
+                if rem & cheap_partner[i] == 0 {
+                    let c = c_lone * sa[s] + dp.cost[s | 1 << i];
+                    if c < best.0 {
+                        best = (c, 1 << i);
+                    }
                 }
                 let mut rem_j = rem_i;
                 while rem_j != 0 {
