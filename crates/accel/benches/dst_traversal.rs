@@ -12,7 +12,7 @@ mod dst_common;
 use divan::Bencher;
 use divan::counter::ItemsCount;
 use dualsplit_accel::dst::{Dst, DstConfig};
-use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_accel::{AccelKind, CountingObserver, NoObserver, Structures};
 use dualsplit_geometry::Ray;
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::{LoadStats, Scene};
@@ -62,6 +62,34 @@ fn prepare(name: &str) -> Prepared {
                 });
             }
         }
+    }
+    // Deterministic per-ray work, printed beside the timings.
+    for (k, kind) in ["primary", "shadow", "diffuse"].iter().enumerate() {
+        let (mut bvh, mut dst) = (CountingObserver::default(), CountingObserver::default());
+        for r in &rays[k] {
+            if k == 1 {
+                b.reference.any_hit(AccelKind::Bvh2, r, &mut bvh);
+                b.dst.any_hit(r, &mut dst);
+            } else {
+                b.reference.closest_hit(AccelKind::Bvh2, r, &mut bvh);
+                b.dst.closest_hit(r, &mut dst);
+            }
+        }
+        let n = rays[k].len().max(1) as f64;
+        eprintln!(
+            "{name}/{kind}: {} rays | BVH2 per ray: {:.1} nodes, {:.1} box tests, {:.1} tris, {:.0} B \
+             | DST per ray: {:.1} nodes, {:.1} plane tests, {:.1} leaves, {:.1} tris, {:.0} B",
+            rays[k].len(),
+            bvh.nodes as f64 / n,
+            bvh.box_tests as f64 / n,
+            bvh.triangle_tests as f64 / n,
+            bvh.bytes as f64 / n,
+            dst.nodes as f64 / n,
+            dst.plane_tests as f64 / n,
+            dst.leaves as f64 / n,
+            dst.triangle_tests as f64 / n,
+            dst.bytes as f64 / n,
+        );
     }
     Prepared {
         reference: b.reference,

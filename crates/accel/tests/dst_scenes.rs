@@ -115,3 +115,34 @@ fn sponza_dabrovic() {
 fn sponza_dabrovic_software_preset() {
     scene_case("sponza_dabrovic.ply.gz", DstConfig::software());
 }
+
+/// Similar partitioning never adds nodes: above each leaf it may only drop carving nodes.
+/// Prints both modes' sizes and per-ray work on the renderer's primary rays.
+#[test]
+fn similar_partitioning_effect() {
+    let tris = load_shipped("bunny.ply.gz");
+    let scene = Scene::from_triangles("bunny", "bunny", tris, LoadStats::default()).expect("scene");
+    let ident = build(&scene.triangles, &DstConfig::hardware());
+    let similar = build(
+        &scene.triangles,
+        &DstConfig::hardware().with_partitioning(Partitioning::Similar),
+    );
+    let settings = RenderSettings::new(128, 128, Workload::Cast);
+    let rays: Vec<_> = (0..128 * 128)
+        .filter_map(|p| PixelJob::new(&scene, &settings, p % 128, p / 128).next_ray())
+        .map(|q| q.ray)
+        .collect();
+    let (si, ss) = (ident.dst.stats(), similar.dst.stats());
+    let (ti, ts) = (ident.dst.trace_stats(&rays), similar.dst.trace_stats(&rays));
+    eprintln!(
+        "identical: {si:?}\n  {:.1} % of BVH2, per ray {ti:?}",
+        si.percent_of_bvh2()
+    );
+    eprintln!(
+        "similar:   {ss:?}\n  {:.1} % of BVH2, per ray {ts:?}",
+        ss.percent_of_bvh2()
+    );
+    assert!(ss.node_bytes <= si.node_bytes);
+    assert_eq!(ss.splitting, si.splitting);
+    assert!(ts.triangle_tests >= ti.triangle_tests);
+}
