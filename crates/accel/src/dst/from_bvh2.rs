@@ -232,11 +232,11 @@ impl ChainDp {
         let mut pair = [[0f32; 6]; 6];
         let mut cheap_partner = [0usize; 6];
         for i in 0..k {
-            for j in 0..k {
+            for (j, &fj) in dp.faces[..k].iter().enumerate() {
                 if i == j {
                     continue;
                 }
-                let c = if dp.faces[i] >> 1 == dp.faces[j] >> 1 {
+                let c = if dp.faces[i] >> 1 == fj >> 1 {
                     costs.single_carve
                 } else {
                     costs.dual_carve
