@@ -32,6 +32,28 @@ fn key(h: Option<Hit>) -> Option<(u32, u32)> {
 fn scene_case(name: &str, cfg: DstConfig) {
     let tris = load_shipped(name);
     let scene = Scene::from_triangles(name, name, tris, LoadStats::default()).expect("scene");
+    rays_case(&scene, name, cfg);
+}
+
+fn builtin_case(spec: &str) {
+    let scene = dualsplit_scene::load(spec).expect("builtin scene");
+    rays_case(&scene, spec, DstConfig::hardware());
+}
+
+/// Every builtin scene (reduced sizes), with its preset camera.
+#[test]
+fn builtins() {
+    for spec in [
+        "builtin:cornell",
+        "builtin:atrium?triangles=20000",
+        "builtin:forest?triangles=20000",
+        "builtin:hairball?triangles=20000",
+    ] {
+        builtin_case(spec);
+    }
+}
+
+fn rays_case(scene: &Scene, name: &str, cfg: DstConfig) {
     let b = build(&scene.triangles, &cfg);
     let s = b.dst.stats();
     assert_eq!(
@@ -55,7 +77,7 @@ fn scene_case(name: &str, cfg: DstConfig) {
         let p = (i as u64 * STRIDE as u64 % pixels as u64) as u32;
         let (x, y) = (p % SIDE, p / SIDE);
         {
-            let mut job = PixelJob::new(&scene, &settings, x, y);
+            let mut job = PixelJob::new(scene, &settings, x, y);
             while let Some(q) = job.next_ray() {
                 let bvh = b
                     .reference
