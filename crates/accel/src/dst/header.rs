@@ -155,6 +155,9 @@ impl HeaderOffset {
 
     /// A splitting node on `axis` whose left child (`left_size` = 1 or 3 words) is at word
     /// `left`; the right child is at `left + left_size`.
+    ///
+    /// # Panics
+    /// When `axis > 2` or `left_size` is not 1 or 3 (a converter bug, not bad input).
     pub fn split(axis: usize, left_size: u32, left: u64) -> Result<Self, DstError> {
         assert!(axis < 3 && (left_size == 1 || left_size == 3));
         Ok(Self(
@@ -163,6 +166,9 @@ impl HeaderOffset {
     }
 
     /// A single-axis carving node on `axis`; `leaf_flag` = the offset is an index run.
+    ///
+    /// # Panics
+    /// When `axis > 2` (a converter bug, not bad input).
     pub fn single_carve(axis: usize, leaf_flag: bool, offset: u64) -> Result<Self, DstError> {
         assert!(axis < 3);
         Ok(Self(
