@@ -29,8 +29,15 @@ fn input() -> &'static Input {
 
 /// The mesh: `dragon_box.ply.gz` unless `DST_BENCH_SCENE` names another shipped mesh (for
 /// quick callgrind runs on a small one).
+/// Under `cargo test --benches` (no `--bench` argument) the small `dragon_res4` is used.
 fn scene_name() -> String {
-    std::env::var("DST_BENCH_SCENE").unwrap_or_else(|_| "dragon_box.ply.gz".into())
+    std::env::var("DST_BENCH_SCENE").unwrap_or_else(|_| {
+        if !std::env::args().any(|a| a == "--bench") {
+            "dragon_res4.ply.gz".into()
+        } else {
+            "dragon_box.ply.gz".into()
+        }
+    })
 }
 
 fn main() {

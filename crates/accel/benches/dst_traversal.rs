@@ -28,7 +28,14 @@ const CASES: [&str; 6] = [
     "sponza_dabrovic/shadow",
     "sponza_dabrovic/diffuse",
 ];
-const SIDE: u32 = 128;
+/// Image side (16 under `cargo test --benches`, no `--bench` argument).
+fn side() -> u32 {
+    if !std::env::args().any(|a| a == "--bench") {
+        16
+    } else {
+        128
+    }
+}
 const MAX_RAYS: usize = 16_384;
 
 struct Prepared {
@@ -41,10 +48,11 @@ fn prepare(name: &str) -> Prepared {
     let tris = dst_common::load_shipped(&format!("{name}.ply.gz"));
     let scene = Scene::from_triangles(name, name, tris, LoadStats::default()).expect("scene");
     let b = dst_common::build(&scene.triangles, &DstConfig::hardware());
-    let settings = RenderSettings::new(SIDE, SIDE, Workload::Path);
+    let side = side();
+    let settings = RenderSettings::new(side, side, Workload::Path);
     let mut rays: [Vec<Ray>; 3] = Default::default();
-    for y in 0..SIDE {
-        for x in 0..SIDE {
+    for y in 0..side {
+        for x in 0..side {
             let mut job = PixelJob::new(&scene, &settings, x, y);
             while let Some(q) = job.next_ray() {
                 let hit = b
