@@ -106,7 +106,12 @@ fn prepare(name: &str) -> Prepared {
     }
 }
 
-fn data(case: &str) -> (&'static Prepared, &'static [Ray], bool) {
+/// The prepared scene, ray set and shadow flag of `case`; `None` when `DST_BENCH_CASE` names
+/// another case (to run one case under callgrind).
+fn data(case: &str) -> Option<(&'static Prepared, &'static [Ray], bool)> {
+    if std::env::var("DST_BENCH_CASE").is_ok_and(|c| c != case) {
+        return None;
+    }
     static DATA: OnceLock<Mutex<HashMap<&'static str, &'static Prepared>>> = OnceLock::new();
     let (scene, kind) = case.split_once('/').unwrap();
     let scene = SCENES.into_iter().find(|s| *s == scene).unwrap();
@@ -121,59 +126,84 @@ fn data(case: &str) -> (&'static Prepared, &'static [Ray], bool) {
         "shadow" => 1,
         _ => 2,
     };
-    (p, &p.rays[k], k == 1)
+    Some((p, &p.rays[k], k == 1))
 }
 
 fn main() {
     divan::main();
 }
 
+// The timed loops are `#[inline(never)]` so callgrind can attribute instructions to each
+// structure (`valgrind --tool=callgrind <bench binary> --bench --sample-count 1
+// --sample-size 1`, then `callgrind_annotate --inclusive=yes`).
+
+#[inline(never)]
+fn run_bvh2(p: &Prepared, rays: &[Ray], shadow: bool) -> u32 {
+    let mut n = 0u32;
+    for r in rays {
+        n += if shadow {
+            p.reference.any_hit(AccelKind::Bvh2, r, &mut NoObserver) as u32
+        } else {
+            p.reference
+                .closest_hit(AccelKind::Bvh2, r, &mut NoObserver)
+                .is_some() as u32
+        };
+    }
+    n
+}
+
+#[inline(never)]
+fn run_dst_software(p: &Prepared, rays: &[Ray], shadow: bool) -> u32 {
+    let mut n = 0u32;
+    for r in rays {
+        n += if shadow {
+            p.dst.any_hit(r, &mut NoObserver) as u32
+        } else {
+            p.dst.closest_hit(r, &mut NoObserver).is_some() as u32
+        };
+    }
+    n
+}
+
+#[inline(never)]
+fn run_dst_pipeline(p: &Prepared, rays: &[Ray], shadow: bool) -> u32 {
+    let mut n = 0u32;
+    for r in rays {
+        n += if shadow {
+            p.dst.any_hit_pipeline(r, &mut NoObserver) as u32
+        } else {
+            p.dst.closest_hit_pipeline(r, &mut NoObserver).is_some() as u32
+        };
+    }
+    n
+}
+
 #[divan::bench(args = CASES)]
 fn bvh2(bencher: Bencher, case: &str) {
-    let (p, rays, shadow) = data(case);
-    bencher.counter(ItemsCount::new(rays.len())).bench(|| {
-        let mut n = 0u32;
-        for r in rays {
-            n += if shadow {
-                p.reference.any_hit(AccelKind::Bvh2, r, &mut NoObserver) as u32
-            } else {
-                p.reference
-                    .closest_hit(AccelKind::Bvh2, r, &mut NoObserver)
-                    .is_some() as u32
-            };
-        }
-        n
-    });
+    let Some((p, rays, shadow)) = data(case) else {
+        return bencher.bench(|| 0);
+    };
+    bencher
+        .counter(ItemsCount::new(rays.len()))
+        .bench(|| run_bvh2(p, rays, shadow));
 }
 
 #[divan::bench(args = CASES)]
 fn dst_software(bencher: Bencher, case: &str) {
-    let (p, rays, shadow) = data(case);
-    bencher.counter(ItemsCount::new(rays.len())).bench(|| {
-        let mut n = 0u32;
-        for r in rays {
-            n += if shadow {
-                p.dst.any_hit(r, &mut NoObserver) as u32
-            } else {
-                p.dst.closest_hit(r, &mut NoObserver).is_some() as u32
-            };
-        }
-        n
-    });
+    let Some((p, rays, shadow)) = data(case) else {
+        return bencher.bench(|| 0);
+    };
+    bencher
+        .counter(ItemsCount::new(rays.len()))
+        .bench(|| run_dst_software(p, rays, shadow));
 }
 
 #[divan::bench(args = CASES)]
 fn dst_pipeline(bencher: Bencher, case: &str) {
-    let (p, rays, shadow) = data(case);
-    bencher.counter(ItemsCount::new(rays.len())).bench(|| {
-        let mut n = 0u32;
-        for r in rays {
-            n += if shadow {
-                p.dst.any_hit_pipeline(r, &mut NoObserver) as u32
-            } else {
-                p.dst.closest_hit_pipeline(r, &mut NoObserver).is_some() as u32
-            };
-        }
-        n
-    });
+    let Some((p, rays, shadow)) = data(case) else {
+        return bencher.bench(|| 0);
+    };
+    bencher
+        .counter(ItemsCount::new(rays.len()))
+        .bench(|| run_dst_pipeline(p, rays, shadow));
 }
