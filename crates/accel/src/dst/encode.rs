@@ -4,7 +4,7 @@
 //! (the last entry of a run has bit 31 set), then the triangles, 36 B each in id order.
 
 use super::from_bvh2::{CarveKind, Chain, plan_split};
-use super::header::HeaderOffset;
+use super::header::{HeaderOffset, OFFSET_LIMIT};
 use super::stats::{DstStats, bvh2_size_bytes};
 use super::{Dst, DstConfig, DstError};
 use crate::build::Bvh2;
@@ -13,6 +13,10 @@ use dualsplit_geometry::{Aabb, Triangle};
 
 /// Bit 31 of an index entry: the last triangle of a leaf's run.
 pub(super) const RUN_END: u32 = 1 << 31;
+
+/// Splitting nodes above this depth encode their two subtrees in parallel (rayon), giving
+/// up to 2^PARALLEL_DEPTH tasks.
+const PARALLEL_DEPTH: u32 = 4;
 
 struct Encoder<'a> {
     bvh: &'a Bvh2,
@@ -24,7 +28,7 @@ struct Encoder<'a> {
     visited: usize,
 }
 
-impl Encoder<'_> {
+impl<'a> Encoder<'a> {
     /// Bump-allocates `n` node words.
     fn reserve(&mut self, n: usize) -> usize {
         let at = self.words.len();
@@ -105,7 +109,7 @@ impl Encoder<'_> {
     }
 
     /// Emits BVH node `n` (entered with the carving `chain`) into the words reserved at `at`.
-    fn emit(&mut self, n: u32, chain: &Chain, mut at: usize) -> Result<(), DstError> {
+    fn emit(&mut self, n: u32, chain: &Chain, mut at: usize, depth: u32) -> Result<(), DstError> {
         self.check_node(n)?;
         let is_leaf = self.bvh.nodes[n as usize].is_leaf();
         let steps = chain.steps();
@@ -161,8 +165,93 @@ impl Encoder<'_> {
         );
         let h = HeaderOffset::split(plan.axis, sl as u32, p as u64)?;
         self.put(at, h, lb.max[plan.axis], rb.min[plan.axis]);
-        self.emit(plan.left, &plan.left_chain, p)?;
-        self.emit(plan.right, &plan.right_chain, p + sl)
+        if depth >= PARALLEL_DEPTH {
+            self.emit(plan.left, &plan.left_chain, p, depth + 1)?;
+            return self.emit(plan.right, &plan.right_chain, p + sl, depth + 1);
+        }
+        // Top levels: both subtrees are encoded in parallel into their own buffers, then
+        // appended in a fixed order (the result does not depend on thread timing).
+        let (l, r) = rayon::join(
+            || self.sub_encoder(plan.left, &plan.left_chain, sl, depth + 1),
+            || self.sub_encoder(plan.right, &plan.right_chain, sr, depth + 1),
+        );
+        self.append(l?, p)?;
+        self.append(r?, p + sl)
+    }
+
+    /// Encodes the subtree of BVH node `n` into a fresh encoder whose root is at local word 0.
+    fn sub_encoder(
+        &self,
+        n: u32,
+        chain: &Chain,
+        size: usize,
+        depth: u32,
+    ) -> Result<Encoder<'a>, DstError> {
+        let mut sub = Encoder {
+            bvh: self.bvh,
+            triangles: self.triangles,
+            cfg: self.cfg,
+            words: Vec::new(),
+            indices: Vec::new(),
+            stats: DstStats::default(),
+            visited: 0,
+        };
+        sub.reserve(size);
+        sub.emit(n, chain, 0, depth)?;
+        Ok(sub)
+    }
+
+    /// Appends a sub-encoder's output: its root node goes to the words reserved at `at`, the
+    /// rest after the current end; node offsets and index-run offsets are relocated.
+    fn append(&mut self, sub: Encoder<'a>, at: usize) -> Result<(), DstError> {
+        let root_size = if HeaderOffset::from_bits(sub.words[0]).is_plain_leaf() {
+            1
+        } else {
+            3
+        };
+        let base = self.words.len();
+        let index_base = self.indices.len() as u64;
+        let map = |local: u32| -> u64 {
+            if (local as usize) < root_size {
+                (at + local as usize) as u64
+            } else {
+                (base + local as usize - root_size) as u64
+            }
+        };
+        let mut words = sub.words;
+        let mut todo = vec![0u32];
+        while let Some(local) = todo.pop() {
+            let w = HeaderOffset::from_bits(words[local as usize]);
+            let off = w.offset();
+            let new = if w.is_leaf_flag() {
+                index_base + off as u64
+            } else {
+                todo.push(off);
+                if w.is_split() {
+                    todo.push(off + w.left_size());
+                }
+                map(off)
+            };
+            if new >= OFFSET_LIMIT {
+                return Err(DstError::OffsetOverflow {
+                    given: new,
+                    limit: OFFSET_LIMIT,
+                });
+            }
+            words[local as usize] = (w.bits() & !(OFFSET_LIMIT as u32 - 1)) | new as u32;
+        }
+        self.words[at..at + root_size].copy_from_slice(&words[..root_size]);
+        self.words.extend_from_slice(&words[root_size..]);
+        self.indices.extend_from_slice(&sub.indices);
+        self.visited += sub.visited;
+        let (a, b) = (&mut self.stats, sub.stats);
+        a.splitting += b.splitting;
+        a.single_carving += b.single_carving;
+        a.dual_carving += b.dual_carving;
+        a.leaves += b.leaves;
+        a.carving_leaves += b.carving_leaves;
+        a.index_entries += b.index_entries;
+        Ok(())
     }
 }
 
@@ -196,7 +285,7 @@ impl Dst {
         if !empty {
             let root_size = if bvh.nodes[0].is_leaf() { 1 } else { 3 };
             let at = enc.reserve(root_size);
-            enc.emit(0, &Chain::EMPTY, at)?;
+            enc.emit(0, &Chain::EMPTY, at, 0)?;
         }
         if enc.words.len() as u64 > super::OFFSET_LIMIT {
             return Err(DstError::OffsetOverflow {
