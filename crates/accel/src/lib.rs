@@ -73,15 +73,19 @@ impl AccelKind {
 }
 
 /// Errors while building the structures of a scene.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum AccelError {
     /// A memory image could not be encoded (an offset field overflowed).
     #[error(transparent)]
     Image(#[from] ImageError),
+    /// The dual-split tree could not be converted or encoded.
+    #[error(transparent)]
+    Dst(#[from] dst::DstError),
 }
 
 /// Every structure built from one scene's BVH2: the logical BVH2 and the encoded BVH2, BVH4
-/// (Dammertz collapse) and BVH8 (Ylitie collapse), all with identical leaves.
+/// (Dammertz collapse) and BVH8 (Ylitie collapse), all with identical leaves, and the
+/// dual-split tree converted from the same BVH2 with identical bounds (hardware preset).
 ///
 /// ```
 /// use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
@@ -104,6 +108,10 @@ pub struct Structures {
     pub bvh4: BvhImage,
     /// The encoded BVH8 (200-byte nodes); its `time` is the collapse time.
     pub bvh8: BvhImage,
+    /// The dual-split tree (identical bounds, [`dst::DstConfig::hardware`]).
+    pub dst: dst::Dst,
+    /// Wall time of the BVH2 → DST conversion, in milliseconds (a host measurement).
+    pub dst_convert_ms: f64,
 }
 
 impl Structures {
@@ -121,6 +129,15 @@ impl Structures {
 
     /// Builds every structure for `triangles`, or reports which image could not be encoded.
     pub fn try_build(triangles: &[Triangle], cfg: &BuildConfig) -> Result<Self, AccelError> {
+        Self::try_build_with(triangles, cfg, &dst::DstConfig::hardware())
+    }
+
+    /// Like [`Structures::try_build`] with an explicit DST configuration.
+    pub fn try_build_with(
+        triangles: &[Triangle],
+        cfg: &BuildConfig,
+        dst_cfg: &dst::DstConfig,
+    ) -> Result<Self, AccelError> {
         let t0 = Instant::now();
         let boxes: Vec<Aabb> = triangles.iter().map(|t| t.bounds()).collect();
         let bvh2 = Bvh2::build(&boxes, cfg);
@@ -135,12 +152,17 @@ impl Structures {
         let wide8 = WideBvh::collapse_bvh8(&bvh2, &CollapseConfig::default());
         let t8 = t0.elapsed();
         let bvh8 = BvhImage::encode(&wide8, &bvh2, triangles, cfg, t8)?;
+        let t0 = Instant::now();
+        let dst = dst::Dst::from_bvh2(&bvh2, triangles, dst_cfg)?;
+        let dst_convert_ms = t0.elapsed().as_secs_f64() * 1e3;
         let s = Self {
             triangles: triangles.to_vec(),
             bvh2,
             bvh2_image,
             bvh4,
             bvh8,
+            dst,
+            dst_convert_ms,
         };
         // Debug builds check every image (bounds containment is undefined for NaN input,
         // which scene loading drops anyway).
@@ -152,52 +174,70 @@ impl Structures {
         Ok(s)
     }
 
-    /// The encoded structure `kind` traverses.
-    pub fn encoded(&self, kind: AccelKind) -> &BvhImage {
+    /// The encoded BVH that `kind` traverses, or `None` for the two DST kinds.
+    pub fn encoded(&self, kind: AccelKind) -> Option<&BvhImage> {
         match kind {
-            AccelKind::Bvh2 => &self.bvh2_image,
-            AccelKind::Bvh4 => &self.bvh4,
-            AccelKind::Bvh8 => &self.bvh8,
-            // INTEGRATION: DST — the DST image replaces this once the converter lands.
-            AccelKind::DstSw | AccelKind::Dst => &self.bvh2_image,
+            AccelKind::Bvh2 => Some(&self.bvh2_image),
+            AccelKind::Bvh4 => Some(&self.bvh4),
+            AccelKind::Bvh8 => Some(&self.bvh8),
+            AccelKind::DstSw | AccelKind::Dst => None,
         }
     }
 
-    /// The memory image `kind` reads (what the simulator replays fetches against).
+    /// The memory image `kind` reads (what the simulator replays fetches against). Both DST
+    /// kinds read the same DST image.
     pub fn image(&self, kind: AccelKind) -> &MemoryImage {
-        &self.encoded(kind).image
+        match self.encoded(kind) {
+            Some(b) => &b.image,
+            None => self.dst.image(),
+        }
     }
 
-    /// Closest hit of `ray` on structure `kind`.
+    /// Closest hit of `ray` on structure `kind`: the BVH traversals, the DST software
+    /// decoder (DST*) or the traversal loop driven by the hardware pipeline's step function.
     #[inline]
     pub fn closest_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        // INTEGRATION: DST — DstSw and Dst dispatch to the BVH2 until the DST lands.
-        self.encoded(kind).closest_hit(ray, obs)
+        match kind {
+            AccelKind::Bvh2 => self.bvh2_image.closest_hit(ray, obs),
+            AccelKind::Bvh4 => self.bvh4.closest_hit(ray, obs),
+            AccelKind::Bvh8 => self.bvh8.closest_hit(ray, obs),
+            AccelKind::DstSw => self.dst.closest_hit(ray, obs),
+            AccelKind::Dst => self.dst.closest_hit_pipeline(ray, obs),
+        }
     }
 
     /// True when `ray` hits any triangle within `[t_min, t_max]`.
     #[inline]
     pub fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool {
-        // INTEGRATION: DST — DstSw and Dst dispatch to the BVH2 until the DST lands.
-        self.encoded(kind).any_hit(ray, obs)
+        match kind {
+            AccelKind::Bvh2 => self.bvh2_image.any_hit(ray, obs),
+            AccelKind::Bvh4 => self.bvh4.any_hit(ray, obs),
+            AccelKind::Bvh8 => self.bvh8.any_hit(ray, obs),
+            AccelKind::DstSw => self.dst.any_hit(ray, obs),
+            AccelKind::Dst => self.dst.any_hit_pipeline(ray, obs),
+        }
     }
 
-    /// Validates the three BVH images (BVH2, BVH4, BVH8).
+    /// Validates the three BVH images (BVH2, BVH4, BVH8) and the DST (which must rebuild
+    /// every BVH2 box exactly from its planes).
     pub fn validate(&self) -> Vec<ValidationReport> {
         vec![
             self.bvh2_image.validate(),
             self.bvh4.validate(),
             self.bvh8.validate(),
+            ValidationReport::of_dst(&self.dst, &self.bvh2),
         ]
     }
 
-    /// Size and build statistics of BVH2, BVH4 and BVH8 (the paper's Table 3).
+    /// Size and build statistics of BVH2, BVH4, BVH8 and the DST (the paper's Table 3),
+    /// percentages relative to the BVH2 image.
     pub fn stats(&self) -> Vec<StructureStats> {
         let base = self.bvh2_image.bytes_total();
         vec![
             StructureStats::of("bvh2", &self.bvh2_image, base),
             StructureStats::of("bvh4", &self.bvh4, base),
             StructureStats::of("bvh8", &self.bvh8, base),
+            StructureStats::of_dst(&self.dst.stats(), self.dst_convert_ms, base),
         ]
     }
 }

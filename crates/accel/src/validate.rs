@@ -31,6 +31,31 @@ pub struct ValidationReport {
 }
 
 impl ValidationReport {
+    /// The report of [`crate::dst::Dst::validate`] in this shape: the DST must rebuild every
+    /// box of `bvh` exactly from its planes and reference every triangle once.
+    pub fn of_dst(dst: &crate::dst::Dst, bvh: &crate::Bvh2) -> Self {
+        let mut rep = ValidationReport {
+            structure: "dst",
+            internal_nodes: 0,
+            leaves: 0,
+            triangles_referenced: 0,
+            triangles: dst.triangles().len(),
+            max_depth: 0,
+            error_count: 0,
+            errors: Vec::new(),
+        };
+        match dst.validate(bvh) {
+            Ok(v) => {
+                rep.internal_nodes = v.internal_nodes as usize;
+                rep.leaves = v.leaves as usize;
+                rep.triangles_referenced = v.index_entries as usize;
+                rep.max_depth = v.max_depth as usize;
+            }
+            Err(e) => rep.error(e.to_string()),
+        }
+        rep
+    }
+
     /// True when no violation was found.
     pub fn is_ok(&self) -> bool {
         self.error_count == 0

@@ -91,8 +91,8 @@ fn fetches_stay_inside_regions_and_match_node_sizes() {
     let s = Structures::build(&tris, &BuildConfig::default());
     for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
         let img = s.image(kind);
-        let node_bytes =
-            s.encoded(kind).arity as u32 * 24 + if kind == AccelKind::Bvh8 { 8 } else { 4 };
+        let node_bytes = s.encoded(kind).expect("a BVH kind").arity as u32 * 24
+            + if kind == AccelKind::Bvh8 { 8 } else { 4 };
         for i in 0..200 {
             let o = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 20.0;
             let d = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5;

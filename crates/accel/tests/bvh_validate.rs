@@ -29,7 +29,7 @@ fn clean_images_validate() {
 fn corruptions_are_reported() {
     let s = scene();
     for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
-        let enc = s.encoded(kind);
+        let enc = s.encoded(kind).expect("a BVH kind");
         // A shrunken child box (slot 0 of the root's child 0 node lies outside its parent box
         // once the root's slot-0 max.x is lowered below its min.x + tiny).
         let mut bad = enc.clone();

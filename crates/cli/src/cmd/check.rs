@@ -1,12 +1,13 @@
 //! `dualsplit check`: validate every structure of a scene and check that every structure
 //! answers every ray exactly like the BVH2 (closest `t` bits and triangle id; any-hit
 //! answer), for primary, shadow and diffuse-bounce rays recorded from path-traced pixel
-//! jobs on the scene's default camera. Exits nonzero on any failure.
+//! jobs on the scene's default camera. BVH2, BVH4, BVH8, the DST software decoder (dst-sw)
+//! and the DST pipeline loop (dst) are all compared. Validation includes the DST rebuilding
+//! every BVH2 box from its planes. Exits nonzero on any failure.
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::{AccelKind, BuildConfig, CountingObserver, NoObserver, Structures};
-use dualsplit_geometry::Ray;
-use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
+use dualsplit_render::RayKind;
 use rayon::prelude::*;
 use std::process::ExitCode;
 
@@ -28,7 +29,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let sp = ctx.spinner(format!("loading {}", args.scene));
     let scene = dualsplit_scene::load(&args.scene)
         .with_context(|| format!("loading scene {}", args.scene))?;
-    sp.set_message("building BVH2, BVH4, BVH8");
+    sp.set_message("building BVH2, BVH4, BVH8, DST");
     let s = Structures::try_build(&scene.triangles, &BuildConfig::default())
         .with_context(|| format!("building the structures of {}", args.scene))?;
     sp.finish_and_clear();
@@ -53,11 +54,20 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         failed |= !rep.is_ok();
     }
 
-    let sets = record(&scene, &s, args.rays, ctx);
+    let sets = super::rays::record(&scene, &s, args.rays, ctx);
     println!("equivalence against BVH2 (per-ray averages from CountingObserver):");
     println!(
-        "  {:<8} {:<8} {:>8} {:>10} {:>8} {:>8} {:>10} {:>10} {:>10}",
-        "kind", "rays", "count", "mismatch", "nodes", "leaves", "boxes", "triangles", "bytes"
+        "  {:<8} {:<8} {:>8} {:>10} {:>8} {:>8} {:>10} {:>10} {:>10} {:>10}",
+        "kind",
+        "rays",
+        "count",
+        "mismatch",
+        "nodes",
+        "leaves",
+        "boxes",
+        "planes",
+        "triangles",
+        "bytes"
     );
     for (what, rays) in [
         (RayKind::Primary, &sets.0),
@@ -101,7 +111,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             bar.finish_and_clear();
             let n = rays.len().max(1) as f64;
             println!(
-                "  {:<8} {:<8} {:>8} {:>10} {:>8.2} {:>8.2} {:>10.2} {:>10.2} {:>10.1}",
+                "  {:<8} {:<8} {:>8} {:>10} {:>8.2} {:>8.2} {:>10.2} {:>10.2} {:>10.2} {:>10.1}",
                 kind.name(),
                 format!("{what:?}").to_lowercase(),
                 rays.len(),
@@ -109,6 +119,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                 counts.nodes as f64 / n,
                 counts.leaves as f64 / n,
                 counts.box_tests as f64 / n,
+                counts.plane_tests as f64 / n,
                 counts.triangle_tests as f64 / n,
                 counts.bytes as f64 / n
             );
@@ -118,8 +129,6 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             failed |= !bad.is_empty();
         }
     }
-    // INTEGRATION: DST — drop this note once `Structures` dispatches the DST kinds.
-    println!("note: dst-sw and dst traverse the BVH2 until the DST is integrated");
     if failed {
         println!("check FAILED");
         Ok(ExitCode::FAILURE)
@@ -127,58 +136,4 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         println!("check passed");
         Ok(ExitCode::SUCCESS)
     }
-}
-
-/// Records `n` rays of each kind (primary, shadow, diffuse) from path-traced pixel jobs
-/// (5 bounces), driven by the BVH2's answers; more passes with new seeds until each kind has
-/// `n` rays (at most 64 passes: a scene the camera barely sees yields fewer).
-fn record(
-    scene: &dualsplit_scene::Scene,
-    s: &Structures,
-    n: usize,
-    ctx: &Ctx,
-) -> (Vec<Ray>, Vec<Ray>, Vec<Ray>) {
-    let side = (n as f64).sqrt().ceil().max(1.0) as u32;
-    let (mut p, mut sh, mut d) = (Vec::new(), Vec::new(), Vec::new());
-    let sp = ctx.spinner("recording rays");
-    for pass in 0..64u32 {
-        if p.len() >= n && sh.len() >= n && d.len() >= n {
-            break;
-        }
-        let mut settings = RenderSettings::new(side, side, Workload::Path);
-        settings.seed = pass;
-        let per_pixel: Vec<Vec<(RayKind, Ray)>> = (0..side * side)
-            .into_par_iter()
-            .map(|i| {
-                let mut job = PixelJob::new(scene, &settings, i % side, i / side);
-                let mut out = Vec::new();
-                while let Some(q) = job.next_ray() {
-                    out.push((q.kind, q.ray));
-                    let r = if q.kind == RayKind::Shadow {
-                        TraceResult::Occluded(s.any_hit(AccelKind::Bvh2, &q.ray, &mut NoObserver))
-                    } else {
-                        TraceResult::Closest(s.closest_hit(
-                            AccelKind::Bvh2,
-                            &q.ray,
-                            &mut NoObserver,
-                        ))
-                    };
-                    job.submit(r);
-                }
-                out
-            })
-            .collect();
-        for (k, r) in per_pixel.into_iter().flatten() {
-            match k {
-                RayKind::Primary => p.push(r),
-                RayKind::Shadow => sh.push(r),
-                RayKind::Diffuse => d.push(r),
-            }
-        }
-    }
-    sp.finish_and_clear();
-    p.truncate(n);
-    sh.truncate(n);
-    d.truncate(n);
-    (p, sh, d)
 }

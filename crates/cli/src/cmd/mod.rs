@@ -2,6 +2,7 @@
 pub mod bench;
 pub mod check;
 pub mod info;
+pub mod rays;
 pub mod render;
 pub mod report;
 pub mod simulate;
