@@ -37,8 +37,7 @@ pub fn split(
         + counts.dst_ops as f64 * e.dst_pipe_nj)
         * nj;
     let d = &cfg.dram;
-    let dram_j = (dram.reads as f64 * d.e_read_nj + dram.activations as f64 * d.e_activate_nj)
-        * nj
+    let dram_j = (dram.reads as f64 * d.e_read_nj + dram.activations as f64 * d.e_activate_nj) * nj
         + d.background_w * frame_ms * 1e-3;
     EnergySplit {
         dram_j,

@@ -348,7 +348,10 @@ mod tests {
         assert_eq!(
             ops,
             vec![
-                Op::Load { addr: 52, words: 13 },
+                Op::Load {
+                    addr: 52,
+                    words: 13
+                },
                 Op::Load { addr: 4, words: 2 }
             ]
         );

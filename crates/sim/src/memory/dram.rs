@@ -134,9 +134,7 @@ impl Dram {
             open => {
                 let mut act = a;
                 let kind = if open.is_some() {
-                    let pre = a
-                        .max(bank.act + c.t_ras)
-                        .max(bank.last_col + c.t_rtp);
+                    let pre = a.max(bank.act + c.t_ras).max(bank.last_col + c.t_rtp);
                     act = pre + c.t_rp;
                     DramAccess::Conflict
                 } else {
@@ -242,8 +240,14 @@ mod tests {
         let bytes_per_cycle = (n * 64) as f64 / last as f64;
         let peak = cfg.dram_peak_bytes_per_cycle();
         assert_eq!(peak, 512.0);
-        assert!(bytes_per_cycle <= peak, "{bytes_per_cycle} above peak {peak}");
-        assert!(bytes_per_cycle > 0.97 * peak, "{bytes_per_cycle} well below peak");
+        assert!(
+            bytes_per_cycle <= peak,
+            "{bytes_per_cycle} above peak {peak}"
+        );
+        assert!(
+            bytes_per_cycle > 0.97 * peak,
+            "{bytes_per_cycle} well below peak"
+        );
     }
 
     #[test]
