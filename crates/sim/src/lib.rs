@@ -175,6 +175,8 @@ pub struct SimResult {
     pub accel: Option<SimAccel>,
     /// Thread multiprocessors simulated.
     pub tms: u32,
+    /// Hardware threads (TMs × TPs per TM).
+    pub threads: u32,
     /// Simulated cycles.
     pub cycles: u64,
     /// Frame time in milliseconds at the configured clock.

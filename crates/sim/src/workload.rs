@@ -127,6 +127,7 @@ pub(crate) fn run(
     SimResult {
         accel: Some(accel),
         tms: cfg.tms,
+        threads: cfg.tms * cfg.tps_per_tm,
         cycles,
         frame_ms,
         energy: energy::split(cfg, &counts, &chip.caches, &dram, frame_ms),
