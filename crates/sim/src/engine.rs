@@ -317,10 +317,11 @@ impl Thread {
                 };
                 let mut c = self.t;
                 let mut last = c;
-                if parallel && pipes.len() >= n as usize {
+                if parallel && pipes.len() >= n as usize && pipes.len() <= 8 {
                     // All n ops start together on the n least-busy pipes, one issue slot.
-                    let mut idx: Vec<usize> = (0..pipes.len()).collect();
-                    idx.sort_by_key(|&i| (pipes[i], i));
+                    let mut idx = [0usize, 1, 2, 3, 4, 5, 6, 7];
+                    let idx = &mut idx[..pipes.len()];
+                    idx.sort_unstable_by_key(|&i| (pipes[i], i));
                     let s = idx[..n as usize]
                         .iter()
                         .map(|&i| pipes[i])
