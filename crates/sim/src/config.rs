@@ -36,7 +36,8 @@ pub struct CacheConfig {
     pub size_bytes: u64,
     /// Line size in bytes (L1 and L2 must match).
     pub line_bytes: u64,
-    /// Word-interleaved banks (bank = word address mod banks), one access per bank per cycle.
+    /// Word-interleaved banks (bank = word address mod banks), one access per bank per cycle;
+    /// a power of two.
     pub banks: u32,
     /// Ways per set (1 = direct-mapped, as in SimTRaX).
     pub associativity: u32,
@@ -296,7 +297,10 @@ impl SimConfig {
             });
         }
         for (f, c) in [("l1", &self.l1), ("l2", &self.l2)] {
-            pos(f, c.banks as u64)?;
+            pow2(
+                if f == "l1" { "l1.banks" } else { "l2.banks" },
+                c.banks as u64,
+            )?;
             pos(f, c.associativity as u64)?;
             let sets = c.size_bytes / c.line_bytes / c.associativity as u64;
             pow2(if f == "l1" { "l1 sets" } else { "l2 sets" }, sets)?;

@@ -1,10 +1,11 @@
 //! The timing engine: TMs of in-order single-issue threads replaying macro-ops against
 //! reservation tables (next-free cycle per L1 bank, L2 bank, pipeline, shared unit, DRAM
-//! bank and bus), driven by a min-heap of thread wake-up times (notes §5.2).
+//! bank and bus), driven by a timing wheel of thread wake-up times (notes §5.2).
 //!
 //! A thread runs while its next operation can start at the current event time; when it must
 //! wait (for data, a busy unit, or because its issue slots run ahead), it goes back into the
-//! heap at the cycle it can continue. Ties are broken by thread id, so runs are
+//! wheel at the cycle it can continue. Threads waking in the same cycle run in the order they
+//! were scheduled, so runs are
 //! deterministic. Operations reserve resources at their own start cycle; because events are
 //! processed in time order, reservations are made in (nearly) causal order.
 
@@ -79,6 +80,10 @@ struct Tm {
 /// The chip's shared state: TMs, L2, DRAM, and the global atomic unit.
 pub struct Chip {
     cfg: SimConfig,
+    /// `l1.banks - 1`, `l2.banks - 1` (power-of-two bank counts) and log2(words per line).
+    l1_bank_mask: u64,
+    l2_bank_mask: u64,
+    line_word_shift: u32,
     tms: Vec<Tm>,
     l2: Cache,
     l2_bank_free: Vec<Cycle>,
@@ -116,6 +121,9 @@ impl Chip {
         };
         Self {
             cfg: cfg.clone(),
+            l1_bank_mask: cfg.l1.banks as u64 - 1,
+            l2_bank_mask: cfg.l2.banks as u64 - 1,
+            line_word_shift: (cfg.l1.line_bytes / 4).trailing_zeros(),
             tms: (0..cfg.tms).map(|_| tm()).collect(),
             l2: Cache::new(cfg.l2.size_bytes, cfg.l2.line_bytes, cfg.l2.associativity),
             l2_bank_free: vec![0; cfg.l2.banks as usize],
@@ -130,20 +138,25 @@ impl Chip {
     /// One word load by TM `tm` whose L1 bank slot is `slot` (already reserved): returns the
     /// cycle the data is in the register.
     fn load_word(&mut self, tm: usize, word: u64, slot: Cycle) -> Cycle {
-        let line = word * 4 / self.cfg.l1.line_bytes;
+        self.load_word_fill(tm, word, slot).0
+    }
+
+    /// As [`Chip::load_word`], also returning the fill cycle now in the line's L1 tag.
+    fn load_word_fill(&mut self, tm: usize, word: u64, slot: Cycle) -> (Cycle, Cycle) {
+        let line = word >> self.line_word_shift;
         let l1_lat = self.cfg.l1.hit_latency;
         self.caches.l1_accesses += 1;
         match self.tms[tm].l1.lookup(line) {
             Lookup::Present { fill } if fill <= slot => {
                 self.caches.l1_hits += 1;
-                slot + l1_lat
+                (slot + l1_lat, fill)
             }
             Lookup::Present { fill } => {
                 self.caches.l1_merged += 1;
-                fill.max(slot + l1_lat)
+                (fill.max(slot + l1_lat), fill)
             }
             Lookup::Absent => {
-                let b = (word % self.cfg.l2.banks as u64) as usize;
+                let b = (word & self.l2_bank_mask) as usize;
                 let s2 = slot.max(self.l2_bank_free[b]);
                 self.caches.l2_bank_wait += s2 - slot;
                 self.l2_bank_free[b] = s2 + 1;
@@ -165,7 +178,7 @@ impl Chip {
                     }
                 };
                 self.tms[tm].l1.install(line, ready);
-                ready
+                (ready, ready)
             }
         }
     }
@@ -287,14 +300,32 @@ impl Thread {
             }
             Op::Load { addr, words } => {
                 let mut c = self.t;
-                let banks = chip.cfg.l1.banks as u64;
+                let bank_mask = chip.l1_bank_mask;
                 let first = addr / 4;
+                let shift = chip.line_word_shift;
+                let l1_lat = chip.cfg.l1.hit_latency;
+                // The line of the previous word and the cycle its data is there: a later
+                // word of the same line sees exactly what a second tag lookup would.
+                let mut prev: Option<(u64, Cycle)> = None;
                 for w in first..first + words as u64 {
-                    let b = (w % banks) as usize;
+                    let b = (w & bank_mask) as usize;
                     let slot = c.max(chip.tms[tm].l1_bank_free[b]);
                     chip.stalls.l1_bank += slot - c;
                     chip.tms[tm].l1_bank_free[b] = slot + 1;
-                    let r = chip.load_word(tm, w, slot);
+                    let line = w >> shift;
+                    let (r, fill) = match prev {
+                        Some((l, fill)) if l == line => {
+                            chip.caches.l1_accesses += 1;
+                            if fill <= slot {
+                                chip.caches.l1_hits += 1;
+                            } else {
+                                chip.caches.l1_merged += 1;
+                            }
+                            (fill.max(slot + l1_lat), fill)
+                        }
+                        _ => chip.load_word_fill(tm, w, slot),
+                    };
+                    prev = Some((line, fill));
                     self.result(r, Cause::Memory);
                     c = slot + 1;
                 }
@@ -369,33 +400,99 @@ pub trait WorkSource {
     fn next(&mut self, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>>;
 }
 
-/// Runs every thread to completion; returns the cycle the last result arrived.
-pub fn run_chip(chip: &mut Chip, threads: &mut [Thread], work: &mut dyn WorkSource) -> Cycle {
-    let mut heap: BinaryHeap<Reverse<(Cycle, u32)>> =
-        (0..threads.len() as u32).map(|i| Reverse((0, i))).collect();
-    let mut finish = vec![0; threads.len()];
-    while let Some(Reverse((now, id))) = heap.pop() {
-        let th = &mut threads[id as usize];
+/// A timing wheel of thread wake-ups (notes §5.2): one bucket per cycle for the next
+/// `WHEEL` cycles, an overflow heap beyond. Within a cycle, threads run in the order they
+/// were scheduled (deterministic).
+struct Wheel {
+    buckets: Vec<Vec<u32>>,
+    now: Cycle,
+    in_wheel: usize,
+    overflow: BinaryHeap<Reverse<(Cycle, u32)>>,
+}
+
+const WHEEL: u64 = 4096;
+
+impl Wheel {
+    fn new() -> Self {
+        Self {
+            buckets: vec![Vec::new(); WHEEL as usize],
+            now: 0,
+            in_wheel: 0,
+            overflow: BinaryHeap::new(),
+        }
+    }
+
+    fn push(&mut self, t: Cycle, id: u32) {
+        debug_assert!(t >= self.now);
+        if t - self.now < WHEEL {
+            self.buckets[(t % WHEEL) as usize].push(id);
+            self.in_wheel += 1;
+        } else {
+            self.overflow.push(Reverse((t, id)));
+        }
+    }
+
+    /// Takes the bucket of the next cycle with events: (cycle, thread ids in order).
+    fn next_bucket(&mut self, spare: Vec<u32>) -> Option<(Cycle, Vec<u32>)> {
+        if self.in_wheel == 0 {
+            let &Reverse((t, _)) = self.overflow.peek()?;
+            self.now = t;
+        }
         loop {
-            if th.run(chip, now) {
-                heap.push(Reverse((th.t, id)));
-                break;
-            }
-            // Program finished: the thread takes more work or retires once results are in.
-            match work.next(th, chip) {
-                Some(ops) => {
-                    th.load_program(ops);
-                    if th.t > now {
-                        heap.push(Reverse((th.t, id)));
-                        break;
-                    }
-                }
-                None => {
-                    finish[id as usize] = th.results_ready();
+            while let Some(&Reverse((t, id))) = self.overflow.peek() {
+                if t - self.now < WHEEL {
+                    self.overflow.pop();
+                    self.buckets[(t % WHEEL) as usize].push(id);
+                    self.in_wheel += 1;
+                } else {
                     break;
                 }
             }
+            let b = (self.now % WHEEL) as usize;
+            if !self.buckets[b].is_empty() {
+                let ids = std::mem::replace(&mut self.buckets[b], spare);
+                self.in_wheel -= ids.len();
+                return Some((self.now, ids));
+            }
+            self.now += 1;
         }
+    }
+}
+
+/// Runs every thread to completion; returns the cycle the last result arrived.
+pub fn run_chip(chip: &mut Chip, threads: &mut [Thread], work: &mut dyn WorkSource) -> Cycle {
+    let mut wheel = Wheel::new();
+    for i in 0..threads.len() as u32 {
+        wheel.push(0, i);
+    }
+    let mut finish = vec![0; threads.len()];
+    let mut spare = Vec::new();
+    while let Some((now, mut ids)) = wheel.next_bucket(spare) {
+        for &id in &ids {
+            let th = &mut threads[id as usize];
+            loop {
+                if th.run(chip, now) {
+                    wheel.push(th.t, id);
+                    break;
+                }
+                // Program finished: the thread takes more work or retires once results are in.
+                match work.next(th, chip) {
+                    Some(ops) => {
+                        th.load_program(ops);
+                        if th.t > now {
+                            wheel.push(th.t, id);
+                            break;
+                        }
+                    }
+                    None => {
+                        finish[id as usize] = th.results_ready();
+                        break;
+                    }
+                }
+            }
+        }
+        ids.clear();
+        spare = ids;
     }
     let end = finish.iter().copied().max().unwrap_or(0);
     chip.stalls.idle = finish.iter().map(|&f| end - f).sum();
