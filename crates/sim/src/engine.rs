@@ -137,6 +137,7 @@ impl Chip {
 
     /// One word load by TM `tm` whose L1 bank slot is `slot` (already reserved): returns the
     /// cycle the data is in the register.
+    #[cfg(test)]
     fn load_word(&mut self, tm: usize, word: u64, slot: Cycle) -> Cycle {
         self.load_word_fill(tm, word, slot).0
     }

@@ -78,7 +78,7 @@ impl WorkSource for Pixels<'_> {
         let mut ops = self.spare.pop().unwrap_or_default();
         ops.clear();
         self.trace_pixel(px, &mut ops);
-        if self.next % 1024 == 0 || self.next == self.total {
+        if self.next.is_multiple_of(1024) || self.next == self.total {
             (self.progress)(self.next, self.total);
         }
         Some(ops)
