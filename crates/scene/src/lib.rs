@@ -13,16 +13,21 @@
 //!
 //! One rule everywhere: triangles with a non-finite coordinate (NaN or ±∞) are **dropped**
 //! at load time and counted in [`LoadStats::non_finite`]; zero-area triangles are **kept**
-//! (they are real input, never hit by the watertight test, and they keep triangle ids equal
-//! to face indices of the file) and counted in [`LoadStats::degenerate`]. A scene with no
-//! triangle left is an error ([`SceneError::Empty`]).
+//! (they are real input and never hit by the watertight test) and counted in
+//! [`LoadStats::degenerate`]. A scene with no triangle left is an error ([`SceneError::Empty`]).
+//!
+//! Triangle ids follow the file: the loaders emit triangles in face order of the file, each
+//! polygon fan-triangulated in place (see [`load`](mod@load)), and dropping keeps that order.
+//! So a triangle's id is its face index in the file after triangulation, minus the number of
+//! non-finite triangles before it: ids equal file face indices whenever
+//! [`LoadStats::non_finite`] is zero.
 
 pub mod builtin;
 mod camera;
 mod error;
 pub mod load;
 
-pub use camera::{Camera, Light};
+pub use camera::{Camera, CameraError, Light, parse_vec3};
 pub use error::SceneError;
 
 use dualsplit_geometry::{Aabb, Triangle};
@@ -38,6 +43,9 @@ pub struct LoadStats {
     pub non_finite: u64,
     /// Polygons with more than three vertices that were fan-triangulated.
     pub polygons_triangulated: u64,
+    /// glTF primitives skipped because their mode is not `TRIANGLES` (points, lines, strips,
+    /// fans).
+    pub primitives_skipped: u64,
 }
 
 /// A loaded scene: the triangle soup, its bounds, and a default camera and light.
@@ -70,16 +78,27 @@ impl Scene {
     ) -> Result<Self, SceneError> {
         let spec = spec.into();
         stats.source_triangles = stats.source_triangles.max(triangles.len() as u64);
+        // Parallel passes (millions of triangles for the big scenes); order is kept and the
+        // bounds are exact min/max, so the result does not depend on the thread count.
+        use rayon::prelude::*;
         let before = triangles.len();
-        let triangles: Vec<Triangle> = triangles.into_iter().filter(|t| t.is_finite()).collect();
+        let triangles: Vec<Triangle> = if triangles.par_iter().all(|t| t.is_finite()) {
+            triangles
+        } else {
+            triangles
+                .into_par_iter()
+                .filter(|t| t.is_finite())
+                .collect()
+        };
         stats.non_finite += (before - triangles.len()) as u64;
-        stats.degenerate = triangles.iter().filter(|t| t.is_degenerate()).count() as u64;
+        stats.degenerate = triangles.par_iter().filter(|t| t.is_degenerate()).count() as u64;
         if triangles.is_empty() {
             return Err(SceneError::Empty { spec });
         }
         let bounds = triangles
-            .iter()
-            .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+            .par_iter()
+            .map(|t| t.bounds())
+            .reduce(|| Aabb::EMPTY, Aabb::union);
         let camera = Camera::fit(&bounds);
         let light = Light::fit(&bounds);
         Ok(Self {
@@ -114,6 +133,23 @@ pub fn load(spec: &str) -> Result<Scene, SceneError> {
     if let Some(rest) = spec.strip_prefix("builtin:") {
         builtin::generate(rest)
     } else {
-        load::load_file(std::path::Path::new(spec))
+        let path = std::path::Path::new(spec);
+        let mut scene = load::load_file(path)?;
+        let stem = file_stem(path);
+        scene.camera = Camera::preset_for(stem, &scene.bounds);
+        scene.light = Light::preset_for(stem, &scene.bounds);
+        Ok(scene)
     }
+}
+
+/// The file name without its scene extensions (`.ply`, `.obj`, `.gz`, ...): the key of the
+/// camera and light presets (`dragon_box.ply.gz` → `dragon_box`).
+pub fn file_stem(path: &std::path::Path) -> &str {
+    let mut name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    for ext in [".gz", ".obj", ".ply", ".gltf", ".glb"] {
+        if let Some(s) = name.strip_suffix(ext) {
+            name = s;
+        }
+    }
+    name
 }
