@@ -13,6 +13,7 @@ use crate::Cycle;
 use crate::config::SimConfig;
 use crate::kernel::{Op, Pipe};
 use crate::memory::{Cache, Dram, Lookup};
+use crate::slots::Slots;
 use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -70,11 +71,11 @@ pub struct UnitStats {
 
 struct Tm {
     l1: Cache,
-    l1_bank_free: Vec<Cycle>,
-    box_pipes: Vec<Cycle>,
-    tri_pipes: Vec<Cycle>,
-    dst_pipes: Vec<Cycle>,
-    fpinv: Vec<Cycle>,
+    l1_banks: Vec<Slots>,
+    box_pipes: Vec<Slots>,
+    tri_pipes: Vec<Slots>,
+    dst_pipes: Vec<Slots>,
+    fpinv: Vec<Slots>,
 }
 
 /// The chip's shared state: TMs, L2, DRAM, and the global atomic unit.
@@ -86,7 +87,7 @@ pub struct Chip {
     line_word_shift: u32,
     tms: Vec<Tm>,
     l2: Cache,
-    l2_bank_free: Vec<Cycle>,
+    l2_banks: Vec<Slots>,
     /// The DRAM.
     pub dram: Dram,
     atomic_free: Cycle,
@@ -113,11 +114,11 @@ impl Chip {
     pub fn new(cfg: &SimConfig, box_pipes: u32) -> Self {
         let tm = || Tm {
             l1: Cache::new(cfg.l1.size_bytes, cfg.l1.line_bytes, cfg.l1.associativity),
-            l1_bank_free: vec![0; cfg.l1.banks as usize],
-            box_pipes: vec![0; box_pipes.max(1) as usize],
-            tri_pipes: vec![0; cfg.units.tri_pipes as usize],
-            dst_pipes: vec![0; cfg.units.dst_pipes as usize],
-            fpinv: vec![0; cfg.units.fpinv_units as usize],
+            l1_banks: vec![Slots::default(); cfg.l1.banks as usize],
+            box_pipes: vec![Slots::default(); box_pipes.max(1) as usize],
+            tri_pipes: vec![Slots::default(); cfg.units.tri_pipes as usize],
+            dst_pipes: vec![Slots::default(); cfg.units.dst_pipes as usize],
+            fpinv: vec![Slots::default(); cfg.units.fpinv_units as usize],
         };
         Self {
             cfg: cfg.clone(),
@@ -126,7 +127,7 @@ impl Chip {
             line_word_shift: (cfg.l1.line_bytes / 4).trailing_zeros(),
             tms: (0..cfg.tms).map(|_| tm()).collect(),
             l2: Cache::new(cfg.l2.size_bytes, cfg.l2.line_bytes, cfg.l2.associativity),
-            l2_bank_free: vec![0; cfg.l2.banks as usize],
+            l2_banks: vec![Slots::default(); cfg.l2.banks as usize],
             dram: Dram::new(&cfg.dram),
             atomic_free: 0,
             caches: CacheStats::default(),
@@ -158,9 +159,8 @@ impl Chip {
             }
             Lookup::Absent => {
                 let b = (word & self.l2_bank_mask) as usize;
-                let s2 = slot.max(self.l2_bank_free[b]);
+                let s2 = self.l2_banks[b].reserve(slot);
                 self.caches.l2_bank_wait += s2 - slot;
-                self.l2_bank_free[b] = s2 + 1;
                 self.caches.l2_accesses += 1;
                 let at = s2 + l1_lat + self.cfg.l2.hit_latency;
                 let ready = match self.l2.lookup(line) {
@@ -287,11 +287,8 @@ impl Thread {
             Op::Issue { n, fpinv } => {
                 let mut c = self.t;
                 for _ in 0..fpinv {
-                    let units = &mut chip.tms[tm].fpinv;
-                    let (i, free) = min_free(units);
-                    let s = c.max(free);
+                    let s = earliest(&mut chip.tms[tm].fpinv, c);
                     chip.stalls.fpinv += s - c;
-                    units[i] = s + 1;
                     chip.units.fpinv_ops += 1;
                     let lat = chip.cfg.units.fpinv_latency;
                     self.result(s + lat, Cause::Fpinv);
@@ -310,9 +307,8 @@ impl Thread {
                 let mut prev: Option<(u64, Cycle)> = None;
                 for w in first..first + words as u64 {
                     let b = (w & bank_mask) as usize;
-                    let slot = c.max(chip.tms[tm].l1_bank_free[b]);
+                    let slot = chip.tms[tm].l1_banks[b].reserve(c);
                     chip.stalls.l1_bank += slot - c;
-                    chip.tms[tm].l1_bank_free[b] = slot + 1;
                     let line = w >> shift;
                     let (r, fill) = match prev {
                         Some((l, fill)) if l == line => {
@@ -349,29 +345,31 @@ impl Thread {
                 };
                 let mut c = self.t;
                 let mut last = c;
-                if parallel && pipes.len() >= n as usize && pipes.len() <= 8 {
-                    // All n ops start together on the n least-busy pipes, one issue slot.
-                    let mut idx = [0usize, 1, 2, 3, 4, 5, 6, 7];
-                    let idx = &mut idx[..pipes.len()];
-                    idx.sort_unstable_by_key(|&i| (pipes[i], i));
-                    let s = idx[..n as usize]
-                        .iter()
-                        .map(|&i| pipes[i])
-                        .max()
-                        .unwrap_or(0)
-                        .max(c);
+                if parallel && pipes.len() >= n as usize {
+                    // All n ops start together on n pipes, in one issue slot: the first
+                    // cycle from `c` at which n pipes are free.
+                    let mut s = c;
+                    loop {
+                        let free = pipes.iter().filter(|p| p.peek(s) == s).count();
+                        if free >= n as usize {
+                            break;
+                        }
+                        s += 1;
+                    }
                     chip.stalls.pipeline_busy += s - c;
-                    for &i in &idx[..n as usize] {
-                        pipes[i] = s + 1;
+                    let mut taken = 0;
+                    for p in pipes.iter_mut() {
+                        if taken < n && p.peek(s) == s {
+                            p.reserve(s);
+                            taken += 1;
+                        }
                     }
                     last = s;
                     c = s + 1;
                 } else {
                     for _ in 0..n {
-                        let (i, free) = min_free(pipes);
-                        let s = c.max(free);
+                        let s = earliest(pipes, c);
                         chip.stalls.pipeline_busy += s - c;
-                        pipes[i] = s + 1;
                         last = s;
                         c = s + 1;
                     }
@@ -383,15 +381,22 @@ impl Thread {
     }
 }
 
+/// Reserves the earliest free cycle at or after `c` on any of `units`.
 #[inline]
-fn min_free(units: &[Cycle]) -> (usize, Cycle) {
-    let mut best = (0, units[0]);
-    for (i, &f) in units.iter().enumerate().skip(1) {
-        if f < best.1 {
-            best = (i, f);
+fn earliest(units: &mut [Slots], c: Cycle) -> Cycle {
+    let mut best = 0;
+    let mut best_s = Cycle::MAX;
+    for (i, u) in units.iter().enumerate() {
+        let s = u.peek(c);
+        if s < best_s {
+            best = i;
+            best_s = s;
+            if s == c {
+                break;
+            }
         }
     }
-    best
+    units[best].reserve(c)
 }
 
 /// Supplies threads with work: called when a thread's program is done; returns the next

@@ -37,6 +37,7 @@ pub mod energy;
 pub mod engine;
 pub mod kernel;
 pub mod memory;
+pub mod slots;
 mod workload;
 
 pub use config::{CacheConfig, ConfigError, DramConfig, EnergyConfig, SimConfig, UnitConfig};
