@@ -5,8 +5,8 @@
 //! BVH2-like stream: per node visit one 13-word (52-byte) node load at a random node of a
 //! 16 MB depth-first region (so L1, L2 and DRAM all see traffic), 2 serial box ops and 17
 //! instructions; every 8th visit a 9-word triangle load and a triangle op. The counter is
-//! node visits. `frame_soup`: a whole frame (functional traversal + timing) on a seeded
-//! triangle soup, counted in rays.
+//! node visits. `frame_soup`: a whole 128×128 path-traced frame (functional traversal +
+//! timing) on a seeded 20 000-triangle soup, counted in simulated node visits.
 
 use divan::counter::ItemsCount;
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
@@ -105,9 +105,10 @@ fn frame_soup(b: divan::Bencher, accel: SimAccel) {
     let settings =
         dualsplit_render::RenderSettings::new(128, 128, dualsplit_render::Workload::Path);
     let cfg = SimConfig::lin2020();
-    let rays = simulate(&scene, &s, accel, &settings, &cfg, &|_, _| {})
+    let nodes = simulate(&scene, &s, accel, &settings, &cfg, &|_, _| {})
         .unwrap()
-        .rays;
-    b.counter(ItemsCount::new(rays))
+        .instructions
+        .node_steps;
+    b.counter(ItemsCount::new(nodes))
         .bench(|| simulate(&scene, &s, accel, &settings, &cfg, &|_, _| {}).unwrap());
 }
