@@ -110,9 +110,9 @@ pub fn load_file(path: &Path) -> Result<Scene, SceneError> {
 /// Reads and parses a scene file into a [`Mesh`] (no degenerate/non-finite rule applied).
 pub fn read_mesh(path: &Path) -> Result<Mesh, SceneError> {
     let (format, _) = format_of(path)?;
-    let raw = std::fs::read(path).map_err(|source| SceneError::Io {
+    let raw = std::fs::read(path).map_err(|error| SceneError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     let bytes = maybe_gunzip(path, raw)?;
     parse_bytes(path, format, &bytes)
