@@ -12,13 +12,16 @@
 //!   its last read), activate after t_RP (≥ t_RC after the previous activate, ≥ t_RRD after
 //!   the channel's previous activate), column command after t_RCD;
 //!
-//! then the data leaves t_CAS later once the channel's bus is free, occupying it t_burst.
+//! then the data leaves t_CAS later in the channel bus's first free burst slot (slots are
+//! t_burst long; a later-reserved row hit may fill a gap before an earlier conflict's data,
+//! approximating FR-FCFS on the bus).
 //! A full read queue delays the request until the oldest in-flight read of its channel
-//! completes (back-pressure). Requests are served in arrival order (open-page FCFS); the
+//! completes (back-pressure). Bank state changes in arrival order (open page); the bank-level
 //! row-hit-first reordering of FR-FCFS is not modelled (see `docs/simulator.md`).
 
 use crate::Cycle;
 use crate::config::DramConfig;
+use crate::slots::Slots;
 use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -68,7 +71,8 @@ struct Bank {
 
 #[derive(Clone, Debug, Default)]
 struct Channel {
-    bus_free: u64,
+    /// Data-bus reservations in units of one burst (t_burst ticks).
+    bus: Slots,
     last_act: Option<u64>,
     inflight: BinaryHeap<Reverse<u64>>,
 }
@@ -155,9 +159,11 @@ impl Dram {
         };
         bank.col_ready = col + c.t_ccd;
         bank.last_col = col;
-        let data = (col + c.t_cas).max(ch.bus_free);
+        // The data bus takes the first free burst slot once the data is ready; a read whose
+        // row is open can use a slot before a conflicting read reserved earlier, which is
+        // the effect of FR-FCFS on the bus.
+        let data = ch.bus.reserve((col + c.t_cas).div_ceil(c.t_burst)) * c.t_burst;
         let done = data + c.t_burst;
-        ch.bus_free = done;
         ch.inflight.push(Reverse(done));
         let done_cycle = done.div_ceil(tpc);
         let s = &mut self.stats;
@@ -208,8 +214,9 @@ mod tests {
         let mut d = dram();
         assert_eq!(d.read(0, 0).0, 30);
         // Immediately conflicting: precharge may not start before act + tRAS (35 ns).
-        // act at 0, pre at 35 ns, act at 49 ns (= tRC too), data at 49 + 14 + 14 + 2 = 79.
-        assert_eq!(d.read(128 * 16 * 16, 0), (79, DramAccess::Conflict));
+        // act at 0, pre at 35 ns, act at 49 ns (= tRC too), data at 49 + 14 + 14 = 77 ns,
+        // rounded up to the 2 ns burst slot grid (78), + burst 2 = 80.
+        assert_eq!(d.read(128 * 16 * 16, 0), (80, DramAccess::Conflict));
     }
 
     #[test]
