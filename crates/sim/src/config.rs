@@ -318,6 +318,13 @@ impl SimConfig {
         pos("dram.ticks_per_cycle", self.dram.ticks_per_cycle)?;
         pos("dram.t_burst", self.dram.t_burst)?;
         pos("dram.read_queue", self.dram.read_queue as u64)?;
+        if self.dram.t_rrd > 64 {
+            return Err(ConfigError::Invalid {
+                field: "dram.t_rrd",
+                value: self.dram.t_rrd,
+                reason: "must be at most 64 ticks",
+            });
+        }
         pos("units.box_pipes", self.units.box_pipes as u64)?;
         pos("units.tri_pipes", self.units.tri_pipes as u64)?;
         pos("units.dst_pipes", self.units.dst_pipes as u64)?;

@@ -48,6 +48,38 @@ impl Slots {
         }
     }
 
+    /// Reserves `len` consecutive free cycles starting at the first possible cycle at or
+    /// after `c` and returns the start: reservations made this way are at least `len` apart
+    /// (a minimum spacing such as t_RRD between activations). `len` ≤ 64.
+    pub fn reserve_span(&mut self, c: Cycle, len: u64) -> Cycle {
+        debug_assert!((1..=WINDOW / 2).contains(&len));
+        if c >= self.base + WINDOW {
+            let nb = c - WINDOW / 2;
+            let shift = nb - self.base;
+            self.mask = if shift >= WINDOW {
+                0
+            } else {
+                self.mask >> shift
+            };
+            self.base = nb;
+        }
+        let span: u128 = (1u128 << len) - 1;
+        let mut s = c.max(self.base);
+        loop {
+            if s + len > self.base + WINDOW {
+                self.mask >>= WINDOW / 2;
+                self.base += WINDOW / 2;
+                continue;
+            }
+            let off = s - self.base;
+            if (self.mask >> off) & span == 0 {
+                self.mask |= span << off;
+                return s;
+            }
+            s += 1;
+        }
+    }
+
     /// The first free cycle at or after `c`, without reserving it.
     #[inline]
     pub fn peek(&self, c: Cycle) -> Cycle {
@@ -69,6 +101,17 @@ mod tests {
         // A request at 5 takes 5, not 21.
         assert_eq!(s.reserve(5), 5);
         assert_eq!(s.reserve(10), 12);
+    }
+
+    #[test]
+    fn spans_keep_their_spacing_and_fill_gaps() {
+        let mut s = Slots::default();
+        assert_eq!(s.reserve_span(100, 13), 100);
+        assert_eq!(s.reserve_span(100, 13), 113);
+        // A gap of 13 before 100 is usable; one of 12 is not.
+        assert_eq!(s.reserve_span(80, 13), 80);
+        assert_eq!(s.reserve_span(90, 13), 126);
+        assert_eq!(s.reserve_span(10_000, 13), 10_000);
     }
 
     #[test]

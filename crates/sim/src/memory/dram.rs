@@ -73,7 +73,8 @@ struct Bank {
 struct Channel {
     /// Data-bus reservations in units of one burst (t_burst ticks).
     bus: Slots,
-    last_act: Option<u64>,
+    /// Activations, each holding t_RRD ticks (minimum spacing between activations).
+    acts: Slots,
     inflight: BinaryHeap<Reverse<u64>>,
 }
 
@@ -147,10 +148,7 @@ impl Dram {
                 if open.is_some() || bank.act > 0 {
                     act = act.max(bank.act + c.t_rc);
                 }
-                if let Some(l) = ch.last_act {
-                    act = act.max(l + c.t_rrd);
-                }
-                ch.last_act = Some(ch.last_act.map_or(act, |l| l.max(act)));
+                act = ch.acts.reserve_span(act, c.t_rrd.max(1));
                 bank.act = act;
                 bank.open_row = Some(row);
                 self.stats.activations += 1;
