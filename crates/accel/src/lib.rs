@@ -11,6 +11,7 @@
 
 pub mod build;
 pub mod bvh2;
+pub mod dst;
 pub mod image;
 pub mod observer;
 pub mod stats;

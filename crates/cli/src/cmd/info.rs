@@ -100,7 +100,37 @@ fn group(n: u64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::group;
+    use super::{Args, group, run};
+    use crate::progress::Ctx;
+
+    fn info(scene: &str) -> anyhow::Result<std::process::ExitCode> {
+        let args = Args {
+            scene: scene.into(),
+            json: true,
+        };
+        run(args, &Ctx::new(true))
+    }
+
+    #[test]
+    fn bad_scenes_are_errors_naming_the_file() {
+        let e = info("no/such/mesh.stl").unwrap_err().to_string();
+        assert!(
+            e.contains("no/such/mesh.stl") && e.contains("unknown scene format"),
+            "{e}"
+        );
+        let e = info("no/such/mesh.ply").unwrap_err().to_string();
+        assert!(e.contains("no/such/mesh.ply"), "{e}");
+        let dir = std::env::temp_dir().join(format!("dualsplit-info-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bad = dir.join("bad.obj");
+        std::fs::write(&bad, "v 0 0 0\nf 1 2 3\n").unwrap();
+        let e = info(bad.to_str().unwrap()).unwrap_err().to_string();
+        assert!(e.contains("bad.obj:2:"), "{e}");
+        let good = dir.join("good.obj");
+        std::fs::write(&good, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        assert!(info(good.to_str().unwrap()).is_ok());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn grouping() {

@@ -1,0 +1,84 @@
+//! Conversion speed bar (issue 3): converting `dragon_box.ply.gz` (871K triangles) into a
+//! DST must take at most 10 % of its BVH2 build time. Both are timed here.
+//!
+//! `cargo bench -p dualsplit-accel --bench dst_convert`
+
+#[path = "../tests/dst_common/mod.rs"]
+mod dst_common;
+
+use dualsplit_accel::dst::{Dst, DstConfig, Partitioning};
+use dualsplit_accel::{BuildConfig, Bvh2};
+use dualsplit_geometry::{Aabb, Triangle};
+use std::sync::OnceLock;
+
+struct Input {
+    tris: Vec<Triangle>,
+    boxes: Vec<Aabb>,
+    bvh: Bvh2,
+}
+
+fn input() -> &'static Input {
+    static INPUT: OnceLock<Input> = OnceLock::new();
+    INPUT.get_or_init(|| {
+        let tris = dst_common::load_shipped(&scene_name());
+        let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
+        let bvh = Bvh2::build(&boxes, &BuildConfig::default());
+        Input { tris, boxes, bvh }
+    })
+}
+
+/// The mesh: `dragon_box.ply.gz` unless `DST_BENCH_SCENE` names another shipped mesh (for
+/// quick callgrind runs on a small one).
+/// Under `cargo test --benches` (no `--bench` argument) the small `dragon_res4` is used.
+fn scene_name() -> String {
+    std::env::var("DST_BENCH_SCENE").unwrap_or_else(|_| {
+        if !std::env::args().any(|a| a == "--bench") {
+            "dragon_res4.ply.gz".into()
+        } else {
+            "dragon_box.ply.gz".into()
+        }
+    })
+}
+
+fn main() {
+    // Correctness before timing: the converted trees validate against their BVH2.
+    let i = input();
+    for cfg in [DstConfig::hardware(), DstConfig::software()] {
+        let dst = Dst::from_bvh2(&i.bvh, &i.tris, &cfg).expect("conversion");
+        dst.validate(&i.bvh).expect("valid DST");
+        let s = dst.stats();
+        eprintln!(
+            "{} {cfg:?}: {s:?}\n  DST {:.2} MiB = {:.1} % of BVH2 {:.2} MiB",
+            scene_name(),
+            s.total_bytes as f64 / 1048576.0,
+            s.percent_of_bvh2(),
+            s.bvh2_bytes as f64 / 1048576.0
+        );
+    }
+    divan::main();
+}
+
+#[divan::bench(sample_count = 5, sample_size = 1)]
+fn bvh2_build() -> Bvh2 {
+    let i = input();
+    Bvh2::build(divan::black_box(&i.boxes), &BuildConfig::default())
+}
+
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn dst_convert_hardware() -> Dst {
+    let i = input();
+    Dst::from_bvh2(divan::black_box(&i.bvh), &i.tris, &DstConfig::hardware()).unwrap()
+}
+
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn dst_convert_software() -> Dst {
+    let i = input();
+    Dst::from_bvh2(divan::black_box(&i.bvh), &i.tris, &DstConfig::software()).unwrap()
+}
+
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn dst_convert_similar() -> Dst {
+    let i = input();
+    let cfg = DstConfig::hardware().with_partitioning(Partitioning::Similar);
+    Dst::from_bvh2(divan::black_box(&i.bvh), &i.tris, &cfg).unwrap()
+}

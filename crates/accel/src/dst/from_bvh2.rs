@@ -1,0 +1,370 @@
+//! BVH2 → DST conversion: the SAH choice of carving chains and of each split's child order
+//! (Lin et al. 2020, §4.2; Lin et al. 2019; dst-spec §5).
+//!
+//! With identical bounds the region entering every splitting node is exactly its BVH node's
+//! box, so each child subtree costs the same whatever its parent chooses. The only choices
+//! left at a BVH node are local: which axis and child order the split uses (which face of
+//! each child the split plane carves for free) and how the remaining faces are carved. The
+//! SAH cost of those choices is Σ C_node · SA(region where the node is tested); minimising
+//! it node by node is exact, and the whole conversion is one O(1) step per BVH node.
+//!
+//! A carving chain covers the set F of faces where the incoming region differs from the
+//! target box. [`ChainDp`] solves it exactly by dynamic programming over the 2^|F| subsets
+//! of carved faces (one DP per child prices all six split choices): a step carves one face or two (two on
+//! one axis = single-axis carving node, on two axes = dual-axis carving node); a lone face
+//! is carved by the cheaper node type with a ±∞ no-op partner plane.
+
+use super::header::{AxisPair, Corner};
+use super::{DstConfig, DstCosts, Partitioning};
+use crate::build::Bvh2;
+use dualsplit_geometry::Aabb;
+
+/// A carving node the converter decided to emit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum CarveKind {
+    /// Single-axis carving on this axis.
+    Single(usize),
+    /// Dual-axis carving.
+    Dual(AxisPair, Corner),
+}
+
+/// One carving node: its kind and planes P0, P1 in the encoding's order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct CarveStep {
+    pub kind: CarveKind,
+    pub p0: f32,
+    pub p1: f32,
+}
+
+const NO_STEP: CarveStep = CarveStep {
+    kind: CarveKind::Single(0),
+    p0: f32::INFINITY,
+    p1: f32::NEG_INFINITY,
+};
+
+/// A carving chain, outermost node first (at most one node per face).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Chain {
+    steps: [CarveStep; 6],
+    len: u8,
+}
+
+impl Chain {
+    pub const EMPTY: Chain = Chain {
+        steps: [NO_STEP; 6],
+        len: 0,
+    };
+    pub fn steps(&self) -> &[CarveStep] {
+        &self.steps[..self.len as usize]
+    }
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+/// Face `f` of a box: axis `f >> 1`, the max face when `f & 1 == 1`.
+#[inline(always)]
+fn face(b: &Aabb, f: usize) -> f32 {
+    if f & 1 == 1 {
+        b.max[f >> 1]
+    } else {
+        b.min[f >> 1]
+    }
+}
+
+/// The carving node covering face set `t` (one or two faces of `faces`), with its cost.
+fn step_for(faces: &[usize], i: usize, j: Option<usize>, target: &Aabb, c: &DstCosts) -> CarveStep {
+    let fi = faces[i];
+    match j {
+        Some(j) => {
+            let fj = faces[j];
+            let (a, b) = (fi >> 1, fj >> 1);
+            if a == b {
+                CarveStep {
+                    kind: CarveKind::Single(a),
+                    p0: target.max[a],
+                    p1: target.min[a],
+                }
+            } else {
+                let (f0, f1) = if a < b { (fi, fj) } else { (fj, fi) };
+                let pair = AxisPair::from_axes(a, b).expect("two different axes");
+                CarveStep {
+                    kind: CarveKind::Dual(
+                        pair,
+                        Corner {
+                            first_lower: f0 & 1 == 0,
+                            second_lower: f1 & 1 == 0,
+                        },
+                    ),
+                    p0: face(target, f0),
+                    p1: face(target, f1),
+                }
+            }
+        }
+        None => {
+            let a = fi >> 1;
+            let upper = fi & 1 == 1;
+            if c.single_carve <= c.dual_carve {
+                // Single-axis node whose other plane is a ±∞ no-op (never 0.0: dst-spec §4.4).
+                CarveStep {
+                    kind: CarveKind::Single(a),
+                    p0: if upper { target.max[a] } else { f32::INFINITY },
+                    p1: if upper {
+                        f32::NEG_INFINITY
+                    } else {
+                        target.min[a]
+                    },
+                }
+            } else {
+                // Dual-axis node whose partner plane is a −∞ lower bound on another axis.
+                let b = if a == 0 { 1 } else { 0 };
+                let pair = AxisPair::from_axes(a, b).expect("two different axes");
+                let v = face(target, fi);
+                let (p0, p1, corner) = if a < b {
+                    (
+                        v,
+                        f32::NEG_INFINITY,
+                        Corner {
+                            first_lower: !upper,
+                            second_lower: true,
+                        },
+                    )
+                } else {
+                    (
+                        f32::NEG_INFINITY,
+                        v,
+                        Corner {
+                            first_lower: true,
+                            second_lower: !upper,
+                        },
+                    )
+                };
+                CarveStep {
+                    kind: CarveKind::Dual(pair, corner),
+                    p0,
+                    p1,
+                }
+            }
+        }
+    }
+}
+
+/// The exact chain DP of one child box against its parent's box (dst-spec §5.2).
+///
+/// States are subsets S of the faces F where the parent box differs from the child box; the
+/// region in state S is the parent box with the faces in S already at the child's values.
+/// `cost[S]` is the cheapest SAH cost of carving the rest. A split that carves face f of the
+/// child enters the chain in state {f}, so one DP per child prices all 6 split choices.
+pub(super) struct ChainDp {
+    faces: [usize; 6],
+    k: usize,
+    target: Aabb,
+    cost: [f32; 64],
+    choice: [u8; 64],
+    /// Leaf cost in the full state (similar partitioning), added to every result.
+    base: f32,
+}
+
+impl ChainDp {
+    /// Solves the DP from `region` (the parent box) down to `target` (the child box).
+    /// `leaf_tris` is `Some(n)` when the child is a leaf of `n` triangles and similar
+    /// partitioning is on: the chain may then stop early, paying `C_tri · n · SA` of the
+    /// looser region instead. Costs are SAH-weighted by the area of the region in which
+    /// each node is tested.
+    pub fn solve(region: &Aabb, target: &Aabb, costs: &DstCosts, leaf_tris: Option<u32>) -> Self {
+        let mut dp = ChainDp {
+            faces: [0; 6],
+            k: 0,
+            target: *target,
+            cost: [0.0; 64],
+            choice: [0; 64],
+            base: 0.0,
+        };
+        for f in 0..6 {
+            if face(region, f) != face(target, f) {
+                dp.faces[dp.k] = f;
+                dp.k += 1;
+            }
+        }
+        let k = dp.k;
+        // Triangle cost of the leaf below (similar partitioning only; with identical bounds
+        // the leaf's cost is the same for every choice and never matters).
+        let leaf_cost = |sa: f32| leaf_tris.map(|n| costs.triangle * n as f32 * sa);
+        let full = (1usize << k) - 1;
+        // Region extent on each axis for each of the 4 carve states of its two faces
+        // (bit 0: min face carved, bit 1: max face carved).
+        let mut ext = [[0f32; 4]; 3];
+        for (a, e) in ext.iter_mut().enumerate() {
+            for (code, slot) in e.iter_mut().enumerate() {
+                let lo = if code & 1 == 1 {
+                    target.min[a]
+                } else {
+                    region.min[a]
+                };
+                let hi = if code & 2 == 2 {
+                    target.max[a]
+                } else {
+                    region.max[a]
+                };
+                *slot = (hi - lo).max(0.0);
+            }
+        }
+        // codes[s]: the carved faces of state s as a 6-bit mask (bit 2a + side).
+        let c_lone = costs.single_carve.min(costs.dual_carve);
+        let mut codes = [0u8; 64];
+        let mut sa = [0f32; 64];
+        for s in 0..=full {
+            if s > 0 {
+                codes[s] = codes[s & (s - 1)] | 1 << dp.faces[s.trailing_zeros() as usize];
+            }
+            let c = codes[s];
+            let (x, y, z) = (
+                ext[0][(c & 3) as usize],
+                ext[1][(c >> 2 & 3) as usize],
+                ext[2][(c >> 4 & 3) as usize],
+            );
+            sa[s] = x * y + y * z + z * x;
+        }
+        dp.base = leaf_cost(sa[full]).unwrap_or(0.0);
+        // Pair costs, and for each face the partners whose pair node costs no more than a
+        // lone-face node: while such a partner remains, carving the face alone is dominated
+        // (the DP cost never grows when more faces are already carved), so it is skipped.
+        let mut pair = [[0f32; 6]; 6];
+        let mut cheap_partner = [0usize; 6];
+        for i in 0..k {
+            for (j, &fj) in dp.faces[..k].iter().enumerate() {
+                if i == j {
+                    continue;
+                }
+                let c = if dp.faces[i] >> 1 == fj >> 1 {
+                    costs.single_carve
+                } else {
+                    costs.dual_carve
+                };
+                pair[i][j] = c;
+                if c <= c_lone {
+                    cheap_partner[i] |= 1 << j;
+                }
+            }
+        }
+        for s in (0..full).rev() {
+            let stop = leaf_cost(sa[s]).map_or(f32::INFINITY, |c| c - dp.base);
+            let mut best = (stop, 0u8);
+            let rem = full & !s;
+            let mut rem_i = rem;
+            while rem_i != 0 {
+                let i = rem_i.trailing_zeros() as usize;
+                rem_i &= rem_i - 1;
+                if rem & cheap_partner[i] == 0 {
+                    let c = c_lone * sa[s] + dp.cost[s | 1 << i];
+                    if c < best.0 {
+                        best = (c, 1 << i);
+                    }
+                }
+                let mut rem_j = rem_i;
+                while rem_j != 0 {
+                    let j = rem_j.trailing_zeros() as usize;
+                    rem_j &= rem_j - 1;
+                    let c = pair[i][j] * sa[s] + dp.cost[s | 1 << i | 1 << j];
+                    if c < best.0 {
+                        best = (c, (1 << i | 1 << j) as u8);
+                    }
+                }
+            }
+            dp.cost[s] = best.0;
+            dp.choice[s] = best.1;
+        }
+        dp
+    }
+
+    /// The state entered when the split carves face `f` of the child (if it is one of F).
+    fn start(&self, carved_by_split: usize) -> usize {
+        self.faces[..self.k]
+            .iter()
+            .position(|&g| g == carved_by_split)
+            .map_or(0, |i| 1 << i)
+    }
+
+    /// Cost of the chain when the split carves face `f`.
+    pub fn cost(&self, carved_by_split: usize) -> f32 {
+        self.cost[self.start(carved_by_split)] + self.base
+    }
+
+    /// The cheapest chain when the split carves face `f`, outermost node first.
+    pub fn chain(&self, carved_by_split: usize, costs: &DstCosts) -> Chain {
+        let full = (1usize << self.k) - 1;
+        let mut chain = Chain::EMPTY;
+        let mut s = self.start(carved_by_split);
+        while s != full && self.choice[s] != 0 {
+            let t = self.choice[s] as usize;
+            let i = t.trailing_zeros() as usize;
+            let rest = t & !(1 << i);
+            let j = (rest != 0).then(|| rest.trailing_zeros() as usize);
+            chain.steps[chain.len as usize] =
+                step_for(&self.faces[..self.k], i, j, &self.target, costs);
+            chain.len += 1;
+            s |= t;
+        }
+        chain
+    }
+}
+
+/// The split chosen for an internal BVH node: axis, which BVH child is the left (lower)
+/// child, and both children's carving chains.
+pub(super) struct SplitPlan {
+    pub axis: usize,
+    pub left: u32,
+    pub right: u32,
+    pub left_chain: Chain,
+    pub right_chain: Chain,
+}
+
+fn leaf_tris(bvh: &Bvh2, n: u32, cfg: &DstConfig) -> Option<u32> {
+    let node = &bvh.nodes[n as usize];
+    (cfg.partitioning == Partitioning::Similar && node.is_leaf()).then_some(node.count)
+}
+
+/// Face index of the max face on `axis` (carved for the left child by P0) and of the min
+/// face (carved for the right child by P1).
+const fn max_face(axis: usize) -> usize {
+    2 * axis + 1
+}
+const fn min_face(axis: usize) -> usize {
+    2 * axis
+}
+
+/// Chooses axis and child order of the splitting node for internal BVH node `n`, whose
+/// region is exactly its box: for each axis and order, the split plane carves the left
+/// child's max face and the right child's min face; the rest is left to the children's
+/// chains. Picks the cheapest (first in axis, then order, on ties).
+pub(super) fn plan_split(bvh: &Bvh2, n: u32, cfg: &DstConfig) -> SplitPlan {
+    let node = &bvh.nodes[n as usize];
+    let b = node.bounds;
+    let [x, y] = node.children();
+    let (bx, by) = (bvh.nodes[x as usize].bounds, bvh.nodes[y as usize].bounds);
+    let dx = ChainDp::solve(&b, &bx, &cfg.costs, leaf_tris(bvh, x, cfg));
+    let dy = ChainDp::solve(&b, &by, &cfg.costs, leaf_tris(bvh, y, cfg));
+    let mut best = (f32::INFINITY, 0usize, false);
+    for axis in 0..3 {
+        for swap in [false, true] {
+            let (lo, hi) = if swap { (&dy, &dx) } else { (&dx, &dy) };
+            let c = lo.cost(max_face(axis)) + hi.cost(min_face(axis));
+            if c < best.0 {
+                best = (c, axis, swap);
+            }
+        }
+    }
+    let (_, axis, swap) = best;
+    let (left, right, lo, hi) = if swap {
+        (y, x, &dy, &dx)
+    } else {
+        (x, y, &dx, &dy)
+    };
+    SplitPlan {
+        axis,
+        left,
+        right,
+        left_chain: lo.chain(max_face(axis), &cfg.costs),
+        right_chain: hi.chain(min_face(axis), &cfg.costs),
+    }
+}

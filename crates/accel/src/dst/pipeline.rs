@@ -1,0 +1,238 @@
+//! The hardware dual-split pipeline as a pure step function (Lin et al. 2020, §3, Fig. 6,
+//! Appendices A–C, Figs. 10–12; dst-spec §4.5), and traversal loops driven only by it.
+//!
+//! The function is written like the datapath: every stage runs for every node type and
+//! 2:1 multiplexers ([`mux`]) pick operands and results, steered by header bits and the ray's
+//! direction signs. There is no branch on the node type.
+//!
+//! ```text
+//!  header ─▶ decode (C, L, A, B) ─┬─▶ component select: axis0, axis1 ─▶ (o, inv) × 2
+//!                                 ├─▶ plane swap by ray sign (1-D nodes) ─▶ q0, q1
+//!  FPADD ×2, FPMUL ×2:  t1 = (q0 − o0)·inv0,  t2 = (q1 − o1)·inv1
+//!  FPCMP ×4: near = t_min ≤ t1, far = t_max ≥ t2, cut ≤, exit/entry steering
+//!  FPMIN3 / FPMAX3: t_max_out = min(t_max, t1?, t2?), t_min_out = max(t_min, t1?, t2?)
+//!  INTADD ×1: right = offset + left size;  near/far muxes;  return-code logic
+//! ```
+//!
+//! Units: 1 INTADD, 2 FPADD, 2 FPMUL, 3 FPMIN/MAX (one 3-way min + one 3-way max),
+//! 4 FPCMP, as in Table 2.
+
+use super::Dst;
+use super::header::HeaderOffset;
+use super::traverse::{Entry, RunResult, Tracer};
+use crate::observer::{NodeStep, Observer};
+use dualsplit_geometry::{Hit, Ray};
+
+/// The pipeline's 2-bit return code, numbered as in the paper (Lin et al. 2020, §3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum ReturnCode {
+    /// 0: no intersection — pop the stack.
+    Miss = 0,
+    /// 1: one child — continue at `offset` with `[t_min_out, t_max_out]`.
+    OneChild = 1,
+    /// 2: both children — push `(offset_stack, t_min_out, t_max_in)`, continue at `offset`
+    /// with `[t_min_in, t_max_out]`.
+    BothChildren = 2,
+    /// 3: leaf (plain leaf or carving node acting as a leaf) — intersect the triangle run
+    /// at `offset`.
+    Leaf = 3,
+}
+
+impl ReturnCode {
+    /// From the 2-bit value.
+    #[inline(always)]
+    pub fn from_bits(b: u8) -> Self {
+        match b & 3 {
+            0 => Self::Miss,
+            1 => Self::OneChild,
+            2 => Self::BothChildren,
+            _ => Self::Leaf,
+        }
+    }
+}
+
+/// The pipeline's inputs: exactly the paper's (Lin et al. 2020, §3, Fig. 6).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PipelineInput {
+    /// The node's header-offset word.
+    pub word: HeaderOffset,
+    /// Plane P0 (word 1 of the node).
+    pub p0: f32,
+    /// Plane P1 (word 2 of the node).
+    pub p1: f32,
+    /// Ray origin.
+    pub origin: [f32; 3],
+    /// Ray inverse direction (IEEE `1/d`, ±∞ for zero components).
+    pub inv_dir: [f32; 3],
+    /// Current interval start.
+    pub t_min: f32,
+    /// Current interval end.
+    pub t_max: f32,
+}
+
+/// The pipeline's outputs (Lin et al. 2020, §3, Fig. 6).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PipelineOutput {
+    /// Return code 0–3.
+    pub code: ReturnCode,
+    /// Next node (codes 1, 2) or triangle run (code 3).
+    pub offset: u32,
+    /// The far child to push (code 2).
+    pub offset_stack: u32,
+    /// Output interval start (see [`ReturnCode`] for how each code uses it).
+    pub t_min_out: f32,
+    /// Output interval end.
+    pub t_max_out: f32,
+}
+
+/// A 2:1 multiplexer: `a` when `s`, else `b`.
+#[inline(always)]
+pub fn mux<T: Copy>(s: bool, a: T, b: T) -> T {
+    [b, a][s as usize]
+}
+
+/// The comparator `a ≤ b` with NaN counted as true: a NaN plane distance (the ray lies in
+/// the plane) never drops a child or culls a node.
+#[inline(always)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // the negated form is exactly the NaN rule
+pub fn le_or_nan(a: f32, b: f32) -> bool {
+    !(a > b)
+}
+
+/// One dual-split pipeline operation (Lin et al. 2020, §3, Fig. 6; Apps. A–C).
+#[inline(always)]
+pub fn step(i: &PipelineInput) -> PipelineOutput {
+    let w = i.word;
+    // ---- decode (bit logic) -------------------------------------------------------------
+    let is_carving = w.is_carving();
+    let leaf_flag = w.is_leaf_flag();
+    let is_split = w.is_split();
+    let is_plain_leaf = w.is_plain_leaf();
+    let is_dual = w.is_dual();
+    let field_a = w.axis_pair_bits() as usize;
+    let field_b = w.field_b_bits();
+    // Component select (App. A): 1-D nodes use one axis for both planes (splitting: field A;
+    // single-axis carving: field B); dual-axis nodes use the pair (A >> 1, (A & 1) + 1).
+    let axis_1d = mux(is_carving, field_b as usize & 3, field_a) % 3;
+    let axis0 = mux(is_dual, field_a >> 1, axis_1d);
+    let axis1 = mux(is_dual, (field_a & 1) + 1, axis_1d);
+    let (o0, inv0) = (i.origin[axis0], i.inv_dir[axis0]);
+    let (o1, inv1) = (i.origin[axis1], i.inv_dir[axis1]);
+    let neg0 = inv0.is_sign_negative();
+    let neg1 = inv1.is_sign_negative();
+    // 1-D nodes: the ray sign swaps (P0, P1) so that q0 is the exit plane, q1 the entry
+    // plane (App. A). 2-D nodes keep the plane order.
+    let swap = !is_dual & neg0;
+    let q0 = mux(swap, i.p1, i.p0);
+    let q1 = mux(swap, i.p0, i.p1);
+    // ---- FPADD ×2, FPMUL ×2 --------------------------------------------------------------
+    let t1 = (q0 - o0) * inv0;
+    let t2 = (q1 - o1) * inv1;
+    // ---- effective corner: which plane clamps t_max (exit) ------------------------------
+    let corner = w.corner();
+    let exit0 = mux(is_dual, neg0 == corner.first_lower, true);
+    let exit1 = mux(is_dual, neg1 == corner.second_lower, false);
+    // ---- FPCMP: splitting-node child tests (NaN-permissive) --------
+    let near_hit = le_or_nan(i.t_min, t1);
+    let far_hit = le_or_nan(t2, i.t_max);
+    // A splitting node hit on one side only keeps the untouched bound of that side:
+    // near-only → [t_min, min(t_max, t1)], far-only → [max(t_min, t2), t_max].
+    let use_t1 = exit0 & !(is_split & !near_hit);
+    let use_t2 = !exit1 & !(is_split & near_hit & !far_hit);
+    // ---- FPMIN3 / FPMAX3 (f32::min/max return the non-NaN operand) -----------------------
+    let t_max_out = i
+        .t_max
+        .min(mux(use_t1, t1, i.t_max))
+        .min(mux(exit1, t2, i.t_max));
+    let t_min_out = i
+        .t_min
+        .max(mux(!exit0, t1, i.t_min))
+        .max(mux(use_t2, t2, i.t_min));
+    // ---- FPCMP: carving cull -------------------------------------------------------------
+    let carve_hit = le_or_nan(t_min_out, t_max_out);
+    // ---- INTADD and offset muxes ---------------------------------------------------------
+    let left = w.offset();
+    let right = left.wrapping_add(field_b);
+    let near = mux(neg0, right, left);
+    let far = mux(neg0, left, right);
+    let offset = mux(is_split, mux(near_hit, near, far), left);
+    // ---- return-code logic ---------------------------------------------------------------
+    let split_code = near_hit as u8 + far_hit as u8;
+    let carve_code = carve_hit as u8 * (1 + 2 * leaf_flag as u8);
+    let code = mux(is_plain_leaf, 3, mux(is_split, split_code, carve_code));
+    PipelineOutput {
+        code: ReturnCode::from_bits(code),
+        offset,
+        offset_stack: far,
+        t_min_out,
+        t_max_out,
+    }
+}
+
+impl Dst {
+    /// Closest hit of `ray`, every node step computed by the pipeline function [`step`].
+    pub fn closest_hit_pipeline<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        self.traverse_pipeline::<O, false>(ray, obs)
+    }
+
+    /// Any hit of `ray` within `[t_min, t_max]`, driven by the pipeline function [`step`].
+    pub fn any_hit_pipeline<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+        self.traverse_pipeline::<O, true>(ray, obs).is_some()
+    }
+
+    #[inline(always)]
+    fn traverse_pipeline<O: Observer, const ANY: bool>(
+        &self,
+        ray: &Ray,
+        obs: &mut O,
+    ) -> Option<Hit> {
+        let (mut tr, mut t_min, mut t_max) = Tracer::start(self, ray)?;
+        let origin = tr.r.ray.origin.to_array();
+        let inv_dir = tr.r.inv_dir.to_array();
+        let mut node = 0u32;
+        loop {
+            let (word, p0, p1) = tr.fetch_node(node, obs);
+            let out = step(&PipelineInput {
+                word,
+                p0,
+                p1,
+                origin,
+                inv_dir,
+                t_min,
+                t_max,
+            });
+            obs.step(NodeStep::Dst {
+                kind: word.node_kind(),
+                code: out.code as u8,
+                carving_leaf: word.is_carving() & word.is_leaf_flag(),
+            });
+            match out.code {
+                ReturnCode::OneChild => {
+                    (node, t_min, t_max) = (out.offset, out.t_min_out, out.t_max_out);
+                    continue;
+                }
+                ReturnCode::BothChildren => {
+                    tr.stack.push(Entry {
+                        node: out.offset_stack,
+                        t_min: out.t_min_out,
+                        t_max,
+                    });
+                    obs.push();
+                    (node, t_max) = (out.offset, out.t_max_out);
+                    continue;
+                }
+                ReturnCode::Leaf => {
+                    if let RunResult::Occluded = tr.test_run::<O, ANY>(out.offset, obs) {
+                        return tr.best;
+                    }
+                }
+                ReturnCode::Miss => {}
+            }
+            let Some(e) = tr.pop(obs) else {
+                return tr.best;
+            };
+            (node, t_min, t_max) = (e.node, e.t_min, e.t_max);
+        }
+    }
+}

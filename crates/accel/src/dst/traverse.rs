@@ -1,0 +1,327 @@
+//! Software traversal of the encoded DST (the paper's DST*): the readable reference that the
+//! pipeline loop is tested against (Lin et al. 2020, §3, Fig. 3; dst-spec §4).
+//!
+//! Each stack entry carries its `[t_min, t_max]` (the region clip, kd-tree style). Sibling
+//! regions may overlap, so traversal continues after a hit; a popped entry is discarded
+//! when its `t_min` lies beyond `cull_limit(best_t)`, otherwise its `t_max` is clamped to
+//! it. Plane distances use [`RayPre::plane_t`]; every min/max is `f32::min/max` and every
+//! cull comparison is written `!(a > b)`, so a NaN distance (ray lying in a plane) never
+//! drops a child. Leaf triangles are tested on the ray's own interval `[ray.t_min, best_t]`.
+
+use super::Dst;
+use super::encode::RUN_END;
+use super::header::HeaderOffset;
+use super::pipeline::le_or_nan;
+use crate::image::MemoryImage;
+use crate::observer::{DstNodeKind, NodeStep, Observer};
+use dualsplit_geometry::{Hit, Ray, RayPre, Triangle, cull_limit};
+
+/// A traversal-stack entry: a node word index and its ray interval.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Entry {
+    pub node: u32,
+    pub t_min: f32,
+    pub t_max: f32,
+}
+
+const INLINE: usize = 64;
+
+/// The traversal stack: 64 entries inline (deeper than any SAH tree in practice), spilling
+/// to the heap beyond that so no tree depth can overflow it.
+pub(super) struct Stack {
+    inline: [Entry; INLINE],
+    len: usize,
+    spill: Vec<Entry>,
+}
+
+impl Stack {
+    #[inline(always)]
+    pub fn new() -> Self {
+        Self {
+            inline: [Entry::default(); INLINE],
+            len: 0,
+            spill: Vec::new(),
+        }
+    }
+    #[inline(always)]
+    pub fn push(&mut self, e: Entry) {
+        if self.len < INLINE {
+            self.inline[self.len] = e;
+        } else {
+            self.spill.push(e);
+        }
+        self.len += 1;
+    }
+    #[inline(always)]
+    pub fn pop(&mut self) -> Option<Entry> {
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        if self.len < INLINE {
+            Some(self.inline[self.len])
+        } else {
+            self.spill.pop()
+        }
+    }
+}
+
+/// The per-ray state shared by the software traversal and the pipeline loop: the best hit
+/// so far and the pop rule.
+pub(super) struct Tracer<'a> {
+    pub r: RayPre,
+    pub words: &'a [u32],
+    pub index_base: usize,
+    pub tri_base: usize,
+    pub tris: &'a [Triangle],
+    pub best: Option<Hit>,
+    pub best_t: f32,
+    pub stack: Stack,
+}
+
+/// What intersecting a triangle run found.
+pub(super) enum RunResult {
+    /// Nothing that ends the traversal.
+    Continue,
+    /// Any-hit mode: an accepted hit.
+    Occluded,
+}
+
+impl<'a> Tracer<'a> {
+    /// Starts a ray: clips it to the scene box (on `[ray.t_min, cull_limit(ray.t_max)]`, as
+    /// the BVH culls), returning the root interval or `None` when it misses the scene.
+    #[inline(always)]
+    pub fn start(dst: &'a Dst, ray: &Ray) -> Option<(Self, f32, f32)> {
+        if dst.is_empty() {
+            return None;
+        }
+        let r = ray.precompute();
+        let b = dst.scene_box;
+        let (t_min, t_max) = r.slab(b.min, b.max, ray.t_min, cull_limit(ray.t_max));
+        if t_min > t_max {
+            return None;
+        }
+        let img = &dst.image;
+        Some((
+            Self {
+                r,
+                words: &img.words,
+                index_base: img.indices.start,
+                tri_base: img.triangles.start,
+                tris: dst.triangles(),
+                best: None,
+                best_t: ray.t_max,
+                stack: Stack::new(),
+            },
+            t_min,
+            t_max,
+        ))
+    }
+
+    /// The node's header word and its two planes (a plain leaf has none).
+    #[inline(always)]
+    pub fn fetch_node<O: Observer>(&self, node: u32, obs: &mut O) -> (HeaderOffset, f32, f32) {
+        let at = node as usize;
+        let w = HeaderOffset::from_bits(self.words[at]);
+        if w.is_plain_leaf() {
+            obs.fetch(MemoryImage::addr(at), 4);
+            (w, 0.0, 0.0)
+        } else {
+            obs.fetch(MemoryImage::addr(at), 12);
+            (
+                w,
+                f32::from_bits(self.words[at + 1]),
+                f32::from_bits(self.words[at + 2]),
+            )
+        }
+    }
+
+    /// Intersects the triangle run starting at index entry `first` on the ray's own interval
+    /// `[ray.t_min, best_t]` (any hit: `[ray.t_min, ray.t_max]`).
+    #[inline(always)]
+    pub fn test_run<O: Observer, const ANY: bool>(&mut self, first: u32, obs: &mut O) -> RunResult {
+        let start = self.index_base + first as usize;
+        let count = self.words[start..]
+            .iter()
+            .position(|&e| e & RUN_END != 0)
+            .map_or(0, |p| p + 1);
+        obs.step(NodeStep::Leaf {
+            count: count as u32,
+        });
+        let t_lo = self.r.ray.t_min;
+        for i in start..start + count {
+            let e = self.words[i];
+            let p = e & !RUN_END;
+            obs.fetch(MemoryImage::addr(i), 4);
+            obs.fetch(MemoryImage::addr(self.tri_base + 9 * p as usize), 36);
+            let h = self.tris[p as usize].intersect(&self.r, t_lo, self.best_t);
+            obs.triangle_test(p, h.is_some());
+            if let Some(h) = h {
+                if ANY {
+                    self.best = Some(Hit {
+                        t: h.t,
+                        prim: p,
+                        u: h.u,
+                        v: h.v,
+                    });
+                    return RunResult::Occluded;
+                }
+                if self.best.is_none_or(|b| !b.closer_than(h.t, p)) {
+                    self.best = Some(Hit {
+                        t: h.t,
+                        prim: p,
+                        u: h.u,
+                        v: h.v,
+                    });
+                    self.best_t = h.t;
+                }
+            }
+        }
+        RunResult::Continue
+    }
+
+    /// Pops the next entry that can still hold a closer hit, clamping its `t_max`.
+    #[inline(always)]
+    pub fn pop<O: Observer>(&mut self, obs: &mut O) -> Option<Entry> {
+        let limit = cull_limit(self.best_t);
+        while let Some(e) = self.stack.pop() {
+            obs.pop();
+            if le_or_nan(e.t_min, limit) {
+                return Some(Entry {
+                    t_max: e.t_max.min(limit),
+                    ..e
+                });
+            }
+        }
+        None
+    }
+}
+
+#[inline(always)]
+fn dst_step(kind: DstNodeKind, code: u8, carving_leaf: bool) -> NodeStep {
+    NodeStep::Dst {
+        kind,
+        code,
+        carving_leaf,
+    }
+}
+
+impl Dst {
+    /// Closest hit of `ray` (software decoder, DST*), ordered by `(t, prim)`.
+    pub fn closest_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        self.traverse::<O, false>(ray, obs)
+    }
+
+    /// True when `ray` hits any triangle within `[t_min, t_max]` (software decoder).
+    pub fn any_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+        self.traverse::<O, true>(ray, obs).is_some()
+    }
+
+    #[inline(always)]
+    fn traverse<O: Observer, const ANY: bool>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        let (mut tr, mut t_min, mut t_max) = Tracer::start(self, ray)?;
+        let mut node = 0u32;
+        loop {
+            let (w, p0, p1) = tr.fetch_node(node, obs);
+            // `Some(run)` when the node ends in a triangle run; `None` when it pops.
+            let run = match w.node_kind() {
+                DstNodeKind::Leaf => {
+                    obs.step(dst_step(DstNodeKind::Leaf, 3, false));
+                    Some(w.offset())
+                }
+                DstNodeKind::Split => {
+                    let a = w.axis();
+                    let left = w.offset();
+                    let right = left + w.left_size();
+                    // t1: where the ray leaves the near child's half-space; t2: where it
+                    // enters the far one (Lin et al. 2020, Fig. 3).
+                    let (near, far, t1, t2) = if tr.r.neg[a] {
+                        (right, left, tr.r.plane_t(a, p1), tr.r.plane_t(a, p0))
+                    } else {
+                        (left, right, tr.r.plane_t(a, p0), tr.r.plane_t(a, p1))
+                    };
+                    let near_hit = le_or_nan(t_min, t1);
+                    let far_hit = le_or_nan(t2, t_max);
+                    obs.step(dst_step(
+                        DstNodeKind::Split,
+                        near_hit as u8 + far_hit as u8,
+                        false,
+                    ));
+                    if far_hit {
+                        if near_hit {
+                            tr.stack.push(Entry {
+                                node: far,
+                                t_min: t_min.max(t2),
+                                t_max,
+                            });
+                            obs.push();
+                        } else {
+                            node = far;
+                            t_min = t_min.max(t2);
+                            continue;
+                        }
+                    }
+                    if near_hit {
+                        node = near;
+                        t_max = t_max.min(t1);
+                        continue;
+                    }
+                    None
+                }
+                kind => {
+                    // Carving: exit planes clamp t_max, entry planes raise t_min.
+                    let (lo, hi) = if kind == DstNodeKind::SingleCarve {
+                        let a = w.axis();
+                        let (t1, t2) = if tr.r.neg[a] {
+                            (tr.r.plane_t(a, p1), tr.r.plane_t(a, p0))
+                        } else {
+                            (tr.r.plane_t(a, p0), tr.r.plane_t(a, p1))
+                        };
+                        (t_min.max(t2), t_max.min(t1))
+                    } else {
+                        let (a0, a1) = w.axis_pair().axes();
+                        let c = w.corner();
+                        let (ta, tb) = (tr.r.plane_t(a0, p0), tr.r.plane_t(a1, p1));
+                        let (mut lo, mut hi) = (t_min, t_max);
+                        // A plane is an exit plane iff its "lower bound" bit equals the
+                        // ray's sign on its axis (Lin et al. 2020, Fig. 2).
+                        if tr.r.neg[a0] == c.first_lower {
+                            hi = hi.min(ta);
+                        } else {
+                            lo = lo.max(ta);
+                        }
+                        if tr.r.neg[a1] == c.second_lower {
+                            hi = hi.min(tb);
+                        } else {
+                            lo = lo.max(tb);
+                        }
+                        (lo, hi)
+                    };
+                    let hit = le_or_nan(lo, hi);
+                    let leaf = w.is_leaf_flag();
+                    obs.step(dst_step(kind, hit as u8 * (1 + 2 * leaf as u8), leaf));
+                    if hit {
+                        t_min = lo;
+                        t_max = hi;
+                        if !leaf {
+                            node = w.offset();
+                            continue;
+                        }
+                        Some(w.offset())
+                    } else {
+                        None
+                    }
+                }
+            };
+            if let Some(first) = run
+                && let RunResult::Occluded = tr.test_run::<O, ANY>(first, obs)
+            {
+                return tr.best;
+            }
+            let Some(e) = tr.pop(obs) else {
+                return tr.best;
+            };
+            (node, t_min, t_max) = (e.node, e.t_min, e.t_max);
+        }
+    }
+}

@@ -1,0 +1,150 @@
+//! DST on random small scenes: per-ray identical closest hits (t bits and triangle id) and
+//! shadow answers against a brute-force oracle and the source BVH2, through the software
+//! traversal and the pipeline loop, for both cost presets and both partitioning modes.
+
+mod dst_common;
+
+use dst_common::{build, build_with, check_all, random_rays};
+use dualsplit_accel::BuildConfig;
+use dualsplit_accel::dst::{DstConfig, Partitioning};
+use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3};
+use proptest::prelude::*;
+
+/// Scene shapes: 0 free triangles, 1 grid-snapped (coincident planes, coordinates 0.0),
+/// 2 axis-aligned triangles (each lying in a coordinate plane), 3 flat scene (one z).
+fn scene(seed: u64, n: usize, shape: u32) -> Vec<Triangle> {
+    let mut rng = Pcg32::new(seed, 7);
+    let pt = |rng: &mut Pcg32| {
+        let p = Vec3::new(
+            rng.range_f32(-4.0, 4.0),
+            rng.range_f32(-4.0, 4.0),
+            rng.range_f32(-4.0, 4.0),
+        );
+        match shape {
+            1 | 2 => p.round(),
+            3 => Vec3::new(p.x, p.y, 1.0),
+            _ => p,
+        }
+    };
+    (0..n)
+        .map(|_| {
+            let a = pt(&mut rng);
+            let mut b = pt(&mut rng);
+            let mut c = pt(&mut rng);
+            if shape == 2 {
+                let axis = rng.below(3) as usize;
+                b[axis] = a[axis];
+                c[axis] = a[axis];
+            } else if shape == 0 {
+                // Mostly small triangles so boxes differ.
+                b = a + (b - a) * 0.3;
+                c = a + (c - a) * 0.3;
+            }
+            Triangle::new(a, b, c)
+        })
+        .collect()
+}
+
+fn configs() -> [DstConfig; 3] {
+    [
+        DstConfig::hardware(),
+        DstConfig::software(),
+        DstConfig::hardware().with_partitioning(Partitioning::Similar),
+    ]
+}
+
+fn run_case(seed: u64, n: usize, shape: u32, leaf: u32) {
+    let tris = scene(seed, n, shape);
+    let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
+    let scene_box = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+    let bcfg = BuildConfig {
+        max_leaf_size: leaf,
+        ..BuildConfig::default()
+    };
+    let mut rng = Pcg32::new(seed ^ 0x5eed, 11);
+    let rays = random_rays(&mut rng, &tris, &scene_box, 60);
+    let mut reference_misses = 0;
+    for cfg in configs() {
+        let b = build_with(&tris, &bcfg, &cfg);
+        for ray in &rays {
+            reference_misses += !check_all(&b, &tris, ray) as u32;
+        }
+    }
+    if reference_misses > 0 {
+        eprintln!("seed {seed}: BVH2 reference missed {reference_misses} oracle hits");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_scenes_match_oracle_and_bvh2(
+        seed in any::<u64>(),
+        n in 1usize..48,
+        shape in 0u32..4,
+        leaf in prop::sample::select(vec![1u32, 2, 4]),
+    ) {
+        run_case(seed, n, shape, leaf);
+    }
+}
+
+#[test]
+fn one_triangle() {
+    for shape in 0..4 {
+        run_case(3, 1, shape, 4);
+    }
+}
+
+#[test]
+fn empty_scene_misses_everything() {
+    let b = build(&[], &DstConfig::hardware());
+    assert!(b.dst.is_empty());
+    let ray = dualsplit_geometry::Ray::new(Vec3::ZERO, Vec3::X);
+    dst_common::check_ray(&b.dst, &ray, None, "empty");
+}
+
+/// A box of axis-aligned quads with rays starting exactly on its faces and running inside
+/// them (direction components zero): the plane distances are NaN, which must not drop a
+/// child.
+#[test]
+fn rays_in_bounding_planes() {
+    let q = |a: Vec3, b: Vec3, c: Vec3, d: Vec3| [Triangle::new(a, b, c), Triangle::new(a, c, d)];
+    let (l, h) = (0.0f32, 2.0f32);
+    let v = |x, y, z| Vec3::new(x, y, z);
+    let mut tris = Vec::new();
+    tris.extend(q(v(l, l, l), v(h, l, l), v(h, h, l), v(l, h, l))); // z = 0
+    tris.extend(q(v(l, l, h), v(h, l, h), v(h, h, h), v(l, h, h))); // z = 2
+    tris.extend(q(v(l, l, l), v(l, h, l), v(l, h, h), v(l, l, h))); // x = 0
+    tris.extend(q(v(h, l, l), v(h, h, l), v(h, h, h), v(h, l, h))); // x = 2
+    tris.push(Triangle::new(
+        v(0.5, 0.5, 1.0),
+        v(1.5, 0.5, 1.0),
+        v(1.0, 1.5, 1.0),
+    ));
+    for cfg in configs() {
+        let b = build(&tris, &cfg);
+        for o in [
+            v(0.0, 1.0, 1.0),
+            v(1.0, 1.0, 0.0),
+            v(2.0, 0.5, 2.0),
+            v(1.0, 1.0, 1.0),
+        ] {
+            for d in [
+                v(1.0, 0.0, 0.0),
+                v(-1.0, 0.0, 0.0),
+                v(0.0, 0.0, 1.0),
+                v(0.0, 0.0, -1.0),
+                v(0.0, 1.0, 0.0),
+                v(1.0, 1.0, 0.0),
+                v(0.0, -0.0, 1.0),
+                v(-0.0, 0.0, -1.0),
+            ] {
+                let mut ray = dualsplit_geometry::Ray::new(o, d);
+                check_all(&b, &tris, &ray);
+                ray.t_max = 0.0; // t_min == t_max == 0 on a face
+                check_all(&b, &tris, &ray);
+            }
+        }
+    }
+}
