@@ -135,8 +135,8 @@ fn print_result(r: &SimResult) {
     let u = &r.utilisation;
     println!("== {label}");
     println!(
-        "  frame time     {:.3} ms ({} cycles), {} rays",
-        r.frame_ms, r.cycles, r.rays
+        "  frame time     {:.3} ms ({} cycles), {} rays, {} node visits",
+        r.frame_ms, r.cycles, r.rays, r.instructions.node_steps
     );
     println!(
         "  energy         {:.4} J total: DRAM {:.4} J, caches {:.4} J, compute {:.4} J",
