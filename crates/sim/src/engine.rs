@@ -384,6 +384,9 @@ impl Thread {
 /// Reserves the earliest free cycle at or after `c` on any of `units`.
 #[inline]
 fn earliest(units: &mut [Slots], c: Cycle) -> Cycle {
+    if let [only] = units {
+        return only.reserve(c);
+    }
     let mut best = 0;
     let mut best_s = Cycle::MAX;
     for (i, u) in units.iter().enumerate() {
