@@ -88,9 +88,96 @@ impl Slots {
     }
 }
 
+/// Reservations kept behind the request being served (requests arrive slightly out of
+/// order; anything older than this can no longer collide with a new one).
+const SPARSE_HISTORY: u64 = 4096;
+
+/// A reservation table for resources whose reservations can lie far in the future (DRAM
+/// channel buses and activation spacing: a backed-up bank schedules its reads hundreds of
+/// nanoseconds ahead). Unlike [`Slots`], a far-future reservation never moves a window past
+/// earlier free cycles, so a read to an idle bank of the same channel still gets the first
+/// free cycle after its own ready time. Reservations are kept in an ordered set and pruned
+/// `SPARSE_HISTORY` cycles behind each request.
+#[derive(Clone, Debug, Default)]
+pub struct SparseSlots {
+    taken: std::collections::BTreeSet<Cycle>,
+}
+
+impl SparseSlots {
+    fn prune(&mut self, c: Cycle) {
+        let floor = c.saturating_sub(SPARSE_HISTORY);
+        while self.taken.first().is_some_and(|&f| f < floor) {
+            self.taken.pop_first();
+        }
+    }
+
+    /// The first free cycle at or after `c`, without reserving it.
+    pub fn peek(&self, c: Cycle) -> Cycle {
+        let mut s = c;
+        for &t in self.taken.range(c..) {
+            if t != s {
+                break;
+            }
+            s += 1;
+        }
+        s
+    }
+
+    /// Reserves the first free cycle at or after `c` and returns it.
+    pub fn reserve(&mut self, c: Cycle) -> Cycle {
+        self.prune(c);
+        let s = self.peek(c);
+        self.taken.insert(s);
+        s
+    }
+
+    /// Reserves a span of `len` cycles at the first start at or after `c` where it overlaps
+    /// no other span (spans are all `len` long, so starts end up at least `len` apart: a
+    /// minimum spacing such as t_RRD between activations).
+    pub fn reserve_span(&mut self, c: Cycle, len: u64) -> Cycle {
+        self.prune(c);
+        let mut s = c;
+        loop {
+            if let Some(&p) = self.taken.range(..=s).next_back()
+                && p + len > s
+            {
+                s = p + len;
+                continue;
+            }
+            match self.taken.range(s..).next() {
+                Some(&n) if n < s + len => s = n + len,
+                _ => break,
+            }
+        }
+        self.taken.insert(s);
+        s
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sparse_far_future_reservations_keep_earlier_cycles_free() {
+        let mut s = SparseSlots::default();
+        assert_eq!(s.reserve(100_000), 100_000);
+        // A plain window would have slid past cycle 1000.
+        assert_eq!(s.reserve(1000), 1000);
+        assert_eq!(s.reserve(1000), 1001);
+        assert_eq!(s.peek(1000), 1002);
+        assert_eq!(s.reserve(99_999), 99_999);
+        assert_eq!(s.reserve(99_999), 100_001);
+        let mut a = SparseSlots::default();
+        assert_eq!(a.reserve_span(100_000, 13), 100_000);
+        assert_eq!(a.reserve_span(100, 13), 100);
+        assert_eq!(a.reserve_span(100, 13), 113);
+        assert_eq!(a.reserve_span(80, 13), 80);
+        assert_eq!(a.reserve_span(90, 13), 126);
+        assert_eq!(a.reserve_span(60, 13), 60);
+        assert_eq!(a.reserve_span(99_990, 13), 100_013);
+        assert_eq!(a.reserve_span(99_980, 13), 99_980);
+    }
 
     #[test]
     fn fills_holes_before_later_reservations() {
