@@ -18,6 +18,17 @@ impl Slots {
     /// Reserves the first free cycle at or after `c` and returns it.
     #[inline]
     pub fn reserve(&mut self, c: Cycle) -> Cycle {
+        // Fast path (most requests): `c` inside the window and free.
+        let off = c.wrapping_sub(self.base);
+        if off < WINDOW && self.mask & (1u128 << off) == 0 {
+            self.mask |= 1u128 << off;
+            return c;
+        }
+        self.reserve_slow(c)
+    }
+
+    #[inline(never)]
+    fn reserve_slow(&mut self, c: Cycle) -> Cycle {
         if c >= self.base + WINDOW {
             // Keep the last 64 cycles of history before `c`.
             let nb = c - WINDOW / 2;
