@@ -299,33 +299,40 @@ impl Thread {
             Op::Load { addr, words } => {
                 let mut c = self.t;
                 let bank_mask = chip.l1_bank_mask;
-                let first = addr / 4;
                 let shift = chip.line_word_shift;
                 let l1_lat = chip.cfg.l1.hit_latency;
-                // The line of the previous word and the cycle its data is there: a later
-                // word of the same line sees exactly what a second tag lookup would.
-                let mut prev: Option<(u64, Cycle)> = None;
-                for w in first..first + words as u64 {
-                    let b = (w & bank_mask) as usize;
-                    let slot = chip.tms[tm].l1_banks[b].reserve(c);
-                    chip.stalls.l1_bank += slot - c;
-                    let line = w >> shift;
-                    let (r, fill) = match prev {
-                        Some((l, fill)) if l == line => {
-                            chip.caches.l1_accesses += 1;
-                            if fill <= slot {
-                                chip.caches.l1_hits += 1;
-                            } else {
-                                chip.caches.l1_merged += 1;
-                            }
-                            (fill.max(slot + l1_lat), fill)
-                        }
-                        _ => chip.load_word_fill(tm, w, slot),
-                    };
-                    prev = Some((line, fill));
-                    self.result(r, Cause::Memory);
+                let mut w = addr / 4;
+                let end = w + words as u64;
+                let mut bank_stall = 0;
+                // Line by line: the first word looks the line up (L1 tags, then L2/DRAM on a
+                // miss); later words of the same line see exactly what a second tag lookup
+                // would (hit once the fill has arrived, merged before). Every word takes its
+                // own L1 bank slot, one issue slot after the previous word's.
+                while w < end {
+                    let seg_end = (((w >> shift) + 1) << shift).min(end);
+                    let slot = chip.tms[tm].l1_banks[(w & bank_mask) as usize].reserve(c);
+                    bank_stall += slot - c;
+                    let (mut r, fill) = chip.load_word_fill(tm, w, slot);
                     c = slot + 1;
+                    if seg_end > w + 1 {
+                        let banks = &mut chip.tms[tm].l1_banks;
+                        let mut hits = 0;
+                        for v in w + 1..seg_end {
+                            let slot = banks[(v & bank_mask) as usize].reserve(c);
+                            bank_stall += slot - c;
+                            hits += u64::from(fill <= slot);
+                            c = slot + 1;
+                        }
+                        let rest = seg_end - w - 1;
+                        chip.caches.l1_accesses += rest;
+                        chip.caches.l1_hits += hits;
+                        chip.caches.l1_merged += rest - hits;
+                        r = r.max(fill.max(c - 1 + l1_lat));
+                    }
+                    self.result(r, Cause::Memory);
+                    w = seg_end;
                 }
+                chip.stalls.l1_bank += bank_stall;
                 self.t = c;
             }
             Op::Pipe { pipe, n, parallel } => {
