@@ -107,39 +107,62 @@ const SPARSE_HISTORY: u64 = 4096;
 /// channel buses and activation spacing: a backed-up bank schedules its reads hundreds of
 /// nanoseconds ahead). Unlike [`Slots`], a far-future reservation never moves a window past
 /// earlier free cycles, so a read to an idle bank of the same channel still gets the first
-/// free cycle after its own ready time. Reservations are kept in an ordered set and pruned
-/// `SPARSE_HISTORY` cycles behind each request.
+/// free cycle after its own ready time. Reservations are kept as sorted, disjoint, merged
+/// half-open intervals (a saturated bus is one long interval, so a search is a binary
+/// search plus a step or two) and pruned `SPARSE_HISTORY` cycles behind each request.
 #[derive(Clone, Debug, Default)]
 pub struct SparseSlots {
-    taken: std::collections::BTreeSet<Cycle>,
+    taken: Vec<(Cycle, Cycle)>,
 }
 
 impl SparseSlots {
     fn prune(&mut self, c: Cycle) {
         let floor = c.saturating_sub(SPARSE_HISTORY);
-        while self.taken.first().is_some_and(|&f| f < floor) {
-            self.taken.pop_first();
+        let old = self.taken.partition_point(|iv| iv.1 < floor);
+        if old > 64 {
+            self.taken.drain(..old);
+        }
+    }
+
+    /// First start `s ≥ c` where `[s, s + len)` overlaps no reservation, and the index of
+    /// the first interval ending after `s`'s predecessors.
+    fn find(&self, c: Cycle, len: u64) -> (Cycle, usize) {
+        let mut i = self.taken.partition_point(|iv| iv.1 <= c);
+        let mut s = c;
+        while let Some(&(lo, hi)) = self.taken.get(i) {
+            if lo >= s + len {
+                break;
+            }
+            s = s.max(hi);
+            i += 1;
+        }
+        (s, i)
+    }
+
+    /// Marks `[s, s + len)` taken; `i` is the index of the first interval starting after it.
+    fn insert(&mut self, s: Cycle, len: u64, i: usize) {
+        let e = s + len;
+        let joins_prev = i > 0 && self.taken[i - 1].1 == s;
+        let joins_next = self.taken.get(i).is_some_and(|iv| iv.0 == e);
+        match (joins_prev, joins_next) {
+            (true, true) => {
+                self.taken[i - 1].1 = self.taken[i].1;
+                self.taken.remove(i);
+            }
+            (true, false) => self.taken[i - 1].1 = e,
+            (false, true) => self.taken[i].0 = s,
+            (false, false) => self.taken.insert(i, (s, e)),
         }
     }
 
     /// The first free cycle at or after `c`, without reserving it.
     pub fn peek(&self, c: Cycle) -> Cycle {
-        let mut s = c;
-        for &t in self.taken.range(c..) {
-            if t != s {
-                break;
-            }
-            s += 1;
-        }
-        s
+        self.find(c, 1).0
     }
 
     /// Reserves the first free cycle at or after `c` and returns it.
     pub fn reserve(&mut self, c: Cycle) -> Cycle {
-        self.prune(c);
-        let s = self.peek(c);
-        self.taken.insert(s);
-        s
+        self.reserve_span(c, 1)
     }
 
     /// Reserves a span of `len` cycles at the first start at or after `c` where it overlaps
@@ -147,20 +170,8 @@ impl SparseSlots {
     /// minimum spacing such as t_RRD between activations).
     pub fn reserve_span(&mut self, c: Cycle, len: u64) -> Cycle {
         self.prune(c);
-        let mut s = c;
-        loop {
-            if let Some(&p) = self.taken.range(..=s).next_back()
-                && p + len > s
-            {
-                s = p + len;
-                continue;
-            }
-            match self.taken.range(s..).next() {
-                Some(&n) if n < s + len => s = n + len,
-                _ => break,
-            }
-        }
-        self.taken.insert(s);
+        let (s, i) = self.find(c, len);
+        self.insert(s, len, i);
         s
     }
 }
