@@ -158,7 +158,12 @@ impl Chip {
                 (fill.max(slot + l1_lat), fill)
             }
             Lookup::Absent => {
-                let b = (word & self.l2_bank_mask) as usize;
+                let bank_addr = if self.cfg.l2.line_interleaved {
+                    line
+                } else {
+                    word
+                };
+                let b = (bank_addr & self.l2_bank_mask) as usize;
                 let s2 = self.l2_banks[b].reserve(slot);
                 self.caches.l2_bank_wait += s2 - slot;
                 self.caches.l2_accesses += 1;
@@ -573,6 +578,24 @@ mod tests {
         // 1 + 3 + tRP 14 + tRCD 14 + tCAS 14 + burst 2 = 48.
         assert_eq!(chip.load_word(0, w, 1000), 1048);
         assert_eq!(chip.dram.stats().row_conflicts, 1);
+    }
+
+    #[test]
+    fn l2_banks_interleave_by_word_or_by_line() {
+        // Words 0 and 128 (lines 0 and 8) missing in two TMs in the same cycle: word
+        // interleaving (SimTRaX) puts both on L2 bank 0, so the second waits one cycle; line
+        // interleaving puts them on banks 0 and 8.
+        let mut cfg = SimConfig::lin2020();
+        for (by_line, wait) in [(false, 1), (true, 0)] {
+            cfg.l2.line_interleaved = by_line;
+            let mut chip = Chip::new(&cfg, 1);
+            chip.load_word(0, 0, 10);
+            chip.load_word(1, 128, 10);
+            assert_eq!(
+                chip.caches.l2_bank_wait, wait,
+                "line_interleaved = {by_line}"
+            );
+        }
     }
 
     #[test]
