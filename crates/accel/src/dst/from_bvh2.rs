@@ -157,6 +157,9 @@ fn step_for(faces: &[usize], i: usize, j: Option<usize>, target: &Aabb, c: &DstC
 /// child enters the chain in state {f}, so one DP per child prices all 6 split choices.
 pub(super) struct ChainDp {
     faces: [usize; 6],
+    /// `bit_of[f]`: the state bit of face `f` (0 when `f` is not one of F), so the state a
+    /// split enters is one lookup.
+    bit_of: [u8; 6],
     k: usize,
     target: Aabb,
     cost: [f32; 64],
@@ -174,6 +177,7 @@ impl ChainDp {
     pub fn solve(region: &Aabb, target: &Aabb, costs: &DstCosts, leaf_tris: Option<u32>) -> Self {
         let mut dp = ChainDp {
             faces: [0; 6],
+            bit_of: [0; 6],
             k: 0,
             target: *target,
             cost: [0.0; 64],
@@ -183,6 +187,7 @@ impl ChainDp {
         for f in 0..6 {
             if face(region, f) != face(target, f) {
                 dp.faces[dp.k] = f;
+                dp.bit_of[f] = 1 << dp.k;
                 dp.k += 1;
             }
         }
@@ -278,14 +283,13 @@ impl ChainDp {
     }
 
     /// The state entered when the split carves face `f` of the child (if it is one of F).
+    #[inline(always)]
     fn start(&self, carved_by_split: usize) -> usize {
-        self.faces[..self.k]
-            .iter()
-            .position(|&g| g == carved_by_split)
-            .map_or(0, |i| 1 << i)
+        self.bit_of[carved_by_split] as usize
     }
 
     /// Cost of the chain when the split carves face `f`.
+    #[inline(always)]
     pub fn cost(&self, carved_by_split: usize) -> f32 {
         self.cost[self.start(carved_by_split)] + self.base
     }
