@@ -168,6 +168,62 @@ pub(super) struct ChainDp {
     base: f32,
 }
 
+/// Start of chain length `k`'s states in [`OptionTable::range`]: Σ_{k' < k} (2^k' + 1).
+const TABLE_START: [usize; 7] = {
+    let mut out = [0usize; 7];
+    let mut k = 1;
+    while k < 7 {
+        out[k] = out[k - 1] + (1 << (k - 1)) + 1;
+        k += 1;
+    }
+    out
+};
+
+/// The DP's options for every chain length `k` ≤ 6 and state `s`: option masks (one or two
+/// faces of the remaining set) `masks[range[TABLE_START[k] + s]..range[TABLE_START[k] + s + 1]]`.
+struct OptionTable {
+    masks: [u8; 1024],
+    range: [u16; 140],
+}
+
+/// The option table, built once at compile time (676 options in all).
+const OPTIONS: OptionTable = {
+    let mut t = OptionTable {
+        masks: [0; 1024],
+        range: [0; 140],
+    };
+    let mut n = 0usize;
+    let mut k = 0;
+    while k < 7 {
+        let full = (1usize << k) - 1;
+        let mut s = 0;
+        while s <= full {
+            t.range[TABLE_START[k] + s] = n as u16;
+            let rem = full & !s;
+            let mut i = 0;
+            while i < k {
+                if rem & 1 << i != 0 {
+                    t.masks[n] = 1 << i;
+                    n += 1;
+                    let mut j = i + 1;
+                    while j < k {
+                        if rem & 1 << j != 0 {
+                            t.masks[n] = (1 << i | 1 << j) as u8;
+                            n += 1;
+                        }
+                        j += 1;
+                    }
+                }
+                i += 1;
+            }
+            s += 1;
+        }
+        t.range[TABLE_START[k] + full + 1] = n as u16;
+        k += 1;
+    }
+    t
+};
+
 impl ChainDp {
     /// Solves the DP from `region` (the parent box) down to `target` (the child box).
     /// `leaf_tris` is `Some(n)` when the child is a leaf of `n` triangles and similar
@@ -231,12 +287,14 @@ impl ChainDp {
             sa[s] = x * y + y * z + z * x;
         }
         dp.base = leaf_cost(sa[full]).unwrap_or(0.0);
-        // Pair costs, and for each face the partners whose pair node costs no more than a
+        // Option weights by option mask (one face = a lone-face node, two faces = a pair
+        // node), and for each lone face the partners whose pair node costs no more than a
         // lone-face node: while such a partner remains, carving the face alone is dominated
         // (the DP cost never grows when more faces are already carved), so it is skipped.
-        let mut pair = [[0f32; 6]; 6];
-        let mut cheap_partner = [0usize; 6];
+        let mut weight = [0f32; 64];
+        let mut cheap_partner = [0u8; 64];
         for i in 0..k {
+            weight[1 << i] = c_lone;
             for (j, &fj) in dp.faces[..k].iter().enumerate() {
                 if i == j {
                     continue;
@@ -246,38 +304,33 @@ impl ChainDp {
                 } else {
                     costs.dual_carve
                 };
-                pair[i][j] = c;
+                weight[1 << i | 1 << j] = c;
                 if c <= c_lone {
-                    cheap_partner[i] |= 1 << j;
+                    cheap_partner[1 << i] |= 1 << j;
                 }
             }
         }
+        // The options of every state come from a table built at compile time, in the order
+        // of the original loops (lone i, then pairs (i, j > i), for i ascending), so ties
+        // go to the same option; the selection is branch-free.
+        let table = &OPTIONS;
+        let first = TABLE_START[k];
         for s in (0..full).rev() {
             let stop = leaf_cost(sa[s]).map_or(f32::INFINITY, |c| c - dp.base);
-            let mut best = (stop, 0u8);
-            let rem = full & !s;
-            let mut rem_i = rem;
-            while rem_i != 0 {
-                let i = rem_i.trailing_zeros() as usize;
-                rem_i &= rem_i - 1;
-                if rem & cheap_partner[i] == 0 {
-                    let c = c_lone * sa[s] + dp.cost[s | 1 << i];
-                    if c < best.0 {
-                        best = (c, 1 << i);
-                    }
-                }
-                let mut rem_j = rem_i;
-                while rem_j != 0 {
-                    let j = rem_j.trailing_zeros() as usize;
-                    rem_j &= rem_j - 1;
-                    let c = pair[i][j] * sa[s] + dp.cost[s | 1 << i | 1 << j];
-                    if c < best.0 {
-                        best = (c, (1 << i | 1 << j) as u8);
-                    }
-                }
+            let (mut best_c, mut best_t) = (stop, 0u8);
+            let rem = (full & !s) as u8;
+            let (lo, hi) = (
+                table.range[first + s] as usize,
+                table.range[first + s + 1] as usize,
+            );
+            for &t in &table.masks[lo..hi] {
+                let c = weight[t as usize] * sa[s] + dp.cost[s | t as usize];
+                let better = (c < best_c) & (rem & cheap_partner[t as usize] == 0);
+                best_c = if better { c } else { best_c };
+                best_t = if better { t } else { best_t };
             }
-            dp.cost[s] = best.0;
-            dp.choice[s] = best.1;
+            dp.cost[s] = best_c;
+            dp.choice[s] = best_t;
         }
         dp
     }
