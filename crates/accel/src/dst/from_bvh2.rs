@@ -186,8 +186,18 @@ struct OptionTable {
     range: [u16; 140],
 }
 
-/// The option table, built once at compile time (676 options in all).
-const OPTIONS: OptionTable = {
+/// The option table, built once at compile time (672 options in all).
+const OPTIONS: OptionTable = option_table(false);
+
+/// The option table when every pair node costs no more than a lone-face node (equal costs,
+/// the hardware preset): a lone face is then only ever carved as the last remaining face
+/// (the dominance rule in [`ChainDp::solve`]), so the other lone options, which the rule
+/// would reject anyway, are left out.
+const OPTIONS_PAIRS_CHEAP: OptionTable = option_table(true);
+
+/// Builds an option table; `pairs_cheap` keeps lone-face options only in states with one
+/// face remaining.
+const fn option_table(pairs_cheap: bool) -> OptionTable {
     let mut t = OptionTable {
         masks: [0; 1024],
         range: [0; 140],
@@ -200,11 +210,14 @@ const OPTIONS: OptionTable = {
         while s <= full {
             t.range[TABLE_START[k] + s] = n as u16;
             let rem = full & !s;
+            let lone = !pairs_cheap || rem.count_ones() == 1;
             let mut i = 0;
             while i < k {
                 if rem & 1 << i != 0 {
-                    t.masks[n] = 1 << i;
-                    n += 1;
+                    if lone {
+                        t.masks[n] = 1 << i;
+                        n += 1;
+                    }
                     let mut j = i + 1;
                     while j < k {
                         if rem & 1 << j != 0 {
@@ -222,7 +235,7 @@ const OPTIONS: OptionTable = {
         k += 1;
     }
     t
-};
+}
 
 impl ChainDp {
     /// Solves the DP from `region` (the parent box) down to `target` (the child box).
@@ -313,7 +326,12 @@ impl ChainDp {
         // The options of every state come from a table built at compile time, in the order
         // of the original loops (lone i, then pairs (i, j > i), for i ascending), so ties
         // go to the same option; the selection is branch-free.
-        let table = &OPTIONS;
+        let pairs_cheap = costs.single_carve <= c_lone && costs.dual_carve <= c_lone;
+        let table = if pairs_cheap {
+            &OPTIONS_PAIRS_CHEAP
+        } else {
+            &OPTIONS
+        };
         let first = TABLE_START[k];
         for s in (0..full).rev() {
             let stop = leaf_cost(sa[s]).map_or(f32::INFINITY, |c| c - dp.base);
