@@ -243,6 +243,7 @@ impl ChainDp {
     /// partitioning is on: the chain may then stop early, paying `C_tri · n · SA` of the
     /// looser region instead. Costs are SAH-weighted by the area of the region in which
     /// each node is tested.
+    #[inline(always)]
     pub fn solve(region: &Aabb, target: &Aabb, costs: &DstCosts, leaf_tris: Option<u32>) -> Self {
         let mut dp = ChainDp {
             faces: [0; 6],
