@@ -161,3 +161,25 @@ const GOLDEN_BUNNY: [Golden; 4] = [
         8513990613833046186,
     ),
 ];
+
+/// The image does not depend on the thread count (the parallel subtrees are appended in a
+/// fixed depth-first order).
+#[test]
+fn same_image_for_any_thread_count() {
+    use dualsplit_accel::dst::Dst;
+    let tris = load_shipped("bunny.ply.gz");
+    let b = build(&tris, &DstConfig::hardware());
+    for threads in [1, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("thread pool");
+        let dst = pool.install(|| Dst::from_bvh2(&b.bvh, &tris, &DstConfig::hardware()));
+        let dst = dst.expect("conversion");
+        assert_eq!(
+            dst.image().words,
+            b.dst.image().words,
+            "{threads} threads: image differs"
+        );
+    }
+}
