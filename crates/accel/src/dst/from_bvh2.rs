@@ -237,6 +237,22 @@ const fn option_table(pairs_cheap: bool) -> OptionTable {
     t
 }
 
+/// What the DP loop of [`ChainDp::solve`] reads.
+struct DpInputs<'a> {
+    /// The state with every face of F carved.
+    full: usize,
+    /// [`TABLE_START`] of the chain length.
+    first: usize,
+    /// Surface area of the region in each state.
+    sa: &'a [f32; 64],
+    /// Node cost by option mask.
+    weight: &'a [f32; 64],
+    /// For a lone-face option mask: the faces whose pair node is no dearer.
+    cheap_partner: &'a [u8; 64],
+    /// `C_tri · n` of the leaf below when the chain may stop early (similar partitioning).
+    tri_weight: Option<f32>,
+}
+
 impl ChainDp {
     /// Solves the DP from `region` (the parent box) down to `target` (the child box).
     /// `leaf_tris` is `Some(n)` when the child is a leaf of `n` triangles and similar
@@ -328,30 +344,58 @@ impl ChainDp {
         // of the original loops (lone i, then pairs (i, j > i), for i ascending), so ties
         // go to the same option; the selection is branch-free.
         let pairs_cheap = costs.single_carve <= c_lone && costs.dual_carve <= c_lone;
-        let table = if pairs_cheap {
+        let inputs = DpInputs {
+            full,
+            first: TABLE_START[k],
+            sa: &sa,
+            weight: &weight,
+            cheap_partner: &cheap_partner,
+            tri_weight: leaf_tris.map(|n| costs.triangle * n as f32),
+        };
+        match (pairs_cheap, inputs.tri_weight.is_some()) {
+            (true, false) => dp.run::<true, false>(&inputs),
+            (true, true) => dp.run::<true, true>(&inputs),
+            (false, false) => dp.run::<false, false>(&inputs),
+            (false, true) => dp.run::<false, true>(&inputs),
+        }
+        dp
+    }
+
+    /// The DP proper, over the states from `full - 1` down to 0, specialised on whether
+    /// every pair node is no dearer than a lone-face node (`PAIRS_CHEAP`: the option table
+    /// then holds no dominated lone option, so none needs the partner test) and on whether
+    /// the chain may stop early above a leaf (`STOP`, similar partitioning).
+    #[inline(always)]
+    fn run<const PAIRS_CHEAP: bool, const STOP: bool>(&mut self, d: &DpInputs) {
+        let table = if PAIRS_CHEAP {
             &OPTIONS_PAIRS_CHEAP
         } else {
             &OPTIONS
         };
-        let first = TABLE_START[k];
-        for s in (0..full).rev() {
-            let stop = leaf_cost(sa[s]).map_or(f32::INFINITY, |c| c - dp.base);
+        let tri_weight = d.tri_weight.unwrap_or(0.0);
+        for s in (0..d.full).rev() {
+            let sa = d.sa[s];
+            let stop = if STOP {
+                tri_weight * sa - self.base
+            } else {
+                f32::INFINITY
+            };
             let (mut best_c, mut best_t) = (stop, 0u8);
-            let rem = (full & !s) as u8;
+            let rem = (d.full & !s) as u8;
             let (lo, hi) = (
-                table.range[first + s] as usize,
-                table.range[first + s + 1] as usize,
+                table.range[d.first + s] as usize,
+                table.range[d.first + s + 1] as usize,
             );
             for &t in &table.masks[lo..hi] {
-                let c = weight[t as usize] * sa[s] + dp.cost[s | t as usize];
-                let better = (c < best_c) & (rem & cheap_partner[t as usize] == 0);
+                let c = d.weight[t as usize] * sa + self.cost[s | t as usize];
+                let allowed = PAIRS_CHEAP || rem & d.cheap_partner[t as usize] == 0;
+                let better = (c < best_c) & allowed;
                 best_c = if better { c } else { best_c };
                 best_t = if better { t } else { best_t };
             }
-            dp.cost[s] = best_c;
-            dp.choice[s] = best_t;
+            self.cost[s] = best_c;
+            self.choice[s] = best_t;
         }
-        dp
     }
 
     /// The state entered when the split carves face `f` of the child (if it is one of F).
