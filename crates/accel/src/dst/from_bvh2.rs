@@ -13,6 +13,11 @@
 //! of carved faces (one DP per child prices all six split choices): a step carves one face or two (two on
 //! one axis = single-axis carving node, on two axes = dual-axis carving node); a lone face
 //! is carved by the cheaper node type with a ±∞ no-op partner plane.
+//!
+//! Speed: each state's options come from a table built at compile time ([`OPTIONS`]) in
+//! the order of the original nested loops, and the cheapest is selected without branches,
+//! with the same strict `<` and the same float expressions, so every decision (ties
+//! included) is the one the plain loops made (`tests/dst_convert_golden.rs`).
 
 use super::header::{AxisPair, Corner};
 use super::{DstConfig, DstCosts, Partitioning};
