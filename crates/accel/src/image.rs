@@ -8,7 +8,32 @@
 //! | nodes | the structure's nodes, depth-first, siblings adjacent |
 //! | indices | triangle-index lists of the leaves |
 //! | triangles | the scene's triangles, 36 B each (9 × f32), in triangle-id order |
+//!
+//! ## BVH images (BVH2, BVH4, BVH8; Lin et al. 2020, §4.2)
+//!
+//! The node region starts with the root's internal node at word 0. An internal node stores
+//! the boxes of its children, one offset word and the children's types ([`ChildKind`]); the
+//! node types are [`crate::bvh2::Node2`] (52 B), [`crate::wide::Node4`] (100 B) and
+//! [`crate::wide::Node8`] (200 B). All children of a node are stored consecutively from its
+//! offset, in slot order, each taking:
+//!
+//! | child kind | words in the child block |
+//! |---|---|
+//! | internal | one whole node (13, 25 or 50 words) |
+//! | leaf | one *leaf word*: the absolute word index of the leaf's triangle-index run |
+//! | empty | nothing (its slot holds [`dualsplit_geometry::Aabb::DEGENERATE`]) |
+//!
+//! so child `k` lives at `offset + Σ_{j<k} size(kind_j)`, exactly as the DST finds its right
+//! child at "left + size(left)" (Lin et al. 2020, §3). A leaf's index run is a list of triangle
+//! ids whose last entry has bit 31 set (the DST convention), so no count is stored. A root
+//! that is itself a leaf (tiny scenes) is encoded as a root node with that leaf in slot 0 and
+//! empty slots elsewhere; an empty scene is a root node whose slots are all empty.
+//!
+//! Runs are laid out in the depth-first order of the leaves. All offsets are absolute word
+//! indices; the triangle of id `i` is at word `triangles.start + 9·i`.
 
+use crate::observer::Observer;
+use dualsplit_geometry::{Aabb, Triangle, Vec3};
 use std::ops::Range;
 
 /// A structure's memory image: words plus the word ranges of its three regions.
@@ -45,5 +70,181 @@ impl MemoryImage {
     /// The whole image as bytes (little-endian).
     pub fn to_bytes(&self) -> Vec<u8> {
         self.words.iter().flat_map(|w| w.to_le_bytes()).collect()
+    }
+    /// The triangle region viewed as triangles (id order).
+    #[inline]
+    pub fn triangle_slice(&self) -> &[Triangle] {
+        bytemuck::cast_slice(&self.words[self.triangles.clone()])
+    }
+    /// Triangle `prim`, read from the image, reporting the 36-byte fetch to `obs`.
+    #[inline(always)]
+    pub fn fetch_triangle<O: Observer>(&self, prim: u32, obs: &mut O) -> Triangle {
+        let w = self.triangles.start + 9 * prim as usize;
+        obs.fetch(Self::addr(w), 36);
+        self.triangle_slice()[prim as usize]
+    }
+    /// Appends the triangle region (36 B per triangle, id order) and records its range.
+    pub fn push_triangles(&mut self, triangles: &[Triangle]) {
+        let start = self.words.len();
+        self.words
+            .extend_from_slice(bytemuck::cast_slice::<Triangle, u32>(triangles));
+        self.triangles = start..self.words.len();
+    }
+}
+
+/// Errors while encoding a memory image.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ImageError {
+    /// A child offset does not fit the node's offset field.
+    #[error("{structure}: offset {given} does not fit the {bits}-bit offset field (limit {limit})")]
+    OffsetOverflow {
+        /// Which node layout.
+        structure: &'static str,
+        /// The offset that was to be stored (word index).
+        given: u64,
+        /// Field width in bits.
+        bits: u32,
+        /// Largest storable offset.
+        limit: u64,
+    },
+    /// A triangle id is too large for a 31-bit index-list entry.
+    #[error("triangle id {given} does not fit a 31-bit index entry (limit {limit})")]
+    PrimOverflow {
+        /// The id.
+        given: u64,
+        /// Largest storable id.
+        limit: u64,
+    },
+}
+
+/// The type of one child slot of a BVH node (see the module table).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ChildKind {
+    /// Empty slot: degenerate box, takes no space in the child block.
+    Empty,
+    /// Internal child: a whole node in the child block.
+    Internal,
+    /// Leaf child: one leaf word in the child block.
+    Leaf,
+}
+
+/// A BVH internal-node layout stored in a memory image (BVH2, BVH4, BVH8).
+///
+/// Implementors are `#[repr(C)]` plain-old-data structs of exactly `WORDS` words, read from
+/// the image with a bytemuck cast.
+pub trait NodeLayout: bytemuck::Pod {
+    /// Structure name (for errors and reports).
+    const NAME: &'static str;
+    /// Child slots.
+    const ARITY: usize;
+    /// Node size in 32-bit words.
+    const WORDS: usize;
+    /// Bits of the offset field.
+    const OFFSET_BITS: u32;
+
+    /// Encodes a node from its children (at most `ARITY`, filled into slots in order, the
+    /// rest empty) and the word offset of its child block.
+    fn encode(children: &[(Aabb, ChildKind)], offset: u32) -> Result<Self, ImageError>;
+    /// The word offset of the child block.
+    fn offset(&self) -> u32;
+    /// Kind of slot `k`.
+    fn kind(&self, k: usize) -> ChildKind;
+    /// Box of slot `k` (degenerate for an empty slot).
+    fn child_bounds(&self, k: usize) -> Aabb;
+
+    /// Size in words of a child of kind `kind` inside a child block.
+    #[inline(always)]
+    fn child_words(kind: ChildKind) -> u32 {
+        match kind {
+            ChildKind::Empty => 0,
+            ChildKind::Internal => Self::WORDS as u32,
+            ChildKind::Leaf => 1,
+        }
+    }
+
+    /// Reads the node at word `at` of `words`.
+    #[inline(always)]
+    fn read(words: &[u32], at: usize) -> &Self {
+        bytemuck::from_bytes(bytemuck::cast_slice(&words[at..at + Self::WORDS]))
+    }
+
+    /// Checks that `offset` fits the offset field.
+    fn check_offset(offset: u32) -> Result<u32, ImageError> {
+        let limit = (1u64 << Self::OFFSET_BITS) - 1;
+        if offset as u64 > limit {
+            return Err(ImageError::OffsetOverflow {
+                structure: Self::NAME,
+                given: offset as u64,
+                bits: Self::OFFSET_BITS,
+                limit,
+            });
+        }
+        Ok(offset)
+    }
+}
+
+/// Writes a box as 6 f32 words: min.xyz, max.xyz.
+#[inline]
+pub(crate) fn box_words(b: Aabb) -> [f32; 6] {
+    [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z]
+}
+
+/// Reads a box from 6 f32 words.
+#[inline(always)]
+pub(crate) fn words_box(w: &[f32; 6]) -> Aabb {
+    Aabb::new(Vec3::new(w[0], w[1], w[2]), Vec3::new(w[3], w[4], w[5]))
+}
+
+/// True for the box of an empty slot (`min > max` on x, as in [`Aabb::DEGENERATE`]).
+#[inline(always)]
+pub(crate) fn is_degenerate_box(w: &[f32; 6]) -> bool {
+    w[0] > w[3]
+}
+
+#[cfg(test)]
+pub(crate) mod test_support {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Up to `arity` children: non-empty ones first (internal or leaf), finite boxes.
+    pub fn arb_children(arity: usize) -> impl Strategy<Value = Vec<(Aabb, ChildKind)>> {
+        let child = (
+            prop::array::uniform3(-1e6f32..1e6),
+            prop::array::uniform3(0f32..1e3),
+            prop::bool::ANY,
+        )
+            .prop_map(|(p, e, leaf)| {
+                let min = Vec3::from(p);
+                (
+                    Aabb::new(min, min + Vec3::from(e)),
+                    if leaf {
+                        ChildKind::Leaf
+                    } else {
+                        ChildKind::Internal
+                    },
+                )
+            });
+        prop::collection::vec(child, 0..=arity)
+    }
+
+    /// Encodes, reads back through the word image, and compares every slot.
+    pub fn roundtrip<L: NodeLayout>(children: &[(Aabb, ChildKind)], offset: u32) {
+        let n = L::encode(children, offset).unwrap();
+        let words: Vec<u32> = bytemuck::cast_slice(std::slice::from_ref(&n)).to_vec();
+        assert_eq!(words.len(), L::WORDS);
+        let back = L::read(&words, 0);
+        assert_eq!(back.offset(), offset);
+        for k in 0..L::ARITY {
+            match children.get(k) {
+                Some(&(b, kind)) => {
+                    assert_eq!(back.kind(k), kind);
+                    assert_eq!(back.child_bounds(k), b);
+                }
+                None => {
+                    assert_eq!(back.kind(k), ChildKind::Empty);
+                    assert_eq!(back.child_bounds(k), Aabb::DEGENERATE);
+                }
+            }
+        }
     }
 }

@@ -10,15 +10,23 @@
 //! [`Structures`] builds all of them from one scene and dispatches by [`AccelKind`].
 
 pub mod build;
+pub mod bvh2;
 pub mod image;
 pub mod observer;
+pub mod stats;
+pub mod validate;
+pub mod wide;
 
 pub use build::{BuildConfig, Bvh2, Bvh2Node};
-pub use image::MemoryImage;
+pub use image::{ImageError, MemoryImage};
 pub use observer::{CountingObserver, DstNodeKind, NoObserver, NodeStep, Observer};
+pub use stats::StructureStats;
+pub use validate::ValidationReport;
+pub use wide::{BvhImage, CollapseConfig, WideBvh};
 
-use dualsplit_geometry::{Aabb, Hit, Ray, Triangle, cull_limit};
+use dualsplit_geometry::{Aabb, Hit, Ray, Triangle};
 use serde::{Deserialize, Serialize};
+use std::time::Instant;
 
 /// The traversal variants a workload can run on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -63,77 +71,124 @@ impl AccelKind {
     }
 }
 
-/// Every structure built from one scene's BVH2.
+/// Errors while building the structures of a scene.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum AccelError {
+    /// A memory image could not be encoded (an offset field overflowed).
+    #[error(transparent)]
+    Image(#[from] ImageError),
+}
+
+/// Every structure built from one scene's BVH2: the logical BVH2 and the encoded BVH2, BVH4
+/// (Dammertz collapse) and BVH8 (Ylitie collapse), all with identical leaves.
 ///
-/// PLACEHOLDER (skeleton): until the encoded structures land, every kind traverses the
-/// logical BVH2. The API (`build`, `closest_hit`, `any_hit`) is the contract.
+/// ```
+/// use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
+/// use dualsplit_geometry::{Ray, Triangle, Vec3};
+/// let tris = [Triangle::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0))];
+/// let s = Structures::build(&tris, &BuildConfig::default());
+/// let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+/// for kind in AccelKind::ALL {
+///     assert_eq!(s.closest_hit(kind, &ray, &mut NoObserver).unwrap().t, 2.0);
+/// }
+/// ```
 pub struct Structures {
     /// The scene's triangles (ids are indices).
     pub triangles: Vec<Triangle>,
-    /// The source BVH2.
+    /// The source BVH2 (logical).
     pub bvh2: Bvh2,
+    /// The encoded BVH2 (52-byte nodes); its `time` is the BVH2 build time.
+    pub bvh2_image: BvhImage,
+    /// The encoded BVH4 (100-byte nodes); its `time` is the collapse time.
+    pub bvh4: BvhImage,
+    /// The encoded BVH8 (200-byte nodes); its `time` is the collapse time.
+    pub bvh8: BvhImage,
 }
 
 impl Structures {
     /// Builds every structure for `triangles`.
+    ///
+    /// # Panics
+    /// When an image offset overflows its field (more than about 2^28 words of BVH4 nodes,
+    /// i.e. tens of millions of triangles); use [`Structures::try_build`] to get the error.
     pub fn build(triangles: &[Triangle], cfg: &BuildConfig) -> Self {
+        match Self::try_build(triangles, cfg) {
+            Ok(s) => s,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    /// Builds every structure for `triangles`, or reports which image could not be encoded.
+    pub fn try_build(triangles: &[Triangle], cfg: &BuildConfig) -> Result<Self, AccelError> {
+        let t0 = Instant::now();
         let boxes: Vec<Aabb> = triangles.iter().map(|t| t.bounds()).collect();
         let bvh2 = Bvh2::build(&boxes, cfg);
-        Self {
+        let build_time = t0.elapsed();
+        let wide2 = WideBvh::from_bvh2(&bvh2);
+        let bvh2_image = BvhImage::encode(&wide2, &bvh2, triangles, cfg, build_time)?;
+        let t0 = Instant::now();
+        let wide4 = WideBvh::collapse_bvh4(&bvh2);
+        let t4 = t0.elapsed();
+        let bvh4 = BvhImage::encode(&wide4, &bvh2, triangles, cfg, t4)?;
+        let t0 = Instant::now();
+        let wide8 = WideBvh::collapse_bvh8(&bvh2, &CollapseConfig::default());
+        let t8 = t0.elapsed();
+        let bvh8 = BvhImage::encode(&wide8, &bvh2, triangles, cfg, t8)?;
+        Ok(Self {
             triangles: triangles.to_vec(),
             bvh2,
+            bvh2_image,
+            bvh4,
+            bvh8,
+        })
+    }
+
+    /// The encoded structure `kind` traverses.
+    pub fn encoded(&self, kind: AccelKind) -> &BvhImage {
+        match kind {
+            AccelKind::Bvh2 => &self.bvh2_image,
+            AccelKind::Bvh4 => &self.bvh4,
+            AccelKind::Bvh8 => &self.bvh8,
+            // INTEGRATION: DST — the DST image replaces this once the converter lands.
+            AccelKind::DstSw | AccelKind::Dst => &self.bvh2_image,
         }
+    }
+
+    /// The memory image `kind` reads (what the simulator replays fetches against).
+    pub fn image(&self, kind: AccelKind) -> &MemoryImage {
+        &self.encoded(kind).image
     }
 
     /// Closest hit of `ray` on structure `kind`.
-    pub fn closest_hit<O: Observer>(
-        &self,
-        _kind: AccelKind,
-        ray: &Ray,
-        obs: &mut O,
-    ) -> Option<Hit> {
-        let r = ray.precompute();
-        let mut best: Option<Hit> = None;
-        let mut best_t = ray.t_max;
-        let mut stack = vec![0u32];
-        while let Some(n) = stack.pop() {
-            let node = &self.bvh2.nodes[n as usize];
-            let (e, x) = r.slab(
-                node.bounds.min,
-                node.bounds.max,
-                ray.t_min,
-                cull_limit(best_t),
-            );
-            if e > x {
-                continue;
-            }
-            if node.is_leaf() {
-                for &p in
-                    &self.bvh2.prim_ids[node.first as usize..(node.first + node.count) as usize]
-                {
-                    let h = self.triangles[p as usize].intersect(&r, ray.t_min, best_t);
-                    obs.triangle_test(p, h.is_some());
-                    if let Some(h) = h {
-                        if best.is_none_or(|b| !b.closer_than(h.t, p)) {
-                            best = Some(Hit {
-                                t: h.t,
-                                prim: p,
-                                u: h.u,
-                                v: h.v,
-                            });
-                            best_t = h.t;
-                        }
-                    }
-                }
-            } else {
-                stack.extend(node.children());
-            }
-        }
-        best
+    #[inline]
+    pub fn closest_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        // INTEGRATION: DST — DstSw and Dst dispatch to the BVH2 until the DST lands.
+        self.encoded(kind).closest_hit(ray, obs)
     }
 
     /// True when `ray` hits any triangle within `[t_min, t_max]`.
+    #[inline]
     pub fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool {
-        self.closest_hit(kind, ray, obs).is_some()
+        // INTEGRATION: DST — DstSw and Dst dispatch to the BVH2 until the DST lands.
+        self.encoded(kind).any_hit(ray, obs)
+    }
+
+    /// Validates the three BVH images (BVH2, BVH4, BVH8).
+    pub fn validate(&self) -> Vec<ValidationReport> {
+        vec![
+            self.bvh2_image.validate(),
+            self.bvh4.validate(),
+            self.bvh8.validate(),
+        ]
+    }
+
+    /// Size and build statistics of BVH2, BVH4 and BVH8 (the paper's Table 3).
+    pub fn stats(&self) -> Vec<StructureStats> {
+        let base = self.bvh2_image.bytes_total();
+        vec![
+            StructureStats::of("bvh2", &self.bvh2_image, base),
+            StructureStats::of("bvh4", &self.bvh4, base),
+            StructureStats::of("bvh8", &self.bvh8, base),
+        ]
     }
 }

@@ -13,9 +13,14 @@
 //!
 //! One rule everywhere: triangles with a non-finite coordinate (NaN or ±∞) are **dropped**
 //! at load time and counted in [`LoadStats::non_finite`]; zero-area triangles are **kept**
-//! (they are real input, never hit by the watertight test, and they keep triangle ids equal
-//! to face indices of the file) and counted in [`LoadStats::degenerate`]. A scene with no
-//! triangle left is an error ([`SceneError::Empty`]).
+//! (they are real input and never hit by the watertight test) and counted in
+//! [`LoadStats::degenerate`]. A scene with no triangle left is an error ([`SceneError::Empty`]).
+//!
+//! Triangle ids follow the file: the loaders emit triangles in face order of the file, each
+//! polygon fan-triangulated in place (see [`load`](mod@load)), and dropping keeps that order.
+//! So a triangle's id is its face index in the file after triangulation, minus the number of
+//! non-finite triangles before it: ids equal file face indices whenever
+//! [`LoadStats::non_finite`] is zero.
 
 pub mod builtin;
 mod camera;
@@ -38,6 +43,9 @@ pub struct LoadStats {
     pub non_finite: u64,
     /// Polygons with more than three vertices that were fan-triangulated.
     pub polygons_triangulated: u64,
+    /// glTF primitives skipped because their mode is not `TRIANGLES` (points, lines, strips,
+    /// fans).
+    pub primitives_skipped: u64,
 }
 
 /// A loaded scene: the triangle soup, its bounds, and a default camera and light.

@@ -1,7 +1,26 @@
-//! The BVH2 builder: SAH without triangle splitting. Builders see only boxes and centroids.
+//! The BVH2 builder: binned SAH without triangle splitting, standing in for Embree 3's
+//! high-quality builder (Lin et al. 2020, §4.2 builds every structure from one such BVH2).
+//!
+//! Builders see only primitive boxes and their centroids. The build is top-down:
+//!
+//! 1. every range is binned by centroid into [`BuildConfig::bins`] bins on each axis (the
+//!    top levels bin in parallel chunks with rayon), and the bin boundary with the smallest
+//!    SAH cost `A_L·n_L + A_R·n_R` is chosen;
+//! 2. a range becomes a leaf when it holds at most [`BuildConfig::max_leaf_size`] primitives
+//!    and a leaf is no more expensive than the best split;
+//! 3. the two halves are built with `rayon::join` above [`BuildConfig::parallel_threshold`]
+//!    primitives;
+//! 4. past depth [`MAX_SAH_DEPTH`] the builder falls back to an object-median split so that
+//!    adversarial inputs cannot produce an unbounded depth.
+//!
+//! The temporary tree is then flattened depth-first with the two children of every node
+//! adjacent (`left = first`, `right = first + 1`), root at index 0.
 
 use dualsplit_geometry::{Aabb, Vec3};
 use serde::{Deserialize, Serialize};
+
+/// Depth after which ranges are split at the object median instead of by SAH.
+pub const MAX_SAH_DEPTH: u32 = 64;
 
 /// Build settings. Every field has a default; [`BuildConfig::high_quality`] is the preset used
 /// for the paper's structures.
@@ -13,8 +32,10 @@ pub struct BuildConfig {
     pub cost_traversal: f32,
     /// SAH cost of one ray–triangle test.
     pub cost_triangle: f32,
-    /// Number of SAH bins per axis.
+    /// Number of SAH bins per axis (clamped to 2..=256).
     pub bins: u32,
+    /// Ranges larger than this are built (and binned) in parallel.
+    pub parallel_threshold: u32,
 }
 
 impl Default for BuildConfig {
@@ -24,13 +45,31 @@ impl Default for BuildConfig {
 }
 
 impl BuildConfig {
-    /// The preset standing in for Embree 3's high-quality builder.
+    /// The preset standing in for Embree 3's high-quality builder: 32 bins, leaves of at most
+    /// 4 triangles, traversal and intersection costs equal.
     pub fn high_quality() -> Self {
         Self {
             max_leaf_size: 4,
             cost_traversal: 1.0,
             cost_triangle: 1.0,
             bins: 32,
+            parallel_threshold: 4096,
+        }
+    }
+
+    /// A cheaper preset for tests and quick previews: 16 bins.
+    pub fn fast() -> Self {
+        Self {
+            bins: 16,
+            ..Self::high_quality()
+        }
+    }
+
+    /// One triangle per leaf (every leaf a single triangle), useful for tests.
+    pub fn single_triangle_leaves() -> Self {
+        Self {
+            max_leaf_size: 1,
+            ..Self::high_quality()
         }
     }
 }
@@ -62,6 +101,9 @@ impl Bvh2Node {
 }
 
 /// The logical binary BVH every other structure is derived from. Root at index 0.
+///
+/// For an empty input the root is a node with `count == 0` and empty bounds and no children
+/// (`first == right == 0`); callers check [`Bvh2::is_empty`].
 #[derive(Clone, Debug)]
 pub struct Bvh2 {
     /// Nodes; index 0 is the root.
@@ -72,21 +114,81 @@ pub struct Bvh2 {
     pub sah_cost: f32,
 }
 
+enum Tmp {
+    Leaf {
+        bounds: Aabb,
+        first: u32,
+        count: u32,
+    },
+    Inner {
+        bounds: Aabb,
+        kids: Box<[Tmp; 2]>,
+    },
+}
+
+struct Ctx<'a> {
+    pb: &'a [Aabb],
+    cent: &'a [Vec3],
+    cfg: BuildConfig,
+    bins: usize,
+}
+
+#[derive(Clone, Copy)]
+struct Bin {
+    bounds: Aabb,
+    cbounds: Aabb,
+    count: u32,
+}
+
+const EMPTY_BIN: Bin = Bin {
+    bounds: Aabb::EMPTY,
+    cbounds: Aabb::EMPTY,
+    count: 0,
+};
+
+/// The chosen split of a range.
+struct Split {
+    cost: f32,
+    axis: usize,
+    bin: usize,
+    left: (Aabb, Aabb),
+    right: (Aabb, Aabb),
+}
+
 impl Bvh2 {
-    /// Builds a BVH2 over primitive boxes.
+    /// Builds a BVH2 over primitive boxes (one per triangle; ids are indices).
     pub fn build(prim_bounds: &[Aabb], cfg: &BuildConfig) -> Self {
         let centroids: Vec<Vec3> = prim_bounds.iter().map(|b| b.center()).collect();
         let mut ids: Vec<u32> = (0..prim_bounds.len() as u32).collect();
-        let mut nodes = Vec::with_capacity(prim_bounds.len() * 2);
+        if prim_bounds.is_empty() {
+            return Self {
+                nodes: vec![Bvh2Node {
+                    bounds: Aabb::EMPTY,
+                    first: 0,
+                    count: 0,
+                    right: 0,
+                }],
+                prim_ids: ids,
+                sah_cost: 0.0,
+            };
+        }
+        let ctx = Ctx {
+            pb: prim_bounds,
+            cent: &centroids,
+            cfg: *cfg,
+            bins: cfg.bins.clamp(2, 256) as usize,
+        };
+        let (bounds, cbounds) = range_bounds(&ctx, &ids);
+        let tmp = build_range(&ctx, &mut ids, 0, bounds, cbounds, 0);
+        let mut nodes =
+            Vec::with_capacity(prim_bounds.len() * 2 / cfg.max_leaf_size.max(1) as usize + 1);
         nodes.push(Bvh2Node {
             bounds: Aabb::EMPTY,
             first: 0,
             count: 0,
             right: 0,
         });
-        if !prim_bounds.is_empty() {
-            build_rec(prim_bounds, &centroids, &mut ids, 0, &mut nodes, 0, cfg);
-        }
+        flatten(&tmp, 0, &mut nodes);
         let mut bvh = Self {
             nodes,
             prim_ids: ids,
@@ -96,8 +198,24 @@ impl Bvh2 {
         bvh
     }
 
+    /// True when the tree holds no primitive.
+    pub fn is_empty(&self) -> bool {
+        self.prim_ids.is_empty()
+    }
+
+    /// Number of leaves.
+    pub fn leaf_count(&self) -> usize {
+        if self.is_empty() {
+            return 0;
+        }
+        self.nodes.iter().filter(|n| n.is_leaf()).count()
+    }
+
     /// SAH cost of the tree: Σ internal SA·c_t + Σ leaf SA·n·c_i, divided by the root SA.
     pub fn compute_sah(&self, cfg: &BuildConfig) -> f32 {
+        if self.is_empty() {
+            return 0.0;
+        }
         let root = self.nodes[0].bounds.half_area().max(f32::MIN_POSITIVE);
         let mut c = 0.0f64;
         for n in &self.nodes {
@@ -112,113 +230,150 @@ impl Bvh2 {
     }
 }
 
-fn build_rec(
-    pb: &[Aabb],
-    cent: &[Vec3],
-    ids: &mut [u32],
-    offset: u32,
-    nodes: &mut Vec<Bvh2Node>,
-    node: usize,
-    cfg: &BuildConfig,
-) {
-    let bounds = ids
-        .iter()
-        .fold(Aabb::EMPTY, |b, &i| b.union(pb[i as usize]));
-    let n = ids.len();
-    nodes[node] = Bvh2Node {
-        bounds,
-        first: offset,
-        count: n as u32,
-        right: 0,
-    };
-    if n <= 1 {
-        return;
-    }
-    let cb = ids
-        .iter()
-        .fold(Aabb::EMPTY, |b, &i| b.grow(cent[i as usize]));
-    const B: usize = 32;
-    let mut best = (f32::INFINITY, 0usize, 0usize);
-    for axis in 0..3 {
-        let lo = cb.min[axis];
-        let ext = cb.max[axis] - lo;
-        if ext <= 0.0 {
-            continue;
+fn flatten(t: &Tmp, idx: usize, nodes: &mut Vec<Bvh2Node>) {
+    match t {
+        Tmp::Leaf {
+            bounds,
+            first,
+            count,
+        } => {
+            nodes[idx] = Bvh2Node {
+                bounds: *bounds,
+                first: *first,
+                count: *count,
+                right: 0,
+            };
         }
-        let scale = B as f32 / ext;
-        let mut bb = [Aabb::EMPTY; B];
-        let mut bc = [0u32; B];
-        for &i in ids.iter() {
-            let b = (((cent[i as usize][axis] - lo) * scale) as usize).min(B - 1);
-            bb[b] = bb[b].union(pb[i as usize]);
-            bc[b] += 1;
+        Tmp::Inner { bounds, kids } => {
+            let l = nodes.len();
+            let placeholder = nodes[idx];
+            nodes.push(placeholder);
+            nodes.push(placeholder);
+            nodes[idx] = Bvh2Node {
+                bounds: *bounds,
+                first: l as u32,
+                count: 0,
+                right: l as u32 + 1,
+            };
+            flatten(&kids[0], l, nodes);
+            flatten(&kids[1], l + 1, nodes);
         }
-        let mut right_area = [0.0f32; B];
-        let mut acc = Aabb::EMPTY;
-        for b in (1..B).rev() {
-            acc = acc.union(bb[b]);
-            right_area[b] = acc.half_area();
-        }
-        let (mut acc, mut nl) = (Aabb::EMPTY, 0u32);
-        for b in 0..B - 1 {
-            acc = acc.union(bb[b]);
-            nl += bc[b];
-            let nr = n as u32 - nl;
-            if nl == 0 || nr == 0 {
-                continue;
-            }
-            let c = acc.half_area() * nl as f32 + right_area[b + 1] * nr as f32;
-            if c < best.0 {
-                best = (c, axis, b + 1);
-            }
-        }
-    }
-    let leaf_cost = bounds.half_area() * n as f32 * cfg.cost_triangle;
-    let split_cost = bounds.half_area() * cfg.cost_traversal + best.0 * cfg.cost_triangle;
-    if best.0.is_finite() && (split_cost < leaf_cost || n > cfg.max_leaf_size as usize) {
-        let (axis, split) = (best.1, best.2);
-        let lo = cb.min[axis];
-        let scale = B as f32 / (cb.max[axis] - lo);
-        let mid = partition(ids, |i| {
-            (((cent[i as usize][axis] - lo) * scale) as usize).min(B - 1) < split
-        });
-        split_here(pb, cent, ids, offset, nodes, node, cfg, mid);
-    } else if n > cfg.max_leaf_size as usize {
-        // All centroids coincide: split in the middle of the id list.
-        split_here(pb, cent, ids, offset, nodes, node, cfg, n / 2);
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn split_here(
-    pb: &[Aabb],
-    cent: &[Vec3],
-    ids: &mut [u32],
-    offset: u32,
-    nodes: &mut Vec<Bvh2Node>,
-    node: usize,
-    cfg: &BuildConfig,
-    mid: usize,
-) {
-    let l = nodes.len();
-    nodes.push(Bvh2Node {
-        bounds: Aabb::EMPTY,
-        first: 0,
-        count: 0,
-        right: 0,
-    });
-    nodes.push(Bvh2Node {
-        bounds: Aabb::EMPTY,
-        first: 0,
-        count: 0,
-        right: 0,
-    });
-    nodes[node].first = l as u32;
-    nodes[node].right = l as u32 + 1;
-    nodes[node].count = 0;
-    let (a, b) = ids.split_at_mut(mid);
-    build_rec(pb, cent, a, offset, nodes, l, cfg);
-    build_rec(pb, cent, b, offset + mid as u32, nodes, l + 1, cfg);
+fn range_bounds(ctx: &Ctx, ids: &[u32]) -> (Aabb, Aabb) {
+    let f = |(b, c): (Aabb, Aabb), &i: &u32| {
+        (b.union(ctx.pb[i as usize]), c.grow(ctx.cent[i as usize]))
+    };
+    if ids.len() as u32 > ctx.cfg.parallel_threshold * 16 {
+        use rayon::prelude::*;
+        ids.par_chunks(16 * 1024)
+            .map(|c| c.iter().fold((Aabb::EMPTY, Aabb::EMPTY), f))
+            .reduce(
+                || (Aabb::EMPTY, Aabb::EMPTY),
+                |a, b| (a.0.union(b.0), a.1.union(b.1)),
+            )
+    } else {
+        ids.iter().fold((Aabb::EMPTY, Aabb::EMPTY), f)
+    }
+}
+
+#[inline]
+fn bin_of(c: f32, lo: f32, scale: f32, bins: usize) -> usize {
+    // `as usize` saturates (NaN → 0), so the index is always in range.
+    (((c - lo) * scale) as usize).min(bins - 1)
+}
+
+/// Bins `ids` on all three axes: `bins[axis * B + b]`.
+fn bin_range(ctx: &Ctx, ids: &[u32], lo: Vec3, scale: Vec3) -> Vec<Bin> {
+    let nb = ctx.bins;
+    let work = |chunk: &[u32]| {
+        let mut bins = vec![EMPTY_BIN; 3 * nb];
+        for &i in chunk {
+            let c = ctx.cent[i as usize];
+            let b = ctx.pb[i as usize];
+            for axis in 0..3 {
+                let k = axis * nb + bin_of(c[axis], lo[axis], scale[axis], nb);
+                let bin = &mut bins[k];
+                bin.bounds = bin.bounds.union(b);
+                bin.cbounds = bin.cbounds.grow(c);
+                bin.count += 1;
+            }
+        }
+        bins
+    };
+    if ids.len() as u32 > ctx.cfg.parallel_threshold * 16 {
+        use rayon::prelude::*;
+        ids.par_chunks(32 * 1024).map(work).reduce(
+            || vec![EMPTY_BIN; 3 * nb],
+            |mut a, b| {
+                for (x, y) in a.iter_mut().zip(&b) {
+                    x.bounds = x.bounds.union(y.bounds);
+                    x.cbounds = x.cbounds.union(y.cbounds);
+                    x.count += y.count;
+                }
+                a
+            },
+        )
+    } else {
+        work(ids)
+    }
+}
+
+fn find_split(ctx: &Ctx, ids: &[u32], cbounds: Aabb) -> (Option<Split>, Vec3, Vec3) {
+    let nb = ctx.bins;
+    let lo = cbounds.min;
+    let ext = cbounds.max - cbounds.min;
+    let mut scale = Vec3::ZERO;
+    for a in 0..3 {
+        if ext[a] > 0.0 && ext[a].is_finite() {
+            scale[a] = nb as f32 / ext[a];
+        }
+    }
+    if scale == Vec3::ZERO {
+        return (None, lo, scale);
+    }
+    let bins = bin_range(ctx, ids, lo, scale);
+    let mut best: Option<Split> = None;
+    let mut right_acc = vec![(Aabb::EMPTY, Aabb::EMPTY, 0u32); nb];
+    for axis in 0..3 {
+        if scale[axis] == 0.0 {
+            continue;
+        }
+        let b = &bins[axis * nb..(axis + 1) * nb];
+        let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0u32);
+        for k in (1..nb).rev() {
+            acc = (
+                acc.0.union(b[k].bounds),
+                acc.1.union(b[k].cbounds),
+                acc.2 + b[k].count,
+            );
+            right_acc[k] = acc;
+        }
+        let mut left = (Aabb::EMPTY, Aabb::EMPTY, 0u32);
+        for k in 0..nb - 1 {
+            left = (
+                left.0.union(b[k].bounds),
+                left.1.union(b[k].cbounds),
+                left.2 + b[k].count,
+            );
+            let right = right_acc[k + 1];
+            if left.2 == 0 || right.2 == 0 {
+                continue;
+            }
+            let cost = left.0.half_area() * left.2 as f32 + right.0.half_area() * right.2 as f32;
+            if best.as_ref().is_none_or(|s| cost < s.cost) {
+                best = Some(Split {
+                    cost,
+                    axis,
+                    bin: k + 1,
+                    left: (left.0, left.1),
+                    right: (right.0, right.1),
+                });
+            }
+        }
+    }
+    (best, lo, scale)
 }
 
 fn partition(ids: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
@@ -230,4 +385,154 @@ fn partition(ids: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
         }
     }
     i
+}
+
+fn build_range(
+    ctx: &Ctx,
+    ids: &mut [u32],
+    offset: u32,
+    bounds: Aabb,
+    cbounds: Aabb,
+    depth: u32,
+) -> Tmp {
+    let n = ids.len();
+    let leaf = Tmp::Leaf {
+        bounds,
+        first: offset,
+        count: n as u32,
+    };
+    if n <= 1 {
+        return leaf;
+    }
+    let max_leaf = ctx.cfg.max_leaf_size.max(1) as usize;
+    let mid;
+    let (lb, rb);
+    let (split, lo, scale) = if depth < MAX_SAH_DEPTH {
+        find_split(ctx, ids, cbounds)
+    } else {
+        (None, Vec3::ZERO, Vec3::ZERO)
+    };
+    match split {
+        Some(s) => {
+            let area = bounds.half_area();
+            let leaf_cost = area * n as f32 * ctx.cfg.cost_triangle;
+            let split_cost = area * ctx.cfg.cost_traversal + s.cost * ctx.cfg.cost_triangle;
+            if n <= max_leaf && leaf_cost <= split_cost {
+                return leaf;
+            }
+            let (axis, bin, nb) = (s.axis, s.bin, ctx.bins);
+            mid = partition(ids, |i| {
+                bin_of(ctx.cent[i as usize][axis], lo[axis], scale[axis], nb) < bin
+            });
+            lb = s.left;
+            rb = s.right;
+        }
+        None => {
+            if n <= max_leaf {
+                return leaf;
+            }
+            // All centroids coincide (or the depth limit was reached): object median on the
+            // widest centroid axis, ties broken by id, so the result is deterministic.
+            let axis = cbounds.largest_axis();
+            mid = n / 2;
+            ids.select_nth_unstable_by(mid, |&a, &b| {
+                let (ca, cb) = (ctx.cent[a as usize][axis], ctx.cent[b as usize][axis]);
+                ca.total_cmp(&cb).then(a.cmp(&b))
+            });
+            lb = range_bounds(ctx, &ids[..mid]);
+            rb = range_bounds(ctx, &ids[mid..]);
+        }
+    }
+    let (l, r) = ids.split_at_mut(mid);
+    let (left, right) = if n as u32 > ctx.cfg.parallel_threshold {
+        rayon::join(
+            || build_range(ctx, l, offset, lb.0, lb.1, depth + 1),
+            || build_range(ctx, r, offset + mid as u32, rb.0, rb.1, depth + 1),
+        )
+    } else {
+        (
+            build_range(ctx, l, offset, lb.0, lb.1, depth + 1),
+            build_range(ctx, r, offset + mid as u32, rb.0, rb.1, depth + 1),
+        )
+    };
+    Tmp::Inner {
+        bounds,
+        kids: Box::new([left, right]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dualsplit_geometry::Pcg32;
+
+    fn random_boxes(n: usize, seed: u64) -> Vec<Aabb> {
+        let mut rng = Pcg32::new(seed, 1);
+        (0..n)
+            .map(|_| {
+                let p = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0;
+                let e = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 0.3;
+                Aabb::new(p, p + e)
+            })
+            .collect()
+    }
+
+    fn check(bvh: &Bvh2, boxes: &[Aabb], max_leaf: u32) {
+        let mut seen = vec![0u32; boxes.len()];
+        let mut stack = vec![0usize];
+        let mut reached = 0;
+        while let Some(i) = stack.pop() {
+            reached += 1;
+            let n = bvh.nodes[i];
+            if n.is_leaf() {
+                assert!(n.count <= max_leaf);
+                for &p in &bvh.prim_ids[n.first as usize..(n.first + n.count) as usize] {
+                    seen[p as usize] += 1;
+                    assert!(n.bounds.contains_box(&boxes[p as usize]));
+                }
+            } else {
+                for c in n.children() {
+                    assert!(n.bounds.contains_box(&bvh.nodes[c as usize].bounds));
+                    stack.push(c as usize);
+                }
+                assert_eq!(n.right, n.first + 1, "siblings adjacent");
+            }
+        }
+        assert_eq!(reached, bvh.nodes.len());
+        assert!(seen.iter().all(|&s| s == 1));
+    }
+
+    #[test]
+    fn builds_valid_trees() {
+        for (n, seed) in [(1, 1), (2, 2), (5, 3), (100, 4), (20_000, 5)] {
+            let boxes = random_boxes(n, seed);
+            let bvh = Bvh2::build(&boxes, &BuildConfig::default());
+            check(&bvh, &boxes, 4);
+            assert!(bvh.sah_cost >= 1.0 || n == 1);
+        }
+    }
+
+    #[test]
+    fn coincident_centroids_split_at_median() {
+        let boxes = vec![Aabb::new(Vec3::ZERO, Vec3::ONE); 37];
+        let bvh = Bvh2::build(&boxes, &BuildConfig::default());
+        check(&bvh, &boxes, 4);
+    }
+
+    #[test]
+    fn empty_input_gives_empty_root() {
+        let bvh = Bvh2::build(&[], &BuildConfig::default());
+        assert!(bvh.is_empty());
+        assert_eq!(bvh.nodes.len(), 1);
+        assert!(!bvh.nodes[0].is_leaf());
+    }
+
+    #[test]
+    fn build_is_deterministic() {
+        let boxes = random_boxes(30_000, 9);
+        let a = Bvh2::build(&boxes, &BuildConfig::default());
+        let b = Bvh2::build(&boxes, &BuildConfig::default());
+        assert_eq!(a.nodes, b.nodes);
+        assert_eq!(a.prim_ids, b.prim_ids);
+    }
 }

@@ -1,0 +1,58 @@
+//! Size and build statistics per structure, shaped like the paper's Table 3 (Lin et al.
+//! 2020, §4.2).
+//!
+//! Sizes count the node region (internal nodes plus one 4-byte leaf word per leaf) and the
+//! triangle-index lists; the triangles themselves (36 B each, identical for every
+//! structure) are not counted. The paper does not say whether its Table 3 includes index
+//! lists; on Dragon Box its BVH2 figure (25.71 MiB) is smaller than the triangles alone
+//! (29.9 MiB), so triangles are surely excluded.
+
+use crate::wide::BvhImage;
+use serde::Serialize;
+
+/// Bytes in one MiB (the paper reports sizes in MiB).
+pub const MIB: f64 = 1024.0 * 1024.0;
+
+/// Size and build statistics of one encoded BVH.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StructureStats {
+    /// `bvh2`, `bvh4` or `bvh8`.
+    pub name: String,
+    /// Internal nodes plus leaves.
+    pub nodes: u64,
+    /// Internal nodes.
+    pub internal_nodes: u64,
+    /// Leaves (leaf words).
+    pub leaves: u64,
+    /// Bytes of the node region (internal nodes and leaf words).
+    pub bytes_nodes: u64,
+    /// Bytes of the triangle-index lists.
+    pub bytes_indices: u64,
+    /// `bytes_nodes + bytes_indices`.
+    pub bytes_total: u64,
+    /// `bytes_total` as a percentage of the BVH2's.
+    pub percent_of_bvh2: f64,
+    /// SAH cost (root-normalised).
+    pub sah_cost: f32,
+    /// Build (BVH2) or collapse (BVH4, BVH8) wall time in milliseconds — a measurement.
+    pub build_ms: f64,
+}
+
+impl StructureStats {
+    /// Statistics of `s`, with percentages relative to `bvh2_total` bytes.
+    pub fn of(name: &str, s: &BvhImage, bvh2_total: u64) -> Self {
+        let bytes_total = s.bytes_total();
+        Self {
+            name: name.to_string(),
+            nodes: (s.internal_nodes + s.leaves) as u64,
+            internal_nodes: s.internal_nodes as u64,
+            leaves: s.leaves as u64,
+            bytes_nodes: s.image.node_bytes(),
+            bytes_indices: s.image.index_bytes(),
+            bytes_total,
+            percent_of_bvh2: 100.0 * bytes_total as f64 / bvh2_total.max(1) as f64,
+            sah_cost: s.sah_cost,
+            build_ms: s.time.as_secs_f64() * 1e3,
+        }
+    }
+}

@@ -1,0 +1,119 @@
+//! Writes a [`WideBvh`] into a byte-exact [`MemoryImage`] (layout in [`crate::image`]).
+
+use super::{WideBvh, WideChild};
+use crate::image::{ChildKind, ImageError, MemoryImage, NodeLayout};
+use dualsplit_geometry::Triangle;
+
+/// Bit 31 of an index-list entry: the last triangle of a leaf's run.
+pub const LAST_IN_RUN: u32 = 1 << 31;
+
+/// Encodes `wide` with node layout `L`: nodes depth-first with all children of a node
+/// stored consecutively (internal children as whole nodes, leaves as one leaf word), then
+/// the leaves' index runs in depth-first leaf order, then `triangles`.
+pub fn encode<L: NodeLayout>(
+    wide: &WideBvh,
+    prim_ids: &[u32],
+    triangles: &[Triangle],
+) -> Result<MemoryImage, ImageError> {
+    assert!(wide.arity <= L::ARITY, "tree wider than the node layout");
+    let leaves = wide.leaf_count();
+    let node_words = wide.nodes.len() * L::WORDS + leaves;
+    let index_words: usize = wide
+        .nodes
+        .iter()
+        .flat_map(|n| &n.children)
+        .map(|c| match c.1 {
+            WideChild::Leaf { count, .. } => count as usize,
+            WideChild::Node(_) => 0,
+        })
+        .sum();
+    let mut e = Encoder {
+        wide,
+        prim_ids,
+        words: vec![0u32; node_words + index_words],
+        next_node: L::WORDS,
+        next_index: node_words,
+    };
+    e.emit::<L>(0, 0)?;
+    debug_assert_eq!(e.next_node, node_words);
+    debug_assert_eq!(e.next_index, node_words + index_words);
+    let mut img = MemoryImage {
+        words: e.words,
+        nodes: 0..node_words,
+        indices: node_words..node_words + index_words,
+        triangles: 0..0,
+    };
+    img.push_triangles(triangles);
+    Ok(img)
+}
+
+struct Encoder<'a> {
+    wide: &'a WideBvh,
+    prim_ids: &'a [u32],
+    words: Vec<u32>,
+    next_node: usize,
+    next_index: usize,
+}
+
+impl Encoder<'_> {
+    fn emit<L: NodeLayout>(&mut self, node: usize, at: usize) -> Result<(), ImageError> {
+        let wide = self.wide;
+        let children = &wide.nodes[node].children;
+        let kinds: Vec<(dualsplit_geometry::Aabb, ChildKind)> = children
+            .iter()
+            .map(|&(b, c)| {
+                let k = match c {
+                    WideChild::Node(_) => ChildKind::Internal,
+                    WideChild::Leaf { .. } => ChildKind::Leaf,
+                };
+                (b, k)
+            })
+            .collect();
+        let block = self.next_node;
+        self.next_node += kinds
+            .iter()
+            .map(|&(_, k)| L::child_words(k) as usize)
+            .sum::<usize>();
+        let offset = u32::try_from(block).map_err(|_| ImageError::OffsetOverflow {
+            structure: L::NAME,
+            given: block as u64,
+            bits: L::OFFSET_BITS,
+            limit: (1u64 << L::OFFSET_BITS) - 1,
+        })?;
+        let n = L::encode(&kinds, offset)?;
+        self.words[at..at + L::WORDS]
+            .copy_from_slice(bytemuck::cast_slice(std::slice::from_ref(&n)));
+        let mut addr = block;
+        for (&(_, child), &(_, kind)) in children.iter().zip(&kinds) {
+            match child {
+                WideChild::Node(c) => self.emit::<L>(c as usize, addr)?,
+                WideChild::Leaf { first, count } => {
+                    let run = self.next_index;
+                    if run as u64 >= LAST_IN_RUN as u64 {
+                        return Err(ImageError::OffsetOverflow {
+                            structure: L::NAME,
+                            given: run as u64,
+                            bits: 31,
+                            limit: LAST_IN_RUN as u64 - 1,
+                        });
+                    }
+                    self.words[addr] = run as u32;
+                    let ids = &self.prim_ids[first as usize..(first + count) as usize];
+                    for (j, &p) in ids.iter().enumerate() {
+                        if p >= LAST_IN_RUN {
+                            return Err(ImageError::PrimOverflow {
+                                given: p as u64,
+                                limit: LAST_IN_RUN as u64 - 1,
+                            });
+                        }
+                        let last = if j + 1 == ids.len() { LAST_IN_RUN } else { 0 };
+                        self.words[run + j] = p | last;
+                    }
+                    self.next_index += ids.len();
+                }
+            }
+            addr += L::child_words(kind) as usize;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,215 @@
+//! Wide BVHs collapsed from the BVH2, their encoding into memory images and their
+//! traversal (Lin et al. 2020, §4.2).
+//!
+//! * [`WideBvh`] is the logical tree: every internal node lists up to `arity` children, each
+//!   an internal node or a leaf that is exactly a leaf of the source BVH2 (same triangle
+//!   range of [`crate::Bvh2::prim_ids`]), so BVH2, BVH4 and BVH8 have identical leaves.
+//!   - [`WideBvh::from_bvh2`]: the BVH2 itself seen as a 2-wide tree;
+//!   - [`WideBvh::collapse_bvh4`]: BVH4 by removing every other level (Dammertz et al. 2008);
+//!   - [`WideBvh::collapse_bvh8`]: BVH8 by the adaptive collapse of Ylitie et al. 2017.
+//! * [`encode`](encode::encode) writes a `WideBvh` into a [`MemoryImage`] with a node layout
+//!   ([`crate::bvh2::Node2`], [`Node4`], [`Node8`]).
+//! * [`traverse`] is the single traversal (closest and any hit) over an image, generic over
+//!   the node layout and the [`crate::Observer`].
+//! * [`BvhImage`] bundles an encoded structure with its statistics.
+
+mod collapse;
+pub mod encode;
+mod node4;
+mod node8;
+pub mod traverse;
+
+pub use collapse::CollapseConfig;
+pub use node4::Node4;
+pub use node8::Node8;
+
+use crate::bvh2::Node2;
+use crate::image::{ImageError, MemoryImage};
+use crate::observer::Observer;
+use crate::validate::{ValidationReport, validate_image};
+use crate::{BuildConfig, Bvh2};
+use dualsplit_geometry::{Aabb, Hit, Ray, Triangle};
+use std::time::Duration;
+
+/// A child of a [`WideNode`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WideChild {
+    /// Internal child: index into [`WideBvh::nodes`].
+    Node(u32),
+    /// Leaf child: a triangle range of the source BVH2's `prim_ids`.
+    Leaf {
+        /// First index into `prim_ids`.
+        first: u32,
+        /// Triangle count.
+        count: u32,
+    },
+}
+
+/// An internal node of a [`WideBvh`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WideNode {
+    /// The children (at most the tree's arity), each with its box.
+    pub children: Vec<(Aabb, WideChild)>,
+}
+
+/// A logical wide BVH derived from a [`Bvh2`]; root at index 0 (always an internal node, with
+/// zero children for an empty scene and one leaf child when the BVH2 root is a leaf).
+#[derive(Clone, Debug, Default)]
+pub struct WideBvh {
+    /// Maximum children per node.
+    pub arity: usize,
+    /// Internal nodes; index 0 is the root.
+    pub nodes: Vec<WideNode>,
+}
+
+impl WideBvh {
+    /// The BVH2 as a 2-wide tree (its internal nodes, in the same order).
+    pub fn from_bvh2(bvh: &Bvh2) -> Self {
+        collapse::from_bvh2(bvh)
+    }
+
+    /// BVH4 by removing every other level of the BVH2 (Dammertz et al. 2008): a BVH4 node is a
+    /// BVH2 node at even depth with each internal child replaced by that child's children.
+    pub fn collapse_bvh4(bvh: &Bvh2) -> Self {
+        collapse::dammertz4(bvh)
+    }
+
+    /// BVH8 by the adaptive collapse of Ylitie, Karras and Laine 2017 (dst-spec §8): a
+    /// bottom-up cost over up to 8 roots per BVH2 node, then a top-down pass following it.
+    /// Leaves stay the BVH2's leaves.
+    pub fn collapse_bvh8(bvh: &Bvh2, cfg: &CollapseConfig) -> Self {
+        collapse::ylitie8(bvh, cfg)
+    }
+
+    /// Number of leaves.
+    pub fn leaf_count(&self) -> usize {
+        self.nodes
+            .iter()
+            .flat_map(|n| &n.children)
+            .filter(|c| matches!(c.1, WideChild::Leaf { .. }))
+            .count()
+    }
+
+    /// The leaves' triangle sets, each sorted, the list sorted (for comparing structures).
+    pub fn leaf_sets(&self, prim_ids: &[u32]) -> Vec<Vec<u32>> {
+        let mut v: Vec<Vec<u32>> = self
+            .nodes
+            .iter()
+            .flat_map(|n| &n.children)
+            .filter_map(|c| match c.1 {
+                WideChild::Leaf { first, count } => {
+                    let mut s = prim_ids[first as usize..(first + count) as usize].to_vec();
+                    s.sort_unstable();
+                    Some(s)
+                }
+                WideChild::Node(_) => None,
+            })
+            .collect();
+        v.sort_unstable();
+        v
+    }
+
+    /// SAH cost with `cfg`'s costs: (Σ internal-node area·c_t + Σ leaf area·n·c_i) / root
+    /// area, where an internal node's area is the union of its children's boxes.
+    pub fn sah_cost(&self, cfg: &BuildConfig) -> f32 {
+        let area = |n: &WideNode| {
+            n.children
+                .iter()
+                .fold(Aabb::EMPTY, |b, c| b.union(c.0))
+                .half_area() as f64
+        };
+        let Some(root) = self.nodes.first() else {
+            return 0.0;
+        };
+        let root_area = area(root).max(f32::MIN_POSITIVE as f64);
+        let mut c = 0.0f64;
+        for n in &self.nodes {
+            c += area(n) * cfg.cost_traversal as f64;
+            for (b, ch) in &n.children {
+                if let WideChild::Leaf { count, .. } = ch {
+                    c += b.half_area() as f64 * *count as f64 * cfg.cost_triangle as f64;
+                }
+            }
+        }
+        (c / root_area) as f32
+    }
+}
+
+/// An encoded BVH (2-, 4- or 8-wide): its memory image plus what it took to make it.
+#[derive(Clone, Debug)]
+pub struct BvhImage {
+    /// Node width: 2, 4 or 8.
+    pub arity: u8,
+    /// The byte-exact memory image.
+    pub image: MemoryImage,
+    /// Internal nodes.
+    pub internal_nodes: usize,
+    /// Leaves (one leaf word each in the node region).
+    pub leaves: usize,
+    /// SAH cost (root-normalised, the build's costs).
+    pub sah_cost: f32,
+    /// Wall time of the BVH2 build (arity 2) or of the collapse (arity 4, 8); a measurement,
+    /// not a result.
+    pub time: Duration,
+}
+
+impl BvhImage {
+    /// Encodes `wide` (arity 2, 4 or 8) over `bvh`'s `prim_ids` and `triangles`.
+    pub fn encode(
+        wide: &WideBvh,
+        bvh: &Bvh2,
+        triangles: &[Triangle],
+        cfg: &BuildConfig,
+        time: Duration,
+    ) -> Result<Self, ImageError> {
+        let image = match wide.arity {
+            2 => encode::encode::<Node2>(wide, &bvh.prim_ids, triangles)?,
+            4 => encode::encode::<Node4>(wide, &bvh.prim_ids, triangles)?,
+            8 => encode::encode::<Node8>(wide, &bvh.prim_ids, triangles)?,
+            a => panic!("unsupported BVH arity {a}"),
+        };
+        Ok(Self {
+            arity: wide.arity as u8,
+            image,
+            internal_nodes: wide.nodes.len(),
+            leaves: wide.leaf_count(),
+            sah_cost: wide.sah_cost(cfg),
+            time,
+        })
+    }
+
+    /// Closest hit of `ray` (ordered by `(t, prim)`), reading the image.
+    #[inline]
+    pub fn closest_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        match self.arity {
+            2 => traverse::traverse::<Node2, O, false>(&self.image, ray, obs),
+            4 => traverse::traverse::<Node4, O, false>(&self.image, ray, obs),
+            _ => traverse::traverse::<Node8, O, false>(&self.image, ray, obs),
+        }
+    }
+
+    /// True when any triangle is hit within `[ray.t_min, ray.t_max]`.
+    #[inline]
+    pub fn any_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+        match self.arity {
+            2 => traverse::traverse::<Node2, O, true>(&self.image, ray, obs),
+            4 => traverse::traverse::<Node4, O, true>(&self.image, ray, obs),
+            _ => traverse::traverse::<Node8, O, true>(&self.image, ray, obs),
+        }
+        .is_some()
+    }
+
+    /// Checks the image (see [`ValidationReport`]).
+    pub fn validate(&self) -> ValidationReport {
+        match self.arity {
+            2 => validate_image::<Node2>(&self.image),
+            4 => validate_image::<Node4>(&self.image),
+            _ => validate_image::<Node8>(&self.image),
+        }
+    }
+
+    /// Bytes of nodes plus triangle-index lists: the quantity of the paper's Table 3.
+    pub fn bytes_total(&self) -> u64 {
+        self.image.node_bytes() + self.image.index_bytes()
+    }
+}

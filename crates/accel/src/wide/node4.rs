@@ -1,0 +1,113 @@
+//! The 100-byte BVH4 internal node (Lin et al. 2020, §4.2).
+
+use crate::image::{ChildKind, ImageError, NodeLayout, box_words, is_degenerate_box, words_box};
+use dualsplit_geometry::Aabb;
+
+/// BVH4 internal node: four child boxes and one packed offset/type word, 100 bytes.
+///
+/// | bytes | words | field |
+/// |---|---|---|
+/// | 0–95 | 0–23 | child boxes, slot `k` at words `6k..6k+6`: min.xyz, max.xyz (f32) |
+/// | 96–99 | 24 | `packed`: bits 0–27 child-block offset (absolute word index), bit `28 + k` child `k` is a leaf |
+///
+/// Children occupy slots `0..n` in order; the remaining slots hold [`Aabb::DEGENERATE`]
+/// (empty, `min.x > max.x`) and take no space in the child block. Internal children take 25
+/// words in the child block, leaf children one leaf word (see [`crate::image`]).
+///
+/// Worked example: slots = [leaf, internal, leaf, empty], child block at word 25 →
+/// `packed = 25 | 1 << 28 | 1 << 30 = 0x5000_0019`; slot 0's leaf word is word 25, slot 1's
+/// node is at word 26, slot 2's leaf word is word 51.
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+pub struct Node4 {
+    /// Child boxes.
+    pub boxes: [[f32; 6]; 4],
+    /// Offset (bits 0–27) and the four child-type bits (28–31).
+    pub packed: u32,
+}
+
+const _: () = assert!(size_of::<Node4>() == 100);
+
+const OFFSET_MASK: u32 = (1 << 28) - 1;
+
+impl NodeLayout for Node4 {
+    const NAME: &'static str = "bvh4";
+    const ARITY: usize = 4;
+    const WORDS: usize = 25;
+    const OFFSET_BITS: u32 = 28;
+
+    fn encode(children: &[(Aabb, ChildKind)], offset: u32) -> Result<Self, ImageError> {
+        assert!(children.len() <= 4, "a BVH4 node has at most 4 children");
+        let mut n = Node4 {
+            boxes: [box_words(Aabb::DEGENERATE); 4],
+            packed: Self::check_offset(offset)?,
+        };
+        for (k, &(b, kind)) in children.iter().enumerate() {
+            if kind == ChildKind::Empty {
+                continue;
+            }
+            n.boxes[k] = box_words(b);
+            if kind == ChildKind::Leaf {
+                n.packed |= 1 << (28 + k);
+            }
+        }
+        Ok(n)
+    }
+
+    #[inline(always)]
+    fn offset(&self) -> u32 {
+        self.packed & OFFSET_MASK
+    }
+
+    #[inline(always)]
+    fn kind(&self, k: usize) -> ChildKind {
+        if is_degenerate_box(&self.boxes[k]) {
+            ChildKind::Empty
+        } else if self.packed & (1 << (28 + k)) != 0 {
+            ChildKind::Leaf
+        } else {
+            ChildKind::Internal
+        }
+    }
+
+    #[inline(always)]
+    fn child_bounds(&self, k: usize) -> Aabb {
+        words_box(&self.boxes[k])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::image::test_support::{arb_children, roundtrip};
+    use proptest::prelude::*;
+
+    #[test]
+    fn worked_example() {
+        let b = Aabb::new(glam::Vec3::ZERO, glam::Vec3::ONE);
+        let n = Node4::encode(
+            &[
+                (b, ChildKind::Leaf),
+                (b, ChildKind::Internal),
+                (b, ChildKind::Leaf),
+            ],
+            25,
+        )
+        .unwrap();
+        assert_eq!(n.packed, 0x5000_0019);
+        assert_eq!(n.kind(3), ChildKind::Empty);
+    }
+
+    #[test]
+    fn offset_overflow_is_an_error() {
+        let e = Node4::encode(&[], 1 << 28).unwrap_err();
+        assert!(matches!(e, ImageError::OffsetOverflow { bits: 28, .. }));
+    }
+
+    proptest! {
+        #[test]
+        fn encode_decode_roundtrip(children in arb_children(4), offset in 0u32..(1 << 28)) {
+            roundtrip::<Node4>(&children, offset);
+        }
+    }
+}

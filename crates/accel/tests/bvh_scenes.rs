@@ -1,0 +1,112 @@
+//! BVH2, BVH4 and BVH8 on the shipped scenes: identical leaves, clean validation, and
+//! per-ray identical answers for primary, shadow and diffuse-bounce rays recorded from
+//! path-traced pixel jobs on each scene's default camera.
+//!
+//! Release builds (`cargo test --release`, what CI runs) compare at least 100K rays of each
+//! kind per scene; debug builds compare 3K of each so that `cargo test` stays quick.
+
+mod support;
+
+use dualsplit_accel::{AccelKind, BuildConfig, CollapseConfig, NoObserver, Structures, WideBvh};
+use rayon::prelude::*;
+use support::{key, load_scene, record_rays};
+
+const RAYS: usize = if cfg!(debug_assertions) {
+    3_000
+} else {
+    100_000
+};
+
+fn equivalence(name: &str) {
+    let scene = load_scene(name);
+    let s = Structures::build(&scene.triangles, &BuildConfig::default());
+    for rep in s.validate() {
+        assert!(rep.is_ok(), "{name}: {rep:?}");
+        assert_eq!(rep.triangles_referenced, scene.triangles.len());
+    }
+    let side = (RAYS as f64).sqrt().ceil() as u32;
+    let rays = record_rays(&scene, &s, side, RAYS);
+    assert!(
+        rays.primary.len() >= RAYS,
+        "{name}: {} primary",
+        rays.primary.len()
+    );
+    assert!(
+        rays.shadow.len() >= RAYS,
+        "{name}: {} shadow",
+        rays.shadow.len()
+    );
+    assert!(
+        rays.diffuse.len() >= RAYS,
+        "{name}: {} diffuse",
+        rays.diffuse.len()
+    );
+    for (what, set) in [("primary", &rays.primary), ("diffuse", &rays.diffuse)] {
+        set.par_iter().enumerate().for_each(|(i, ray)| {
+            let want = key(s.closest_hit(AccelKind::Bvh2, ray, &mut NoObserver));
+            for kind in [AccelKind::Bvh4, AccelKind::Bvh8] {
+                let got = key(s.closest_hit(kind, ray, &mut NoObserver));
+                assert_eq!(got, want, "{name}: {what} ray {i} {ray:?} on {kind:?}");
+            }
+        });
+    }
+    rays.shadow.par_iter().enumerate().for_each(|(i, ray)| {
+        let want = s
+            .closest_hit(AccelKind::Bvh2, ray, &mut NoObserver)
+            .is_some();
+        for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+            let got = s.any_hit(kind, ray, &mut NoObserver);
+            assert_eq!(got, want, "{name}: shadow ray {i} {ray:?} on {kind:?}");
+        }
+    });
+}
+
+#[test]
+fn equivalence_dragon_res4() {
+    equivalence("dragon_res4.ply.gz");
+}
+
+#[test]
+fn equivalence_bunny() {
+    equivalence("bunny.ply.gz");
+}
+
+#[test]
+fn equivalence_sponza_dabrovic() {
+    equivalence("sponza_dabrovic.ply.gz");
+}
+
+#[test]
+fn equivalence_dragon_box() {
+    equivalence("dragon_box.ply.gz");
+}
+
+#[test]
+fn identical_leaves_in_all_three() {
+    for name in ["dragon_res4.ply.gz", "sponza_dabrovic.ply.gz"] {
+        let scene = load_scene(name);
+        let boxes: Vec<_> = scene.triangles.iter().map(|t| t.bounds()).collect();
+        let bvh = dualsplit_accel::Bvh2::build(&boxes, &BuildConfig::default());
+        let l2 = WideBvh::from_bvh2(&bvh).leaf_sets(&bvh.prim_ids);
+        let l4 = WideBvh::collapse_bvh4(&bvh).leaf_sets(&bvh.prim_ids);
+        let l8 = WideBvh::collapse_bvh8(&bvh, &CollapseConfig::default()).leaf_sets(&bvh.prim_ids);
+        assert_eq!(l2.len(), bvh.leaf_count());
+        assert_eq!(l2, l4, "{name}: BVH4 leaves differ");
+        assert_eq!(l2, l8, "{name}: BVH8 leaves differ");
+        let w4 = WideBvh::collapse_bvh4(&bvh);
+        let w8 = WideBvh::collapse_bvh8(&bvh, &CollapseConfig::default());
+        assert!(
+            w4.nodes
+                .iter()
+                .all(|n| n.children.len() <= 4 && !n.children.is_empty())
+        );
+        assert!(
+            w8.nodes
+                .iter()
+                .all(|n| n.children.len() <= 8 && !n.children.is_empty())
+        );
+        // Wider trees have fewer internal nodes.
+        assert!(w4.nodes.len() < bvh.nodes.len() / 2 + 1);
+        assert!(w8.nodes.len() < w4.nodes.len());
+    }
+}

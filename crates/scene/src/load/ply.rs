@@ -1,0 +1,587 @@
+//! PLY: header and ASCII body through `ply-rs-bw`, binary bodies (either endianness) through
+//! a small decoder of our own (the speed bar; see `docs/performance.md`).
+//!
+//! What is read: element `vertex` with scalar properties `x`, `y`, `z` (any scalar type, any
+//! position among other properties) and element `face` with a list property
+//! `vertex_indices` (or `vertex_index`) of any count and index type. Faces are
+//! fan-triangulated in file order. Every other element and property is skipped, wherever it
+//! appears.
+
+use super::{Mesh, fan, gather, parse_error};
+use crate::{LoadStats, SceneError};
+use dualsplit_geometry::Vec3;
+use ply_rs_bw::parser::{ParseError, Parser, Reader};
+use ply_rs_bw::ply::{
+    DefaultElement, ElementDef, Encoding, Header, Property, PropertyType, ScalarType,
+};
+use std::path::Path;
+
+/// Where the loader finds its data in the header.
+struct Schema {
+    /// Number of vertices (the `vertex` element's count).
+    vertex_count: u32,
+    /// Index of the `face` list property within the `face` element.
+    face_list: usize,
+    /// Indices of `x`, `y`, `z` within the `vertex` element.
+    xyz: [usize; 3],
+}
+
+/// Parses a whole PLY file (already inflated).
+pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, SceneError> {
+    let parser = Parser::<DefaultElement>::new();
+    let mut reader = Reader::new(bytes);
+    let header = parser
+        .read_header(&mut reader)
+        .map_err(|e| ply_error(path, &e))?;
+    // ply-rs-bw's reader is now on the first body line (1-based).
+    let first_body_line = reader.line() as u64;
+    let schema = schema(path, &header)?;
+    match header.encoding {
+        Encoding::Ascii => parse_ascii(path, &parser, reader, &header, &schema, first_body_line),
+        Encoding::BinaryLittleEndian => {
+            parse_binary(path, reader.into_inner(), &header, &schema, false)
+        }
+        Encoding::BinaryBigEndian => {
+            parse_binary(path, reader.into_inner(), &header, &schema, true)
+        }
+    }
+}
+
+/// A ply-rs-bw error as a [`SceneError::Parse`], keeping its line.
+fn ply_error(path: &Path, e: &ParseError) -> SceneError {
+    let text = e.to_string();
+    let message = match e.line() {
+        Some(l) => text
+            .strip_prefix(&format!("Line {l}: "))
+            .unwrap_or(&text)
+            .to_string(),
+        None => text,
+    };
+    let message = message.replace("\n\t", "; ");
+    parse_error(path, e.line().map(|l| l as u64), message)
+}
+
+/// Finds the `vertex` and `face` elements and the properties the loader needs.
+fn schema(path: &Path, header: &Header) -> Result<Schema, SceneError> {
+    let vertex = header
+        .elements
+        .get("vertex")
+        .ok_or_else(|| parse_error(path, None, "no `vertex` element in the header"))?;
+    let face = header.elements.get("face").ok_or_else(|| {
+        parse_error(
+            path,
+            None,
+            "no `face` element in the header (a point cloud?)",
+        )
+    })?;
+    let mut xyz = [0; 3];
+    for (slot, name) in xyz.iter_mut().zip(["x", "y", "z"]) {
+        let (i, _, def) = vertex.properties.get_full(name).ok_or_else(|| {
+            parse_error(
+                path,
+                None,
+                format!("element `vertex` has no property `{name}`"),
+            )
+        })?;
+        if !matches!(def.data_type, PropertyType::Scalar(_)) {
+            return Err(parse_error(
+                path,
+                None,
+                format!("vertex property `{name}` is a list"),
+            ));
+        }
+        *slot = i;
+    }
+    let face_list = ["vertex_indices", "vertex_index"]
+        .iter()
+        .find_map(|n| face.properties.get_full(*n))
+        .ok_or_else(|| {
+            parse_error(
+                path,
+                None,
+                "element `face` has no property `vertex_indices`",
+            )
+        })?;
+    let (face_list, _, def) = face_list;
+    match def.data_type {
+        PropertyType::List(_, ScalarType::Float | ScalarType::Double) | PropertyType::Scalar(_) => {
+            return Err(parse_error(
+                path,
+                None,
+                format!("face property `{}` must be a list of integers", def.name),
+            ));
+        }
+        PropertyType::List(..) => {}
+    }
+    let vertex_count = u32::try_from(vertex.count).map_err(|_| {
+        parse_error(
+            path,
+            None,
+            format!("{} vertices: more than 2^32 - 1", vertex.count),
+        )
+    })?;
+    Ok(Schema {
+        vertex_count,
+        face_list,
+        xyz,
+    })
+}
+
+/// Checks a vertex index read from face `face` (0-based), returning it as `u32`.
+fn check_index(
+    path: &Path,
+    line: Option<u64>,
+    face: usize,
+    index: f64,
+    vertex_count: u32,
+) -> Result<u32, SceneError> {
+    if index >= 0.0 && index < vertex_count as f64 && index.fract() == 0.0 {
+        Ok(index as u32)
+    } else {
+        Err(parse_error(
+            path,
+            line,
+            format!(
+                "face {face}: vertex index {index} out of range (the file has {vertex_count} vertices)"
+            ),
+        ))
+    }
+}
+
+/// A face with fewer than three vertices.
+fn short_face(path: &Path, line: Option<u64>, face: usize, n: usize) -> SceneError {
+    parse_error(
+        path,
+        line,
+        format!("face {face} has {n} vertices; a polygon needs at least 3"),
+    )
+}
+
+// ---------------------------------------------------------------------------------------
+// ASCII
+// ---------------------------------------------------------------------------------------
+
+/// The ASCII body through ply-rs-bw's `DefaultElement`.
+fn parse_ascii(
+    path: &Path,
+    parser: &Parser<DefaultElement>,
+    mut reader: Reader<&[u8]>,
+    header: &Header,
+    schema: &Schema,
+    first_body_line: u64,
+) -> Result<Mesh, SceneError> {
+    let mut positions = Vec::new();
+    let mut faces = Vec::new();
+    let mut stats = LoadStats::default();
+    // Each element record takes one line.
+    let mut first_line = first_body_line;
+    for (name, def) in &header.elements {
+        let elems = parser
+            .read_payload_for_element(&mut reader, def, header)
+            .map_err(|e| ply_error(path, &e))?;
+        if name == "vertex" {
+            positions.reserve(elems.len());
+            for (i, e) in elems.iter().enumerate() {
+                let mut p = [0.0f32; 3];
+                for (c, &k) in p.iter_mut().zip(&schema.xyz) {
+                    *c = e.get_index(k).and_then(|(_, v)| scalar(v)).ok_or_else(|| {
+                        parse_error(
+                            path,
+                            Some(first_line + i as u64),
+                            "missing vertex coordinate",
+                        )
+                    })? as f32;
+                }
+                positions.push(Vec3::from_array(p));
+            }
+        } else if name == "face" {
+            faces.reserve(elems.len());
+            let mut poly = Vec::new();
+            for (i, e) in elems.iter().enumerate() {
+                let line = Some(first_line + i as u64);
+                let list = e.get_index(schema.face_list).map(|(_, v)| v);
+                poly.clear();
+                for x in list.map(list_values).unwrap_or_default() {
+                    poly.push(check_index(path, line, i, x, schema.vertex_count)?);
+                }
+                if poly.len() < 3 {
+                    return Err(short_face(path, line, i, poly.len()));
+                }
+                fan(&poly, &mut faces, &mut stats);
+            }
+        }
+        first_line += def.count as u64;
+    }
+    stats.source_triangles = faces.len() as u64;
+    Ok(Mesh {
+        triangles: gather(&positions, &faces),
+        stats,
+    })
+}
+
+/// A scalar property as `f64`.
+fn scalar(p: &Property) -> Option<f64> {
+    Some(match *p {
+        Property::Char(v) => v.into(),
+        Property::UChar(v) => v.into(),
+        Property::Short(v) => v.into(),
+        Property::UShort(v) => v.into(),
+        Property::Int(v) => v.into(),
+        Property::UInt(v) => v.into(),
+        Property::Float(v) => v.into(),
+        Property::Double(v) => v,
+        _ => return None,
+    })
+}
+
+/// The values of a list property as `f64`.
+fn list_values(p: &Property) -> Vec<f64> {
+    fn conv<T: Copy + Into<f64>>(v: &[T]) -> Vec<f64> {
+        v.iter().map(|&x| x.into()).collect()
+    }
+    match p {
+        Property::ListChar(v) => conv(v),
+        Property::ListUChar(v) => conv(v),
+        Property::ListShort(v) => conv(v),
+        Property::ListUShort(v) => conv(v),
+        Property::ListInt(v) => conv(v),
+        Property::ListUInt(v) => conv(v),
+        Property::ListFloat(v) => conv(v),
+        Property::ListDouble(v) => v.clone(),
+        _ => Vec::new(),
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Binary
+// ---------------------------------------------------------------------------------------
+
+/// A copyable mirror of ply-rs-bw's `ScalarType`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+/// A copyable mirror of ply-rs-bw's `PropertyType`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Prop {
+    /// One value.
+    One(Scalar),
+    /// A list: count type, item type.
+    List(Scalar, Scalar),
+}
+
+impl From<&ScalarType> for Scalar {
+    fn from(t: &ScalarType) -> Self {
+        match t {
+            ScalarType::Char => Scalar::I8,
+            ScalarType::UChar => Scalar::U8,
+            ScalarType::Short => Scalar::I16,
+            ScalarType::UShort => Scalar::U16,
+            ScalarType::Int => Scalar::I32,
+            ScalarType::UInt => Scalar::U32,
+            ScalarType::Float => Scalar::F32,
+            ScalarType::Double => Scalar::F64,
+        }
+    }
+}
+
+impl From<&PropertyType> for Prop {
+    fn from(t: &PropertyType) -> Self {
+        match t {
+            PropertyType::Scalar(s) => Prop::One(s.into()),
+            PropertyType::List(c, i) => Prop::List(c.into(), i.into()),
+        }
+    }
+}
+
+/// The properties of an element, in order.
+fn props(def: &ElementDef) -> Vec<Prop> {
+    def.properties
+        .values()
+        .map(|p| Prop::from(&p.data_type))
+        .collect()
+}
+
+/// Size in bytes of a scalar type.
+fn size_of(t: Scalar) -> usize {
+    match t {
+        Scalar::I8 | Scalar::U8 => 1,
+        Scalar::I16 | Scalar::U16 => 2,
+        Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+        Scalar::F64 => 8,
+    }
+}
+
+/// A bounds-checked reader over a binary body.
+struct Cursor<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    big_endian: bool,
+}
+
+impl Cursor<'_> {
+    /// The next `N` bytes, or `None` at the end of the data.
+    #[inline]
+    fn take<const N: usize>(&mut self) -> Option<[u8; N]> {
+        let b = self.bytes.get(self.pos..self.pos + N)?;
+        self.pos += N;
+        b.try_into().ok()
+    }
+
+    /// The next scalar of type `t`, widened to `f64` (exact for every PLY type).
+    #[inline]
+    fn scalar(&mut self, t: Scalar) -> Option<f64> {
+        macro_rules! rd {
+            ($ty:ty, $n:literal) => {{
+                let b = self.take::<$n>()?;
+                if self.big_endian {
+                    <$ty>::from_be_bytes(b)
+                } else {
+                    <$ty>::from_le_bytes(b)
+                }
+            }};
+        }
+        Some(match t {
+            Scalar::I8 => rd!(i8, 1).into(),
+            Scalar::U8 => rd!(u8, 1).into(),
+            Scalar::I16 => rd!(i16, 2).into(),
+            Scalar::U16 => rd!(u16, 2).into(),
+            Scalar::I32 => rd!(i32, 4).into(),
+            Scalar::U32 => rd!(u32, 4).into(),
+            Scalar::F32 => rd!(f32, 4).into(),
+            Scalar::F64 => rd!(f64, 8),
+        })
+    }
+
+    /// Bytes left.
+    fn remaining(&self) -> usize {
+        self.bytes.len() - self.pos
+    }
+}
+
+/// Smallest record size of an element (lists counted as empty), and whether every record
+/// has exactly that size (no list properties).
+fn record_size(def: &ElementDef) -> (usize, bool) {
+    let mut size = 0;
+    let mut fixed = true;
+    for p in props(def) {
+        match p {
+            Prop::One(t) => size += size_of(t),
+            Prop::List(c, _) => {
+                size += size_of(c);
+                fixed = false;
+            }
+        }
+    }
+    (size, fixed)
+}
+
+/// The binary body, either endianness.
+fn parse_binary(
+    path: &Path,
+    body: &[u8],
+    header: &Header,
+    schema: &Schema,
+    big_endian: bool,
+) -> Result<Mesh, SceneError> {
+    let mut cur = Cursor {
+        bytes: body,
+        pos: 0,
+        big_endian,
+    };
+    let mut positions: Vec<Vec3> = Vec::new();
+    let mut faces: Vec<[u32; 3]> = Vec::new();
+    let mut stats = LoadStats::default();
+    for (name, def) in &header.elements {
+        let (min_size, fixed) = record_size(def);
+        let need = def.count.checked_mul(min_size).unwrap_or(usize::MAX);
+        if need > cur.remaining() {
+            return Err(truncated(path, def, cur.remaining(), need));
+        }
+        if name == "vertex" {
+            positions = read_vertices(path, &mut cur, def, schema)?;
+        } else if name == "face" {
+            // Most files have triangles only, so one triangle per record is a good guess.
+            faces.reserve(def.count);
+            read_faces(path, &mut cur, def, schema, &mut faces, &mut stats)?;
+        } else if fixed {
+            cur.pos += need;
+        } else {
+            let props = props(def);
+            for i in 0..def.count {
+                for &p in &props {
+                    skip_property(path, &mut cur, def, i, p)?;
+                }
+            }
+        }
+    }
+    stats.source_triangles = faces.len() as u64;
+    Ok(Mesh {
+        triangles: gather(&positions, &faces),
+        stats,
+    })
+}
+
+/// The error for a body that ends before `element` does.
+fn truncated(path: &Path, def: &ElementDef, remaining: usize, need: usize) -> SceneError {
+    parse_error(
+        path,
+        None,
+        format!(
+            "truncated: element `{}` declares {} records, needing at least {need} bytes, \
+             but only {remaining} bytes are left",
+            def.name, def.count
+        ),
+    )
+}
+
+/// The error for a record cut off by the end of the data.
+fn cut(path: &Path, def: &ElementDef, record: usize) -> SceneError {
+    parse_error(
+        path,
+        None,
+        format!(
+            "truncated: the data ends inside record {record} of element `{}` ({} declared)",
+            def.name, def.count
+        ),
+    )
+}
+
+/// Reads a list length of type `t`, checking it is a sane non-negative integer that fits
+/// in the remaining bytes.
+fn list_len(
+    path: &Path,
+    cur: &mut Cursor<'_>,
+    def: &ElementDef,
+    record: usize,
+    count_t: Scalar,
+    item_t: Scalar,
+) -> Result<usize, SceneError> {
+    let n = cur.scalar(count_t).ok_or_else(|| cut(path, def, record))?;
+    if !(n >= 0.0 && n.fract() == 0.0) {
+        return Err(parse_error(
+            path,
+            None,
+            format!(
+                "record {record} of element `{}`: bad list length {n}",
+                def.name
+            ),
+        ));
+    }
+    let n = n as usize;
+    if n.saturating_mul(size_of(item_t)) > cur.remaining() {
+        return Err(cut(path, def, record));
+    }
+    Ok(n)
+}
+
+/// Skips one property of record `record`.
+fn skip_property(
+    path: &Path,
+    cur: &mut Cursor<'_>,
+    def: &ElementDef,
+    record: usize,
+    t: Prop,
+) -> Result<(), SceneError> {
+    let bytes = match t {
+        Prop::One(t) => size_of(t),
+        Prop::List(c, i) => list_len(path, cur, def, record, c, i)? * size_of(i),
+    };
+    if bytes > cur.remaining() {
+        return Err(cut(path, def, record));
+    }
+    cur.pos += bytes;
+    Ok(())
+}
+
+/// Reads the `vertex` element's positions.
+fn read_vertices(
+    path: &Path,
+    cur: &mut Cursor<'_>,
+    def: &ElementDef,
+    schema: &Schema,
+) -> Result<Vec<Vec3>, SceneError> {
+    let props = props(def);
+    let mut out = Vec::with_capacity(def.count);
+    // Fast path: the common `float x, float y, float z` as the first three properties.
+    let plain = props.len() == 3
+        && schema.xyz == [0, 1, 2]
+        && props.iter().all(|&t| t == Prop::One(Scalar::F32));
+    if plain {
+        let bytes = &cur.bytes[cur.pos..cur.pos + def.count * 12];
+        let be = cur.big_endian;
+        out.extend(bytes.chunks_exact(12).map(|c| {
+            let f = |i: usize| {
+                let b = [c[i], c[i + 1], c[i + 2], c[i + 3]];
+                if be {
+                    f32::from_be_bytes(b)
+                } else {
+                    f32::from_le_bytes(b)
+                }
+            };
+            Vec3::new(f(0), f(4), f(8))
+        }));
+        cur.pos += def.count * 12;
+        return Ok(out);
+    }
+    for i in 0..def.count {
+        let mut p = [0.0f32; 3];
+        for (k, &t) in props.iter().enumerate() {
+            match t {
+                Prop::One(s) => {
+                    let v = cur.scalar(s).ok_or_else(|| cut(path, def, i))?;
+                    if let Some(c) = schema.xyz.iter().position(|&x| x == k) {
+                        p[c] = v as f32;
+                    }
+                }
+                Prop::List(..) => skip_property(path, cur, def, i, t)?,
+            }
+        }
+        out.push(Vec3::from_array(p));
+    }
+    Ok(out)
+}
+
+/// Reads the `face` element, fan-triangulating into `faces`.
+fn read_faces(
+    path: &Path,
+    cur: &mut Cursor<'_>,
+    def: &ElementDef,
+    schema: &Schema,
+    faces: &mut Vec<[u32; 3]>,
+    stats: &mut LoadStats,
+) -> Result<(), SceneError> {
+    let props = props(def);
+    let mut poly: Vec<u32> = Vec::with_capacity(16);
+    for i in 0..def.count {
+        for (k, &t) in props.iter().enumerate() {
+            match t {
+                Prop::List(c, it) if k == schema.face_list => {
+                    let n = list_len(path, cur, def, i, c, it)?;
+                    poly.clear();
+                    for _ in 0..n {
+                        let x = cur.scalar(it).ok_or_else(|| cut(path, def, i))?;
+                        poly.push(check_index(path, None, i, x, schema.vertex_count)?);
+                    }
+                    if n == 3 {
+                        faces.push([poly[0], poly[1], poly[2]]);
+                    } else if n < 3 {
+                        return Err(short_face(path, None, i, n));
+                    } else {
+                        fan(&poly, faces, stats);
+                    }
+                }
+                _ => skip_property(path, cur, def, i, t)?,
+            }
+        }
+    }
+    Ok(())
+}
