@@ -114,7 +114,8 @@ pub(crate) fn load_scene(spec: &str, ctx: &Ctx) -> anyhow::Result<Scene> {
 pub(crate) fn build_structures(scene: &Scene, ctx: &Ctx) -> anyhow::Result<Structures> {
     let sp = ctx.spinner("building structures");
     let t = Instant::now();
-    let s = Structures::build(&scene.triangles, &BuildConfig::default());
+    let s = Structures::try_build(&scene.triangles, &BuildConfig::default())
+        .context("building the acceleration structures")?;
     sp.finish_and_clear();
     println!("structures built in {:.2} s", t.elapsed().as_secs_f64());
     Ok(s)
