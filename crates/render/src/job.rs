@@ -12,8 +12,9 @@
 //!   face the incoming ray).
 //! * One light from the scene ([`dualsplit_scene::Light`]): a point light whose position is
 //!   jittered uniformly over a sphere of the light's radius (radius 0 = hard shadows). Its
-//!   power is normalised so that a surface at the scene centre facing the light receives an
-//!   irradiance of `2 · intensity` whatever the scene's scale ([`PixelJob::new`]).
+//!   power is `2 · intensity · d²` with `d` the distance from the light to the scene centre,
+//!   so that a surface at the centre facing the light receives an irradiance of
+//!   `2 · intensity` whatever the scene's scale (the "exposure" needs no tuning per scene).
 //! * Rays that leave the scene see a constant sky of radiance [`SKY`]. The light is not
 //!   geometry, so next-event estimation and sky hits never count the same light twice.
 //! * *cast* adds a small ambient term ([`AMBIENT`] · albedo) at the primary hit so that shadowed
@@ -247,8 +248,11 @@ impl<'a> PixelJob<'a> {
         let ext = b.extent().max_element();
         let mag = b.min.abs().max(b.max.abs()).max_element();
         let eps = (ext.max(mag) * 2e-5).max(1e-9);
+        // Distance² from the light to the scene centre, floored at (1 % of the extent)² so a
+        // light placed at the centre still lights the scene.
         let dc = (scene.light.position - b.center())
             .length_squared()
+            .max((ext * 0.01).powi(2))
             .max(1e-12);
         let c = &scene.camera;
         let fwd = (c.target - c.eye).normalize();
