@@ -1,3 +1,11 @@
+//! Cameras and lights: a fit to the bounds for unknown scenes, presets for the shipped scene
+//! files (keyed by file stem), and command-line overrides.
+//!
+//! The paper renders each test scene from one fixed view (Lin et al. 2020, §4, Fig. 6); the
+//! presets play that role for the files in `shared/scenes/`, each showing its subject (the
+//! dragon inside its box, the Sponza courtyard from inside, the dragons in a row). Presets
+//! are expressed relative to the scene bounds, so a rescaled file still gets a sensible view.
+
 use dualsplit_geometry::{Aabb, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -25,33 +33,261 @@ pub struct Light {
     pub intensity: f32,
 }
 
-impl Camera {
-    /// A camera looking at the centre of `b` from the +z/+y side, far enough to see it all.
-    pub fn fit(b: &Aabb) -> Self {
-        let c = b.center();
-        let r = (b.extent().length() * 0.5).max(1e-3);
-        let fov_y_deg: f32 = 45.0;
-        let dist = r / (fov_y_deg.to_radians() * 0.5).sin();
-        let dir = Vec3::new(0.35, 0.35, 1.0).normalize();
-        Self {
-            eye: c + dir * dist,
-            target: c,
+/// A bad camera or light override from the command line.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CameraError {
+    /// A vector is not three comma-separated finite numbers.
+    #[error("--{what} `{value}`: expected three finite numbers `x,y,z`")]
+    BadVector {
+        /// Which option (`eye`, `target`, `light`).
+        what: &'static str,
+        /// The text given.
+        value: String,
+    },
+    /// A scalar is out of its range (or not finite).
+    #[error("--{what} {value}: must lie in ({min}, {max})")]
+    OutOfRange {
+        /// Which option (`fov`, `light-radius`, `light-intensity`).
+        what: &'static str,
+        /// The value given.
+        value: f32,
+        /// Exclusive lower bound.
+        min: f32,
+        /// Exclusive upper bound.
+        max: f32,
+    },
+    /// The eye and the target coincide, or the view direction is parallel to up.
+    #[error(
+        "camera eye {eye:?} and target {target:?} give no view direction (equal, or looking straight along up)"
+    )]
+    NoViewDirection {
+        /// Eye.
+        eye: Vec3,
+        /// Target.
+        target: Vec3,
+    },
+}
+
+/// Parses `x,y,z` (spaces allowed) into a finite vector.
+pub fn parse_vec3(what: &'static str, s: &str) -> Result<Vec3, CameraError> {
+    let bad = || CameraError::BadVector {
+        what,
+        value: s.to_string(),
+    };
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|c| c.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
+    match v[..] {
+        [x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => Ok(Vec3::new(x, y, z)),
+        _ => Err(bad()),
+    }
+}
+
+fn check_range(what: &'static str, value: f32, min: f32, max: f32) -> Result<f32, CameraError> {
+    if value > min && value < max {
+        Ok(value)
+    } else {
+        Err(CameraError::OutOfRange {
+            what,
+            value,
+            min,
+            max,
+        })
+    }
+}
+
+/// A view relative to the bounds: looks at `target` (fractions of the box, 0 = min, 1 = max)
+/// from `eye` (same fractions), or, when `eye` is `None`, from direction `dir` at the distance
+/// that fits the box's bounding sphere scaled by `zoom`.
+struct View {
+    target: [f32; 3],
+    eye: Option<[f32; 3]>,
+    dir: Vec3,
+    zoom: f32,
+    fov: f32,
+}
+
+impl View {
+    fn camera(&self, b: &Aabb) -> Camera {
+        let at = |f: [f32; 3]| b.min + b.extent() * Vec3::from_array(f);
+        let target = at(self.target);
+        let eye = match self.eye {
+            Some(e) => at(e),
+            None => {
+                let r = (b.extent().length() * 0.5).max(1e-3);
+                let dist = r / (self.fov.to_radians() * 0.5).sin() * self.zoom;
+                target + self.dir.normalize() * dist
+            }
+        };
+        Camera {
+            eye,
+            target,
             up: Vec3::Y,
-            fov_y_deg,
+            fov_y_deg: self.fov,
         }
     }
 }
 
+/// The shipped files' views, by stem (y is up in all of them, see `shared/scenes/README.md`).
+fn preset_view(stem: &str) -> Option<View> {
+    Some(match stem {
+        // The dragon alone: three-quarter view of its left side, slightly from above.
+        "dragon" | "dragon_res2" | "dragon_res3" | "dragon_res4" => View {
+            target: [0.5, 0.45, 0.5],
+            eye: None,
+            dir: Vec3::new(0.45, 0.3, 1.0),
+            zoom: 0.72,
+            fov: 40.0,
+        },
+        "bunny" => View {
+            target: [0.5, 0.45, 0.5],
+            eye: None,
+            dir: Vec3::new(0.2, 0.25, 1.0),
+            zoom: 0.72,
+            fov: 40.0,
+        },
+        // The dragon inside its box, seen through the open +z side.
+        "dragon_box" => View {
+            target: [0.5, 0.28, 0.45],
+            eye: None,
+            dir: Vec3::new(0.12, 0.15, 1.0),
+            zoom: 0.7,
+            fov: 45.0,
+        },
+        // Inside the courtyard from its west end, looking down the arcades.
+        "sponza_dabrovic" => View {
+            target: [0.9, 0.38, 0.47],
+            eye: Some([0.1, 0.2, 0.56]),
+            dir: Vec3::X,
+            zoom: 1.0,
+            fov: 60.0,
+        },
+        // The row of dragons on the courtyard floor, seen diagonally from a corner.
+        "dragon_sponza" => View {
+            target: [0.45, 0.11, 0.5],
+            eye: Some([0.1, 0.27, 0.385]),
+            dir: Vec3::X,
+            zoom: 1.0,
+            fov: 55.0,
+        },
+        _ => return None,
+    })
+}
+
+impl Camera {
+    /// A camera looking at the centre of `b` from the front (+z), a little from the right and
+    /// above, at the distance where the box's bounding sphere just fills a 45° view. Used for
+    /// files without a preset (y assumed up, as in most mesh files).
+    pub fn fit(b: &Aabb) -> Self {
+        View {
+            target: [0.5, 0.5, 0.5],
+            eye: None,
+            dir: Vec3::new(0.35, 0.35, 1.0),
+            zoom: 1.0,
+            fov: 45.0,
+        }
+        .camera(b)
+    }
+
+    /// The preset view of a shipped scene file by its stem (`dragon_box`, `sponza_dabrovic`,
+    /// …; see `docs/scenes.md`), placed relative to `bounds`; [`Camera::fit`] for any other
+    /// stem.
+    pub fn preset_for(stem: &str, bounds: &Aabb) -> Self {
+        preset_view(stem).map_or_else(|| Self::fit(bounds), |v| v.camera(bounds))
+    }
+
+    /// True when `stem` has a preset view.
+    pub fn has_preset(stem: &str) -> bool {
+        preset_view(stem).is_some()
+    }
+
+    /// This camera with command-line overrides: `eye` and `target` as `x,y,z`, `fov` the
+    /// vertical field of view in degrees (0, 180).
+    pub fn with_overrides(
+        &self,
+        eye: Option<&str>,
+        target: Option<&str>,
+        fov: Option<f32>,
+    ) -> Result<Self, CameraError> {
+        let mut c = *self;
+        if let Some(e) = eye {
+            c.eye = parse_vec3("eye", e)?;
+        }
+        if let Some(t) = target {
+            c.target = parse_vec3("target", t)?;
+        }
+        if let Some(f) = fov {
+            c.fov_y_deg = check_range("fov", f, 0.0, 180.0)?;
+        }
+        let fwd = c.target - c.eye;
+        if fwd.length_squared() == 0.0 || fwd.cross(c.up).length_squared() == 0.0 {
+            return Err(CameraError::NoViewDirection {
+                eye: c.eye,
+                target: c.target,
+            });
+        }
+        Ok(c)
+    }
+}
+
 impl Light {
-    /// A light above and in front of the scene, a little to the side of a fitted camera.
+    /// A light above the scene, in front of it and to the left of a fitted camera, so
+    /// shadows fall visibly to the right and back. Its radius is 2 % of the scene radius.
     pub fn fit(b: &Aabb) -> Self {
         let c = b.center();
         let e = b.extent();
         let r = (e.length() * 0.5).max(1e-3);
         Self {
-            position: c + Vec3::new(-0.4 * e.x, 0.9 * e.y.max(r * 0.5), 0.6 * e.z.max(r * 0.3)),
+            position: c + Vec3::new(-0.5 * r, 1.1 * r, 0.8 * r),
             radius: r * 0.02,
             intensity: 1.0,
         }
+    }
+
+    /// The preset light of a shipped scene file by its stem, relative to `bounds`;
+    /// [`Light::fit`] for any other stem.
+    pub fn preset_for(stem: &str, b: &Aabb) -> Self {
+        let at = |f: [f32; 3]| b.min + b.extent() * Vec3::from_array(f);
+        let r = (b.extent().length() * 0.5).max(1e-3);
+        match stem {
+            // Under the top of the box, toward the open side: the dragon casts a shadow on
+            // the floor and the back wall.
+            "dragon_box" => Self {
+                position: at([0.3, 0.85, 0.75]),
+                radius: r * 0.02,
+                intensity: 1.0,
+            },
+            // High over the open courtyard: sun-like light falling into the atrium.
+            "sponza_dabrovic" | "dragon_sponza" => Self {
+                position: at([0.4, 0.95, 0.5]),
+                radius: r * 0.01,
+                intensity: 1.0,
+            },
+            _ => Self::fit(b),
+        }
+    }
+
+    /// This light with command-line overrides: `position` as `x,y,z`, `radius` ≥ 0 (0 is
+    /// a point light) and `intensity` > 0.
+    pub fn with_overrides(
+        &self,
+        position: Option<&str>,
+        radius: Option<f32>,
+        intensity: Option<f32>,
+    ) -> Result<Self, CameraError> {
+        let mut l = *self;
+        if let Some(p) = position {
+            l.position = parse_vec3("light", p)?;
+        }
+        if let Some(r) = radius {
+            // Radius 0 is allowed (a point light): check against a range open below -0.
+            l.radius = check_range("light-radius", r, -f32::MIN_POSITIVE, f32::MAX)?.max(0.0);
+        }
+        if let Some(i) = intensity {
+            l.intensity = check_range("light-intensity", i, 0.0, f32::MAX)?;
+        }
+        Ok(l)
     }
 }

@@ -27,7 +27,7 @@ mod camera;
 mod error;
 pub mod load;
 
-pub use camera::{Camera, Light};
+pub use camera::{Camera, CameraError, Light, parse_vec3};
 pub use error::SceneError;
 
 use dualsplit_geometry::{Aabb, Triangle};
@@ -78,16 +78,27 @@ impl Scene {
     ) -> Result<Self, SceneError> {
         let spec = spec.into();
         stats.source_triangles = stats.source_triangles.max(triangles.len() as u64);
+        // Parallel passes (millions of triangles for the big scenes); order is kept and the
+        // bounds are exact min/max, so the result does not depend on the thread count.
+        use rayon::prelude::*;
         let before = triangles.len();
-        let triangles: Vec<Triangle> = triangles.into_iter().filter(|t| t.is_finite()).collect();
+        let triangles: Vec<Triangle> = if triangles.par_iter().all(|t| t.is_finite()) {
+            triangles
+        } else {
+            triangles
+                .into_par_iter()
+                .filter(|t| t.is_finite())
+                .collect()
+        };
         stats.non_finite += (before - triangles.len()) as u64;
-        stats.degenerate = triangles.iter().filter(|t| t.is_degenerate()).count() as u64;
+        stats.degenerate = triangles.par_iter().filter(|t| t.is_degenerate()).count() as u64;
         if triangles.is_empty() {
             return Err(SceneError::Empty { spec });
         }
         let bounds = triangles
-            .iter()
-            .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+            .par_iter()
+            .map(|t| t.bounds())
+            .reduce(|| Aabb::EMPTY, Aabb::union);
         let camera = Camera::fit(&bounds);
         let light = Light::fit(&bounds);
         Ok(Self {
@@ -122,6 +133,23 @@ pub fn load(spec: &str) -> Result<Scene, SceneError> {
     if let Some(rest) = spec.strip_prefix("builtin:") {
         builtin::generate(rest)
     } else {
-        load::load_file(std::path::Path::new(spec))
+        let path = std::path::Path::new(spec);
+        let mut scene = load::load_file(path)?;
+        let stem = file_stem(path);
+        scene.camera = Camera::preset_for(stem, &scene.bounds);
+        scene.light = Light::preset_for(stem, &scene.bounds);
+        Ok(scene)
     }
+}
+
+/// The file name without its scene extensions (`.ply`, `.obj`, `.gz`, ...): the key of the
+/// camera and light presets (`dragon_box.ply.gz` → `dragon_box`).
+pub fn file_stem(path: &std::path::Path) -> &str {
+    let mut name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    for ext in [".gz", ".obj", ".ply", ".gltf", ".glb"] {
+        if let Some(s) = name.strip_suffix(ext) {
+            name = s;
+        }
+    }
+    name
 }

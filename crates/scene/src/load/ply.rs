@@ -138,14 +138,25 @@ fn check_index(
     if index >= 0.0 && index < vertex_count as f64 && index.fract() == 0.0 {
         Ok(index as u32)
     } else {
-        Err(parse_error(
-            path,
-            line,
-            format!(
-                "face {face}: vertex index {index} out of range (the file has {vertex_count} vertices)"
-            ),
-        ))
+        Err(index_error(path, line, face, index, vertex_count))
     }
+}
+
+/// The error for a vertex index out of range (or not an integer) in face `face`.
+fn index_error(
+    path: &Path,
+    line: Option<u64>,
+    face: usize,
+    index: f64,
+    vertex_count: u32,
+) -> SceneError {
+    parse_error(
+        path,
+        line,
+        format!(
+            "face {face}: vertex index {index} out of range (the file has {vertex_count} vertices)"
+        ),
+    )
 }
 
 /// A face with fewer than three vertices.
@@ -409,8 +420,6 @@ fn parse_binary(
         if name == "vertex" {
             positions = read_vertices(path, &mut cur, def, schema)?;
         } else if name == "face" {
-            // Most files have triangles only, so one triangle per record is a good guess.
-            faces.reserve(def.count);
             read_faces(path, &mut cur, def, schema, &mut faces, &mut stats)?;
         } else if fixed {
             cur.pos += need;
@@ -516,9 +525,10 @@ fn read_vertices(
         && schema.xyz == [0, 1, 2]
         && props.iter().all(|&t| t == Prop::One(Scalar::F32));
     if plain {
+        use rayon::prelude::*;
         let bytes = &cur.bytes[cur.pos..cur.pos + def.count * 12];
         let be = cur.big_endian;
-        out.extend(bytes.chunks_exact(12).map(|c| {
+        out.par_extend(bytes.par_chunks_exact(12).with_min_len(1 << 14).map(|c| {
             let f = |i: usize| {
                 let b = [c[i], c[i + 1], c[i + 2], c[i + 3]];
                 if be {
@@ -560,6 +570,19 @@ fn read_faces(
     stats: &mut LoadStats,
 ) -> Result<(), SceneError> {
     let props = props(def);
+    if let [Prop::List(count_t, index_t)] = props[..]
+        && let Some(done) = read_triangles_fast(path, cur, def, schema, count_t, index_t)?
+    {
+        if faces.is_empty() {
+            *faces = done;
+        } else {
+            faces.extend_from_slice(&done);
+        }
+        return Ok(());
+    }
+    // Most files have triangles only, so one triangle per record is a good guess (the count
+    // was checked against the bytes present).
+    faces.reserve(def.count);
     let mut poly: Vec<u32> = Vec::with_capacity(16);
     for i in 0..def.count {
         for (k, &t) in props.iter().enumerate() {
@@ -584,4 +607,75 @@ fn read_faces(
         }
     }
     Ok(())
+}
+
+/// The fast path of [`read_faces`] for a `face` element whose only property is the index list
+/// with an 8-bit count and 32-bit indices (the shipped scenes): when every record's count is
+/// 3, the records are a fixed 13-byte stride, so they are decoded in parallel. Returns `None`
+/// (nothing consumed) when the element does not have that shape; the general path then runs.
+///
+/// The shape test is sound: if the record at offset 0 has count 3 it is 13 bytes long, so
+/// the next record starts at 13, and so on; checking every 13th byte for 3 is exactly what
+/// the sequential reader would see.
+fn read_triangles_fast(
+    path: &Path,
+    cur: &mut Cursor<'_>,
+    def: &ElementDef,
+    schema: &Schema,
+    count_t: Scalar,
+    index_t: Scalar,
+) -> Result<Option<Vec<[u32; 3]>>, SceneError> {
+    use rayon::prelude::*;
+    const REC: usize = 13;
+    if !matches!(count_t, Scalar::U8 | Scalar::I8) || !matches!(index_t, Scalar::U32 | Scalar::I32)
+    {
+        return Ok(None);
+    }
+    let Some(bytes) = def
+        .count
+        .checked_mul(REC)
+        .and_then(|n| cur.bytes.get(cur.pos..cur.pos + n))
+    else {
+        return Ok(None);
+    };
+    if !bytes
+        .par_chunks_exact(REC)
+        .with_min_len(1 << 14)
+        .all(|r| r[0] == 3)
+    {
+        return Ok(None);
+    }
+    let be = cur.big_endian;
+    let signed = index_t == Scalar::I32;
+    let n = schema.vertex_count;
+    // A negative i32 reads as a u32 >= 2^31 > any vertex count, so one range test covers
+    // both index types.
+    let decode = |r: &[u8], k: usize| {
+        let b = [r[k], r[k + 1], r[k + 2], r[k + 3]];
+        if be {
+            u32::from_be_bytes(b)
+        } else {
+            u32::from_le_bytes(b)
+        }
+    };
+    let faces: Vec<[u32; 3]> = bytes
+        .par_chunks_exact(REC)
+        .with_min_len(1 << 14)
+        .map(|r| [decode(r, 1), decode(r, 5), decode(r, 9)])
+        .collect();
+    if let Some((i, f)) = faces
+        .par_iter()
+        .enumerate()
+        .find_first(|(_, f)| f.iter().any(|&v| v >= n))
+    {
+        let bad = f.iter().copied().find(|&v| v >= n).unwrap_or_default();
+        let shown = if signed {
+            f64::from(bad as i32)
+        } else {
+            f64::from(bad)
+        };
+        return Err(index_error(path, None, i, shown, n));
+    }
+    cur.pos += bytes.len();
+    Ok(Some(faces))
 }
