@@ -84,15 +84,35 @@ impl Image {
         })
     }
 
-    /// Writes a PNG or an EXR, chosen by the extension of `path` (case-insensitive).
+    /// Writes a PNG or an EXR, chosen by the extension of `path` ([`ImageFormat::from_path`]).
     pub fn write(&self, path: &Path) -> Result<(), RenderError> {
+        match ImageFormat::from_path(path)? {
+            ImageFormat::Png => self.write_png(path),
+            ImageFormat::Exr => self.write_exr(path),
+        }
+    }
+}
+
+/// The output formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// Tone-mapped 8-bit sRGB PNG.
+    Png,
+    /// Linear f32 OpenEXR.
+    Exr,
+}
+
+impl ImageFormat {
+    /// The format named by the extension of `path` (`.png` or `.exr`, case-insensitive), so a
+    /// caller can reject a bad output name before rendering.
+    pub fn from_path(path: &Path) -> Result<Self, RenderError> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
             .map(|e| e.to_ascii_lowercase());
         match ext.as_deref() {
-            Some("png") => self.write_png(path),
-            Some("exr") => self.write_exr(path),
+            Some("png") => Ok(ImageFormat::Png),
+            Some("exr") => Ok(ImageFormat::Exr),
             _ => Err(RenderError::UnknownFormat {
                 path: path.to_path_buf(),
             }),

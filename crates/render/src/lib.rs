@@ -60,7 +60,7 @@ pub use counts::{KindCounts, RayCounts};
 pub use dualsplit_accel::AccelKind;
 pub use error::RenderError;
 pub use frame::{Frame, TILE, render, render_records, tile_count, validate};
-pub use image::{Image, srgb_encode};
+pub use image::{Image, ImageFormat, srgb_encode};
 pub use job::{
     ALBEDO, AMBIENT, PixelJob, RayKind, RayQuery, RenderSettings, SKY, TraceResult, Workload,
 };

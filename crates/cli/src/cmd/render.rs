@@ -1,11 +1,9 @@
 //! `dualsplit render`: one frame of a workload on a structure, written as PNG or EXR.
 //!
-//! Also holds the argument parsers `bench` shares (resolution, structure and workload names,
-//! vectors) and the scene/structure loading steps with their spinners.
+//! Also holds the argument parsers `bench` shares (resolution, structure and workload names) and the scene/structure loading steps with their spinners.
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::{AccelKind, BuildConfig, Structures};
-use dualsplit_geometry::Vec3;
 use dualsplit_render::{RayCounts, RayKind, RenderSettings, Workload, render, tile_count};
 use dualsplit_scene::Scene;
 use std::path::PathBuf;
@@ -33,17 +31,20 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     seed: u32,
     /// Camera position x,y,z (default: the scene's camera).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    eye: Option<Vec3>,
+    #[arg(long, allow_hyphen_values = true)]
+    eye: Option<String>,
     /// Point the camera looks at, x,y,z.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    target: Option<Vec3>,
-    /// Vertical field of view in degrees.
+    #[arg(long, allow_hyphen_values = true)]
+    target: Option<String>,
+    /// Vertical field of view in degrees, in (0, 180).
     #[arg(long)]
     fov: Option<f32>,
     /// Light centre x,y,z (default: the scene's light).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    light: Option<Vec3>,
+    #[arg(long, allow_hyphen_values = true)]
+    light: Option<String>,
+    /// Light radius (0 = point light, hard shadows).
+    #[arg(long)]
+    light_radius: Option<f32>,
     /// Output image: .png (tone-mapped sRGB, 8-bit) or .exr (linear f32).
     #[arg(short, long)]
     output: PathBuf,
@@ -77,21 +78,6 @@ pub(crate) fn parse_res(s: &str) -> Result<(u32, u32), String> {
     match s.split_once(['x', 'X']) {
         Some((w, h)) => Ok((num(w)?, num(h)?)),
         None => num(s).map(|n| (n, n)),
-    }
-}
-
-/// Parses `x,y,z`.
-pub(crate) fn parse_vec3(s: &str) -> Result<Vec3, String> {
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|t| t.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("bad vector `{s}`: {e}"))?;
-    match v[..] {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
-        _ => Err(format!(
-            "bad vector `{s}` (expected three finite numbers x,y,z)"
-        )),
     }
 }
 
@@ -144,19 +130,15 @@ pub(crate) fn print_counts(c: &RayCounts) {
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+    dualsplit_render::ImageFormat::from_path(&args.output)?;
     let mut scene = load_scene(&args.scene, ctx)?;
-    if let Some(e) = args.eye {
-        scene.camera.eye = e;
-    }
-    if let Some(t) = args.target {
-        scene.camera.target = t;
-    }
-    if let Some(f) = args.fov {
-        scene.camera.fov_y_deg = f;
-    }
-    if let Some(l) = args.light {
-        scene.light.position = l;
-    }
+    scene.camera =
+        scene
+            .camera
+            .with_overrides(args.eye.as_deref(), args.target.as_deref(), args.fov)?;
+    scene.light = scene
+        .light
+        .with_overrides(args.light.as_deref(), args.light_radius, None)?;
     let settings = RenderSettings {
         spp: args.spp,
         seed: args.seed,
