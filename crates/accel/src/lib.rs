@@ -134,13 +134,21 @@ impl Structures {
         let wide8 = WideBvh::collapse_bvh8(&bvh2, &CollapseConfig::default());
         let t8 = t0.elapsed();
         let bvh8 = BvhImage::encode(&wide8, &bvh2, triangles, cfg, t8)?;
-        Ok(Self {
+        let s = Self {
             triangles: triangles.to_vec(),
             bvh2,
             bvh2_image,
             bvh4,
             bvh8,
-        })
+        };
+        // Debug builds check every image (bounds containment is undefined for NaN input,
+        // which scene loading drops anyway).
+        if cfg!(debug_assertions) && triangles.iter().all(Triangle::is_finite) {
+            for rep in s.validate() {
+                debug_assert!(rep.is_ok(), "encoder produced an invalid image: {rep:?}");
+            }
+        }
+        Ok(s)
     }
 
     /// The encoded structure `kind` traverses.

@@ -6,6 +6,14 @@
 //! structure) are not counted. The paper does not say whether its Table 3 includes index
 //! lists; on Dragon Box its BVH2 figure (25.71 MiB) is smaller than the triangles alone
 //! (29.9 MiB), so triangles are surely excluded.
+//!
+//! Check against the paper (`dualsplit stats ../shared/scenes/dragon_box.ply.gz`): BVH2
+//! 28.88 MiB, BVH4 28.00 MiB (97.0 %), BVH8 24.53 MiB (84.9 %), against the paper's 25.71,
+//! 24.77 (96 %) and 21.42 MiB (83 %). The ratios agree. Our absolute size is 12 % larger
+//! because our leaves hold 1.82 triangles on average (more nodes than Embree's tree) and
+//! because each leaf costs a 4-byte leaf word in its parent's child block (1.8 MiB here; see
+//! [`crate::image`]). The ratios barely depend on the index lists: without them they are
+//! 96.6 % and 83.0 %.
 
 use crate::wide::BvhImage;
 use serde::Serialize;

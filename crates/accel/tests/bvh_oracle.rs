@@ -151,3 +151,30 @@ fn ray_through_shared_edge_and_t_min_equals_t_max() {
     ];
     check(&tris, &rays, &BuildConfig::default());
 }
+
+#[test]
+fn non_finite_and_huge_coordinates_do_not_panic() {
+    let tris = [
+        Triangle::new(Vec3::splat(f32::NAN), Vec3::ONE, Vec3::ZERO),
+        Triangle::new(
+            Vec3::splat(-3e38),
+            Vec3::new(3e38, -3e38, 0.0),
+            Vec3::new(0.0, 3e38, 1.0),
+        ),
+        Triangle::new(
+            Vec3::new(-1.0, -1.0, 2.0),
+            Vec3::new(1.0, -1.0, 2.0),
+            Vec3::new(0.0, 1.0, 2.0),
+        ),
+    ];
+    let s = Structures::build(&tris, &BuildConfig::default());
+    let ray = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
+    let want = key(oracle_closest(&tris, &ray));
+    for kind in KINDS {
+        assert_eq!(
+            key(s.closest_hit(kind, &ray, &mut NoObserver)),
+            want,
+            "{kind:?}"
+        );
+    }
+}

@@ -101,8 +101,7 @@ impl Triangle {
         let t_scaled = u * az + v * bz + w * cz;
         let inv_det = 1.0 / det;
         let t = t_scaled * inv_det;
-        // NaN-safe: a NaN t fails both comparisons and is rejected.
-        if !(t >= t_lo && t <= t_hi) {
+        if t.is_nan() || t < t_lo || t > t_hi {
             return None;
         }
         Some(TriangleHit {

@@ -9,9 +9,7 @@
 
 use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
 use dualsplit_render::{PixelJob, RenderSettings, TraceResult, Workload};
-use dualsplit_scene::Scene;
 use rayon::prelude::*;
-use std::io::Read;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -22,7 +20,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let size: u32 = args.get(3).map(|s| s.parse()).transpose()?.unwrap_or(256);
     let t0 = Instant::now();
-    let mut scene = load(&args[1])?;
+    let mut scene = dualsplit_scene::load(&args[1])?;
     let t_load = t0.elapsed();
     let env = |k: &str| std::env::var(k).ok();
     scene.camera = scene.camera.with_overrides(
@@ -83,54 +81,4 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         scene.camera
     );
     Ok(())
-}
-
-/// `dualsplit_scene::load`, with a fallback reader for the shipped `*.ply.gz` shape (binary
-/// little-endian, float xyz, uchar/uint triangle lists) while the general loaders are not
-/// in this tree.
-fn load(spec: &str) -> Result<Scene, Box<dyn std::error::Error>> {
-    match dualsplit_scene::load(spec) {
-        Ok(s) => Ok(s),
-        Err(dualsplit_scene::SceneError::UnknownFormat { .. }) if spec.ends_with(".ply.gz") => {
-            let mut data = Vec::new();
-            flate2::read::GzDecoder::new(std::fs::File::open(spec)?).read_to_end(&mut data)?;
-            let end = data
-                .windows(11)
-                .position(|w| w == b"end_header\n")
-                .ok_or("no end_header")?
-                + 11;
-            let header = std::str::from_utf8(&data[..end])?;
-            let count = |e: &str| -> usize {
-                header
-                    .lines()
-                    .find_map(|l| l.strip_prefix(e))
-                    .and_then(|n| n.trim().parse().ok())
-                    .unwrap_or(0)
-            };
-            let (nv, nf) = (count("element vertex"), count("element face"));
-            let f = |o: usize| f32::from_le_bytes(data[o..o + 4].try_into().unwrap());
-            let u = |o: usize| u32::from_le_bytes(data[o..o + 4].try_into().unwrap()) as usize;
-            let verts: Vec<glam::Vec3> = (0..nv)
-                .map(|i| glam::Vec3::new(f(end + 12 * i), f(end + 12 * i + 4), f(end + 12 * i + 8)))
-                .collect();
-            let fb = end + 12 * nv;
-            let tris = (0..nf)
-                .map(|i| {
-                    let o = fb + 13 * i + 1;
-                    dualsplit_geometry::Triangle::new(verts[u(o)], verts[u(o + 4)], verts[u(o + 8)])
-                })
-                .collect();
-            let stem = std::path::Path::new(spec)
-                .file_name()
-                .and_then(|s| s.to_str())
-                .unwrap_or("")
-                .trim_end_matches(".ply.gz")
-                .to_string();
-            let mut s = Scene::from_triangles(stem.clone(), spec, tris, Default::default())?;
-            s.camera = dualsplit_scene::Camera::preset_for(&stem, &s.bounds);
-            s.light = dualsplit_scene::Light::preset_for(&stem, &s.bounds);
-            Ok(s)
-        }
-        Err(e) => Err(e.into()),
-    }
 }

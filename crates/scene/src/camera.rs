@@ -111,7 +111,15 @@ struct View {
 
 impl View {
     fn camera(&self, b: &Aabb) -> Camera {
-        let at = |f: [f32; 3]| b.min + b.extent() * Vec3::from_array(f);
+        // Fraction 0.5 is exactly the centre (`(min + max) / 2`, not `min + extent / 2`).
+        let at = |f: [f32; 3]| {
+            let f = Vec3::from_array(f);
+            Vec3::select(
+                f.cmpeq(Vec3::splat(0.5)),
+                b.center(),
+                b.min + b.extent() * f,
+            )
+        };
         let target = at(self.target);
         let eye = match self.eye {
             Some(e) => at(e),
@@ -166,8 +174,8 @@ fn preset_view(stem: &str) -> Option<View> {
         },
         // The row of dragons on the courtyard floor, seen diagonally from a corner.
         "dragon_sponza" => View {
-            target: [0.45, 0.11, 0.5],
-            eye: Some([0.1, 0.27, 0.385]),
+            target: [0.5, 0.11, 0.487],
+            eye: Some([0.155, 0.248, 0.577]),
             dir: Vec3::X,
             zoom: 1.0,
             fov: 55.0,

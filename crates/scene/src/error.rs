@@ -4,12 +4,13 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The file could not be opened or read.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
+        /// The I/O error (shown in the message, deliberately not a `source()`, so that
+        /// `anyhow`'s `{:#}` chain does not print it twice).
+        error: std::io::Error,
     },
     /// The file's contents are malformed.
     #[error("{path}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]

@@ -1,8 +1,9 @@
 //! Scenes for dualsplit: triangle soups with a camera and a light.
 //!
 //! A scene is addressed by a *spec*: a file path (`.obj`, `.ply`, either also `.gz`, `.gltf`,
-//! `.glb`) or `builtin:NAME?key=value&...` (see [`builtin`]). [`load`] resolves a spec into a
-//! [`Scene`].
+//! `.glb`) or `builtin:NAME?key=value&...` (see [`builtin`]). [`load()`] resolves a spec into a
+//! [`Scene`]. Builtins come with their own camera and light; files get the preset of their
+//! stem ([`Camera::preset_for`], see `docs/scenes.md`) or a fit to their bounds.
 //!
 //! ```no_run
 //! let scene = dualsplit_scene::load("builtin:cornell").unwrap();
@@ -82,7 +83,25 @@ impl Scene {
         // bounds are exact min/max, so the result does not depend on the thread count.
         use rayon::prelude::*;
         let before = triangles.len();
-        let triangles: Vec<Triangle> = if triangles.par_iter().all(|t| t.is_finite()) {
+        // One pass: all finite?, degenerate count, bounds.
+        let (finite, degenerate, bounds) = triangles
+            .par_iter()
+            .with_min_len(1 << 12)
+            .fold(
+                || (true, 0u64, Aabb::EMPTY),
+                |(f, d, b), t| {
+                    if t.is_finite() {
+                        (f, d + u64::from(t.is_degenerate()), b.union(t.bounds()))
+                    } else {
+                        (false, d, b)
+                    }
+                },
+            )
+            .reduce(
+                || (true, 0, Aabb::EMPTY),
+                |x, y| (x.0 && y.0, x.1 + y.1, x.2.union(y.2)),
+            );
+        let triangles: Vec<Triangle> = if finite {
             triangles
         } else {
             triangles
@@ -91,14 +110,10 @@ impl Scene {
                 .collect()
         };
         stats.non_finite += (before - triangles.len()) as u64;
-        stats.degenerate = triangles.par_iter().filter(|t| t.is_degenerate()).count() as u64;
+        stats.degenerate = degenerate;
         if triangles.is_empty() {
             return Err(SceneError::Empty { spec });
         }
-        let bounds = triangles
-            .par_iter()
-            .map(|t| t.bounds())
-            .reduce(|| Aabb::EMPTY, Aabb::union);
         let camera = Camera::fit(&bounds);
         let light = Light::fit(&bounds);
         Ok(Self {

@@ -226,3 +226,29 @@ fn bad_spec_errors_display_the_spec() {
         "{text}"
     );
 }
+
+#[test]
+fn extreme_knobs_give_finite_scenes_of_the_right_size() {
+    for (spec, want) in [
+        ("hairball?triangles=5000&sides=3&segments=2&curl=0", 5000),
+        (
+            "hairball?triangles=5000&sides=16&segments=10000&radius=0.2&length=100",
+            5000,
+        ),
+        ("hairball?triangles=5000&radius=0.00001&curl=1000", 5000),
+        ("forest?triangles=5000&leaves=0&tree_share=1", 5000),
+        ("forest?triangles=5000&tree_share=0&size=1", 5000),
+        ("forest?triangles=20000&leaves=100000", 20000),
+        ("atrium?triangles=100000&bays=64", 100000),
+        ("atrium?triangles=20000&bays=2", 20000),
+    ] {
+        let s = scene_of(spec);
+        assert_eq!(s.stats.non_finite, 0, "{spec}");
+        assert!(s.bounds.is_finite(), "{spec}");
+        let n = s.triangles.len();
+        assert!(
+            n.abs_diff(want) * 20 <= want,
+            "{spec}: {n} triangles, want {want}"
+        );
+    }
+}

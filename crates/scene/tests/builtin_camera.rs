@@ -180,3 +180,15 @@ fn light_overrides_apply_and_check() {
         Err(CameraError::BadVector { what: "light", .. })
     ));
 }
+
+#[test]
+fn loading_a_shipped_file_applies_its_preset() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/scenes/dragon_res4.ply.gz"
+    );
+    let s = dualsplit_scene::load(path).unwrap();
+    assert_eq!(s.camera, Camera::preset_for("dragon_res4", &s.bounds));
+    assert_eq!(s.light, Light::preset_for("dragon_res4", &s.bounds));
+    assert_ne!(s.camera, Camera::fit(&s.bounds));
+}

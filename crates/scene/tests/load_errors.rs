@@ -366,6 +366,15 @@ fn gltf_errors() {
         None,
         "vertex index 9 out of range",
     );
+    // POSITION names an accessor that does not exist (gltf-json's validator would index
+    // out of bounds here; found by the proptest in load_fuzz.rs).
+    let json = r#"{"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+      "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]}"#;
+    expect_parse(
+        &fail("noacc.gltf", json.as_bytes()),
+        None,
+        "accessor 0 does not exist",
+    );
     // A node cycle.
     let json = r#"{"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],
       "nodes":[{"children":[1]},{"children":[0]}]}"#;

@@ -246,7 +246,7 @@ fn gltf_buffer() -> (Vec<u8>, usize, usize) {
             }
         }
     }
-    while b.len() % 4 != 0 {
+    while !b.len().is_multiple_of(4) {
         b.push(0);
     }
     (b, pos_len, n)
@@ -360,7 +360,7 @@ fn gltf_external_bin() {
 /// A GLB container around `json` and `bin`.
 pub fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
     let mut j = json.as_bytes().to_vec();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let total = 12 + 8 + j.len() + 8 + bin.len();

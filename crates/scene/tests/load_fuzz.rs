@@ -69,7 +69,7 @@ fn format() -> impl Strategy<Value = Format> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 2048, ..ProptestConfig::default() })]
 
     #[test]
     fn random_bytes_never_panic(f in format(), bytes in proptest::collection::vec(any::<u8>(), 0..512)) {

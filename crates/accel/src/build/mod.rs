@@ -5,7 +5,8 @@
 //!
 //! 1. every range is binned by centroid into [`BuildConfig::bins`] bins on each axis (the
 //!    top levels bin in parallel chunks with rayon), and the bin boundary with the smallest
-//!    SAH cost `A_L·n_L + A_R·n_R` is chosen;
+//!    SAH cost `A_L·n_L + A_R·n_R` is chosen; ranges of at most [`SWEEP_MAX`] primitives
+//!    instead sweep every boundary between their sorted centroids (exact SAH);
 //! 2. a range becomes a leaf when it holds at most [`BuildConfig::max_leaf_size`] primitives
 //!    and a leaf is no more expensive than the best split;
 //! 3. the two halves are built with `rayon::join` above [`BuildConfig::parallel_threshold`]
@@ -16,7 +17,8 @@
 //! The temporary tree is then flattened depth-first with the two children of every node
 //! adjacent (`left = first`, `right = first + 1`), root at index 0.
 
-use dualsplit_geometry::{Aabb, Vec3};
+use dualsplit_geometry::Aabb;
+use glam::Vec3A;
 use serde::{Deserialize, Serialize};
 
 /// Depth after which ranges are split at the object median instead of by SAH.
@@ -126,40 +128,112 @@ enum Tmp {
     },
 }
 
-struct Ctx<'a> {
-    pb: &'a [Aabb],
-    cent: &'a [Vec3],
+/// A box in SIMD registers, used only inside the builder (bit-exact with [`Aabb`]: unions
+/// are plain min/max).
+#[derive(Clone, Copy, Debug)]
+struct Box3 {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl Box3 {
+    const EMPTY: Box3 = Box3 {
+        min: Vec3A::INFINITY,
+        max: Vec3A::NEG_INFINITY,
+    };
+    #[inline(always)]
+    fn union(self, o: Box3) -> Box3 {
+        Box3 {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
+    }
+    #[inline(always)]
+    fn grow(self, p: Vec3A) -> Box3 {
+        Box3 {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+    /// Half the surface area, 0 for an empty box (the same value as [`Aabb::half_area`]).
+    #[inline(always)]
+    fn half_area(self) -> f32 {
+        self.aabb().half_area()
+    }
+    #[inline(always)]
+    fn aabb(self) -> Aabb {
+        Aabb::new(self.min.into(), self.max.into())
+    }
+}
+
+/// A primitive reference: its box and id, moved with the partition so that every range is
+/// contiguous in memory (the centroid is recomputed as `(min + max) / 2`, the same value as
+/// [`Aabb::center`]).
+#[derive(Clone, Copy, Debug)]
+struct PrimRef {
+    b: Box3,
+    id: u32,
+}
+
+impl PrimRef {
+    #[inline(always)]
+    fn c(&self) -> Vec3A {
+        (self.b.min + self.b.max) * 0.5
+    }
+}
+
+struct Ctx {
     cfg: BuildConfig,
     bins: usize,
 }
 
 #[derive(Clone, Copy)]
 struct Bin {
-    bounds: Aabb,
-    cbounds: Aabb,
+    bounds: Box3,
+    cbounds: Box3,
     count: u32,
 }
 
 const EMPTY_BIN: Bin = Bin {
-    bounds: Aabb::EMPTY,
-    cbounds: Aabb::EMPTY,
+    bounds: Box3::EMPTY,
+    cbounds: Box3::EMPTY,
     count: 0,
 };
 
-/// The chosen split of a range.
+/// Ranges of at most this many primitives are split by a full SAH sweep over the sorted
+/// centroids instead of by binning.
+pub const SWEEP_MAX: usize = 32;
+
+/// The chosen split of a range: SAH cost `A_L·n_L + A_R·n_R`, how to partition, and the
+/// halves' (bounds, centroid bounds).
 struct Split {
     cost: f32,
-    axis: usize,
-    bin: usize,
-    left: (Aabb, Aabb),
-    right: (Aabb, Aabb),
+    how: How,
+    left: (Box3, Box3),
+    right: (Box3, Box3),
+}
+
+enum How {
+    /// Binned: primitives whose bin on `axis` is below `bin` go left.
+    Bin { axis: usize, bin: usize },
+    /// Swept: the ids are already sorted on the best axis; the first `mid` go left.
+    Sorted { mid: usize },
 }
 
 impl Bvh2 {
     /// Builds a BVH2 over primitive boxes (one per triangle; ids are indices).
     pub fn build(prim_bounds: &[Aabb], cfg: &BuildConfig) -> Self {
-        let centroids: Vec<Vec3> = prim_bounds.iter().map(|b| b.center()).collect();
-        let mut ids: Vec<u32> = (0..prim_bounds.len() as u32).collect();
+        let mut refs: Vec<PrimRef> = prim_bounds
+            .iter()
+            .enumerate()
+            .map(|(i, b)| PrimRef {
+                b: Box3 {
+                    min: b.min.into(),
+                    max: b.max.into(),
+                },
+                id: i as u32,
+            })
+            .collect();
         if prim_bounds.is_empty() {
             return Self {
                 nodes: vec![Bvh2Node {
@@ -168,18 +242,16 @@ impl Bvh2 {
                     count: 0,
                     right: 0,
                 }],
-                prim_ids: ids,
+                prim_ids: Vec::new(),
                 sah_cost: 0.0,
             };
         }
         let ctx = Ctx {
-            pb: prim_bounds,
-            cent: &centroids,
             cfg: *cfg,
             bins: cfg.bins.clamp(2, 256) as usize,
         };
-        let (bounds, cbounds) = range_bounds(&ctx, &ids);
-        let tmp = build_range(&ctx, &mut ids, 0, bounds, cbounds, 0);
+        let (bounds, cbounds) = range_bounds(&ctx, &refs);
+        let tmp = build_range(&ctx, &mut refs, 0, (bounds, cbounds), 0);
         let mut nodes =
             Vec::with_capacity(prim_bounds.len() * 2 / cfg.max_leaf_size.max(1) as usize + 1);
         nodes.push(Bvh2Node {
@@ -191,7 +263,7 @@ impl Bvh2 {
         flatten(&tmp, 0, &mut nodes);
         let mut bvh = Self {
             nodes,
-            prim_ids: ids,
+            prim_ids: refs.iter().map(|r| r.id).collect(),
             sah_cost: 0.0,
         };
         bvh.sah_cost = bvh.compute_sah(cfg);
@@ -261,40 +333,38 @@ fn flatten(t: &Tmp, idx: usize, nodes: &mut Vec<Bvh2Node>) {
     }
 }
 
-fn range_bounds(ctx: &Ctx, ids: &[u32]) -> (Aabb, Aabb) {
-    let f = |(b, c): (Aabb, Aabb), &i: &u32| {
-        (b.union(ctx.pb[i as usize]), c.grow(ctx.cent[i as usize]))
-    };
+fn range_bounds(ctx: &Ctx, ids: &[PrimRef]) -> (Box3, Box3) {
+    let f = |(b, c): (Box3, Box3), i: &PrimRef| (b.union(i.b), c.grow(i.c()));
     if ids.len() as u32 > ctx.cfg.parallel_threshold * 16 {
         use rayon::prelude::*;
         ids.par_chunks(16 * 1024)
-            .map(|c| c.iter().fold((Aabb::EMPTY, Aabb::EMPTY), f))
+            .map(|c| c.iter().fold((Box3::EMPTY, Box3::EMPTY), f))
             .reduce(
-                || (Aabb::EMPTY, Aabb::EMPTY),
+                || (Box3::EMPTY, Box3::EMPTY),
                 |a, b| (a.0.union(b.0), a.1.union(b.1)),
             )
     } else {
-        ids.iter().fold((Aabb::EMPTY, Aabb::EMPTY), f)
+        ids.iter().fold((Box3::EMPTY, Box3::EMPTY), f)
     }
 }
 
-#[inline]
+#[inline(always)]
 fn bin_of(c: f32, lo: f32, scale: f32, bins: usize) -> usize {
     // `as usize` saturates (NaN → 0), so the index is always in range.
     (((c - lo) * scale) as usize).min(bins - 1)
 }
 
 /// Bins `ids` on all three axes: `bins[axis * B + b]`.
-fn bin_range(ctx: &Ctx, ids: &[u32], lo: Vec3, scale: Vec3) -> Vec<Bin> {
+fn bin_range(ctx: &Ctx, ids: &[PrimRef], lo: Vec3A, scale: Vec3A) -> Vec<Bin> {
     let nb = ctx.bins;
-    let work = |chunk: &[u32]| {
+    let work = |chunk: &[PrimRef]| {
         let mut bins = vec![EMPTY_BIN; 3 * nb];
-        for &i in chunk {
-            let c = ctx.cent[i as usize];
-            let b = ctx.pb[i as usize];
-            for axis in 0..3 {
-                let k = axis * nb + bin_of(c[axis], lo[axis], scale[axis], nb);
-                let bin = &mut bins[k];
+        for i in chunk {
+            let c = i.c();
+            let b = i.b;
+            let k = ((c - lo) * scale).to_array();
+            for (axis, &k) in k.iter().enumerate() {
+                let bin = &mut bins[axis * nb + (k as usize).min(nb - 1)];
                 bin.bounds = bin.bounds.union(b);
                 bin.cbounds = bin.cbounds.grow(c);
                 bin.count += 1;
@@ -320,28 +390,29 @@ fn bin_range(ctx: &Ctx, ids: &[u32], lo: Vec3, scale: Vec3) -> Vec<Bin> {
     }
 }
 
-fn find_split(ctx: &Ctx, ids: &[u32], cbounds: Aabb) -> (Option<Split>, Vec3, Vec3) {
+/// Best binned split, or `None` when every centroid coincides.
+fn binned_split(ctx: &Ctx, ids: &[PrimRef], cbounds: Box3) -> Option<(Split, Vec3A, Vec3A)> {
     let nb = ctx.bins;
     let lo = cbounds.min;
     let ext = cbounds.max - cbounds.min;
-    let mut scale = Vec3::ZERO;
+    let mut scale = Vec3A::ZERO;
     for a in 0..3 {
         if ext[a] > 0.0 && ext[a].is_finite() {
             scale[a] = nb as f32 / ext[a];
         }
     }
-    if scale == Vec3::ZERO {
-        return (None, lo, scale);
+    if scale == Vec3A::ZERO {
+        return None;
     }
     let bins = bin_range(ctx, ids, lo, scale);
     let mut best: Option<Split> = None;
-    let mut right_acc = vec![(Aabb::EMPTY, Aabb::EMPTY, 0u32); nb];
+    let mut right_acc = vec![(Box3::EMPTY, Box3::EMPTY, 0u32); nb];
     for axis in 0..3 {
         if scale[axis] == 0.0 {
             continue;
         }
         let b = &bins[axis * nb..(axis + 1) * nb];
-        let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0u32);
+        let mut acc = (Box3::EMPTY, Box3::EMPTY, 0u32);
         for k in (1..nb).rev() {
             acc = (
                 acc.0.union(b[k].bounds),
@@ -350,7 +421,7 @@ fn find_split(ctx: &Ctx, ids: &[u32], cbounds: Aabb) -> (Option<Split>, Vec3, Ve
             );
             right_acc[k] = acc;
         }
-        let mut left = (Aabb::EMPTY, Aabb::EMPTY, 0u32);
+        let mut left = (Box3::EMPTY, Box3::EMPTY, 0u32);
         for k in 0..nb - 1 {
             left = (
                 left.0.union(b[k].bounds),
@@ -365,21 +436,65 @@ fn find_split(ctx: &Ctx, ids: &[u32], cbounds: Aabb) -> (Option<Split>, Vec3, Ve
             if best.as_ref().is_none_or(|s| cost < s.cost) {
                 best = Some(Split {
                     cost,
-                    axis,
-                    bin: k + 1,
+                    how: How::Bin { axis, bin: k + 1 },
                     left: (left.0, left.1),
                     right: (right.0, right.1),
                 });
             }
         }
     }
-    (best, lo, scale)
+    best.map(|s| (s, lo, scale))
 }
 
-fn partition(ids: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
+/// Full SAH sweep over the centroids sorted on each axis (ties by id); leaves `ids` sorted
+/// on the best axis. `None` when every centroid coincides.
+fn sweep_split(ctx: &Ctx, ids: &mut [PrimRef], cbounds: Box3) -> Option<Split> {
+    let n = ids.len();
+    let ext = cbounds.max - cbounds.min;
+    let mut right_area = [0f32; SWEEP_MAX];
+    let mut best: Option<(f32, usize, usize)> = None;
+    for axis in 0..3 {
+        if ext[axis] <= 0.0 {
+            continue;
+        }
+        sort_on(ids, axis);
+        let mut acc = Box3::EMPTY;
+        for k in (1..n).rev() {
+            acc = acc.union(ids[k].b);
+            right_area[k] = acc.half_area();
+        }
+        let mut left = Box3::EMPTY;
+        for k in 0..n - 1 {
+            left = left.union(ids[k].b);
+            let cost = left.half_area() * (k + 1) as f32 + right_area[k + 1] * (n - k - 1) as f32;
+            if best.is_none_or(|b| cost < b.0) {
+                best = Some((cost, axis, k + 1));
+            }
+        }
+    }
+    let (cost, axis, mid) = best?;
+    sort_on(ids, axis);
+    let left = range_bounds(ctx, &ids[..mid]);
+    let right = range_bounds(ctx, &ids[mid..]);
+    Some(Split {
+        cost,
+        how: How::Sorted { mid },
+        left,
+        right,
+    })
+}
+
+fn sort_on(ids: &mut [PrimRef], axis: usize) {
+    ids.sort_unstable_by(|a, b| {
+        let (ca, cb) = (a.c()[axis], b.c()[axis]);
+        ca.total_cmp(&cb).then(a.id.cmp(&b.id))
+    });
+}
+
+fn partition(ids: &mut [PrimRef], pred: impl Fn(&PrimRef) -> bool) -> usize {
     let mut i = 0;
     for j in 0..ids.len() {
-        if pred(ids[j]) {
+        if pred(&ids[j]) {
             ids.swap(i, j);
             i += 1;
         }
@@ -389,15 +504,14 @@ fn partition(ids: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
 
 fn build_range(
     ctx: &Ctx,
-    ids: &mut [u32],
+    ids: &mut [PrimRef],
     offset: u32,
-    bounds: Aabb,
-    cbounds: Aabb,
+    (bounds, cbounds): (Box3, Box3),
     depth: u32,
 ) -> Tmp {
     let n = ids.len();
     let leaf = Tmp::Leaf {
-        bounds,
+        bounds: bounds.aabb(),
         first: offset,
         count: n as u32,
     };
@@ -405,27 +519,28 @@ fn build_range(
         return leaf;
     }
     let max_leaf = ctx.cfg.max_leaf_size.max(1) as usize;
-    let mid;
-    let (lb, rb);
-    let (split, lo, scale) = if depth < MAX_SAH_DEPTH {
-        find_split(ctx, ids, cbounds)
+    let split = if depth >= MAX_SAH_DEPTH {
+        None
+    } else if n <= SWEEP_MAX {
+        sweep_split(ctx, ids, cbounds).map(|s| (s, Vec3A::ZERO, Vec3A::ZERO))
     } else {
-        (None, Vec3::ZERO, Vec3::ZERO)
+        binned_split(ctx, ids, cbounds)
     };
-    match split {
-        Some(s) => {
+    let (mid, lb, rb) = match split {
+        Some((s, lo, scale)) => {
             let area = bounds.half_area();
             let leaf_cost = area * n as f32 * ctx.cfg.cost_triangle;
             let split_cost = area * ctx.cfg.cost_traversal + s.cost * ctx.cfg.cost_triangle;
             if n <= max_leaf && leaf_cost <= split_cost {
                 return leaf;
             }
-            let (axis, bin, nb) = (s.axis, s.bin, ctx.bins);
-            mid = partition(ids, |i| {
-                bin_of(ctx.cent[i as usize][axis], lo[axis], scale[axis], nb) < bin
-            });
-            lb = s.left;
-            rb = s.right;
+            let mid = match s.how {
+                How::Sorted { mid } => mid,
+                How::Bin { axis, bin } => partition(ids, |i| {
+                    bin_of(i.c()[axis], lo[axis], scale[axis], ctx.bins) < bin
+                }),
+            };
+            (mid, s.left, s.right)
         }
         None => {
             if n <= max_leaf {
@@ -433,30 +548,33 @@ fn build_range(
             }
             // All centroids coincide (or the depth limit was reached): object median on the
             // widest centroid axis, ties broken by id, so the result is deterministic.
-            let axis = cbounds.largest_axis();
-            mid = n / 2;
-            ids.select_nth_unstable_by(mid, |&a, &b| {
-                let (ca, cb) = (ctx.cent[a as usize][axis], ctx.cent[b as usize][axis]);
-                ca.total_cmp(&cb).then(a.cmp(&b))
+            let axis = cbounds.aabb().largest_axis();
+            let mid = n / 2;
+            ids.select_nth_unstable_by(mid, |a, b| {
+                let (ca, cb) = (a.c()[axis], b.c()[axis]);
+                ca.total_cmp(&cb).then(a.id.cmp(&b.id))
             });
-            lb = range_bounds(ctx, &ids[..mid]);
-            rb = range_bounds(ctx, &ids[mid..]);
+            (
+                mid,
+                range_bounds(ctx, &ids[..mid]),
+                range_bounds(ctx, &ids[mid..]),
+            )
         }
-    }
+    };
     let (l, r) = ids.split_at_mut(mid);
     let (left, right) = if n as u32 > ctx.cfg.parallel_threshold {
         rayon::join(
-            || build_range(ctx, l, offset, lb.0, lb.1, depth + 1),
-            || build_range(ctx, r, offset + mid as u32, rb.0, rb.1, depth + 1),
+            || build_range(ctx, l, offset, lb, depth + 1),
+            || build_range(ctx, r, offset + mid as u32, rb, depth + 1),
         )
     } else {
         (
-            build_range(ctx, l, offset, lb.0, lb.1, depth + 1),
-            build_range(ctx, r, offset + mid as u32, rb.0, rb.1, depth + 1),
+            build_range(ctx, l, offset, lb, depth + 1),
+            build_range(ctx, r, offset + mid as u32, rb, depth + 1),
         )
     };
     Tmp::Inner {
-        bounds,
+        bounds: bounds.aabb(),
         kids: Box::new([left, right]),
     }
 }
@@ -464,7 +582,7 @@ fn build_range(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use dualsplit_geometry::Pcg32;
+    use dualsplit_geometry::{Pcg32, Vec3};
 
     fn random_boxes(n: usize, seed: u64) -> Vec<Aabb> {
         let mut rng = Pcg32::new(seed, 1);

@@ -5,8 +5,7 @@
 use dualsplit_accel::{AccelKind, NoObserver, Structures};
 use dualsplit_geometry::{Hit, Ray, Triangle};
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
-use dualsplit_scene::{LoadStats, Scene};
-use std::io::Read;
+use dualsplit_scene::Scene;
 
 /// Closest hit over all triangles in `(t, prim)` order: the reference every structure must
 /// match bit for bit.
@@ -49,50 +48,10 @@ pub fn scene_path(name: &str) -> String {
     )
 }
 
-/// Loads a shipped `*.ply.gz` scene.
-///
-/// TEMPORARY: a private reader of the fixed binary layout of `shared/scenes/README.md`
-/// (gzip, binary little-endian PLY, float xyz vertices, `uchar uint` triangle lists), used
-/// until `dualsplit_scene::load` reads PLY files; then this becomes `dualsplit_scene::load`.
+/// Loads a shipped scene with `dualsplit_scene::load`.
 pub fn load_scene(name: &str) -> Scene {
     let path = scene_path(name);
-    if let Ok(s) = dualsplit_scene::load(&path) {
-        return s;
-    }
-    let f = std::fs::File::open(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let mut data = Vec::new();
-    flate2::read::GzDecoder::new(std::io::BufReader::new(f))
-        .read_to_end(&mut data)
-        .unwrap();
-    let end = b"end_header\n";
-    let hdr_len = data.windows(end.len()).position(|w| w == end).unwrap() + end.len();
-    let header = std::str::from_utf8(&data[..hdr_len]).unwrap();
-    let count = |el: &str| -> usize {
-        header
-            .lines()
-            .find_map(|l| l.strip_prefix(&format!("element {el} ")))
-            .unwrap()
-            .trim()
-            .parse()
-            .unwrap()
-    };
-    let (nv, nf) = (count("vertex"), count("face"));
-    let body = &data[hdr_len..];
-    let f32_at = |o: usize| f32::from_le_bytes(body[o..o + 4].try_into().unwrap());
-    let u32_at = |o: usize| u32::from_le_bytes(body[o..o + 4].try_into().unwrap());
-    let verts: Vec<glam::Vec3> = (0..nv)
-        .map(|i| glam::Vec3::new(f32_at(12 * i), f32_at(12 * i + 4), f32_at(12 * i + 8)))
-        .collect();
-    let faces = &body[12 * nv..];
-    let tris: Vec<Triangle> = (0..nf)
-        .map(|i| {
-            let o = 13 * i;
-            assert_eq!(faces[o], 3);
-            let v = |k: usize| verts[u32_at(12 * nv + o + 1 + 4 * k) as usize];
-            Triangle::new(v(0), v(1), v(2))
-        })
-        .collect();
-    Scene::from_triangles(name, path, tris, LoadStats::default()).unwrap()
+    dualsplit_scene::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
 /// Rays of each kind recorded from path-traced pixel jobs (5 bounces, a shadow ray at every

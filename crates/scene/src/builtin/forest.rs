@@ -13,10 +13,9 @@
 //! the remainder exactly, so the count equals `triangles`.
 
 use super::Params;
-use super::mesh::{Mesh, split_evenly, unit_vector};
+use super::mesh::{Mesh, par_objects, split_evenly, unit_vector};
 use crate::{Camera, Light, SceneError};
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
-use rayon::prelude::*;
 
 /// Parameters of `builtin:forest`; each field is a spec key with its default.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -108,28 +107,27 @@ impl ForestParams {
         let g = self.ground_res();
         let (trees, blades) = self.split();
         let half = self.size * 0.5;
-        let mut ground = Mesh::with_capacity(2 * g * g);
-        ground.grid(g, g, |u, v| {
-            let (x, z) = (-half + u * self.size, half - v * self.size);
-            Vec3::new(x, self.height(x, z), z)
-        });
         let tufts = blades.div_ceil(TUFT);
-        let mut out = ground.tris;
-        out.reserve(self.triangles as usize);
-        let tree_tris: Vec<Triangle> = (0..trees)
-            .into_par_iter()
-            .flat_map_iter(|i| self.tree(i as u64).tris)
-            .collect();
-        out.extend_from_slice(&tree_tris);
-        drop(tree_tris);
-        let counts: Vec<usize> = split_evenly(blades, tufts).collect();
-        let grass: Vec<Triangle> = counts
-            .par_iter()
-            .enumerate()
-            .flat_map_iter(|(i, &n)| self.tuft(i as u64, n).tris)
-            .collect();
-        out.extend_from_slice(&grass);
-        out
+        let blade_counts: Vec<usize> = split_evenly(blades, tufts).collect();
+        let mut counts = vec![2 * g * g];
+        counts.extend(std::iter::repeat_n(self.tree_triangles(), trees));
+        counts.extend_from_slice(&blade_counts);
+        // Object 0 is the ground, then the trees, then the grass tufts.
+        par_objects(&counts, |i| match i {
+            0 => {
+                let mut ground = Mesh::with_capacity(2 * g * g);
+                ground.grid(g, g, |u, v| {
+                    let (x, z) = (-half + u * self.size, half - v * self.size);
+                    Vec3::new(x, self.height(x, z), z)
+                });
+                ground
+            }
+            i if i <= trees => self.tree((i - 1) as u64),
+            i => {
+                let t = i - 1 - trees;
+                self.tuft(t as u64, blade_counts[t])
+            }
+        })
     }
 
     /// A random point on the patch (away from the very edge), on the ground.

@@ -10,10 +10,9 @@
 //! surfaces along every ray.
 
 use super::Params;
-use super::mesh::{Mesh, in_unit_ball, split_evenly, unit_vector};
+use super::mesh::{Mesh, in_unit_ball, par_objects, split_evenly, unit_vector};
 use crate::{Camera, Light, SceneError};
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
-use rayon::prelude::*;
 
 /// Parameters of `builtin:hairball`; each field is a spec key with its default.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -93,10 +92,9 @@ impl HairballParams {
     /// Generates the triangles (in parallel, deterministic).
     pub fn triangles(&self) -> Vec<Triangle> {
         let segs = self.strand_segments();
-        segs.par_iter()
-            .enumerate()
-            .flat_map_iter(|(i, &n)| self.strand(i as u64, n).tris)
-            .collect()
+        let per_seg = 2 * self.sides as usize;
+        let counts: Vec<usize> = segs.iter().map(|&n| n * per_seg).collect();
+        par_objects(&counts, |i| self.strand(i as u64, segs[i]))
     }
 
     /// Strand `id` with `n` segments.

@@ -88,29 +88,29 @@ impl Mesh {
             let b = path[(i + 1).min(path.len() - 1)];
             (b - a).normalize_or(Vec3::Y)
         };
-        let mut t = tangent(0);
+        self.tris.reserve(2 * sides * (path.len() - 1));
+        let t = tangent(0);
         let (mut n, _) = t.any_orthonormal_pair();
-        let ring = |c: Vec3, t: Vec3, n: Vec3, r: f32| -> Vec<Vec3> {
+        let ring = |out: &mut Vec<Vec3>, c: Vec3, t: Vec3, n: Vec3, r: f32| {
             let b = t.cross(n);
-            (0..sides)
-                .map(|k| {
-                    let a = std::f32::consts::TAU * k as f32 / sides as f32;
-                    c + (n * a.cos() + b * a.sin()) * r
-                })
-                .collect()
+            out.clear();
+            out.extend((0..sides).map(|k| {
+                let a = std::f32::consts::TAU * k as f32 / sides as f32;
+                c + (n * a.cos() + b * a.sin()) * r
+            }));
         };
-        let mut prev = ring(path[0], t, n, radius(0));
+        let (mut prev, mut cur) = (Vec::with_capacity(sides), Vec::with_capacity(sides));
+        ring(&mut prev, path[0], t, n, radius(0));
         for (i, &c) in path.iter().enumerate().skip(1) {
-            let t2 = tangent(i);
+            let t = tangent(i);
             // Parallel transport: remove the new tangent's component from the old normal.
-            n = (n - t2 * n.dot(t2)).normalize_or(t2.any_orthonormal_pair().0);
-            t = t2;
-            let cur = ring(c, t, n, radius(i));
+            n = (n - t * n.dot(t)).normalize_or(t.any_orthonormal_pair().0);
+            ring(&mut cur, c, t, n, radius(i));
             for k in 0..sides {
                 let k1 = (k + 1) % sides;
                 self.quad(prev[k], prev[k1], cur[k1], cur[k]);
             }
-            prev = cur;
+            std::mem::swap(&mut prev, &mut cur);
         }
     }
 
@@ -157,4 +157,29 @@ pub(crate) fn split_evenly(total: usize, parts: usize) -> impl Iterator<Item = u
     let base = total / parts.max(1);
     let extra = total % parts.max(1);
     (0..parts).map(move |i| base + usize::from(i < extra))
+}
+
+/// Generates objects in parallel straight into their slots of one output array: object `i`
+/// has exactly `counts[i]` triangles and lands after objects `0..i`, whatever the thread
+/// count, so the result is deterministic.
+pub(crate) fn par_objects(counts: &[usize], make: impl Fn(usize) -> Mesh + Sync) -> Vec<Triangle> {
+    use rayon::prelude::*;
+    let mut out = vec![Triangle::default(); counts.iter().sum()];
+    let mut slots = Vec::with_capacity(counts.len());
+    let mut rest = out.as_mut_slice();
+    for &n in counts {
+        let (slot, tail) = std::mem::take(&mut rest).split_at_mut(n);
+        slots.push(slot);
+        rest = tail;
+    }
+    slots.into_par_iter().enumerate().for_each(|(i, slot)| {
+        let m = make(i);
+        assert_eq!(
+            m.len(),
+            slot.len(),
+            "object {i} has the wrong triangle count"
+        );
+        slot.copy_from_slice(&m.tris);
+    });
+    out
 }

@@ -21,8 +21,30 @@ use std::path::Path;
 
 /// Parses a `.gltf` or `.glb` file's bytes; external buffers are read relative to `path`.
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, SceneError> {
-    let gltf =
-        gltf::Gltf::from_slice(bytes).map_err(|e| parse_error(path, None, format!("glTF: {e}")))?;
+    let glerr = |e: gltf::Error| parse_error(path, None, format!("glTF: {e}"));
+    // gltf-json's validation indexes `accessors[POSITION]` unchecked (gltf-json 1.4.1,
+    // mesh.rs:151), so check the attribute indices first, on the unvalidated document.
+    let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(glerr)?;
+    let root = raw.document.as_json();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for index in prim.attributes.values() {
+                if index.value() >= root.accessors.len() {
+                    return Err(parse_error(
+                        path,
+                        None,
+                        format!(
+                            "glTF: mesh {m} primitive {p}: accessor {} does not exist ({} accessors)",
+                            index.value(),
+                            root.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    drop(raw);
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(glerr)?;
     let doc = &gltf.document;
     let buffers = doc
         .buffers()
@@ -186,7 +208,7 @@ fn emit(
         }
         None => (0..positions.len()).collect(),
     };
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         return Err(err(format!(
             "{} indices, not a multiple of 3",
             indices.len()

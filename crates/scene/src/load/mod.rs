@@ -11,7 +11,7 @@
 //! |---|---|---|
 //! | `.obj`, `.obj.gz` | [`tobj`] | `v` positions and `f` faces only (texture coordinates, normals, materials, points and lines ignored); negative (relative) indices; polygons fan-triangulated |
 //! | `.ply`, `.ply.gz` | header: [`ply_rs_bw`]; ASCII body: [`ply_rs_bw`]; binary body (little- and big-endian): our own decoder | element `vertex` with float/double (or integer) `x`, `y`, `z` in any order among other properties; element `face` with a list `vertex_indices` (or `vertex_index`) of any count and index type; polygons fan-triangulated; other elements and properties skipped |
-//! | `.gltf`, `.glb` | [`gltf`] (JSON and GLB container) plus our own bounds-checked accessor reader | buffers embedded as base64 `data:` URIs, external files relative to the `.gltf`, or the GLB `BIN` chunk; every `TRIANGLES` primitive of every mesh instanced by the default scene (else scene 0), with node transforms (matrix or TRS) composed down the hierarchy; other primitive modes are skipped and counted |
+//! | `.gltf`, `.glb` | [`gltf`](::gltf) (JSON and GLB container) plus our own bounds-checked accessor reader | buffers embedded as base64 `data:` URIs, external files relative to the `.gltf`, or the GLB `BIN` chunk; every `TRIANGLES` primitive of every mesh instanced by the default scene (else scene 0), with node transforms (matrix or TRS) composed down the hierarchy; other primitive modes are skipped and counted |
 //!
 //! The binary PLY body has its own decoder because ply-rs-bw builds one `IndexMap` per
 //! element, far too slow for the 6.2M-triangle `dragon_sponza.ply.gz` speed bar (3 s);
@@ -91,14 +91,11 @@ pub fn format_of(path: &Path) -> Result<(Format, bool), SceneError> {
 
 /// Loads a scene file, choosing the format by extension (see the module docs).
 ///
-/// The scene's name is the file name without its extensions; its spec is the path.
+/// The scene's name is [`file_stem`](crate::file_stem) (the file name without its scene
+/// extensions); its spec is the path.
 pub fn load_file(path: &Path) -> Result<Scene, SceneError> {
     let mesh = read_mesh(path)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let name = name.split('.').next().unwrap_or_default().to_string();
+    let name = crate::file_stem(path).to_string();
     Scene::from_triangles(
         name,
         path.to_string_lossy().into_owned(),
@@ -110,9 +107,9 @@ pub fn load_file(path: &Path) -> Result<Scene, SceneError> {
 /// Reads and parses a scene file into a [`Mesh`] (no degenerate/non-finite rule applied).
 pub fn read_mesh(path: &Path) -> Result<Mesh, SceneError> {
     let (format, _) = format_of(path)?;
-    let raw = std::fs::read(path).map_err(|source| SceneError::Io {
+    let raw = std::fs::read(path).map_err(|error| SceneError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     let bytes = maybe_gunzip(path, raw)?;
     parse_bytes(path, format, &bytes)

@@ -55,7 +55,6 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, SceneError> {
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let result = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)

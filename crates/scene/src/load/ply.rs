@@ -9,7 +9,7 @@
 
 use super::{Mesh, fan, gather, parse_error};
 use crate::{LoadStats, SceneError};
-use dualsplit_geometry::Vec3;
+use dualsplit_geometry::{Triangle, Vec3};
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
 use ply_rs_bw::ply::{
     DefaultElement, ElementDef, Encoding, Header, Property, PropertyType, ScalarType,
@@ -410,17 +410,31 @@ fn parse_binary(
     };
     let mut positions: Vec<Vec3> = Vec::new();
     let mut faces: Vec<[u32; 3]> = Vec::new();
+    let mut triangles: Vec<Triangle> = Vec::new();
     let mut stats = LoadStats::default();
     for (name, def) in &header.elements {
         let (min_size, fixed) = record_size(def);
-        let need = def.count.checked_mul(min_size).unwrap_or(usize::MAX);
+        let need = def.count.saturating_mul(min_size);
         if need > cur.remaining() {
             return Err(truncated(path, def, cur.remaining(), need));
         }
         if name == "vertex" {
             positions = read_vertices(path, &mut cur, def, schema)?;
         } else if name == "face" {
-            read_faces(path, &mut cur, def, schema, &mut faces, &mut stats)?;
+            // The fast path builds triangles straight from the records, so it needs the
+            // positions first (the usual order: vertices before faces).
+            let fast = match props(def)[..] {
+                [Prop::List(count_t, index_t)]
+                    if positions.len() == schema.vertex_count as usize =>
+                {
+                    read_triangles_fast(path, &mut cur, def, &positions, count_t, index_t)?
+                }
+                _ => None,
+            };
+            match fast {
+                Some(t) => triangles = t,
+                None => read_faces(path, &mut cur, def, schema, &mut faces, &mut stats)?,
+            }
         } else if fixed {
             cur.pos += need;
         } else {
@@ -432,11 +446,11 @@ fn parse_binary(
             }
         }
     }
-    stats.source_triangles = faces.len() as u64;
-    Ok(Mesh {
-        triangles: gather(&positions, &faces),
-        stats,
-    })
+    if !faces.is_empty() {
+        triangles.extend(gather(&positions, &faces));
+    }
+    stats.source_triangles = triangles.len() as u64;
+    Ok(Mesh { triangles, stats })
 }
 
 /// The error for a body that ends before `element` does.
@@ -570,16 +584,6 @@ fn read_faces(
     stats: &mut LoadStats,
 ) -> Result<(), SceneError> {
     let props = props(def);
-    if let [Prop::List(count_t, index_t)] = props[..]
-        && let Some(done) = read_triangles_fast(path, cur, def, schema, count_t, index_t)?
-    {
-        if faces.is_empty() {
-            *faces = done;
-        } else {
-            faces.extend_from_slice(&done);
-        }
-        return Ok(());
-    }
     // Most files have triangles only, so one triangle per record is a good guess (the count
     // was checked against the bytes present).
     faces.reserve(def.count);
@@ -609,10 +613,11 @@ fn read_faces(
     Ok(())
 }
 
-/// The fast path of [`read_faces`] for a `face` element whose only property is the index list
-/// with an 8-bit count and 32-bit indices (the shipped scenes): when every record's count is
-/// 3, the records are a fixed 13-byte stride, so they are decoded in parallel. Returns `None`
-/// (nothing consumed) when the element does not have that shape; the general path then runs.
+/// The fast path for a `face` element whose only property is the index list with an 8-bit
+/// count and 32-bit indices (the shipped scenes): when every record's count is 3, the
+/// records are a fixed 13-byte stride, so triangles are built from them in parallel, straight
+/// from `positions`. Returns `None` (nothing consumed) when the element does not have that
+/// shape; [`read_faces`] then runs.
 ///
 /// The shape test is sound: if the record at offset 0 has count 3 it is 13 bytes long, so
 /// the next record starts at 13, and so on; checking every 13th byte for 3 is exactly what
@@ -621,10 +626,10 @@ fn read_triangles_fast(
     path: &Path,
     cur: &mut Cursor<'_>,
     def: &ElementDef,
-    schema: &Schema,
+    positions: &[Vec3],
     count_t: Scalar,
     index_t: Scalar,
-) -> Result<Option<Vec<[u32; 3]>>, SceneError> {
+) -> Result<Option<Vec<Triangle>>, SceneError> {
     use rayon::prelude::*;
     const REC: usize = 13;
     if !matches!(count_t, Scalar::U8 | Scalar::I8) || !matches!(index_t, Scalar::U32 | Scalar::I32)
@@ -634,7 +639,7 @@ fn read_triangles_fast(
     let Some(bytes) = def
         .count
         .checked_mul(REC)
-        .and_then(|n| cur.bytes.get(cur.pos..cur.pos + n))
+        .and_then(|n| cur.bytes.get(cur.pos..cur.pos.checked_add(n)?))
     else {
         return Ok(None);
     };
@@ -646,36 +651,54 @@ fn read_triangles_fast(
         return Ok(None);
     }
     let be = cur.big_endian;
-    let signed = index_t == Scalar::I32;
-    let n = schema.vertex_count;
     // A negative i32 reads as a u32 >= 2^31 > any vertex count, so one range test covers
     // both index types.
     let decode = |r: &[u8], k: usize| {
         let b = [r[k], r[k + 1], r[k + 2], r[k + 3]];
-        if be {
+        let i = if be {
             u32::from_be_bytes(b)
         } else {
             u32::from_le_bytes(b)
-        }
+        };
+        i as usize
     };
-    let faces: Vec<[u32; 3]> = bytes
+    let n = positions.len();
+    let in_range = |r: &[u8]| decode(r, 1) < n && decode(r, 5) < n && decode(r, 9) < n;
+    if !bytes
         .par_chunks_exact(REC)
         .with_min_len(1 << 14)
-        .map(|r| [decode(r, 1), decode(r, 5), decode(r, 9)])
-        .collect();
-    if let Some((i, f)) = faces
-        .par_iter()
-        .enumerate()
-        .find_first(|(_, f)| f.iter().any(|&v| v >= n))
+        .all(in_range)
     {
-        let bad = f.iter().copied().find(|&v| v >= n).unwrap_or_default();
-        let shown = if signed {
-            f64::from(bad as i32)
-        } else {
-            f64::from(bad)
-        };
-        return Err(index_error(path, None, i, shown, n));
+        // Find the first bad index for the message.
+        for (i, r) in bytes.chunks_exact(REC).enumerate() {
+            if let Some(bad) = [1, 5, 9]
+                .map(|k| decode(r, k))
+                .into_iter()
+                .find(|&v| v >= n)
+            {
+                let shown = if index_t == Scalar::I32 {
+                    f64::from(bad as u32 as i32)
+                } else {
+                    bad as f64
+                };
+                return Err(index_error(path, None, i, shown, n as u32));
+            }
+        }
+        return Err(parse_error(path, None, "vertex index out of range"));
     }
+    // Every index was checked above, so the indexing below cannot fail; an indexed parallel
+    // iterator collects straight into the output vector.
+    let triangles: Vec<Triangle> = bytes
+        .par_chunks_exact(REC)
+        .with_min_len(1 << 14)
+        .map(|r| {
+            Triangle::new(
+                positions[decode(r, 1)],
+                positions[decode(r, 5)],
+                positions[decode(r, 9)],
+            )
+        })
+        .collect();
     cur.pos += bytes.len();
-    Ok(Some(faces))
+    Ok(Some(triangles))
 }

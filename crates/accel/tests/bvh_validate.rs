@@ -1,0 +1,64 @@
+//! `validate()` accepts what the encoder writes and catches corrupted images.
+
+use dualsplit_accel::{AccelKind, BuildConfig, Structures};
+use dualsplit_geometry::{Pcg32, Triangle, Vec3};
+
+fn scene() -> Structures {
+    let mut rng = Pcg32::new(11, 5);
+    let tris: Vec<Triangle> = (0..500)
+        .map(|_| {
+            let p = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0;
+            let d = |r: &mut Pcg32| Vec3::new(r.next_f32(), r.next_f32(), r.next_f32());
+            Triangle::new(p, p + d(&mut rng), p + d(&mut rng))
+        })
+        .collect();
+    Structures::build(&tris, &BuildConfig::default())
+}
+
+#[test]
+fn clean_images_validate() {
+    let s = scene();
+    for rep in s.validate() {
+        assert!(rep.is_ok(), "{rep:?}");
+        assert_eq!(rep.triangles_referenced, 500);
+        assert!(rep.max_depth > 0);
+    }
+}
+
+#[test]
+fn corruptions_are_reported() {
+    let s = scene();
+    for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+        let enc = s.encoded(kind);
+        // A shrunken child box (slot 0 of the root's child 0 node lies outside its parent box
+        // once the root's slot-0 max.x is lowered below its min.x + tiny).
+        let mut bad = enc.clone();
+        bad.image.words[3] = f32::from_bits(bad.image.words[0]).to_bits();
+        let rep = bad.validate();
+        assert!(!rep.is_ok(), "{kind:?}: shrunken box not reported");
+        // An index entry duplicated: one triangle twice, another never.
+        let mut bad = enc.clone();
+        let i = bad.image.indices.start;
+        bad.image.words[i + 1] = bad.image.words[i] | (bad.image.words[i + 1] & (1 << 31));
+        let rep = bad.validate();
+        assert!(
+            rep.errors.iter().any(|e| e.contains("referenced")),
+            "{kind:?}: {rep:?}"
+        );
+        // The root's offset pointing past the node region.
+        let mut bad = enc.clone();
+        let words = bad.image.nodes.len();
+        let off_word = match kind {
+            AccelKind::Bvh2 => 12,
+            AccelKind::Bvh4 => 24,
+            _ => 48,
+        };
+        let high = bad.image.words[off_word] & 0xF000_0000;
+        bad.image.words[off_word] = high | (words as u32 & 0x0FFF_FFFF);
+        let rep = bad.validate();
+        assert!(
+            rep.errors.iter().any(|e| e.contains("outside")),
+            "{kind:?}: {rep:?}"
+        );
+    }
+}

@@ -1,0 +1,584 @@
+//! Producers: compute each piece of [`ReportData`], each cached on disk by [`CacheKey`].
+//!
+//! ```text
+//!  Scene ──▶ cpu piece     (structure sizes, build times, Mrays/s)   key: scene, cpu_res
+//!        ──▶ render piece  (small PNG of the path workload)          key: scene, render_res
+//!        ──▶ sim pieces    (one per configuration × workload × TMs)  key: scene, accel,
+//!                                                                     workload, SimConfig, res
+//! ```
+//!
+//! Structures are built only when some piece of their scene is missing. Simulations run two
+//! at a time (the machine has two cores). A simulator error is recorded in the data as
+//! "simulator unavailable: <error>" and never cached, so it is retried next time.
+
+use crate::ReportError;
+use crate::cache::{CODE_VERSION, Cache, CacheKey, SCHEMA};
+use crate::data::{
+    BuildTime, CpuData, ReportData, ReportSettings, SceneReport, SimRun, Skipped, StructureSize,
+    Throughput,
+};
+use crate::paper::{PaperMatch, PaperScene, PaperValues};
+use base64::Engine;
+use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
+use dualsplit_geometry::Hit;
+use dualsplit_render::{PixelJob, RayKind, RayQuery, RenderSettings, TraceResult, Workload};
+use dualsplit_scene::Scene;
+use dualsplit_sim::{SimAccel, SimConfig, SimResult};
+use std::collections::VecDeque;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, OnceLock};
+use std::time::Instant;
+
+/// Side of the square render shown for each scene.
+pub const RENDER_RES: u32 = 192;
+/// Samples per pixel of that render.
+pub const RENDER_SPP: u32 = 8;
+/// Minimum host time spent timing one (structure, ray kind) pair, in seconds.
+pub const MIN_TIMING_S: f64 = 0.1;
+/// Simulations run side by side.
+pub const SIM_WORKERS: usize = 2;
+
+/// Where producers report progress (the CLI draws indicatif bars; tests pass
+/// [`NoProgress`]).
+pub trait Progress: Sync {
+    /// A phase of `total` units starts.
+    fn begin(&self, phase: &str, total: u64);
+    /// `n` more units are done.
+    fn advance(&self, n: u64);
+    /// The current phase is over.
+    fn end(&self);
+}
+
+/// Progress that goes nowhere.
+pub struct NoProgress;
+
+impl Progress for NoProgress {
+    fn begin(&self, _phase: &str, _total: u64) {}
+    fn advance(&self, _n: u64) {}
+    fn end(&self) {}
+}
+
+/// The simulator entry point, injectable so tests can count and fake simulations.
+pub type SimulateFn<'a> = dyn Fn(
+        &Scene,
+        &Structures,
+        SimAccel,
+        &RenderSettings,
+        &SimConfig,
+        &(dyn Fn(u64, u64) + Sync),
+    ) -> Result<SimResult, String>
+    + Sync
+    + 'a;
+
+/// The real simulator ([`dualsplit_sim::simulate`]), errors as "simulator unavailable: …".
+pub fn real_simulator(
+    scene: &Scene,
+    structures: &Structures,
+    accel: SimAccel,
+    settings: &RenderSettings,
+    cfg: &SimConfig,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<SimResult, String> {
+    dualsplit_sim::simulate(scene, structures, accel, settings, cfg, progress)
+        .map_err(|e| format!("simulator unavailable: {e}"))
+}
+
+/// One simulation to run.
+#[derive(Clone, Debug)]
+struct SimJob {
+    scene: usize,
+    accel: SimAccel,
+    workload: Workload,
+    tms: u32,
+    key: CacheKey,
+}
+
+/// Computes a report, piece by piece, reusing cached pieces.
+pub struct Producer<'a> {
+    cache: Cache,
+    settings: ReportSettings,
+    progress: &'a dyn Progress,
+    simulate: &'a SimulateFn<'a>,
+    computed: AtomicU64,
+}
+
+impl<'a> Producer<'a> {
+    /// A producer writing its cache to `cache`.
+    pub fn new(
+        cache: Cache,
+        settings: ReportSettings,
+        progress: &'a dyn Progress,
+        simulate: &'a SimulateFn<'a>,
+    ) -> Self {
+        Self {
+            cache,
+            settings,
+            progress,
+            simulate,
+            computed: AtomicU64::new(0),
+        }
+    }
+
+    /// How many pieces were computed (not found in the cache) so far.
+    pub fn computed(&self) -> u64 {
+        self.computed.load(Ordering::Relaxed)
+    }
+
+    /// The simulated jobs of a scene: every configuration × workload at the base TM count
+    /// (Tables 4–6), plus path tracing at every TM count when `scaling` (Table 7).
+    fn sim_plan(&self, scaling: bool) -> Vec<(SimAccel, Workload, u32)> {
+        let s = &self.settings;
+        let mut plan = Vec::new();
+        for workload in [Workload::Cast, Workload::Path] {
+            for accel in SimAccel::ALL {
+                plan.push((accel, workload, s.base_tms));
+            }
+        }
+        if scaling {
+            for &tms in &s.tms {
+                if tms != s.base_tms {
+                    for accel in SimAccel::ALL {
+                        plan.push((accel, Workload::Path, tms));
+                    }
+                }
+            }
+        }
+        plan
+    }
+
+    /// The scenes that get the TM-scaling study: those standing for the paper's Crytek
+    /// Sponza and Hairball (Table 7), or the first scene when none does.
+    pub fn scaling_scenes(scenes: &[Scene]) -> Vec<bool> {
+        let wanted: Vec<bool> = scenes
+            .iter()
+            .map(|s| {
+                PaperMatch::for_scene(&s.name, &s.spec).is_some_and(|m| {
+                    matches!(m.scene, PaperScene::CrytekSponza | PaperScene::Hairball)
+                })
+            })
+            .collect();
+        if wanted.iter().any(|&w| w) {
+            wanted
+        } else {
+            (0..scenes.len()).map(|i| i == 0).collect()
+        }
+    }
+
+    fn sim_config(&self, tms: u32) -> SimConfig {
+        let mut cfg = SimConfig::lin2020();
+        cfg.tms = tms;
+        cfg
+    }
+
+    fn sim_settings(&self, workload: Workload) -> RenderSettings {
+        RenderSettings::new(self.settings.width, self.settings.height, workload)
+    }
+
+    /// Produces the whole report for `scenes` (already loaded); `skipped` lists the scenes
+    /// that could not be loaded.
+    pub fn run(&self, scenes: &[Scene], skipped: Vec<Skipped>) -> Result<ReportData, ReportError> {
+        let structures: Vec<OnceLock<Structures>> =
+            scenes.iter().map(|_| OnceLock::new()).collect();
+        let get = |i: usize| {
+            structures[i].get_or_init(|| {
+                Structures::build(&scenes[i].triangles, &BuildConfig::high_quality())
+            })
+        };
+        let hashes: Vec<String> = scenes.iter().map(|s| s.content_hash()).collect();
+
+        // Host pieces: CPU measurements and renders.
+        let mut cpu = Vec::new();
+        let mut renders = Vec::new();
+        self.progress
+            .begin("CPU + renders", scenes.len() as u64 * 2);
+        for (i, scene) in scenes.iter().enumerate() {
+            let key = CacheKey::new(
+                "cpu",
+                &hashes[i],
+                "all",
+                "path",
+                &format!("cpu_res={}", self.settings.cpu_res),
+                (self.settings.cpu_res, self.settings.cpu_res),
+            );
+            // Incomplete CPU data (a structure the accel crate does not build yet) is not
+            // cached, so it is measured again once the structure exists.
+            cpu.push(self.cached(
+                &key,
+                || Ok(cpu_data(scene, self.settings.cpu_res)),
+                |c: &CpuData| c.sizes.iter().all(|s| s.bytes.is_ok()),
+            )?);
+            self.progress.advance(1);
+            let key = CacheKey::new(
+                "render",
+                &hashes[i],
+                "bvh2",
+                "path",
+                &format!("spp={RENDER_SPP}"),
+                (RENDER_RES, RENDER_RES),
+            );
+            renders.push(self.cached(&key, || render_png_base64(scene, get(i)), |_| true)?);
+            self.progress.advance(1);
+        }
+        self.progress.end();
+
+        // Simulated pieces.
+        let scaling = Self::scaling_scenes(scenes);
+        let mut runs: Vec<Vec<SimRun>> = scenes.iter().map(|_| Vec::new()).collect();
+        let mut missing = VecDeque::new();
+        for (i, _) in scenes.iter().enumerate() {
+            for (accel, workload, tms) in self.sim_plan(scaling[i]) {
+                let cfg = self.sim_config(tms);
+                let key = CacheKey::new(
+                    "sim",
+                    &hashes[i],
+                    accel.name(),
+                    workload.name(),
+                    &serde_json::to_string(&cfg).unwrap_or_default(),
+                    (self.settings.width, self.settings.height),
+                );
+                match self.cache.get::<SimResult>(&key) {
+                    Some(r) => runs[i].push(SimRun {
+                        accel,
+                        workload,
+                        tms,
+                        result: Ok(r),
+                    }),
+                    None => missing.push_back(SimJob {
+                        scene: i,
+                        accel,
+                        workload,
+                        tms,
+                        key,
+                    }),
+                }
+            }
+        }
+        let pixels = u64::from(self.settings.width) * u64::from(self.settings.height);
+        self.progress
+            .begin("simulating", missing.len() as u64 * pixels);
+        let queue = Mutex::new(missing);
+        let done: Mutex<Vec<(SimJob, Result<SimResult, String>)>> = Mutex::new(Vec::new());
+        let write_error: Mutex<Option<ReportError>> = Mutex::new(None);
+        std::thread::scope(|s| {
+            for _ in 0..SIM_WORKERS {
+                s.spawn(|| {
+                    loop {
+                        let job = queue.lock().map(|mut q| q.pop_front()).ok().flatten();
+                        let Some(job) = job else { break };
+                        // Until the accel crate builds a DST it dispatches DST to BVH2, and a
+                        // "DST" simulation would be BVH2's: report that instead of simulating.
+                        if matches!(job.accel, SimAccel::Dst | SimAccel::DstSw)
+                            && let Err(e) = structure_bytes(get(job.scene), AccelKind::Dst)
+                        {
+                            self.progress.advance(pixels);
+                            if let Ok(mut d) = done.lock() {
+                                d.push((job, Err(format!("not simulated: {e}"))));
+                            }
+                            continue;
+                        }
+                        let last = AtomicU64::new(0);
+                        let report = |d: u64, _t: u64| {
+                            let prev = last.swap(d, Ordering::Relaxed);
+                            self.progress.advance(d.saturating_sub(prev));
+                        };
+                        let result = (self.simulate)(
+                            &scenes[job.scene],
+                            get(job.scene),
+                            job.accel,
+                            &self.sim_settings(job.workload),
+                            &self.sim_config(job.tms),
+                            &report,
+                        );
+                        self.progress
+                            .advance(pixels.saturating_sub(last.load(Ordering::Relaxed)));
+                        if let Ok(r) = &result {
+                            self.computed.fetch_add(1, Ordering::Relaxed);
+                            if let Err(e) = self.cache.put(&job.key, r)
+                                && let Ok(mut w) = write_error.lock()
+                            {
+                                w.get_or_insert(e);
+                            }
+                        }
+                        if let Ok(mut d) = done.lock() {
+                            d.push((job, result));
+                        }
+                    }
+                });
+            }
+        });
+        self.progress.end();
+        if let Some(e) = write_error.into_inner().ok().flatten() {
+            return Err(e);
+        }
+        for (job, result) in done.into_inner().unwrap_or_default() {
+            runs[job.scene].push(SimRun {
+                accel: job.accel,
+                workload: job.workload,
+                tms: job.tms,
+                result,
+            });
+        }
+
+        let mut out = Vec::new();
+        for (((scene, cpu), render), mut sim) in scenes.iter().zip(cpu).zip(renders).zip(runs) {
+            let order = |r: &SimRun| {
+                (
+                    r.workload == Workload::Path,
+                    r.tms,
+                    SimAccel::ALL.iter().position(|&a| a == r.accel),
+                )
+            };
+            sim.sort_by_key(order);
+            out.push(SceneReport {
+                name: scene.name.clone(),
+                spec: scene.spec.clone(),
+                triangles: scene.triangles.len() as u64,
+                content_hash: scene.content_hash(),
+                paper: PaperMatch::for_scene(&scene.name, &scene.spec),
+                cpu,
+                sim,
+                render_png_base64: render,
+                render_res: RENDER_RES,
+            });
+        }
+        Ok(ReportData {
+            code_version: format!("{CODE_VERSION}{SCHEMA}"),
+            settings: self.settings.clone(),
+            scenes: out,
+            skipped,
+            paper: PaperValues::published(),
+        })
+    }
+
+    fn cached<T: serde::Serialize + serde::de::DeserializeOwned>(
+        &self,
+        key: &CacheKey,
+        compute: impl FnOnce() -> Result<T, ReportError>,
+        keep: impl FnOnce(&T) -> bool,
+    ) -> Result<T, ReportError> {
+        if let Some(v) = self.cache.get(key) {
+            return Ok(v);
+        }
+        let v = compute()?;
+        self.computed.fetch_add(1, Ordering::Relaxed);
+        if keep(&v) {
+            self.cache.put(key, &v)?;
+        }
+        Ok(v)
+    }
+}
+
+/// Bytes of structure `kind`: nodes plus triangle-index lists (Table 3's sizes; triangle
+/// data is shared by all structures and not counted), from `Structures::stats`. Both DST
+/// variants share one image (`dst`). A structure the accel crate does not build yet reports
+/// why instead of a number.
+pub fn structure_bytes(structures: &Structures, kind: AccelKind) -> Result<u64, String> {
+    let name = stats_name(kind);
+    structures
+        .stats()
+        .into_iter()
+        .find(|s| s.name == name)
+        .map(|s| s.bytes_total)
+        .ok_or_else(|| format!("the accel crate does not build `{name}` yet"))
+}
+
+/// The name `Structures::stats` uses for `kind`.
+fn stats_name(kind: AccelKind) -> &'static str {
+    match kind {
+        AccelKind::DstSw | AccelKind::Dst => "dst",
+        k => k.name(),
+    }
+}
+
+/// A traced ray and its BVH2 answer.
+struct Traced {
+    query: RayQuery,
+    answer: TraceResult,
+}
+
+fn trace(structures: &Structures, kind: AccelKind, q: &RayQuery) -> TraceResult {
+    match q.kind {
+        RayKind::Shadow => TraceResult::Occluded(structures.any_hit(kind, &q.ray, &mut NoObserver)),
+        _ => TraceResult::Closest(structures.closest_hit(kind, &q.ray, &mut NoObserver)),
+    }
+}
+
+fn same_answer(a: &TraceResult, b: &TraceResult) -> bool {
+    let hit_eq = |x: &Option<Hit>, y: &Option<Hit>| match (x, y) {
+        (None, None) => true,
+        (Some(x), Some(y)) => x.t.to_bits() == y.t.to_bits() && x.prim == y.prim,
+        _ => false,
+    };
+    match (a, b) {
+        (TraceResult::Closest(x), TraceResult::Closest(y)) => hit_eq(x, y),
+        (TraceResult::Occluded(x), TraceResult::Occluded(y)) => x == y,
+        _ => false,
+    }
+}
+
+/// The rays of the path workload at `res`×`res`, 1 spp, traced on BVH2.
+fn ray_set(scene: &Scene, structures: &Structures, res: u32) -> Vec<Traced> {
+    let settings = RenderSettings::new(res, res, Workload::Path);
+    let mut out = Vec::new();
+    for y in 0..res {
+        for x in 0..res {
+            let mut job = PixelJob::new(scene, &settings, x, y);
+            while let Some(q) = job.next_ray() {
+                let answer = trace(structures, AccelKind::Bvh2, &q);
+                out.push(Traced { query: q, answer });
+                job.submit(answer);
+            }
+        }
+    }
+    out
+}
+
+/// Host measurements of one scene: build times, sizes, and single-thread Mrays/s per
+/// structure and ray kind, each structure checked ray by ray against BVH2 before it is
+/// timed.
+pub fn cpu_data(scene: &Scene, cpu_res: u32) -> CpuData {
+    let t0 = Instant::now();
+    let structures = Structures::build(&scene.triangles, &BuildConfig::high_quality());
+    let all_structures_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let build_ms = structures
+        .stats()
+        .into_iter()
+        .map(|s| BuildTime {
+            structure: s.name,
+            ms: s.build_ms,
+        })
+        .collect();
+    let sizes = AccelKind::ALL
+        .iter()
+        .map(|&kind| StructureSize {
+            kind,
+            bytes: structure_bytes(&structures, kind),
+        })
+        .collect();
+    let rays = ray_set(scene, &structures, cpu_res);
+    let mut throughput = Vec::new();
+    for ray_kind in [RayKind::Primary, RayKind::Shadow, RayKind::Diffuse] {
+        let set: Vec<&Traced> = rays.iter().filter(|r| r.query.kind == ray_kind).collect();
+        for kind in AccelKind::ALL {
+            throughput.push(Throughput {
+                kind,
+                ray_kind,
+                rays: set.len() as u64,
+                mrays_per_s: time_set(&structures, kind, ray_kind, &set),
+            });
+        }
+    }
+    CpuData {
+        sizes,
+        build_ms,
+        all_structures_ms,
+        throughput,
+    }
+}
+
+fn time_set(
+    structures: &Structures,
+    kind: AccelKind,
+    ray_kind: RayKind,
+    set: &[&Traced],
+) -> Result<f64, String> {
+    if matches!(kind, AccelKind::DstSw | AccelKind::Dst) {
+        // A DST variant: timed only once the accel crate builds a DST (until then it
+        // dispatches to BVH2, and timing it would report BVH2 under DST's name).
+        structure_bytes(structures, kind)?;
+    }
+    if set.is_empty() {
+        return Err("no rays of this kind".into());
+    }
+    let mismatches = set
+        .iter()
+        .filter(|r| !same_answer(&trace(structures, kind, &r.query), &r.answer))
+        .count() as u64;
+    if mismatches > 0 {
+        return Err(ReportError::Mismatch {
+            structure: kind.name().into(),
+            ray_kind: format!("{ray_kind:?}"),
+            mismatches,
+            rays: set.len() as u64,
+        }
+        .to_string());
+    }
+    let t0 = Instant::now();
+    let mut traced = 0u64;
+    let mut sink = 0u64;
+    while t0.elapsed().as_secs_f64() < MIN_TIMING_S {
+        for r in set {
+            if let TraceResult::Closest(Some(_)) | TraceResult::Occluded(true) =
+                trace(structures, kind, &r.query)
+            {
+                sink += 1;
+            }
+        }
+        traced += set.len() as u64;
+    }
+    std::hint::black_box(sink);
+    Ok(traced as f64 / t0.elapsed().as_secs_f64() / 1e6)
+}
+
+/// Renders the scene's path workload ([`RENDER_RES`]², [`RENDER_SPP`] spp) on BVH2 and
+/// returns it as a base64 PNG (grey, gamma 2.2).
+pub fn render_png_base64(scene: &Scene, structures: &Structures) -> Result<String, ReportError> {
+    let mut settings = RenderSettings::new(RENDER_RES, RENDER_RES, Workload::Path);
+    settings.spp = RENDER_SPP;
+    let row = |y: u32| -> Vec<u8> {
+        (0..RENDER_RES)
+            .map(|x| {
+                let mut job = PixelJob::new(scene, &settings, x, y);
+                while let Some(q) = job.next_ray() {
+                    job.submit(trace(structures, AccelKind::Bvh2, &q));
+                }
+                let v = job.radiance().clamp(0.0, 1.0).powf(1.0 / 2.2);
+                (v * 255.0).round() as u8
+            })
+            .collect()
+    };
+    // Two threads (even and odd rows); each pixel is deterministic, so the image is too.
+    let mut rows: Vec<Vec<u8>> = vec![Vec::new(); RENDER_RES as usize];
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..2u32)
+            .map(|k| {
+                s.spawn(move || {
+                    (k..RENDER_RES)
+                        .step_by(2)
+                        .map(|y| (y, row(y)))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        for h in handles {
+            for (y, r) in h.join().unwrap_or_default() {
+                rows[y as usize] = r;
+            }
+        }
+    });
+    let pixels: Vec<u8> = rows.concat();
+    let png = encode_png(RENDER_RES, RENDER_RES, png::ColorType::Grayscale, &pixels).map_err(
+        |message| ReportError::Png {
+            what: format!("render of {}", scene.name),
+            message,
+        },
+    )?;
+    Ok(base64::engine::general_purpose::STANDARD.encode(png))
+}
+
+/// Encodes 8-bit pixels as a PNG.
+pub fn encode_png(
+    width: u32,
+    height: u32,
+    color: png::ColorType,
+    data: &[u8],
+) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, width, height);
+    enc.set_color(color);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut w = enc.write_header().map_err(|e| e.to_string())?;
+    w.write_image_data(data).map_err(|e| e.to_string())?;
+    w.finish().map_err(|e| e.to_string())?;
+    Ok(out)
+}
