@@ -1,11 +1,57 @@
-//! A TRaX-style many-core simulator with the dual-split pipeline (Lin et al. 2020, §4).
+//! A TRaX-style many-core simulator with the dual-split pipeline (Lin et al. 2020, §2.3, §4).
 //!
-//! SKELETON: the public API below is the contract the report and the CLI code against.
+//! ```text
+//!  PixelJob (renderer)        Structures::closest_hit / any_hit  (the real traversal)
+//!       │ rays                     │ Observer events: fetch, step, triangle_test, push, pop
+//!       ▼                          ▼
+//!  workload.rs ── per pixel ──▶ kernel::Recorder ──▶ Vec<Op>  (macro-ops, functional first)
+//!                                                        │
+//!                                                        ▼  timing second
+//!  engine.rs: threads on TMs, heap of wake-up cycles, reservation tables
+//!      ├─ per TM: L1 (banks, tags with fill times), ray-box / ray-triangle / dual-split
+//!      │          pipelines, shared reciprocal unit
+//!      └─ chip:   L2 (banks, tags), memory::dram (GDDR5 row buffers, buses, read queues)
+//!                                                        │
+//!                                                        ▼
+//!  energy.rs: counts × per-event energy, split like Table 6 ──▶ SimResult
+//! ```
+//!
+//! Ray paths do not depend on timing, so each pixel's rays are traced functionally when a
+//! simulated thread takes the pixel from the global counter, and the recorded macro-ops are
+//! then replayed by the timing model. Simulated hits are the renderer's hits by
+//! construction ([`SimResult::radiance`] is the renderer's per-pixel value).
+//!
+//! ```no_run
+//! use dualsplit_sim::{SimAccel, SimConfig, simulate};
+//! use dualsplit_render::{RenderSettings, Workload};
+//! let scene = dualsplit_scene::load("builtin:hairball").unwrap();
+//! let structures = dualsplit_accel::Structures::build(&scene.triangles, &Default::default());
+//! let settings = RenderSettings::new(64, 64, Workload::Cast);
+//! let r = simulate(&scene, &structures, SimAccel::Dst, &settings, &SimConfig::lin2020(),
+//!                  &|_, _| {}).unwrap();
+//! println!("{} cycles, {:.3} ms", r.cycles, r.frame_ms);
+//! ```
 
-use dualsplit_accel::Structures;
+pub mod config;
+pub mod energy;
+pub mod engine;
+pub mod kernel;
+pub mod memory;
+pub mod slots;
+mod workload;
+
+pub use config::{CacheConfig, ConfigError, DramConfig, EnergyConfig, SimConfig, UnitConfig};
+pub use engine::{CacheStats, Stalls, UnitStats};
+pub use kernel::{InstrCounts, Mix};
+pub use memory::DramStats;
+
+use dualsplit_accel::{AccelKind, Structures};
 use dualsplit_render::RenderSettings;
 use dualsplit_scene::Scene;
 use serde::{Deserialize, Serialize};
+
+/// A core clock cycle.
+pub type Cycle = u64;
 
 /// The eight simulated configurations of the paper (§4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -71,19 +117,24 @@ impl SimAccel {
     pub fn parse(s: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|k| k.name() == s)
     }
-}
-
-/// Hardware configuration (TOML, see `configs/lin2020.toml`).
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-pub struct SimConfig {
-    /// Thread multiprocessors.
-    pub tms: u32,
-}
-
-impl SimConfig {
-    /// The paper's Table 1 configuration.
-    pub fn lin2020() -> Self {
-        Self { tms: 64 }
+    /// The traversal this configuration runs.
+    pub fn kind(self) -> AccelKind {
+        match self {
+            SimAccel::Bvh2 | SimAccel::Bvh2Plus => AccelKind::Bvh2,
+            SimAccel::Bvh4 | SimAccel::Bvh4Plus => AccelKind::Bvh4,
+            SimAccel::Bvh8 | SimAccel::Bvh8Plus => AccelKind::Bvh8,
+            SimAccel::DstSw => AccelKind::DstSw,
+            SimAccel::Dst => AccelKind::Dst,
+        }
+    }
+    /// Ray-box pipelines per TM: the node arity for the "+" configurations (§4).
+    pub fn box_pipes(self, cfg: &SimConfig) -> u32 {
+        match self {
+            SimAccel::Bvh2Plus => 2,
+            SimAccel::Bvh4Plus => 4,
+            SimAccel::Bvh8Plus => 8,
+            _ => cfg.units.box_pipes,
+        }
     }
 }
 
@@ -105,9 +156,28 @@ impl EnergySplit {
     }
 }
 
+/// Pipeline utilisation: ops / (cycles × pipes × TMs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Utilisation {
+    /// Ray-box pipelines.
+    pub box_pipe: f64,
+    /// Ray-triangle pipelines.
+    pub tri_pipe: f64,
+    /// Dual-split pipelines.
+    pub dst_pipe: f64,
+    /// Issue slots used: instructions / (cycles × threads).
+    pub issue: f64,
+}
+
 /// What one simulated frame reports.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct SimResult {
+    /// Configuration simulated.
+    pub accel: Option<SimAccel>,
+    /// Thread multiprocessors simulated.
+    pub tms: u32,
+    /// Hardware threads (TMs × TPs per TM).
+    pub threads: u32,
     /// Simulated cycles.
     pub cycles: u64,
     /// Frame time in milliseconds at the configured clock.
@@ -120,31 +190,65 @@ pub struct SimResult {
     pub dram_activations: u64,
     /// Row-buffer hit rate of DRAM reads.
     pub row_hit_rate: f64,
-    /// L1 hit rate.
+    /// L1 hit rate (hits on filled lines / accesses; merged misses count as misses).
     pub l1_hit_rate: f64,
-    /// L2 hit rate.
+    /// L2 hit rate (hits on filled lines / accesses).
     pub l2_hit_rate: f64,
     /// Rays traced.
     pub rays: u64,
+    /// Pixels simulated.
+    pub pixels: u64,
+    /// Instructions by class.
+    pub instructions: InstrCounts,
+    /// Cache counters.
+    pub caches: CacheStats,
+    /// DRAM counters.
+    pub dram: DramStats,
+    /// Pipeline and unit op counts.
+    pub units: UnitStats,
+    /// Pipeline and issue utilisation.
+    pub utilisation: Utilisation,
+    /// Stall breakdown in thread-cycles.
+    pub stalls: Stalls,
+    /// Per-pixel radiance in scanline order, as the renderer computes it from the same hits.
+    #[serde(skip)]
+    pub radiance: Vec<f32>,
 }
 
 /// Errors of the simulator.
 #[derive(Debug, thiserror::Error)]
 pub enum SimError {
-    /// Not yet implemented.
-    #[error("the simulator is not implemented yet")]
-    Unimplemented,
+    /// The configuration is invalid.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// The frame has no pixels.
+    #[error("empty frame: {width}×{height} pixels")]
+    EmptyFrame {
+        /// Requested width.
+        width: u32,
+        /// Requested height.
+        height: u32,
+    },
 }
 
 /// Simulates one frame of `settings` on `scene` with configuration `accel`; `progress` is
 /// called with (pixels done, pixels total).
 pub fn simulate(
-    _scene: &Scene,
-    _structures: &Structures,
-    _accel: SimAccel,
-    _settings: &RenderSettings,
-    _cfg: &SimConfig,
-    _progress: &(dyn Fn(u64, u64) + Sync),
+    scene: &Scene,
+    structures: &Structures,
+    accel: SimAccel,
+    settings: &RenderSettings,
+    cfg: &SimConfig,
+    progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<SimResult, SimError> {
-    Err(SimError::Unimplemented)
+    cfg.validate()?;
+    if settings.width == 0 || settings.height == 0 {
+        return Err(SimError::EmptyFrame {
+            width: settings.width,
+            height: settings.height,
+        });
+    }
+    Ok(workload::run(
+        scene, structures, accel, settings, cfg, progress,
+    ))
 }

@@ -1,15 +1,195 @@
-//! `dualsplit simulate`.
+//! `dualsplit simulate`: one frame on the TRaX-style many-core model (Lin et al. 2020, §4).
 use crate::progress::Ctx;
+use anyhow::{Context, bail};
+use dualsplit_accel::{BuildConfig, Structures};
+use dualsplit_render::{RenderSettings, Workload};
+use dualsplit_sim::{SimAccel, SimConfig, SimResult, simulate};
 use std::process::ExitCode;
 
 /// Arguments of `dualsplit simulate`.
 #[derive(clap::Args)]
 pub struct Args {
     /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
-    scene: Option<String>,
+    scene: String,
+    /// Configuration: bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst, or all (two at a time).
+    #[arg(long, default_value = "dst")]
+    accel: String,
+    /// Workload: cast (primary + shadow ray) or path (5 diffuse bounces).
+    #[arg(long, default_value = "path")]
+    workload: String,
+    /// Image resolution (N×N pixels).
+    #[arg(long, default_value_t = 512)]
+    res: u32,
+    /// Override the number of TMs.
+    #[arg(long)]
+    tms: Option<u32>,
+    /// Hardware configuration TOML (default: the built-in lin2020 = configs/lin2020.toml).
+    #[arg(long)]
+    config: Option<std::path::PathBuf>,
+    /// Print JSON (an array of results) instead of a table.
+    #[arg(long)]
+    json: bool,
 }
 
 /// Runs the subcommand.
-pub fn run(_args: Args, _ctx: &Ctx) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`dualsplit simulate` is coming soon")
+pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+    let accels: Vec<SimAccel> = if args.accel == "all" {
+        SimAccel::ALL.to_vec()
+    } else {
+        match SimAccel::parse(&args.accel) {
+            Some(a) => vec![a],
+            None => bail!(
+                "unknown --accel `{}` (expected bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst or all)",
+                args.accel
+            ),
+        }
+    };
+    let workload = match args.workload.as_str() {
+        "cast" => Workload::Cast,
+        "path" => Workload::Path,
+        w => bail!("unknown --workload `{w}` (expected cast or path)"),
+    };
+    if args.res == 0 {
+        bail!("--res must be at least 1");
+    }
+    let mut cfg = match &args.config {
+        Some(p) => {
+            let text =
+                std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            SimConfig::from_toml(&text).with_context(|| format!("in {}", p.display()))?
+        }
+        None => SimConfig::lin2020(),
+    };
+    if let Some(t) = args.tms {
+        cfg.tms = t;
+    }
+    cfg.validate()?;
+
+    let sp = ctx.spinner(format!("loading {}", args.scene));
+    let scene = dualsplit_scene::load(&args.scene)
+        .with_context(|| format!("loading scene {}", args.scene))?;
+    sp.set_message(format!(
+        "building structures ({} triangles)",
+        scene.triangles.len()
+    ));
+    let structures = Structures::build(&scene.triangles, &BuildConfig::high_quality());
+    sp.finish_and_clear();
+    let settings = RenderSettings::new(args.res, args.res, workload);
+
+    let sim_one = |accel: SimAccel| -> anyhow::Result<SimResult> {
+        let total = settings.width as u64 * settings.height as u64;
+        let bar = ctx.bar(total, format!("{} {}", accel.label(), workload.name()));
+        let r = simulate(&scene, &structures, accel, &settings, &cfg, &|done, _| {
+            bar.set_position(done)
+        })
+        .with_context(|| format!("simulating {}", accel.label()))?;
+        bar.finish_and_clear();
+        Ok(r)
+    };
+    // Two configurations at a time: each run is single-threaded and deterministic.
+    let mut results = Vec::with_capacity(accels.len());
+    for pair in accels.chunks(2) {
+        let out: Vec<anyhow::Result<SimResult>> = std::thread::scope(|s| {
+            let handles: Vec<_> = pair
+                .iter()
+                .map(|&a| {
+                    let f = &sim_one;
+                    s.spawn(move || f(a))
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().expect("simulation thread panicked"))
+                .collect()
+        });
+        for r in out {
+            results.push(r?);
+        }
+    }
+
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&results)?);
+    } else {
+        println!(
+            "scene {} ({} triangles), {}×{} {}, {} TMs × {} TPs",
+            scene.name,
+            scene.triangles.len(),
+            args.res,
+            args.res,
+            workload.name(),
+            cfg.tms,
+            cfg.tps_per_tm
+        );
+        for r in &results {
+            print_result(r);
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_result(r: &SimResult) {
+    let label = r.accel.map_or("?", |a| a.label());
+    let e = &r.energy;
+    let i = &r.instructions;
+    let s = &r.stalls;
+    let u = &r.utilisation;
+    println!("== {label}");
+    println!(
+        "  frame time     {:.3} ms ({} cycles), {} rays, {} node visits",
+        r.frame_ms, r.cycles, r.rays, r.instructions.node_steps
+    );
+    println!(
+        "  energy         {:.4} J total: DRAM {:.4} J, caches {:.4} J, compute {:.4} J",
+        e.total(),
+        e.dram_j,
+        e.caches_j,
+        e.compute_j
+    );
+    println!(
+        "  DRAM           {} lines read, {} activations, row-hit rate {:.1} %",
+        r.dram_lines,
+        r.dram_activations,
+        100.0 * r.row_hit_rate
+    );
+    println!(
+        "  caches         L1 hit {:.1} % ({} accesses), L2 hit {:.1} % ({} accesses)",
+        100.0 * r.l1_hit_rate,
+        r.caches.l1_accesses,
+        100.0 * r.l2_hit_rate,
+        r.caches.l2_accesses
+    );
+    println!(
+        "  instructions   {} total: int {}, fpadd {}, fpmul {}, fpcmp {}, fpinv {}, local {}, loads {}, box issues {}, tri {}, dual-split {}, atomics {}",
+        i.total(),
+        i.mix.int,
+        i.mix.fpadd,
+        i.mix.fpmul,
+        i.mix.fpcmp,
+        i.mix.fpinv,
+        i.mix.local,
+        i.loads,
+        i.box_issues,
+        i.tri_ops,
+        i.dst_ops,
+        i.atomics
+    );
+    println!(
+        "  utilisation    issue {:.1} %, ray-box {:.1} %, ray-triangle {:.1} %, dual-split {:.1} %",
+        100.0 * u.issue,
+        100.0 * u.box_pipe,
+        100.0 * u.tri_pipe,
+        100.0 * u.dst_pipe
+    );
+    let tot = (r.cycles as f64 * r.threads as f64).max(1.0);
+    let pct = |x: u64| 100.0 * x as f64 / tot;
+    println!(
+        "  stalls (% of thread-cycles)  memory {:.1}, pipeline latency {:.1}, pipeline busy {:.1}, fpinv {:.1}, L1 bank {:.1}, atomic {:.1}, idle at end {:.1}",
+        pct(s.memory),
+        pct(s.pipeline_latency),
+        pct(s.pipeline_busy),
+        pct(s.fpinv),
+        pct(s.l1_bank),
+        pct(s.atomic),
+        pct(s.idle)
+    );
 }

@@ -1,0 +1,114 @@
+//! Simulator speed: simulated node visits per host second (issue 5's speed bar: ≥ 2 M per
+//! core). `cargo bench -p dualsplit-sim`.
+//!
+//! `engine_node_visits`: the lin2020 chip (64 TMs × 32 threads) replaying a synthetic
+//! BVH2-like stream: per node visit one 13-word (52-byte) node load at a random node of a
+//! 16 MB depth-first region (so L1, L2 and DRAM all see traffic), 2 serial box ops and 17
+//! instructions; every 8th visit a 9-word triangle load and a triangle op. The counter is
+//! node visits. `frame_soup`: a whole 128×128 path-traced frame (functional traversal +
+//! timing) on a seeded 20 000-triangle soup, counted in simulated node visits.
+
+use divan::counter::ItemsCount;
+use dualsplit_geometry::{Pcg32, Triangle, Vec3};
+use dualsplit_sim::engine::{Chip, Thread, WorkSource, run_chip};
+use dualsplit_sim::kernel::{Op, Pipe};
+use dualsplit_sim::{SimAccel, SimConfig, simulate};
+
+fn main() {
+    divan::main();
+}
+
+struct Synthetic {
+    rng: Pcg32,
+    programs_left: u64,
+    visits_per_program: u32,
+}
+
+impl WorkSource for Synthetic {
+    fn next(&mut self, _t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
+        if self.programs_left == 0 {
+            return None;
+        }
+        self.programs_left -= 1;
+        let mut ops = Vec::with_capacity(self.visits_per_program as usize * 3);
+        for v in 0..self.visits_per_program {
+            let node = self.rng.below(16 * 1024 * 1024 / 52) as u64;
+            ops.push(Op::Load {
+                addr: node * 52,
+                words: 13,
+            });
+            ops.push(Op::Pipe {
+                pipe: Pipe::Box,
+                n: 2,
+                parallel: false,
+            });
+            ops.push(Op::Issue { n: 17, fpinv: 0 });
+            if v % 8 == 7 {
+                let tri = self.rng.below(1 << 20) as u64;
+                ops.push(Op::Load {
+                    addr: (1 << 26) + tri * 36,
+                    words: 9,
+                });
+                ops.push(Op::Pipe {
+                    pipe: Pipe::Triangle,
+                    n: 1,
+                    parallel: false,
+                });
+            }
+        }
+        Some(ops)
+    }
+}
+
+#[divan::bench(sample_count = 5)]
+fn engine_node_visits(b: divan::Bencher) {
+    let cfg = SimConfig::lin2020();
+    let threads = cfg.tms * cfg.tps_per_tm;
+    let programs = threads as u64 * 2;
+    let visits = 100u32;
+    b.counter(ItemsCount::new(programs * visits as u64))
+        .bench(|| {
+            let mut chip = Chip::new(&cfg, 1);
+            let mut th: Vec<Thread> = (0..threads)
+                .map(|i| Thread::new((i / cfg.tps_per_tm) as usize))
+                .collect();
+            let mut w = Synthetic {
+                rng: Pcg32::new(1, 2),
+                programs_left: programs,
+                visits_per_program: visits,
+            };
+            run_chip(&mut chip, &mut th, &mut w)
+        });
+}
+
+#[divan::bench(args = [SimAccel::Bvh2, SimAccel::Dst], sample_count = 3)]
+fn frame_soup(b: divan::Bencher, accel: SimAccel) {
+    let mut rng = Pcg32::new(7, 1);
+    let tris: Vec<Triangle> = (0..20_000)
+        .map(|_| {
+            let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+            let mut v = || {
+                c + Vec3::new(
+                    rng.range_f32(-0.02, 0.02),
+                    rng.range_f32(-0.02, 0.02),
+                    rng.range_f32(-0.02, 0.02),
+                )
+            };
+            let (a, b, d) = (v(), v(), v());
+            Triangle::new(a, b, d)
+        })
+        .collect();
+    let scene =
+        dualsplit_scene::Scene::from_triangles("soup", "bench:soup", tris, Default::default())
+            .unwrap();
+    let s = dualsplit_accel::Structures::build(&scene.triangles, &Default::default());
+    let settings =
+        dualsplit_render::RenderSettings::new(128, 128, dualsplit_render::Workload::Path);
+    let cfg = SimConfig::lin2020();
+    let nodes = simulate(&scene, &s, accel, &settings, &cfg, &|_, _| {})
+        .unwrap()
+        .instructions
+        .node_steps;
+    b.counter(ItemsCount::new(nodes))
+        .bench(|| simulate(&scene, &s, accel, &settings, &cfg, &|_, _| {}).unwrap());
+}

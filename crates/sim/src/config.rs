@@ -1,0 +1,347 @@
+//! The hardware configuration: every parameter of the model, read from commented TOML
+//! (`configs/lin2020.toml` is the paper's Table 1; Lin et al. 2020, §4, Table 1).
+//!
+//! Every field has a default equal to [`SimConfig::lin2020`], so a TOML file only needs the
+//! values it changes; unknown keys are rejected (a measurement tool never ignores an option).
+
+use serde::{Deserialize, Serialize};
+
+/// Hardware configuration of the simulated TRaX chip.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SimConfig {
+    /// Thread multiprocessors (TMs).
+    pub tms: u32,
+    /// Thread processors (TPs) per TM.
+    pub tps_per_tm: u32,
+    /// Core clock in GHz.
+    pub clock_ghz: f64,
+    /// The per-TM L1 data cache.
+    pub l1: CacheConfig,
+    /// The chip-wide L2 cache.
+    pub l2: CacheConfig,
+    /// GDDR5 main memory.
+    pub dram: DramConfig,
+    /// Functional units and pipelines per TM.
+    pub units: UnitConfig,
+    /// Energy per event.
+    pub energy: EnergyConfig,
+}
+
+/// A cache: size, line, banks, associativity and hit latency.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CacheConfig {
+    /// Capacity in bytes.
+    pub size_bytes: u64,
+    /// Line size in bytes (L1 and L2 must match).
+    pub line_bytes: u64,
+    /// Word-interleaved banks (bank = word address mod banks), one access per bank per cycle;
+    /// a power of two.
+    pub banks: u32,
+    /// Ways per set (1 = direct-mapped, as in SimTRaX).
+    pub associativity: u32,
+    /// Hit latency in core cycles (for L2: on top of the L1 latency).
+    pub hit_latency: u64,
+}
+
+/// GDDR5 main memory; timings in DRAM clock ticks (`ticks_per_cycle` per core cycle).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DramConfig {
+    /// Channels (each with its own data bus).
+    pub channels: u32,
+    /// Banks per channel.
+    pub banks_per_channel: u32,
+    /// Bytes of one row of one channel.
+    pub row_bytes: u64,
+    /// DRAM controller ticks per core cycle.
+    pub ticks_per_cycle: u64,
+    /// Column access strobe latency.
+    pub t_cas: u64,
+    /// Activate-to-read delay.
+    pub t_rcd: u64,
+    /// Precharge time.
+    pub t_rp: u64,
+    /// Minimum activate-to-precharge time.
+    pub t_ras: u64,
+    /// Minimum activate-to-activate time in one bank.
+    pub t_rc: u64,
+    /// Minimum activate-to-activate time in one channel (different banks).
+    pub t_rrd: u64,
+    /// Read-to-precharge delay.
+    pub t_rtp: u64,
+    /// Column-to-column delay in one bank.
+    pub t_ccd: u64,
+    /// Data-bus occupancy of one 64-byte line.
+    pub t_burst: u64,
+    /// Read-queue entries per channel; a full queue stalls the request (back-pressure).
+    pub read_queue: u32,
+    /// Energy of one 64-byte read burst, nJ.
+    pub e_read_nj: f64,
+    /// Energy of one row activation (and its precharge), nJ.
+    pub e_activate_nj: f64,
+    /// Background plus refresh power of all channels, W.
+    pub background_w: f64,
+}
+
+/// Functional units and fixed-function pipelines of one TM.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct UnitConfig {
+    /// Ray-box pipelines of the serial configurations (BVH2/4/8); the "+" configurations
+    /// have as many as the node's arity.
+    pub box_pipes: u32,
+    /// Ray-box pipeline latency (cycles, initiation interval 1).
+    pub box_latency: u64,
+    /// Ray-triangle pipelines.
+    pub tri_pipes: u32,
+    /// Ray-triangle pipeline latency.
+    pub tri_latency: u64,
+    /// Dual-split pipelines.
+    pub dst_pipes: u32,
+    /// Dual-split pipeline latency.
+    pub dst_latency: u64,
+    /// Shared reciprocal / inverse-square-root units.
+    pub fpinv_units: u32,
+    /// Their latency.
+    pub fpinv_latency: u64,
+    /// Latency of the global atomic increment that hands out pixels.
+    pub atomic_latency: u64,
+}
+
+/// Energy per event in nanojoules (65 nm).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EnergyConfig {
+    /// Integer add, branch, bitwise op.
+    pub int_nj: f64,
+    /// FP add/sub.
+    pub fpadd_nj: f64,
+    /// FP multiply.
+    pub fpmul_nj: f64,
+    /// FP min/max/compare.
+    pub fpcmp_nj: f64,
+    /// FP reciprocal / inverse square root.
+    pub fpinv_nj: f64,
+    /// One register-file access (3 per instruction).
+    pub rf_access_nj: f64,
+    /// One instruction-cache fetch (1 per instruction).
+    pub icache_nj: f64,
+    /// One local-store (stack) access.
+    pub local_store_nj: f64,
+    /// One L1 access (per load word).
+    pub l1_nj: f64,
+    /// One L2 access.
+    pub l2_nj: f64,
+    /// One ray-box pipeline op.
+    pub box_pipe_nj: f64,
+    /// One ray-triangle pipeline op.
+    pub tri_pipe_nj: f64,
+    /// One dual-split pipeline op.
+    pub dst_pipe_nj: f64,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        Self::lin2020()
+    }
+}
+
+impl Default for DramConfig {
+    fn default() -> Self {
+        SimConfig::lin2020().dram
+    }
+}
+
+impl Default for UnitConfig {
+    fn default() -> Self {
+        SimConfig::lin2020().units
+    }
+}
+
+impl Default for EnergyConfig {
+    fn default() -> Self {
+        SimConfig::lin2020().energy
+    }
+}
+
+/// Why a configuration was rejected.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The TOML did not parse or had an unknown key.
+    #[error("config parse error: {0}")]
+    Parse(#[from] toml::de::Error),
+    /// A value is out of range.
+    #[error("config value `{field}` = {value} is invalid: {reason}")]
+    Invalid {
+        /// The key.
+        field: &'static str,
+        /// Its value.
+        value: u64,
+        /// What it must be.
+        reason: &'static str,
+    },
+}
+
+impl SimConfig {
+    /// The paper's Table 1 configuration (Lin et al. 2020, §4, Table 1), with the parameters
+    /// the paper does not give taken from SimTRaX as documented in `configs/lin2020.toml`.
+    pub fn lin2020() -> Self {
+        Self {
+            tms: 64,
+            tps_per_tm: 32,
+            clock_ghz: 1.0,
+            l1: CacheConfig {
+                size_bytes: 64 * 1024,
+                line_bytes: 64,
+                banks: 16,
+                associativity: 1,
+                hit_latency: 1,
+            },
+            l2: CacheConfig {
+                size_bytes: 4 * 1024 * 1024,
+                line_bytes: 64,
+                banks: 128,
+                associativity: 1,
+                hit_latency: 3,
+            },
+            dram: DramConfig {
+                channels: 16,
+                banks_per_channel: 16,
+                row_bytes: 8192,
+                ticks_per_cycle: 2,
+                t_cas: 28,
+                t_rcd: 28,
+                t_rp: 28,
+                t_ras: 70,
+                t_rc: 98,
+                t_rrd: 13,
+                t_rtp: 15,
+                t_ccd: 4,
+                t_burst: 4,
+                read_queue: 64,
+                e_read_nj: 9.8,
+                e_activate_nj: 61.3,
+                background_w: 26.7,
+            },
+            units: UnitConfig {
+                box_pipes: 1,
+                box_latency: 8,
+                tri_pipes: 1,
+                tri_latency: 24,
+                dst_pipes: 1,
+                dst_latency: 8,
+                fpinv_units: 1,
+                fpinv_latency: 16,
+                atomic_latency: 4,
+            },
+            energy: EnergyConfig {
+                int_nj: 0.000572,
+                fpadd_nj: 0.0074,
+                fpmul_nj: 0.0142,
+                fpcmp_nj: 0.000536,
+                fpinv_nj: 0.1563,
+                rf_access_nj: 0.00789613,
+                icache_nj: 0.01349,
+                local_store_nj: 0.00692867,
+                l1_nj: 0.3107,
+                l2_nj: 1.71,
+                box_pipe_nj: 0.1377,
+                tri_pipe_nj: 0.71,
+                dst_pipe_nj: 0.0610,
+            },
+        }
+    }
+
+    /// Parses a TOML configuration (missing keys take the [`SimConfig::lin2020`] values) and
+    /// validates it.
+    pub fn from_toml(text: &str) -> Result<Self, ConfigError> {
+        let cfg: SimConfig = toml::from_str(text)?;
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    /// Checks the values the engine relies on.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let pow2 = |field, v: u64| {
+            if v == 0 || !v.is_power_of_two() {
+                Err(ConfigError::Invalid {
+                    field,
+                    value: v,
+                    reason: "must be a power of two",
+                })
+            } else {
+                Ok(())
+            }
+        };
+        let pos = |field, v: u64| {
+            if v == 0 {
+                Err(ConfigError::Invalid {
+                    field,
+                    value: v,
+                    reason: "must be at least 1",
+                })
+            } else {
+                Ok(())
+            }
+        };
+        pos("tms", self.tms as u64)?;
+        pos("tps_per_tm", self.tps_per_tm as u64)?;
+        pow2("l1.line_bytes", self.l1.line_bytes)?;
+        if self.l1.line_bytes != self.l2.line_bytes || self.l1.line_bytes != 64 {
+            return Err(ConfigError::Invalid {
+                field: "l2.line_bytes",
+                value: self.l2.line_bytes,
+                reason: "L1 and L2 lines must both be 64 bytes (one DRAM burst pair)",
+            });
+        }
+        for (f, c) in [("l1", &self.l1), ("l2", &self.l2)] {
+            pow2(
+                if f == "l1" { "l1.banks" } else { "l2.banks" },
+                c.banks as u64,
+            )?;
+            pos(f, c.associativity as u64)?;
+            let sets = c.size_bytes / c.line_bytes / c.associativity as u64;
+            pow2(if f == "l1" { "l1 sets" } else { "l2 sets" }, sets)?;
+        }
+        pow2("dram.channels", self.dram.channels as u64)?;
+        pow2("dram.banks_per_channel", self.dram.banks_per_channel as u64)?;
+        pow2("dram.row_bytes", self.dram.row_bytes)?;
+        if self.dram.row_bytes < 64 {
+            return Err(ConfigError::Invalid {
+                field: "dram.row_bytes",
+                value: self.dram.row_bytes,
+                reason: "must hold at least one 64-byte line",
+            });
+        }
+        pos("dram.ticks_per_cycle", self.dram.ticks_per_cycle)?;
+        pos("dram.t_burst", self.dram.t_burst)?;
+        pos("dram.read_queue", self.dram.read_queue as u64)?;
+        if self.dram.t_rrd > 64 {
+            return Err(ConfigError::Invalid {
+                field: "dram.t_rrd",
+                value: self.dram.t_rrd,
+                reason: "must be at most 64 ticks",
+            });
+        }
+        pos("units.box_pipes", self.units.box_pipes as u64)?;
+        pos("units.tri_pipes", self.units.tri_pipes as u64)?;
+        pos("units.dst_pipes", self.units.dst_pipes as u64)?;
+        pos("units.fpinv_units", self.units.fpinv_units as u64)?;
+        if !(self.clock_ghz > 0.0 && self.clock_ghz.is_finite()) {
+            return Err(ConfigError::Invalid {
+                field: "clock_ghz",
+                value: 0,
+                reason: "must be a positive finite number",
+            });
+        }
+        Ok(())
+    }
+
+    /// Peak DRAM bandwidth in bytes per core cycle (64 B per `t_burst` per channel).
+    pub fn dram_peak_bytes_per_cycle(&self) -> f64 {
+        64.0 * self.dram.channels as f64 * self.dram.ticks_per_cycle as f64
+            / self.dram.t_burst as f64
+    }
+}

@@ -1,0 +1,47 @@
+//! Energy: event counts × per-event energies (notes §1.9, §4.2), split like the paper's
+//! Table 6 into DRAM, caches (L1, L2, instruction caches, register files, local stores) and
+//! compute (functional units and pipelines). No on-chip leakage, as in SimTRaX.
+
+use crate::engine::CacheStats;
+use crate::kernel::InstrCounts;
+use crate::memory::DramStats;
+use crate::{EnergySplit, SimConfig};
+
+/// The energy of a frame from its counts and frame time (ms).
+pub fn split(
+    cfg: &SimConfig,
+    counts: &InstrCounts,
+    caches: &CacheStats,
+    dram: &DramStats,
+    frame_ms: f64,
+) -> EnergySplit {
+    let e = &cfg.energy;
+    let nj = 1e-9;
+    let instrs = counts.total() as f64;
+    let m = &counts.mix;
+    let caches_j = (caches.l1_accesses as f64 * e.l1_nj
+        + caches.l2_accesses as f64 * e.l2_nj
+        + instrs * e.icache_nj
+        + instrs * 3.0 * e.rf_access_nj
+        + m.local as f64 * e.local_store_nj)
+        * nj;
+    // Loads, pipeline issues and atomics use the integer unit for address arithmetic.
+    let int_ops = m.int as u64 + counts.loads + counts.atomics;
+    let compute_j = (int_ops as f64 * e.int_nj
+        + m.fpadd as f64 * e.fpadd_nj
+        + m.fpmul as f64 * e.fpmul_nj
+        + m.fpcmp as f64 * e.fpcmp_nj
+        + m.fpinv as f64 * e.fpinv_nj
+        + counts.box_ops as f64 * e.box_pipe_nj
+        + counts.tri_ops as f64 * e.tri_pipe_nj
+        + counts.dst_ops as f64 * e.dst_pipe_nj)
+        * nj;
+    let d = &cfg.dram;
+    let dram_j = (dram.reads as f64 * d.e_read_nj + dram.activations as f64 * d.e_activate_nj) * nj
+        + d.background_w * frame_ms * 1e-3;
+    EnergySplit {
+        dram_j,
+        caches_j,
+        compute_j,
+    }
+}

@@ -1,0 +1,662 @@
+//! The timing engine: TMs of in-order single-issue threads replaying macro-ops against
+//! reservation tables (next-free cycle per L1 bank, L2 bank, pipeline, shared unit, DRAM
+//! bank and bus), driven by a timing wheel of thread wake-up times (notes §5.2).
+//!
+//! A thread runs while its next operation can start at the current event time; when it must
+//! wait (for data, a busy unit, or because its issue slots run ahead), it goes back into the
+//! wheel at the cycle it can continue. Threads waking in the same cycle run in the order they
+//! were scheduled, so runs are
+//! deterministic. Operations reserve resources at their own start cycle; because events are
+//! processed in time order, reservations are made in (nearly) causal order.
+
+use crate::Cycle;
+use crate::config::SimConfig;
+use crate::kernel::{Op, Pipe};
+use crate::memory::{Cache, Dram, Lookup};
+use crate::slots::Slots;
+use serde::{Deserialize, Serialize};
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// Why a thread waited (stall breakdown, in thread-cycles).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Stalls {
+    /// Waiting for load data (L1 hit latency, L2, DRAM).
+    pub memory: u64,
+    /// Waiting for a pipeline result (latency).
+    pub pipeline_latency: u64,
+    /// Waiting for a free pipeline (contention with the TM's other threads).
+    pub pipeline_busy: u64,
+    /// Waiting for the shared reciprocal unit's result or a free slot on it.
+    pub fpinv: u64,
+    /// An L1 bank already used this cycle (bank conflict).
+    pub l1_bank: u64,
+    /// Waiting for the global atomic unit (pixel hand-out).
+    pub atomic: u64,
+    /// Finished early while other threads still ran.
+    pub idle: u64,
+}
+
+/// Counters of the cache hierarchy.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CacheStats {
+    /// L1 accesses (one per load word).
+    pub l1_accesses: u64,
+    /// L1 hits on a line already filled.
+    pub l1_hits: u64,
+    /// L1 misses merged into a fill already in flight (no L2 access).
+    pub l1_merged: u64,
+    /// L2 accesses (L1 misses that were not merged).
+    pub l2_accesses: u64,
+    /// L2 hits on a line already filled.
+    pub l2_hits: u64,
+    /// L2 misses merged into a DRAM read already in flight.
+    pub l2_merged: u64,
+    /// Cycles L2 requests waited for a busy L2 bank.
+    pub l2_bank_wait: u64,
+}
+
+/// Pipeline and shared-unit operation counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct UnitStats {
+    /// Ray-box pipeline ops.
+    pub box_ops: u64,
+    /// Ray-triangle pipeline ops.
+    pub tri_ops: u64,
+    /// Dual-split pipeline ops.
+    pub dst_ops: u64,
+    /// Reciprocal-unit ops.
+    pub fpinv_ops: u64,
+}
+
+struct Tm {
+    l1: Cache,
+    l1_banks: Vec<Slots>,
+    box_pipes: Vec<Slots>,
+    tri_pipes: Vec<Slots>,
+    dst_pipes: Vec<Slots>,
+    fpinv: Vec<Slots>,
+}
+
+/// The chip's shared state: TMs, L2, DRAM, and the global atomic unit.
+pub struct Chip {
+    cfg: SimConfig,
+    /// `l1.banks - 1`, `l2.banks - 1` (power-of-two bank counts) and log2(words per line).
+    l1_bank_mask: u64,
+    l2_bank_mask: u64,
+    line_word_shift: u32,
+    tms: Vec<Tm>,
+    l2: Cache,
+    l2_banks: Vec<Slots>,
+    /// The DRAM.
+    pub dram: Dram,
+    atomic_free: Cycle,
+    /// Cache counters.
+    pub caches: CacheStats,
+    /// Unit counters.
+    pub units: UnitStats,
+    /// Stall counters.
+    pub stalls: Stalls,
+}
+
+/// Which resource a thread's pending result comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Cause {
+    Memory,
+    Pipeline,
+    Fpinv,
+    Atomic,
+}
+
+impl Chip {
+    /// A cold chip; `box_pipes` ray-box pipelines per TM (the "+" configurations use the
+    /// node arity).
+    pub fn new(cfg: &SimConfig, box_pipes: u32) -> Self {
+        let tm = || Tm {
+            l1: Cache::new(cfg.l1.size_bytes, cfg.l1.line_bytes, cfg.l1.associativity),
+            l1_banks: vec![Slots::default(); cfg.l1.banks as usize],
+            box_pipes: vec![Slots::default(); box_pipes.max(1) as usize],
+            tri_pipes: vec![Slots::default(); cfg.units.tri_pipes as usize],
+            dst_pipes: vec![Slots::default(); cfg.units.dst_pipes as usize],
+            fpinv: vec![Slots::default(); cfg.units.fpinv_units as usize],
+        };
+        Self {
+            cfg: cfg.clone(),
+            l1_bank_mask: cfg.l1.banks as u64 - 1,
+            l2_bank_mask: cfg.l2.banks as u64 - 1,
+            line_word_shift: (cfg.l1.line_bytes / 4).trailing_zeros(),
+            tms: (0..cfg.tms).map(|_| tm()).collect(),
+            l2: Cache::new(cfg.l2.size_bytes, cfg.l2.line_bytes, cfg.l2.associativity),
+            l2_banks: vec![Slots::default(); cfg.l2.banks as usize],
+            dram: Dram::new(&cfg.dram),
+            atomic_free: 0,
+            caches: CacheStats::default(),
+            units: UnitStats::default(),
+            stalls: Stalls::default(),
+        }
+    }
+
+    /// One word load by TM `tm` whose L1 bank slot is `slot` (already reserved): returns the
+    /// cycle the data is in the register.
+    #[cfg(test)]
+    fn load_word(&mut self, tm: usize, word: u64, slot: Cycle) -> Cycle {
+        self.load_word_fill(tm, word, slot).0
+    }
+
+    /// As [`Chip::load_word`], also returning the fill cycle now in the line's L1 tag.
+    fn load_word_fill(&mut self, tm: usize, word: u64, slot: Cycle) -> (Cycle, Cycle) {
+        let line = word >> self.line_word_shift;
+        let l1_lat = self.cfg.l1.hit_latency;
+        self.caches.l1_accesses += 1;
+        match self.tms[tm].l1.lookup(line) {
+            Lookup::Present { fill } if fill <= slot => {
+                self.caches.l1_hits += 1;
+                (slot + l1_lat, fill)
+            }
+            Lookup::Present { fill } => {
+                self.caches.l1_merged += 1;
+                (fill.max(slot + l1_lat), fill)
+            }
+            Lookup::Absent => {
+                let b = (word & self.l2_bank_mask) as usize;
+                let s2 = self.l2_banks[b].reserve(slot);
+                self.caches.l2_bank_wait += s2 - slot;
+                self.caches.l2_accesses += 1;
+                let at = s2 + l1_lat + self.cfg.l2.hit_latency;
+                let ready = match self.l2.lookup(line) {
+                    Lookup::Present { fill } if fill <= s2 => {
+                        self.caches.l2_hits += 1;
+                        at
+                    }
+                    Lookup::Present { fill } => {
+                        self.caches.l2_merged += 1;
+                        fill.max(at)
+                    }
+                    Lookup::Absent => {
+                        let (done, _) = self.dram.read(line, at);
+                        self.l2.install(line, done);
+                        done
+                    }
+                };
+                self.tms[tm].l1.install(line, ready);
+                (ready, ready)
+            }
+        }
+    }
+}
+
+/// A thread's program and position in it.
+#[derive(Clone, Debug)]
+pub struct Thread {
+    tm: usize,
+    /// The cycle of its next issue slot.
+    pub t: Cycle,
+    ready: Cycle,
+    cause: Cause,
+    /// The macro-ops of its current work item.
+    pub ops: Vec<Op>,
+    pc: usize,
+}
+
+impl Thread {
+    /// An idle thread on TM `tm`.
+    pub fn new(tm: usize) -> Self {
+        Self {
+            tm,
+            t: 0,
+            ready: 0,
+            cause: Cause::Memory,
+            ops: Vec::new(),
+            pc: 0,
+        }
+    }
+
+    /// True when every op of the current program has issued.
+    pub fn program_done(&self) -> bool {
+        self.pc >= self.ops.len()
+    }
+
+    /// Cycle when every outstanding result has arrived.
+    pub fn results_ready(&self) -> Cycle {
+        self.ready.max(self.t)
+    }
+
+    /// Replaces the program (the previous one must be done).
+    pub fn load_program(&mut self, ops: Vec<Op>) {
+        self.ops = ops;
+        self.pc = 0;
+    }
+
+    fn wait(&mut self, until: Cycle, stalls: &mut Stalls) {
+        if until > self.t {
+            let d = until - self.t;
+            match self.cause {
+                Cause::Memory => stalls.memory += d,
+                Cause::Pipeline => stalls.pipeline_latency += d,
+                Cause::Fpinv => stalls.fpinv += d,
+                Cause::Atomic => stalls.atomic += d,
+            }
+            self.t = until;
+        }
+    }
+
+    fn result(&mut self, at: Cycle, cause: Cause) {
+        if at > self.ready {
+            self.ready = at;
+            self.cause = cause;
+        }
+    }
+
+    /// Takes a pixel from the global atomic counter: one issue slot, the value returns after
+    /// the atomic latency (it is needed before the pixel's first ray).
+    pub fn atomic(&mut self, chip: &mut Chip) {
+        let s = self.t.max(chip.atomic_free);
+        chip.stalls.atomic += s - self.t;
+        chip.atomic_free = s + 1;
+        self.t = s + 1;
+        self.result(s + chip.cfg.units.atomic_latency, Cause::Atomic);
+    }
+
+    /// Runs ops while they can start at or before `now`; returns false when the program is
+    /// finished. The thread's next event is then at `self.t`.
+    pub fn run(&mut self, chip: &mut Chip, now: Cycle) -> bool {
+        while self.pc < self.ops.len() {
+            if self.t > now {
+                return true;
+            }
+            let op = self.ops[self.pc];
+            if !matches!(op, Op::Load { .. }) && self.ready > self.t {
+                if self.ready > now {
+                    // Sleep until the operands are there.
+                    let r = self.ready;
+                    self.wait(r, &mut chip.stalls);
+                    return true;
+                }
+                let r = self.ready;
+                self.wait(r, &mut chip.stalls);
+            }
+            self.pc += 1;
+            self.execute(op, chip);
+        }
+        false
+    }
+
+    fn execute(&mut self, op: Op, chip: &mut Chip) {
+        let tm = self.tm;
+        match op {
+            Op::Issue { n, fpinv } => {
+                let mut c = self.t;
+                for _ in 0..fpinv {
+                    let s = earliest(&mut chip.tms[tm].fpinv, c);
+                    chip.stalls.fpinv += s - c;
+                    chip.units.fpinv_ops += 1;
+                    let lat = chip.cfg.units.fpinv_latency;
+                    self.result(s + lat, Cause::Fpinv);
+                    c = s + 1;
+                }
+                self.t = c + (n - fpinv) as Cycle;
+            }
+            Op::Load { addr, words } => {
+                let mut c = self.t;
+                let bank_mask = chip.l1_bank_mask;
+                let first = addr / 4;
+                let shift = chip.line_word_shift;
+                let l1_lat = chip.cfg.l1.hit_latency;
+                // The line of the previous word and the cycle its data is there: a later
+                // word of the same line sees exactly what a second tag lookup would.
+                let mut prev: Option<(u64, Cycle)> = None;
+                for w in first..first + words as u64 {
+                    let b = (w & bank_mask) as usize;
+                    let slot = chip.tms[tm].l1_banks[b].reserve(c);
+                    chip.stalls.l1_bank += slot - c;
+                    let line = w >> shift;
+                    let (r, fill) = match prev {
+                        Some((l, fill)) if l == line => {
+                            chip.caches.l1_accesses += 1;
+                            if fill <= slot {
+                                chip.caches.l1_hits += 1;
+                            } else {
+                                chip.caches.l1_merged += 1;
+                            }
+                            (fill.max(slot + l1_lat), fill)
+                        }
+                        _ => chip.load_word_fill(tm, w, slot),
+                    };
+                    prev = Some((line, fill));
+                    self.result(r, Cause::Memory);
+                    c = slot + 1;
+                }
+                self.t = c;
+            }
+            Op::Pipe { pipe, n, parallel } => {
+                let (pipes, lat) = match pipe {
+                    Pipe::Box => {
+                        chip.units.box_ops += n as u64;
+                        (&mut chip.tms[tm].box_pipes, chip.cfg.units.box_latency)
+                    }
+                    Pipe::Triangle => {
+                        chip.units.tri_ops += n as u64;
+                        (&mut chip.tms[tm].tri_pipes, chip.cfg.units.tri_latency)
+                    }
+                    Pipe::DualSplit => {
+                        chip.units.dst_ops += n as u64;
+                        (&mut chip.tms[tm].dst_pipes, chip.cfg.units.dst_latency)
+                    }
+                };
+                let mut c = self.t;
+                let mut last = c;
+                if parallel && pipes.len() >= n as usize {
+                    // All n ops start together on n pipes, in one issue slot: the first
+                    // cycle from `c` at which n pipes are free.
+                    let mut s = c;
+                    loop {
+                        let free = pipes.iter().filter(|p| p.peek(s) == s).count();
+                        if free >= n as usize {
+                            break;
+                        }
+                        s += 1;
+                    }
+                    chip.stalls.pipeline_busy += s - c;
+                    let mut taken = 0;
+                    for p in pipes.iter_mut() {
+                        if taken < n && p.peek(s) == s {
+                            p.reserve(s);
+                            taken += 1;
+                        }
+                    }
+                    last = s;
+                    c = s + 1;
+                } else {
+                    for _ in 0..n {
+                        let s = earliest(pipes, c);
+                        chip.stalls.pipeline_busy += s - c;
+                        last = s;
+                        c = s + 1;
+                    }
+                }
+                self.t = c;
+                self.result(last + lat, Cause::Pipeline);
+            }
+        }
+    }
+}
+
+/// Reserves the earliest free cycle at or after `c` on any of `units`.
+#[inline]
+fn earliest(units: &mut [Slots], c: Cycle) -> Cycle {
+    if let [only] = units {
+        return only.reserve(c);
+    }
+    let mut best = 0;
+    let mut best_s = Cycle::MAX;
+    for (i, u) in units.iter().enumerate() {
+        let s = u.peek(c);
+        if s < best_s {
+            best = i;
+            best_s = s;
+            if s == c {
+                break;
+            }
+        }
+    }
+    units[best].reserve(c)
+}
+
+/// Supplies threads with work: called when a thread's program is done; returns the next
+/// program or `None` when there is no work left.
+pub trait WorkSource {
+    /// The next program for a thread (after its atomic increment).
+    fn next(&mut self, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>>;
+}
+
+/// A timing wheel of thread wake-ups (notes §5.2): one bucket per cycle for the next
+/// `WHEEL` cycles, an overflow heap beyond. Within a cycle, threads run in the order they
+/// were scheduled (deterministic).
+struct Wheel {
+    buckets: Vec<Vec<u32>>,
+    now: Cycle,
+    in_wheel: usize,
+    overflow: BinaryHeap<Reverse<(Cycle, u32)>>,
+}
+
+const WHEEL: u64 = 4096;
+
+impl Wheel {
+    fn new() -> Self {
+        Self {
+            buckets: vec![Vec::new(); WHEEL as usize],
+            now: 0,
+            in_wheel: 0,
+            overflow: BinaryHeap::new(),
+        }
+    }
+
+    fn push(&mut self, t: Cycle, id: u32) {
+        debug_assert!(t >= self.now);
+        if t - self.now < WHEEL {
+            self.buckets[(t % WHEEL) as usize].push(id);
+            self.in_wheel += 1;
+        } else {
+            self.overflow.push(Reverse((t, id)));
+        }
+    }
+
+    /// Takes the bucket of the next cycle with events: (cycle, thread ids in order).
+    fn next_bucket(&mut self, spare: Vec<u32>) -> Option<(Cycle, Vec<u32>)> {
+        if self.in_wheel == 0 {
+            let &Reverse((t, _)) = self.overflow.peek()?;
+            self.now = t;
+        }
+        loop {
+            while let Some(&Reverse((t, id))) = self.overflow.peek() {
+                if t - self.now < WHEEL {
+                    self.overflow.pop();
+                    self.buckets[(t % WHEEL) as usize].push(id);
+                    self.in_wheel += 1;
+                } else {
+                    break;
+                }
+            }
+            let b = (self.now % WHEEL) as usize;
+            if !self.buckets[b].is_empty() {
+                let ids = std::mem::replace(&mut self.buckets[b], spare);
+                self.in_wheel -= ids.len();
+                return Some((self.now, ids));
+            }
+            self.now += 1;
+        }
+    }
+}
+
+/// Runs every thread to completion; returns the cycle the last result arrived.
+pub fn run_chip(chip: &mut Chip, threads: &mut [Thread], work: &mut dyn WorkSource) -> Cycle {
+    let mut wheel = Wheel::new();
+    for i in 0..threads.len() as u32 {
+        wheel.push(0, i);
+    }
+    let mut finish = vec![0; threads.len()];
+    let mut spare = Vec::new();
+    while let Some((now, mut ids)) = wheel.next_bucket(spare) {
+        for &id in &ids {
+            let th = &mut threads[id as usize];
+            loop {
+                if th.run(chip, now) {
+                    wheel.push(th.t, id);
+                    break;
+                }
+                // Program finished: the thread takes more work or retires once results are in.
+                match work.next(th, chip) {
+                    Some(ops) => {
+                        th.load_program(ops);
+                        if th.t > now {
+                            wheel.push(th.t, id);
+                            break;
+                        }
+                    }
+                    None => {
+                        finish[id as usize] = th.results_ready();
+                        break;
+                    }
+                }
+            }
+        }
+        ids.clear();
+        spare = ids;
+    }
+    let end = finish.iter().copied().max().unwrap_or(0);
+    chip.stalls.idle = finish.iter().map(|&f| end - f).sum();
+    end
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::Op;
+
+    struct Programs(Vec<Vec<Op>>);
+    impl WorkSource for Programs {
+        fn next(&mut self, t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
+            // One program per thread.
+            if t.ops.is_empty() { self.0.pop() } else { None }
+        }
+    }
+
+    fn one_thread(cfg: &SimConfig, box_pipes: u32, prog: Vec<Op>) -> (Cycle, Chip) {
+        let mut chip = Chip::new(cfg, box_pipes);
+        let mut th = vec![Thread::new(0)];
+        let end = run_chip(&mut chip, &mut th, &mut Programs(vec![prog]));
+        (end, chip)
+    }
+
+    fn use_data() -> Op {
+        Op::Issue { n: 1, fpinv: 0 }
+    }
+
+    #[test]
+    fn l1_hit_takes_one_cycle() {
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        // Warm the line, then time a hit directly.
+        let fill = chip.load_word(0, 0, 0);
+        assert_eq!(chip.load_word(0, 1, fill), fill + 1);
+        assert_eq!(chip.caches.l1_hits, 1);
+    }
+
+    #[test]
+    fn cold_load_is_a_closed_row_read_and_reload_hits_l2() {
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        // L1 1 + L2 3 + closed row (tRCD 14 + tCAS 14 + burst 2) = 34.
+        assert_eq!(chip.load_word(0, 0, 100), 134);
+        // Another TM: L1 miss, L2 hit: 1 + 3.
+        assert_eq!(chip.load_word(1, 0, 200), 204);
+        // Same TM, another line in the same DRAM row: row hit, 1 + 3 + 14 + 2 = 20.
+        assert_eq!(chip.load_word(0, 16, 300), 320);
+        assert_eq!(chip.caches.l2_hits, 1);
+        assert_eq!(chip.dram.stats().row_hits, 1);
+    }
+
+    #[test]
+    fn row_conflict_load() {
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        chip.load_word(0, 0, 0);
+        // Same channel and bank, next row: 128 lines × 16 channels × 16 banks × 16 words.
+        let w = 128 * 16 * 16 * 16;
+        // 1 + 3 + tRP 14 + tRCD 14 + tCAS 14 + burst 2 = 48.
+        assert_eq!(chip.load_word(0, w, 1000), 1048);
+        assert_eq!(chip.dram.stats().row_conflicts, 1);
+    }
+
+    #[test]
+    fn miss_to_line_in_flight_merges() {
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        let r0 = chip.load_word(0, 0, 0);
+        let r1 = chip.load_word(0, 1, 1);
+        assert_eq!(r1, r0);
+        assert_eq!(chip.caches.l1_merged, 1);
+        assert_eq!(chip.caches.l2_accesses, 1);
+        assert_eq!(chip.dram.stats().reads, 1);
+    }
+
+    #[test]
+    fn thread_load_then_use_waits_for_data() {
+        let cfg = SimConfig::lin2020();
+        // Load at cycle 0 (cold: 34), use at 34, one issue: finish 35.
+        let (end, chip) = one_thread(&cfg, 1, vec![Op::Load { addr: 0, words: 1 }, use_data()]);
+        assert_eq!(end, 35);
+        assert_eq!(chip.stalls.memory, 33);
+    }
+
+    #[test]
+    fn bank_conflict_costs_one_cycle() {
+        let cfg = SimConfig::lin2020();
+        // Two threads on one TM load words 0 and 16 (both bank 0) at cycle 0: the second
+        // gets the bank at cycle 1.
+        let mut chip = Chip::new(&cfg, 1);
+        let mut th = vec![Thread::new(0), Thread::new(0)];
+        let progs = vec![
+            vec![Op::Load { addr: 64, words: 1 }],
+            vec![Op::Load { addr: 0, words: 1 }],
+        ];
+        run_chip(&mut chip, &mut th, &mut Programs(progs));
+        assert_eq!(chip.stalls.l1_bank, 1);
+        // A single 16-word line load spans all 16 banks without conflict.
+        let (_, chip) = one_thread(&cfg, 1, vec![Op::Load { addr: 0, words: 16 }]);
+        assert_eq!(chip.stalls.l1_bank, 0);
+    }
+
+    #[test]
+    fn one_pipeline_op_takes_its_latency() {
+        let cfg = SimConfig::lin2020();
+        let box_op = |n, parallel| Op::Pipe {
+            pipe: Pipe::Box,
+            n,
+            parallel,
+        };
+        // Issue at 0, result at 8, use at 8: end 9.
+        let (end, _) = one_thread(&cfg, 1, vec![box_op(1, false), use_data()]);
+        assert_eq!(end, 9);
+        // Four serial box tests: issue 0..3, last result 11, use: 12.
+        let (end, _) = one_thread(&cfg, 1, vec![box_op(4, false), use_data()]);
+        assert_eq!(end, 12);
+        // Four in parallel on four pipes: one issue, result 8, use: 9.
+        let (end, _) = one_thread(&cfg, 4, vec![box_op(4, true), use_data()]);
+        assert_eq!(end, 9);
+        let dst = Op::Pipe {
+            pipe: Pipe::DualSplit,
+            n: 1,
+            parallel: false,
+        };
+        let (end, chip) = one_thread(&cfg, 1, vec![dst, use_data()]);
+        assert_eq!(end, 9);
+        assert_eq!(chip.units.dst_ops, 1);
+    }
+
+    #[test]
+    fn two_threads_share_one_pipeline() {
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        let mut th = vec![Thread::new(0), Thread::new(0)];
+        let op = Op::Pipe {
+            pipe: Pipe::Box,
+            n: 1,
+            parallel: false,
+        };
+        let progs = vec![vec![op, use_data()], vec![op, use_data()]];
+        let end = run_chip(&mut chip, &mut th, &mut Programs(progs));
+        // The second thread gets the pipe at cycle 1: result 9, use ends at 10.
+        assert_eq!(end, 10);
+        assert_eq!(chip.stalls.pipeline_busy, 1);
+    }
+
+    #[test]
+    fn fpinv_is_shared_and_long() {
+        let cfg = SimConfig::lin2020();
+        // 3 reciprocals at 0, 1, 2 (pipelined unit), last result 18; 5 more issues 3..7;
+        // then use at 18: end 19.
+        let (end, _) = one_thread(&cfg, 1, vec![Op::Issue { n: 8, fpinv: 3 }, use_data()]);
+        assert_eq!(end, 19);
+    }
+}

@@ -1,0 +1,275 @@
+//! GDDR5 main memory: channels of banks with open rows, per-channel data bus, read queue
+//! (notes §1.8 and §3.3; SimTRaX's USIMM configuration `gddr5_8ch.cfg`).
+//!
+//! Address mapping (SimTRaX mapping 1), from the low bits up: line offset → column →
+//! channel → bank → row, so one row of one channel holds `row_bytes` contiguous bytes.
+//!
+//! Each read is reserved when it arrives (immediate response, Eyerman et al. 2021):
+//!
+//! * **row hit** (bank's open row): column command at the bank's next column slot;
+//! * **closed** (no open row): activate, then after t_RCD the column command;
+//! * **conflict** (another row open): precharge (≥ t_RAS after its activate, ≥ t_RTP after
+//!   its last read), activate after t_RP (≥ t_RC after the previous activate, ≥ t_RRD after
+//!   the channel's previous activate), column command after t_RCD;
+//!
+//! then the data leaves t_CAS later in the channel bus's first free burst slot (slots are
+//! t_burst long; a later-reserved row hit may fill a gap before an earlier conflict's data,
+//! approximating FR-FCFS on the bus).
+//! A full read queue delays the request until the oldest in-flight read of its channel
+//! completes (back-pressure). Bank state changes in arrival order (open page); the bank-level
+//! row-hit-first reordering of FR-FCFS is not modelled (see `docs/simulator.md`).
+
+use crate::Cycle;
+use crate::config::DramConfig;
+use crate::slots::Slots;
+use serde::{Deserialize, Serialize};
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// How a read found its bank.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DramAccess {
+    /// The row was open.
+    RowHit,
+    /// No row was open.
+    Closed,
+    /// Another row was open.
+    Conflict,
+}
+
+/// Counters of the DRAM.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DramStats {
+    /// 64-byte reads served.
+    pub reads: u64,
+    /// Row activations.
+    pub activations: u64,
+    /// Reads that hit the open row.
+    pub row_hits: u64,
+    /// Reads to a closed bank.
+    pub row_closed: u64,
+    /// Reads that had to close another row.
+    pub row_conflicts: u64,
+    /// Core cycles reads spent waiting for a read-queue entry (summed over reads).
+    pub queue_wait_cycles: u64,
+    /// Sum over reads of (completion − arrival) in core cycles.
+    pub latency_cycles: u64,
+    /// Core cycle of the last completion.
+    pub last_done: Cycle,
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct Bank {
+    open_row: Option<u64>,
+    /// Tick of the last activate.
+    act: u64,
+    /// Earliest tick of the next column command.
+    col_ready: u64,
+    /// Tick of the last column command (for t_RTP).
+    last_col: u64,
+}
+
+#[derive(Clone, Debug, Default)]
+struct Channel {
+    /// Data-bus reservations in units of one burst (t_burst ticks).
+    bus: Slots,
+    /// Activations, each holding t_RRD ticks (minimum spacing between activations).
+    acts: Slots,
+    inflight: BinaryHeap<Reverse<u64>>,
+}
+
+/// The DRAM system.
+#[derive(Clone, Debug)]
+pub struct Dram {
+    cfg: DramConfig,
+    banks: Vec<Bank>,
+    channels: Vec<Channel>,
+    col_bits: u32,
+    ch_bits: u32,
+    bank_bits: u32,
+    stats: DramStats,
+}
+
+impl Dram {
+    /// All banks closed, all buses idle.
+    pub fn new(cfg: &DramConfig) -> Self {
+        Self {
+            cfg: cfg.clone(),
+            banks: vec![Bank::default(); (cfg.channels * cfg.banks_per_channel) as usize],
+            channels: vec![Channel::default(); cfg.channels as usize],
+            col_bits: (cfg.row_bytes / 64).trailing_zeros(),
+            ch_bits: cfg.channels.trailing_zeros(),
+            bank_bits: cfg.banks_per_channel.trailing_zeros(),
+            stats: DramStats::default(),
+        }
+    }
+
+    /// (channel, bank, row) of a line number (byte address / 64).
+    pub fn map(&self, line: u64) -> (usize, usize, u64) {
+        let x = line >> self.col_bits;
+        let ch = (x & ((1 << self.ch_bits) - 1)) as usize;
+        let x = x >> self.ch_bits;
+        let bank = (x & ((1 << self.bank_bits) - 1)) as usize;
+        (ch, bank, x >> self.bank_bits)
+    }
+
+    /// Reads `line` arriving at core cycle `arrive`; returns the core cycle its data has
+    /// arrived and how the bank was found.
+    pub fn read(&mut self, line: u64, arrive: Cycle) -> (Cycle, DramAccess) {
+        let c = &self.cfg;
+        let tpc = c.ticks_per_cycle;
+        let (chi, bi, row) = self.map(line);
+        let ch = &mut self.channels[chi];
+        let mut a = arrive * tpc;
+        while let Some(&Reverse(d)) = ch.inflight.peek() {
+            if d <= a {
+                ch.inflight.pop();
+            } else {
+                break;
+            }
+        }
+        if ch.inflight.len() >= c.read_queue as usize {
+            let Reverse(d) = ch.inflight.pop().expect("queue is full");
+            self.stats.queue_wait_cycles += (d - a).div_ceil(tpc);
+            a = d;
+        }
+        let bank = &mut self.banks[chi * c.banks_per_channel as usize + bi];
+        let (col, kind) = match bank.open_row {
+            Some(r) if r == row => (a.max(bank.col_ready), DramAccess::RowHit),
+            open => {
+                let mut act = a;
+                let kind = if open.is_some() {
+                    let pre = a.max(bank.act + c.t_ras).max(bank.last_col + c.t_rtp);
+                    act = pre + c.t_rp;
+                    DramAccess::Conflict
+                } else {
+                    DramAccess::Closed
+                };
+                if open.is_some() || bank.act > 0 {
+                    act = act.max(bank.act + c.t_rc);
+                }
+                act = ch.acts.reserve_span(act, c.t_rrd.max(1));
+                bank.act = act;
+                bank.open_row = Some(row);
+                self.stats.activations += 1;
+                ((act + c.t_rcd).max(bank.col_ready), kind)
+            }
+        };
+        bank.col_ready = col + c.t_ccd;
+        bank.last_col = col;
+        // The data bus takes the first free burst slot once the data is ready; a read whose
+        // row is open can use a slot before a conflicting read reserved earlier, which is
+        // the effect of FR-FCFS on the bus.
+        let data = ch.bus.reserve((col + c.t_cas).div_ceil(c.t_burst)) * c.t_burst;
+        let done = data + c.t_burst;
+        ch.inflight.push(Reverse(done));
+        let done_cycle = done.div_ceil(tpc);
+        let s = &mut self.stats;
+        s.reads += 1;
+        match kind {
+            DramAccess::RowHit => s.row_hits += 1,
+            DramAccess::Closed => s.row_closed += 1,
+            DramAccess::Conflict => s.row_conflicts += 1,
+        }
+        s.latency_cycles += done_cycle - arrive;
+        s.last_done = s.last_done.max(done_cycle);
+        (done_cycle, kind)
+    }
+
+    /// Counters so far.
+    pub fn stats(&self) -> DramStats {
+        self.stats
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::SimConfig;
+
+    fn dram() -> Dram {
+        Dram::new(&SimConfig::lin2020().dram)
+    }
+
+    #[test]
+    fn closed_then_hit_then_conflict_exact_latencies() {
+        let mut d = dram();
+        // Closed: tRCD 14 + tCAS 14 + burst 2 = 30 core cycles.
+        assert_eq!(d.read(0, 1000), (1030, DramAccess::Closed));
+        // Row hit on the same row (line 1 is column 1 of row 0): tCAS 14 + burst 2.
+        assert_eq!(d.read(1, 2000), (2016, DramAccess::RowHit));
+        // Conflict: same channel and bank, next row. Lines per row 128, channels 16, banks 16.
+        let other_row = 128 * 16 * 16;
+        assert_eq!(d.map(other_row), (0, 0, 1));
+        // tRP 14 + tRCD 14 + tCAS 14 + burst 2 = 44.
+        assert_eq!(d.read(other_row, 3000), (3044, DramAccess::Conflict));
+        let s = d.stats();
+        assert_eq!((s.reads, s.activations, s.row_hits), (3, 2, 1));
+    }
+
+    #[test]
+    fn conflict_waits_for_t_ras() {
+        let mut d = dram();
+        assert_eq!(d.read(0, 0).0, 30);
+        // Immediately conflicting: precharge may not start before act + tRAS (35 ns).
+        // act at 0, pre at 35 ns, act at 49 ns (= tRC too), data at 49 + 14 + 14 = 77 ns,
+        // rounded up to the 2 ns burst slot grid (78), + burst 2 = 80.
+        assert_eq!(d.read(128 * 16 * 16, 0), (80, DramAccess::Conflict));
+    }
+
+    #[test]
+    fn mapping_is_column_channel_bank_row() {
+        let d = dram();
+        assert_eq!(d.map(127), (0, 0, 0));
+        assert_eq!(d.map(128), (1, 0, 0));
+        assert_eq!(d.map(128 * 16), (0, 1, 0));
+    }
+
+    #[test]
+    fn one_channel_streams_at_one_line_per_burst() {
+        let mut d = dram();
+        // 100 row-hit reads of one row arriving together: the bus serialises them.
+        let dones: Vec<_> = (0..100).map(|i| d.read(i % 128, 0).0).collect();
+        for w in dones.windows(2) {
+            assert_eq!(w[1] - w[0], 2, "one 64-B line per 2 ns per channel");
+        }
+    }
+
+    #[test]
+    fn saturates_at_peak_bandwidth_and_no_faster() {
+        let cfg = SimConfig::lin2020();
+        let mut d = Dram::new(&cfg.dram);
+        // 64 K lines, all requested at cycle 0, spread over every channel and bank.
+        let n = 65_536u64;
+        let last = (0..n).map(|l| d.read(l, 0).0).max().unwrap();
+        let bytes_per_cycle = (n * 64) as f64 / last as f64;
+        let peak = cfg.dram_peak_bytes_per_cycle();
+        assert_eq!(peak, 512.0);
+        assert!(
+            bytes_per_cycle <= peak,
+            "{bytes_per_cycle} above peak {peak}"
+        );
+        assert!(
+            bytes_per_cycle > 0.97 * peak,
+            "{bytes_per_cycle} well below peak"
+        );
+    }
+
+    #[test]
+    fn full_read_queue_back_pressures() {
+        let mut cfg = SimConfig::lin2020().dram;
+        cfg.read_queue = 2;
+        let mut d = Dram::new(&cfg);
+        d.read(0, 0);
+        d.read(1, 0);
+        d.read(2, 0);
+        assert!(d.stats().queue_wait_cycles > 0);
+        let mut cfg = SimConfig::lin2020().dram;
+        cfg.read_queue = 64;
+        let mut d = Dram::new(&cfg);
+        (0..3).for_each(|l| {
+            d.read(l, 0);
+        });
+        assert_eq!(d.stats().queue_wait_cycles, 0);
+    }
+}

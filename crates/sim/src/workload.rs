@@ -1,0 +1,149 @@
+//! The workload: threads take pixels from a global atomic counter in scanline order and run
+//! each pixel's [`PixelJob`] through the real traversal with a [`Recorder`] (Lin et al.
+//! 2020, §4.3–4.4; notes §5.2).
+
+use crate::engine::{Chip, Thread, WorkSource, run_chip};
+use crate::kernel::{Mix, Op, Recorder};
+use crate::{SimAccel, SimConfig, SimResult, energy};
+use dualsplit_accel::Structures;
+use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult};
+use dualsplit_scene::Scene;
+
+/// After an any-hit (shadow) ray: branch on the answer, add the light's contribution.
+const SHADOW_FINISH: Mix = Mix {
+    int: 3,
+    fpadd: 1,
+    fpmul: 1,
+    fpcmp: 0,
+    fpinv: 0,
+    local: 0,
+};
+
+struct Pixels<'a> {
+    scene: &'a Scene,
+    structures: &'a Structures,
+    accel: SimAccel,
+    settings: &'a RenderSettings,
+    next: u64,
+    total: u64,
+    rays: u64,
+    counts: crate::InstrCounts,
+    radiance: Vec<f32>,
+    progress: &'a (dyn Fn(u64, u64) + Sync),
+    spare: Vec<Vec<Op>>,
+}
+
+impl Pixels<'_> {
+    fn trace_pixel(&mut self, px: u64, ops: &mut Vec<Op>) {
+        let w = self.settings.width as u64;
+        let (x, y) = ((px % w) as u32, (px / w) as u32);
+        let kind = self.accel.kind();
+        let mut rec = Recorder::new(self.accel, ops);
+        rec.atomic();
+        let mut job = PixelJob::new(self.scene, self.settings, x, y);
+        while let Some(q) = job.next_ray() {
+            self.rays += 1;
+            rec.issue(crate::kernel::RAY_SETUP);
+            let result = match q.kind {
+                RayKind::Shadow => {
+                    let occ = self.structures.any_hit(kind, &q.ray, &mut rec);
+                    rec.issue(SHADOW_FINISH);
+                    TraceResult::Occluded(occ)
+                }
+                RayKind::Primary | RayKind::Diffuse => {
+                    let hit = self.structures.closest_hit(kind, &q.ray, &mut rec);
+                    rec.issue(crate::kernel::RAY_FINISH);
+                    TraceResult::Closest(hit)
+                }
+            };
+            job.submit(result);
+        }
+        self.counts.add(&rec.counts);
+        self.radiance[px as usize] = job.radiance();
+    }
+}
+
+impl WorkSource for Pixels<'_> {
+    fn next(&mut self, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>> {
+        let old = std::mem::take(&mut thread.ops);
+        if old.capacity() > 0 {
+            self.spare.push(old);
+        }
+        if self.next >= self.total {
+            return None;
+        }
+        thread.atomic(chip);
+        let px = self.next;
+        self.next += 1;
+        let mut ops = self.spare.pop().unwrap_or_default();
+        ops.clear();
+        self.trace_pixel(px, &mut ops);
+        if self.next.is_multiple_of(1024) || self.next == self.total {
+            (self.progress)(self.next, self.total);
+        }
+        Some(ops)
+    }
+}
+
+pub(crate) fn run(
+    scene: &Scene,
+    structures: &Structures,
+    accel: SimAccel,
+    settings: &RenderSettings,
+    cfg: &SimConfig,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> SimResult {
+    let total = settings.width as u64 * settings.height as u64;
+    let mut chip = Chip::new(cfg, accel.box_pipes(cfg));
+    let mut threads: Vec<Thread> = (0..cfg.tms * cfg.tps_per_tm)
+        .map(|i| Thread::new((i / cfg.tps_per_tm) as usize))
+        .collect();
+    let mut work = Pixels {
+        scene,
+        structures,
+        accel,
+        settings,
+        next: 0,
+        total,
+        rays: 0,
+        counts: Default::default(),
+        radiance: vec![0.0; total as usize],
+        progress,
+        spare: Vec::new(),
+    };
+    let cycles = run_chip(&mut chip, &mut threads, &mut work);
+    let dram = chip.dram.stats();
+    let c = &chip.caches;
+    let ratio = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
+    let frame_ms = cycles as f64 / (cfg.clock_ghz * 1e6);
+    let counts = work.counts;
+    let cyc_units = cycles.max(1) as f64 * cfg.tms as f64;
+    let utilisation = crate::Utilisation {
+        box_pipe: chip.units.box_ops as f64 / (cyc_units * accel.box_pipes(cfg) as f64),
+        tri_pipe: chip.units.tri_ops as f64 / (cyc_units * cfg.units.tri_pipes as f64),
+        dst_pipe: chip.units.dst_ops as f64 / (cyc_units * cfg.units.dst_pipes as f64),
+        issue: counts.total() as f64 / (cyc_units * cfg.tps_per_tm as f64),
+    };
+    SimResult {
+        accel: Some(accel),
+        tms: cfg.tms,
+        threads: cfg.tms * cfg.tps_per_tm,
+        cycles,
+        frame_ms,
+        energy: energy::split(cfg, &counts, &chip.caches, &dram, frame_ms),
+        dram_lines: dram.reads,
+        dram_activations: dram.activations,
+        row_hit_rate: ratio(dram.row_hits, dram.reads),
+        l1_hit_rate: ratio(c.l1_hits, c.l1_accesses),
+        l2_hit_rate: ratio(c.l2_hits, c.l2_accesses),
+        rays: work.rays,
+        pixels: total,
+        instructions: counts,
+        caches: chip.caches,
+        dram,
+        units: chip.units,
+        utilisation,
+        stalls: chip.stalls,
+        radiance: work.radiance,
+    }
+}
