@@ -43,6 +43,12 @@ pub struct CacheConfig {
     pub associativity: u32,
     /// Hit latency in core cycles (for L2: on top of the L1 latency).
     pub hit_latency: u64,
+    /// L2 only: bank = line address mod banks instead of word address mod banks (SimTRaX
+    /// interleaves by word, notes §1.4, so `false` in lin2020; `true` is the line-interleaved
+    /// organisation of a line-granular shared cache, a sensitivity option). The L1 is always
+    /// word-interleaved.
+    #[serde(default)]
+    pub line_interleaved: bool,
 }
 
 /// GDDR5 main memory; timings in DRAM clock ticks (`ticks_per_cycle` per core cycle).
@@ -198,6 +204,7 @@ impl SimConfig {
                 banks: 16,
                 associativity: 1,
                 hit_latency: 1,
+                line_interleaved: false,
             },
             l2: CacheConfig {
                 size_bytes: 4 * 1024 * 1024,
@@ -205,6 +212,7 @@ impl SimConfig {
                 banks: 128,
                 associativity: 1,
                 hit_latency: 3,
+                line_interleaved: false,
             },
             dram: DramConfig {
                 channels: 16,

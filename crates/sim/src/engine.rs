@@ -158,7 +158,12 @@ impl Chip {
                 (fill.max(slot + l1_lat), fill)
             }
             Lookup::Absent => {
-                let b = (word & self.l2_bank_mask) as usize;
+                let bank_addr = if self.cfg.l2.line_interleaved {
+                    line
+                } else {
+                    word
+                };
+                let b = (bank_addr & self.l2_bank_mask) as usize;
                 let s2 = self.l2_banks[b].reserve(slot);
                 self.caches.l2_bank_wait += s2 - slot;
                 self.caches.l2_accesses += 1;
@@ -299,33 +304,40 @@ impl Thread {
             Op::Load { addr, words } => {
                 let mut c = self.t;
                 let bank_mask = chip.l1_bank_mask;
-                let first = addr / 4;
                 let shift = chip.line_word_shift;
                 let l1_lat = chip.cfg.l1.hit_latency;
-                // The line of the previous word and the cycle its data is there: a later
-                // word of the same line sees exactly what a second tag lookup would.
-                let mut prev: Option<(u64, Cycle)> = None;
-                for w in first..first + words as u64 {
-                    let b = (w & bank_mask) as usize;
-                    let slot = chip.tms[tm].l1_banks[b].reserve(c);
-                    chip.stalls.l1_bank += slot - c;
-                    let line = w >> shift;
-                    let (r, fill) = match prev {
-                        Some((l, fill)) if l == line => {
-                            chip.caches.l1_accesses += 1;
-                            if fill <= slot {
-                                chip.caches.l1_hits += 1;
-                            } else {
-                                chip.caches.l1_merged += 1;
-                            }
-                            (fill.max(slot + l1_lat), fill)
-                        }
-                        _ => chip.load_word_fill(tm, w, slot),
-                    };
-                    prev = Some((line, fill));
-                    self.result(r, Cause::Memory);
+                let mut w = addr / 4;
+                let end = w + words as u64;
+                let mut bank_stall = 0;
+                // Line by line: the first word looks the line up (L1 tags, then L2/DRAM on a
+                // miss); later words of the same line see exactly what a second tag lookup
+                // would (hit once the fill has arrived, merged before). Every word takes its
+                // own L1 bank slot, one issue slot after the previous word's.
+                while w < end {
+                    let seg_end = (((w >> shift) + 1) << shift).min(end);
+                    let slot = chip.tms[tm].l1_banks[(w & bank_mask) as usize].reserve(c);
+                    bank_stall += slot - c;
+                    let (mut r, fill) = chip.load_word_fill(tm, w, slot);
                     c = slot + 1;
+                    if seg_end > w + 1 {
+                        let banks = &mut chip.tms[tm].l1_banks;
+                        let mut hits = 0;
+                        for v in w + 1..seg_end {
+                            let slot = banks[(v & bank_mask) as usize].reserve(c);
+                            bank_stall += slot - c;
+                            hits += u64::from(fill <= slot);
+                            c = slot + 1;
+                        }
+                        let rest = seg_end - w - 1;
+                        chip.caches.l1_accesses += rest;
+                        chip.caches.l1_hits += hits;
+                        chip.caches.l1_merged += rest - hits;
+                        r = r.max(fill.max(c - 1 + l1_lat));
+                    }
+                    self.result(r, Cause::Memory);
+                    w = seg_end;
                 }
+                chip.stalls.l1_bank += bank_stall;
                 self.t = c;
             }
             Op::Pipe { pipe, n, parallel } => {
@@ -566,6 +578,24 @@ mod tests {
         // 1 + 3 + tRP 14 + tRCD 14 + tCAS 14 + burst 2 = 48.
         assert_eq!(chip.load_word(0, w, 1000), 1048);
         assert_eq!(chip.dram.stats().row_conflicts, 1);
+    }
+
+    #[test]
+    fn l2_banks_interleave_by_word_or_by_line() {
+        // Words 0 and 128 (lines 0 and 8) missing in two TMs in the same cycle: word
+        // interleaving (SimTRaX) puts both on L2 bank 0, so the second waits one cycle; line
+        // interleaving puts them on banks 0 and 8.
+        let mut cfg = SimConfig::lin2020();
+        for (by_line, wait) in [(false, 1), (true, 0)] {
+            cfg.l2.line_interleaved = by_line;
+            let mut chip = Chip::new(&cfg, 1);
+            chip.load_word(0, 0, 10);
+            chip.load_word(1, 128, 10);
+            assert_eq!(
+                chip.caches.l2_bank_wait, wait,
+                "line_interleaved = {by_line}"
+            );
+        }
     }
 
     #[test]

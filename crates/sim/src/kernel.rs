@@ -102,8 +102,10 @@ pub fn dst_sw_step(kind: DstNodeKind, code: u8) -> Mix {
         // corner type decides which side of each plane (2 cmp + 4 int), interval update 2,
         // empty test 1 cmp + branch, offset 2.
         DstNodeKind::DualCarve => Mix::new(16, 2, 2, 5, 0, 0),
-        // Leaf word: header decode 5, triangle count and offset 3.
-        DstNodeKind::Leaf => Mix::new(8, 0, 0, 0, 0, 0),
+        // Leaf word: header decode 5 (shift, mask, type test, branch, offset mask). The
+        // triangle run's set-up is the leaf entry that follows (`LEAF`, reported by the
+        // traversal as `NodeStep::Leaf`), so it is not counted twice here.
+        DstNodeKind::Leaf => Mix::new(5, 0, 0, 0, 0, 0),
     }
     .with_code(code)
 }

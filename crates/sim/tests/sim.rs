@@ -1,9 +1,10 @@
 //! End-to-end tests of the simulator on small scenes and the tiny chip.
 
-use dualsplit_accel::{NoObserver, Structures};
+use dualsplit_accel::{DstNodeKind, NoObserver, NodeStep, Observer, Structures};
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::Scene;
+use dualsplit_sim::kernel::{DST_HW_STEP, dst_sw_step};
 use dualsplit_sim::{SimAccel, SimConfig, SimResult, simulate};
 
 fn config(name: &str) -> String {
@@ -152,6 +153,92 @@ fn simulated_pixels_equal_the_renderers() {
                 }
             }
             assert_eq!(rays, r.rays);
+        }
+    }
+}
+
+/// DST (dual-split pipeline) and DST* (software decoder) run the real DST traversals over
+/// the DST memory image: their pixels equal the renderer's, both see the same memory stream
+/// and triangle tests, DST issues one dual-split op per DST node step (leaf words included)
+/// and DST* none, paying the decoder's instructions instead.
+#[test]
+fn dst_and_dst_sw_pixels_equal_the_renderers_and_use_their_units() {
+    let (scene, s) = scene();
+    let cfg = tiny();
+    for wl in [Workload::Cast, Workload::Path] {
+        let settings = RenderSettings::new(24, 16, wl);
+        let hw = simulate(&scene, &s, SimAccel::Dst, &settings, &cfg, &|_, _| {}).unwrap();
+        let sw = simulate(&scene, &s, SimAccel::DstSw, &settings, &cfg, &|_, _| {}).unwrap();
+        // Count the DST steps, fetches and triangle tests of the renderer's own rays.
+        let mut counter = DstSteps::default();
+        for y in 0..16 {
+            for x in 0..24 {
+                let mut job = PixelJob::new(&scene, &settings, x, y);
+                while let Some(q) = job.next_ray() {
+                    let res = match q.kind {
+                        RayKind::Shadow => TraceResult::Occluded(s.any_hit(
+                            SimAccel::Dst.kind(),
+                            &q.ray,
+                            &mut counter,
+                        )),
+                        _ => TraceResult::Closest(s.closest_hit(
+                            SimAccel::Dst.kind(),
+                            &q.ray,
+                            &mut counter,
+                        )),
+                    };
+                    job.submit(res);
+                }
+                let i = (y * 24 + x) as usize;
+                let want = job.radiance().to_bits();
+                assert_eq!(
+                    hw.radiance[i].to_bits(),
+                    want,
+                    "DST pixel ({x}, {y}) {wl:?}"
+                );
+                assert_eq!(
+                    sw.radiance[i].to_bits(),
+                    want,
+                    "DST* pixel ({x}, {y}) {wl:?}"
+                );
+            }
+        }
+        assert!(counter.nodes > 0, "the DST traversal ran: {counter:?}");
+        assert_eq!(hw.units.dst_ops, counter.steps);
+        assert_eq!(hw.instructions.node_steps, counter.nodes);
+        assert_eq!(sw.instructions.node_steps, counter.nodes);
+        // DST* pays the decoder per node kind where DST pays the pipeline op's bookkeeping.
+        assert_eq!(
+            sw.instructions.mix.total() as u64 + counter.steps * DST_HW_STEP.total() as u64,
+            hw.instructions.mix.total() as u64 + counter.sw_decode
+        );
+        assert_eq!(hw.units.box_ops, 0);
+        assert_eq!(sw.units.dst_ops, 0);
+        assert_eq!(sw.units.box_ops, 0);
+        assert_eq!(hw.instructions.loads, sw.instructions.loads);
+        assert_eq!(hw.units.tri_ops, sw.units.tri_ops);
+        assert_eq!(hw.dram_lines, sw.dram_lines);
+        assert!(
+            sw.instructions.total() > hw.instructions.total(),
+            "software decoding issues more instructions"
+        );
+    }
+}
+
+/// Counts DST node steps and the software decoder's instructions for them.
+#[derive(Debug, Default)]
+struct DstSteps {
+    steps: u64,
+    nodes: u64,
+    sw_decode: u64,
+}
+
+impl Observer for DstSteps {
+    fn step(&mut self, step: NodeStep) {
+        if let NodeStep::Dst { kind, code, .. } = step {
+            self.steps += 1;
+            self.nodes += u64::from(kind != DstNodeKind::Leaf);
+            self.sw_decode += dst_sw_step(kind, code).total() as u64;
         }
     }
 }

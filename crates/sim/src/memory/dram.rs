@@ -13,18 +13,28 @@
 //!   the channel's previous activate), column command after t_RCD;
 //!
 //! then the data leaves t_CAS later in the channel bus's first free burst slot (slots are
-//! t_burst long; a later-reserved row hit may fill a gap before an earlier conflict's data,
-//! approximating FR-FCFS on the bus).
+//! t_burst long; a later-reserved row hit may fill a gap before an earlier conflict's data).
 //! A full read queue delays the request until the oldest in-flight read of its channel
-//! completes (back-pressure). Bank state changes in arrival order (open page); the bank-level
-//! row-hit-first reordering of FR-FCFS is not modelled (see `docs/simulator.md`).
+//! completes (back-pressure).
+//!
+//! **Row-hit-first scheduling (FR-FCFS).** Each bank keeps its schedule as a short list of
+//! row *epochs*: the row, its activation tick and the last tick a column command may use it
+//! (`close`: the next epoch's activation − t_RP − t_RTP; open-ended for the last epoch).
+//! A read to a row that is open in an epoch still ahead of it is served there as a row hit
+//! — in front of the older reads that caused the next epoch's precharge — provided its
+//! column command (delayed to its data-bus slot) fits before `close`. That is what an
+//! FR-FCFS controller does with the requests queued while t_RAS / t_RC / t_RRD hold a row
+//! open: the oldest request to the open row goes first, the oldest conflict when none is
+//! left. Because every read learns its completion when it arrives (the reservation model),
+//! a row hit never *extends* an epoch: already promised later epochs keep their times, so a
+//! hit arriving after `close` opens a new epoch like any conflict.
 
 use crate::Cycle;
 use crate::config::DramConfig;
-use crate::slots::Slots;
+use crate::slots::SparseSlots;
 use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
+use std::collections::{BinaryHeap, VecDeque};
 
 /// How a read found its bank.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -58,8 +68,24 @@ pub struct DramStats {
     pub last_done: Cycle,
 }
 
-#[derive(Clone, Copy, Debug, Default)]
+/// A row's time open in a bank's schedule.
+#[derive(Clone, Copy, Debug)]
+struct Epoch {
+    row: u64,
+    /// Tick of its activate.
+    act: u64,
+    /// Last tick a column command may read it (`u64::MAX` while no later epoch exists).
+    close: u64,
+}
+
+/// Ticks an epoch is kept after its `close` (reads arrive slightly out of order: fluffy
+/// time).
+const EPOCH_KEEP: u64 = 256;
+
+#[derive(Clone, Debug, Default)]
 struct Bank {
+    /// Earlier epochs still usable by row hits, oldest first (the last one is `open_row`'s).
+    epochs: VecDeque<Epoch>,
     open_row: Option<u64>,
     /// Tick of the last activate.
     act: u64,
@@ -72,9 +98,9 @@ struct Bank {
 #[derive(Clone, Debug, Default)]
 struct Channel {
     /// Data-bus reservations in units of one burst (t_burst ticks).
-    bus: Slots,
+    bus: SparseSlots,
     /// Activations, each holding t_RRD ticks (minimum spacing between activations).
-    acts: Slots,
+    acts: SparseSlots,
     inflight: BinaryHeap<Reverse<u64>>,
 }
 
@@ -134,6 +160,35 @@ impl Dram {
             a = d;
         }
         let bank = &mut self.banks[chi * c.banks_per_channel as usize + bi];
+        while bank
+            .epochs
+            .front()
+            .is_some_and(|e| e.close.saturating_add(EPOCH_KEEP) < a)
+        {
+            bank.epochs.pop_front();
+        }
+        // Row-hit-first: an earlier epoch of this row still ahead of the read serves it.
+        if bank.open_row != Some(row) {
+            let mut hit = None;
+            for e in bank.epochs.iter().filter(|e| e.row == row) {
+                let col = a.max(e.act + c.t_rcd);
+                if col > e.close {
+                    continue;
+                }
+                // The column command waits for its data-bus slot (t_CAS before it).
+                let slot = ch.bus.peek((col + c.t_cas).div_ceil(c.t_burst));
+                if slot * c.t_burst - c.t_cas <= e.close {
+                    hit = Some(slot);
+                    break;
+                }
+            }
+            if let Some(slot) = hit {
+                ch.bus.reserve(slot);
+                let done = slot * c.t_burst + c.t_burst;
+                ch.inflight.push(Reverse(done));
+                return self.finish(arrive, done, DramAccess::RowHit);
+            }
+        }
         let (col, kind) = match bank.open_row {
             Some(r) if r == row => (a.max(bank.col_ready), DramAccess::RowHit),
             open => {
@@ -149,6 +204,14 @@ impl Dram {
                     act = act.max(bank.act + c.t_rc);
                 }
                 act = ch.acts.reserve_span(act, c.t_rrd.max(1));
+                if let Some(last) = bank.epochs.back_mut() {
+                    last.close = act - c.t_rp - c.t_rtp;
+                }
+                bank.epochs.push_back(Epoch {
+                    row,
+                    act,
+                    close: u64::MAX,
+                });
                 bank.act = act;
                 bank.open_row = Some(row);
                 self.stats.activations += 1;
@@ -163,7 +226,12 @@ impl Dram {
         let data = ch.bus.reserve((col + c.t_cas).div_ceil(c.t_burst)) * c.t_burst;
         let done = data + c.t_burst;
         ch.inflight.push(Reverse(done));
-        let done_cycle = done.div_ceil(tpc);
+        self.finish(arrive, done, kind)
+    }
+
+    /// Counts a read arriving at core cycle `arrive` whose data is complete at tick `done`.
+    fn finish(&mut self, arrive: Cycle, done: u64, kind: DramAccess) -> (Cycle, DramAccess) {
+        let done_cycle = done.div_ceil(self.cfg.ticks_per_cycle);
         let s = &mut self.stats;
         s.reads += 1;
         match kind {
@@ -215,6 +283,62 @@ mod tests {
         // act at 0, pre at 35 ns, act at 49 ns (= tRC too), data at 49 + 14 + 14 = 77 ns,
         // rounded up to the 2 ns burst slot grid (78), + burst 2 = 80.
         assert_eq!(d.read(128 * 16 * 16, 0), (80, DramAccess::Conflict));
+    }
+
+    #[test]
+    fn row_hit_overtakes_an_older_conflict() {
+        let mut d = dram();
+        let row1 = 128 * 16 * 16;
+        // A: row 0, closed: act at tick 0, column 28, data slot 14 (ticks 56–60): cycle 30.
+        assert_eq!(d.read(0, 0), (30, DramAccess::Closed));
+        // B: row 1, conflict: precharge at t_RAS (70), act 98 (= t_RC), column 126, data at
+        // 154 rounded up to the burst grid 156, done 160 ticks: cycle 80. Row 0's epoch now
+        // closes at 98 − t_RP 28 − t_RTP 15 = tick 55.
+        assert_eq!(d.read(row1, 0), (80, DramAccess::Conflict));
+        // C: row 0 again, one cycle after B. In arrival order it would be a second conflict
+        // (≥ 49 ns after B's activate). Row-hit-first: row 0 is still open before B's
+        // precharge, so C is a row hit: column at 28, data slot 14 is A's, so slot 15
+        // (column effectively at 60 − 28 = 32 ≤ 55), done at tick 64: cycle 32, before B.
+        assert_eq!(d.read(1, 1), (32, DramAccess::RowHit));
+        // D: row 0 at cycle 20 (tick 40): column 40, data at 68 = slot 17, done 72: cycle 36.
+        assert_eq!(d.read(2, 20), (36, DramAccess::RowHit));
+        // E: row 0 at cycle 30 (tick 60 > 55): too late for row 0's epoch, so a conflict
+        // after B: precharge at B's act 98 + t_RAS 70 = 168, act 196 (= 98 + t_RC), column
+        // 224, data 252, done 256 ticks: cycle 128.
+        assert_eq!(d.read(3, 30), (128, DramAccess::Conflict));
+        let s = d.stats();
+        assert_eq!(
+            (s.reads, s.activations, s.row_hits, s.row_conflicts),
+            (5, 3, 2, 2)
+        );
+    }
+
+    #[test]
+    fn interleaved_rows_pay_one_activation_per_row_and_epoch() {
+        // Two rows of one bank requested alternately, all at once: in arrival order every
+        // read would be a conflict (8 activations); row-hit-first groups them per row.
+        let mut d = dram();
+        let row1 = 128 * 16 * 16;
+        for i in 0..4 {
+            d.read(i, 0);
+            d.read(row1 + i, 0);
+        }
+        let s = d.stats();
+        assert_eq!((s.reads, s.activations, s.row_hits), (8, 2, 6));
+    }
+
+    #[test]
+    fn a_backed_up_bank_does_not_delay_another_bank_of_its_channel() {
+        let mut d = dram();
+        let row = 128 * 16 * 16;
+        // 20 different rows of bank 0 (channel 0), all at cycle 0: each waits t_RC for the
+        // previous one, so the last data is ~1 µs ahead.
+        let last = (0..20).map(|r| d.read(r * row, 0).0).max().unwrap();
+        assert!(last > 900, "{last}");
+        // Bank 1 of channel 0 at cycle 0: closed row, its activation only spaced t_RRD
+        // (13 ticks) after bank 0's first: act 13, column 41, data at 69 rounded to the
+        // burst grid 72, done 76 ticks = cycle 38 (not behind bank 0's far-future bursts).
+        assert_eq!(d.read(128 * 16, 0), (38, DramAccess::Closed));
     }
 
     #[test]
