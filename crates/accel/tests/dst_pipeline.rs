@@ -8,7 +8,7 @@ use dst_common::{build, random_rays};
 use dualsplit_accel::dst::pipeline::{PipelineInput, ReturnCode, step};
 use dualsplit_accel::dst::{AxisPair, Corner, DstConfig, HeaderOffset};
 use dualsplit_accel::{CountingObserver, DstNodeKind};
-use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3};
+use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3, widen_exit};
 use proptest::prelude::*;
 use std::cmp::Ordering;
 
@@ -33,12 +33,13 @@ fn split_cases_of_fig3() {
     let out = step(&input(w, 4.0, 6.0, [0.0; 3], [1.0, 0.0, 0.0]));
     assert_eq!(out.code, ReturnCode::BothChildren);
     assert_eq!((out.offset, out.offset_stack), (30, 33));
-    assert_eq!((out.t_min_out, out.t_max_out), (6.0, 4.0));
+    // t1 is the near child's exit: widened by 1 + 2γ₃ (Ize 2013); t2 (entry) is exact.
+    assert_eq!((out.t_min_out, out.t_max_out), (6.0, widen_exit(4.0)));
     // −x ray from x = 10: near = right (t1 = (6 − 10)/−1 = 4), far = left (t2 = 6).
     let out = step(&input(w, 4.0, 6.0, [10.0, 0.0, 0.0], [-1.0, 0.0, 0.0]));
     assert_eq!(out.code, ReturnCode::BothChildren);
     assert_eq!((out.offset, out.offset_stack), (33, 30));
-    assert_eq!((out.t_min_out, out.t_max_out), (6.0, 4.0));
+    assert_eq!((out.t_min_out, out.t_max_out), (6.0, widen_exit(4.0)));
     // +x ray from x = 5 (in the gap, moving right): only the far (right) child.
     let out = step(&input(w, 4.0, 6.0, [5.0, 0.0, 0.0], [1.0, 0.0, 0.0]));
     assert_eq!(out.code, ReturnCode::OneChild);
@@ -50,7 +51,7 @@ fn split_cases_of_fig3() {
     let out = step(&i);
     assert_eq!(out.code, ReturnCode::OneChild);
     assert_eq!(out.offset, 30);
-    assert_eq!((out.t_min_out, out.t_max_out), (0.0, 4.0));
+    assert_eq!((out.t_min_out, out.t_max_out), (0.0, widen_exit(4.0)));
     // t_min = 4.5, t_max = 5.5: the ray segment lies in the gap: miss.
     i.t_min = 4.5;
     i.t_max = 5.5;
@@ -67,11 +68,14 @@ fn carving_and_leaf_codes() {
     let w = HeaderOffset::single_carve(1, false, 9).unwrap();
     let out = step(&input(w, 3.0, 2.0, [0.0; 3], [0.0, 1.0, 0.0]));
     assert_eq!(out.code, ReturnCode::OneChild);
-    assert_eq!((out.offset, out.t_min_out, out.t_max_out), (9, 2.0, 3.0));
+    assert_eq!(
+        (out.offset, out.t_min_out, out.t_max_out),
+        (9, 2.0, widen_exit(3.0))
+    );
     let out = step(&input(w, 3.0, 2.0, [0.0, 5.0, 0.0], [0.0, -1.0, 0.0]));
     assert_eq!(
         (out.code, out.t_min_out, out.t_max_out),
-        (ReturnCode::OneChild, 2.0, 3.0)
+        (ReturnCode::OneChild, 2.0, widen_exit(3.0))
     );
     assert_eq!(
         step(&input(w, 3.0, 2.0, [0.0, 5.0, 0.0], [0.0, 1.0, 0.0])).code,
@@ -104,17 +108,19 @@ fn carving_and_leaf_codes() {
     .unwrap();
     let out = step(&input(wd, 1.0, 2.0, [0.0; 3], [1.0, 0.0, 1.0]));
     assert_eq!((out.code, out.offset), (ReturnCode::OneChild, 12));
-    assert_eq!((out.t_min_out, out.t_max_out), (1.0, 2.0));
+    assert_eq!((out.t_min_out, out.t_max_out), (1.0, widen_exit(2.0)));
     // Ray −x: x ≥ 1 is now an exit plane, hit only if starting beyond it.
     let out = step(&input(wd, 1.0, 2.0, [3.0, 0.0, 0.0], [-1.0, 0.0, 1.0]));
-    assert_eq!((out.t_min_out, out.t_max_out), (0.0, 2.0));
+    assert_eq!((out.t_min_out, out.t_max_out), (0.0, widen_exit(2.0)));
     assert_eq!(
         step(&input(wd, 1.0, 2.0, [0.5, 0.0, 0.0], [-1.0, 0.0, 1.0])).code,
         ReturnCode::Miss
     );
 }
 
-/// The paper's per-node rules written as plainly as possible (a `match` per node type).
+/// The paper's per-node rules written as plainly as possible (a `match` per node type),
+/// with exit-role distances widened by `widen_exit` (Ize 2013; the robustness rule of
+/// `dualsplit-geometry`): a splitting node's t1 and every carving plane that clamps `hi`.
 fn reference(i: &PipelineInput) -> (u8, u32, f32, f32, Option<(u32, f32)>) {
     let w = i.word;
     let t = |a: usize, p: f32| (p - i.origin[a]) * i.inv_dir[a];
@@ -125,9 +131,9 @@ fn reference(i: &PipelineInput) -> (u8, u32, f32, f32, Option<(u32, f32)>) {
             let a = w.axis();
             let (l, r) = (w.offset(), w.offset() + w.left_size());
             let (near, far, t1, t2) = if neg(a) {
-                (r, l, t(a, i.p1), t(a, i.p0))
+                (r, l, widen_exit(t(a, i.p1)), t(a, i.p0))
             } else {
-                (l, r, t(a, i.p0), t(a, i.p1))
+                (l, r, widen_exit(t(a, i.p0)), t(a, i.p1))
             };
             let near_hit = i.t_min.partial_cmp(&t1) != Some(Ordering::Greater);
             let far_hit = i.t_max.partial_cmp(&t2) != Some(Ordering::Less);
@@ -156,7 +162,7 @@ fn reference(i: &PipelineInput) -> (u8, u32, f32, f32, Option<(u32, f32)>) {
             };
             for (a, p, lower) in planes {
                 if neg(a) == lower {
-                    hi = hi.min(t(a, p));
+                    hi = hi.min(widen_exit(t(a, p)));
                 } else {
                     lo = lo.max(t(a, p));
                 }

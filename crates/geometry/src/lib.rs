@@ -20,6 +20,14 @@
 //!   every structure returns the same triangle whatever its visiting order ([`Hit::closer_than`]).
 //! * Culling against the best hit uses [`cull_limit`], a bound a little beyond the best `t`,
 //!   so rounding differences between slab and triangle arithmetic never lose a tie.
+//! * Exit-role plane distances are conservative (Ize 2013, "Robust BVH ray traversal",
+//!   JCGT 2(2)): every distance that can end an interval (a far plane chosen by the ray's
+//!   sign, a DST splitting node's `t1`, a carving plane acting as an exit) is multiplied by
+//!   [`EXIT_WIDEN`] `= 1 + 2γ₃` ([`widen_exit`], [`RayPre::exit_t`]); entry distances are
+//!   not. A ray aimed exactly at a triangle vertex that is also a box corner then still
+//!   enters the box, as the watertight triangle test accepts the hit. Every structure
+//!   widens the same distances with the same single multiplication, and widening commutes
+//!   with `min`, so all structures still reach the same leaves and return bit-identical hits.
 
 mod aabb;
 mod hit;
@@ -30,6 +38,6 @@ mod triangle;
 pub use aabb::Aabb;
 pub use glam::Vec3;
 pub use hit::{Hit, cull_limit};
-pub use ray::{Ray, RayPre};
+pub use ray::{EXIT_WIDEN, Ray, RayPre, gamma, widen_exit};
 pub use rng::{Pcg32, hash_u32s};
 pub use triangle::{Triangle, TriangleHit};

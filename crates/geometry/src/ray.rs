@@ -1,5 +1,39 @@
 use glam::Vec3;
 
+/// `γ_n = n·ε / (1 − n·ε)` with `ε = f32::EPSILON / 2` (the unit roundoff): a bound on the
+/// relative error of `n` chained IEEE roundings (Higham; Ize 2013, "Robust BVH ray
+/// traversal", JCGT 2(2), §3).
+pub const fn gamma(n: u32) -> f32 {
+    let e = f32::EPSILON * 0.5;
+    let ne = n as f32 * e;
+    ne / (1.0 - ne)
+}
+
+/// The factor `1 + 2γ₃` by which every exit-role plane distance is multiplied (Ize 2013).
+///
+/// A plane distance `(p - o) * inv` takes three roundings (the subtraction, the reciprocal
+/// and the product), so the computed entry can lie up to `γ₃` (relative) after the exact
+/// one and the computed exit up to `γ₃` before it: a ray aimed exactly at a box corner (or
+/// a triangle vertex lying on a box face) could see `entry > exit` and lose a hit that the
+/// watertight triangle test accepts. Widening exits by `1 + 2γ₃` restores `entry ≤ exit`.
+pub const EXIT_WIDEN: f32 = 1.0 + 2.0 * gamma(3);
+
+/// Widens an exit-role plane distance: `t * EXIT_WIDEN` (one multiplication, so NaN stays
+/// NaN, ±∞ stays ±∞, ±0 stays ±0).
+///
+/// Every structure applies it to exactly the distances that play the exit role for the ray
+/// (far planes by ray sign), and to nothing else. Because rounding is monotone and the
+/// factor is positive, `min(widen_exit(a), widen_exit(b)) == widen_exit(min(a, b))`: a
+/// structure that clips with the same planes in another grouping (the DST against its BVH2)
+/// reaches exactly the same leaves.
+///
+/// Exits are widened away from zero: for the usual `t_min ≥ 0` a negative exit is a box
+/// behind the ray and stays a miss, so the widening is conservative on `[0, ∞)`.
+#[inline(always)]
+pub fn widen_exit(t: f32) -> f32 {
+    t * EXIT_WIDEN
+}
+
 /// A ray `origin + t * dir` valid for `t` in `[t_min, t_max]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
@@ -101,11 +135,21 @@ impl RayPre {
         (p - self.ray.origin[axis]) * self.inv_dir[axis]
     }
 
+    /// The distance of an exit-role plane `x[axis] = p`: [`widen_exit`] of
+    /// [`RayPre::plane_t`]. Callers decide the role (far plane by ray sign, or a carving
+    /// plane whose corner bit says so); entry-role planes use plain [`RayPre::plane_t`].
+    #[inline(always)]
+    pub fn exit_t(&self, axis: usize, p: f32) -> f32 {
+        widen_exit(self.plane_t(axis, p))
+    }
+
     /// Slab test of a box against `[t_lo, t_hi]`: the clipped interval `(entry, exit)`, which
     /// is non-empty (`entry <= exit`) when the ray meets the box. Near and far planes are
     /// chosen by the ray's direction signs (not by swapping distances), so the degenerate
     /// box [`crate::Aabb::DEGENERATE`] (`min = +∞, max = -∞`) never hits, and NaN plane
-    /// distances are ignored (closed slabs).
+    /// distances are ignored (closed slabs). The far-plane distances are widened by
+    /// [`EXIT_WIDEN`] (Ize 2013) so grazing rays through a box corner are never rounded
+    /// away; `t_hi` itself is not widened.
     #[inline(always)]
     pub fn slab(&self, min: Vec3, max: Vec3, t_lo: f32, t_hi: f32) -> (f32, f32) {
         let o = self.ray.origin;
@@ -130,9 +174,9 @@ impl RayPre {
             .max((ny - o.y) * inv.y)
             .max((nz - o.z) * inv.z);
         let exit = t_hi
-            .min((fx - o.x) * inv.x)
-            .min((fy - o.y) * inv.y)
-            .min((fz - o.z) * inv.z);
+            .min(widen_exit((fx - o.x) * inv.x))
+            .min(widen_exit((fy - o.y) * inv.y))
+            .min(widen_exit((fz - o.z) * inv.z));
         (entry, exit)
     }
 }

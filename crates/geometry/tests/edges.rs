@@ -1,6 +1,6 @@
 //! Edge cases of the shared ray tests: zero direction components, degenerate boxes, shared
 //! edges.
-use dualsplit_geometry::{Aabb, Ray, Triangle, Vec3};
+use dualsplit_geometry::{Aabb, EXIT_WIDEN, Pcg32, Ray, RayPre, Triangle, Vec3, widen_exit};
 
 #[test]
 fn degenerate_box_never_hits() {
@@ -27,7 +27,7 @@ fn zero_direction_component_inside_closed_slab() {
     let r = Ray::new(Vec3::new(1.0, 0.5, -1.0), Vec3::Z).precompute();
     let (e, x) = r.slab(Vec3::ZERO, Vec3::ONE, 0.0, f32::INFINITY);
     assert!(e <= x);
-    assert_eq!((e, x), (1.0, 2.0));
+    assert_eq!((e, x), (1.0, widen_exit(2.0)));
     // Same ray just outside the slab misses.
     let r = Ray::new(Vec3::new(1.0 + 1e-6, 0.5, -1.0), Vec3::Z).precompute();
     let (e, x) = r.slab(Vec3::ZERO, Vec3::ONE, 0.0, f32::INFINITY);
@@ -35,7 +35,7 @@ fn zero_direction_component_inside_closed_slab() {
     // Negative zero direction components behave the same.
     let r = Ray::new(Vec3::new(0.0, 0.5, 2.0), Vec3::new(-0.0, -0.0, -1.0)).precompute();
     let (e, x) = r.slab(Vec3::ZERO, Vec3::ONE, 0.0, f32::INFINITY);
-    assert_eq!((e, x), (1.0, 2.0));
+    assert_eq!((e, x), (1.0, widen_exit(2.0)));
 }
 
 #[test]
@@ -47,7 +47,8 @@ fn flat_box_is_hit() {
         0.0,
         f32::INFINITY,
     );
-    assert_eq!((e, x), (1.0, 1.0));
+    // The exit is widened by 1 + 2γ₃ (Ize 2013); the entry is exact.
+    assert_eq!((e, x), (1.0, widen_exit(1.0)));
 }
 
 #[test]
@@ -93,4 +94,147 @@ fn interval_is_inclusive() {
     let r = Ray::new(Vec3::ZERO, Vec3::Z).precompute();
     assert!(t.intersect(&r, 2.0, 2.0).is_some());
     assert!(t.intersect(&r, 0.0, 1.999).is_none());
+}
+
+/// Rays aimed exactly at a triangle vertex that is a corner of the triangle's box (found by
+/// a seeded search): without widened exits the slab test's computed entry lands one ulp
+/// above its exit while the watertight test accepts the hit (Ize 2013).
+const GRAZING_CASES: [([[f32; 3]; 3], [u32; 3], usize); 4] = [
+    (
+        [[4.0, -0.0, 2.0], [4.0, 2.0, 2.0], [1.0, -1.0, 1.0]],
+        [1057123824, 3226476036, 1077493544],
+        2,
+    ),
+    (
+        [[-3.0, 3.0, -0.0], [-4.0, 2.0, -1.0], [2.0, 1.0, -2.0]],
+        [3217441944, 3222153514, 3228377840],
+        2,
+    ),
+    (
+        [[3.0, 2.0, -2.0], [-3.0, -1.0, -2.0], [-1.0, 0.0, -3.0]],
+        [3207833408, 1076492226, 3213691328],
+        1,
+    ),
+    (
+        [[-3.0, 3.0, -1.0], [-0.0, -2.0, 2.0], [4.0, -3.0, -0.0]],
+        [3227753434, 1077816614, 3173895040],
+        0,
+    ),
+];
+
+fn grazing_case(i: usize) -> (Triangle, Ray) {
+    let (v, o, k) = GRAZING_CASES[i];
+    let tri = Triangle::new(Vec3::from(v[0]), Vec3::from(v[1]), Vec3::from(v[2]));
+    let o = Vec3::new(
+        f32::from_bits(o[0]),
+        f32::from_bits(o[1]),
+        f32::from_bits(o[2]),
+    );
+    (tri, Ray::new(o, tri.v[k] - o))
+}
+
+/// The slab test without widening (the old rule), for the regression's premise.
+fn slab_unwidened(r: &RayPre, min: Vec3, max: Vec3) -> (f32, f32) {
+    let (mut entry, mut exit) = (0.0f32, f32::INFINITY);
+    for a in 0..3 {
+        let (n, f) = if r.neg[a] {
+            (max[a], min[a])
+        } else {
+            (min[a], max[a])
+        };
+        entry = entry.max(r.plane_t(a, n));
+        exit = exit.min(r.plane_t(a, f));
+    }
+    (entry, exit)
+}
+
+#[test]
+fn vertex_at_box_corner_enters_the_box() {
+    for (i, &(_, _, k)) in GRAZING_CASES.iter().enumerate() {
+        let (tri, ray) = grazing_case(i);
+        let b = tri.bounds();
+        assert!(
+            (0..3).all(|a| tri.v[k][a] == b.min[a] || tri.v[k][a] == b.max[a]),
+            "case {i}: vertex is not a box corner"
+        );
+        let r = ray.precompute();
+        assert!(
+            tri.intersect(&r, 0.0, f32::INFINITY).is_some(),
+            "case {i}: watertight test misses"
+        );
+        let (e0, x0) = slab_unwidened(&r, b.min, b.max);
+        assert!(
+            e0 > x0,
+            "case {i}: premise: the unwidened slab rounds the box away"
+        );
+        let (e, x) = r.slab(b.min, b.max, 0.0, f32::INFINITY);
+        assert!(e <= x, "case {i}: widened slab still misses: ({e}, {x})");
+    }
+}
+
+/// Seeded search: for every ray aimed at a box-corner vertex that the watertight test hits,
+/// the slab test enters the triangle's box.
+#[test]
+fn rays_at_corner_vertices_always_enter_the_box() {
+    let mut rng = Pcg32::new(0x1be, 3);
+    let mut hits = 0;
+    for _ in 0..50_000 {
+        let mut p = || {
+            Vec3::new(
+                rng.range_f32(-4.0, 4.0),
+                rng.range_f32(-4.0, 4.0),
+                rng.range_f32(-4.0, 4.0),
+            )
+        };
+        let (a, b, c, o) = (p().round(), p().round(), p().round(), p());
+        let tri = Triangle::new(a, b, c);
+        let bb = tri.bounds();
+        for v in tri.v {
+            let ray = Ray::new(o, v - o);
+            let r = ray.precompute();
+            if tri.intersect(&r, 0.0, f32::INFINITY).is_none() {
+                continue;
+            }
+            hits += 1;
+            let (e, x) = r.slab(bb.min, bb.max, 0.0, f32::INFINITY);
+            assert!(e <= x, "ray {ray:?} at vertex {v:?} of {tri:?}: ({e}, {x})");
+        }
+    }
+    assert!(hits > 10_000, "only {hits} vertex hits");
+}
+
+#[test]
+fn widen_exit_rules() {
+    // 1 + 2γ₃ with γ_n = nε/(1 − nε), ε = f32::EPSILON / 2.
+    let e = f64::from(f32::EPSILON) / 2.0;
+    let g3 = 3.0 * e / (1.0 - 3.0 * e);
+    assert!((f64::from(EXIT_WIDEN) - (1.0 + 2.0 * g3)).abs() <= f64::from(f32::EPSILON) / 2.0);
+    const { assert!(EXIT_WIDEN > 1.0) };
+    assert!(widen_exit(f32::NAN).is_nan());
+    assert_eq!(widen_exit(f32::INFINITY), f32::INFINITY);
+    assert_eq!(widen_exit(f32::NEG_INFINITY), f32::NEG_INFINITY);
+    assert_eq!(widen_exit(0.0).to_bits(), 0.0f32.to_bits());
+    assert_eq!(widen_exit(-0.0).to_bits(), (-0.0f32).to_bits());
+    // Monotone, so it commutes with min: the DST (planes clipped one node at a time) and
+    // the BVH (one box at a time) reach the same leaves.
+    let mut rng = Pcg32::new(9, 9);
+    for _ in 0..10_000 {
+        let (a, b) = (rng.range_f32(-8.0, 8.0), rng.range_f32(-8.0, 8.0));
+        if a >= 0.0 {
+            assert!(widen_exit(a) >= a, "{a}");
+        }
+        assert_eq!(
+            widen_exit(a.min(b)).to_bits(),
+            widen_exit(a).min(widen_exit(b)).to_bits(),
+            "{a} {b}"
+        );
+    }
+    // exit_t is widen_exit(plane_t).
+    let r = Ray::new(Vec3::new(0.3, -1.0, 2.0), Vec3::new(0.7, 0.2, -0.5)).precompute();
+    for a in 0..3 {
+        assert_eq!(
+            r.exit_t(a, 1.5).to_bits(),
+            widen_exit(r.plane_t(a, 1.5)).to_bits()
+        );
+    }
 }

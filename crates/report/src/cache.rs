@@ -11,10 +11,10 @@ use serde::{Serialize, de::DeserializeOwned};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
-/// Bump when the meaning or layout of a cached value changes, or when the simulator's model
-/// changes in a way that changes its results (all crates share one version number, so the
-/// crate version alone does not tell).
-pub const SCHEMA: u32 = 2;
+/// Bump when the meaning or layout of a cached value changes. Simulator model changes are
+/// tracked separately by [`dualsplit_sim::MODEL_VERSION`], which is also part of every key
+/// (all crates share one version number, so the crate version alone does not tell).
+pub const SCHEMA: u32 = 3;
 
 /// Crate version plus [`SCHEMA`]: part of every cache key.
 pub const CODE_VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+schema");
@@ -55,7 +55,7 @@ impl CacheKey {
             workload: workload.into(),
             config: config.into(),
             resolution: format!("{}x{}", resolution.0, resolution.1),
-            code_version: format!("{CODE_VERSION}{SCHEMA}"),
+            code_version: format!("{CODE_VERSION}{SCHEMA}+sim{}", dualsplit_sim::MODEL_VERSION),
         }
     }
 

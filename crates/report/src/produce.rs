@@ -342,7 +342,7 @@ impl<'a> Producer<'a> {
             });
         }
         Ok(ReportData {
-            code_version: format!("{CODE_VERSION}{SCHEMA}"),
+            code_version: format!("{CODE_VERSION}{SCHEMA}+sim{}", dualsplit_sim::MODEL_VERSION),
             settings: self.settings.clone(),
             scenes: out,
             skipped,

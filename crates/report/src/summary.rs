@@ -82,6 +82,35 @@ pub fn table3(data: &ReportData) -> String {
             pct_range(&p)
         ));
     }
+    // Scene by scene for the DST, so a range overlap cannot hide a scene that differs.
+    let per_scene: Vec<String> = data
+        .scenes
+        .iter()
+        .filter_map(|s| {
+            let m = s.paper?;
+            let ours = s.bytes(AccelKind::Dst)? as f64 / s.bytes(AccelKind::Bvh2)? as f64;
+            let i = m.scene.index();
+            let theirs = paper::TABLE3_MIB[i][3] / paper::TABLE3_MIB[i][0];
+            let diff = (ours - theirs) * 100.0;
+            let word = if diff.abs() <= 5.0 {
+                "close to"
+            } else if diff < 0.0 {
+                "below"
+            } else {
+                "above"
+            };
+            Some(format!(
+                "{} {:.0}% ({word} {} {:.0}%)",
+                s.name,
+                ours * 100.0,
+                m.scene.label(),
+                theirs * 100.0
+            ))
+        })
+        .collect();
+    if !per_scene.is_empty() {
+        out.push(format!("DST by scene: {}.", per_scene.join(", ")));
+    }
     out.join(" ")
 }
 

@@ -10,13 +10,18 @@ use super::{Dst, DstConfig, DstError};
 use crate::build::Bvh2;
 use crate::image::MemoryImage;
 use dualsplit_geometry::{Aabb, Triangle};
+use rayon::prelude::*;
 
 /// Bit 31 of an index entry: the last triangle of a leaf's run.
 pub(super) const RUN_END: u32 = 1 << 31;
 
-/// Splitting nodes above this depth encode their two subtrees in parallel (rayon), giving
-/// up to 2^PARALLEL_DEPTH tasks.
-const PARALLEL_DEPTH: u32 = 4;
+/// Subtrees entered below a splitting node at this depth (the root is at depth 0) are
+/// encoded as independent tasks in parallel (rayon), up to 2^PARALLEL_DEPTH of them; each is
+/// relocated once when the sequential top-level pass reaches it.
+const PARALLEL_DEPTH: u32 = 6;
+
+/// The subtrees encoded in parallel, in depth-first order: BVH node and incoming chain.
+type Tasks = Vec<(u32, Chain)>;
 
 struct Encoder<'a> {
     bvh: &'a Bvh2,
@@ -80,7 +85,6 @@ impl<'a> Encoder<'a> {
     fn check_node(&mut self, n: u32) -> Result<(), DstError> {
         self.visited += 1;
         let nodes = self.bvh.nodes.len();
-        let node = &self.bvh.nodes[n as usize];
         if self.visited > nodes {
             return Err(DstError::BadBvhLink {
                 node: n,
@@ -88,6 +92,13 @@ impl<'a> Encoder<'a> {
                 nodes,
             });
         }
+        self.check_links(n)
+    }
+
+    /// Checks node `n`'s box and child links (what planning and emission index with).
+    fn check_links(&self, n: u32) -> Result<(), DstError> {
+        let nodes = self.bvh.nodes.len();
+        let node = &self.bvh.nodes[n as usize];
         if !node.bounds.is_finite() {
             return Err(DstError::NonFiniteBounds {
                 node: n,
@@ -108,8 +119,35 @@ impl<'a> Encoder<'a> {
         Ok(())
     }
 
+    /// Lists, in depth-first order, the subtrees [`Encoder::emit`] takes from its task
+    /// results: both children of every splitting node at depth `PARALLEL_DEPTH - 1`.
+    fn collect(&self, n: u32, depth: u32, tasks: &mut Tasks) -> Result<(), DstError> {
+        self.check_links(n)?;
+        if self.bvh.nodes[n as usize].is_leaf() {
+            return Ok(());
+        }
+        let plan = plan_split(self.bvh, n, self.cfg);
+        if depth + 1 == PARALLEL_DEPTH {
+            tasks.push((plan.left, plan.left_chain));
+            tasks.push((plan.right, plan.right_chain));
+            return Ok(());
+        }
+        self.collect(plan.left, depth + 1, tasks)?;
+        self.collect(plan.right, depth + 1, tasks)
+    }
+
     /// Emits BVH node `n` (entered with the carving `chain`) into the words reserved at `at`.
-    fn emit(&mut self, n: u32, chain: &Chain, mut at: usize, depth: u32) -> Result<(), DstError> {
+    /// Subtrees at depth `PARALLEL_DEPTH` are not emitted here but taken, in depth-first
+    /// order, from `done` (encoded in parallel beforehand) and appended; the layout is the
+    /// one a fully sequential depth-first emission gives.
+    fn emit(
+        &mut self,
+        n: u32,
+        chain: &Chain,
+        mut at: usize,
+        depth: u32,
+        done: &mut std::vec::IntoIter<Result<Encoder<'a>, DstError>>,
+    ) -> Result<(), DstError> {
         self.check_node(n)?;
         let is_leaf = self.bvh.nodes[n as usize].is_leaf();
         let steps = chain.steps();
@@ -165,39 +203,40 @@ impl<'a> Encoder<'a> {
         );
         let h = HeaderOffset::split(plan.axis, sl as u32, p as u64)?;
         self.put(at, h, lb.max[plan.axis], rb.min[plan.axis]);
-        if depth >= PARALLEL_DEPTH {
-            self.emit(plan.left, &plan.left_chain, p, depth + 1)?;
-            return self.emit(plan.right, &plan.right_chain, p + sl, depth + 1);
+        if depth + 1 == PARALLEL_DEPTH {
+            // Both subtrees were encoded in parallel into their own buffers; they are
+            // appended in a fixed order (the result does not depend on thread timing).
+            let mut next = || done.next().expect("one task result per collected subtree");
+            let l = next()?;
+            self.append(l, p)?;
+            let r = next()?;
+            return self.append(r, p + sl);
         }
-        // Top levels: both subtrees are encoded in parallel into their own buffers, then
-        // appended in a fixed order (the result does not depend on thread timing).
-        let (l, r) = rayon::join(
-            || self.sub_encoder(plan.left, &plan.left_chain, sl, depth + 1),
-            || self.sub_encoder(plan.right, &plan.right_chain, sr, depth + 1),
-        );
-        self.append(l?, p)?;
-        self.append(r?, p + sl)
+        self.emit(plan.left, &plan.left_chain, p, depth + 1, done)?;
+        self.emit(plan.right, &plan.right_chain, p + sl, depth + 1, done)
     }
 
     /// Encodes the subtree of BVH node `n` into a fresh encoder whose root is at local word 0.
-    fn sub_encoder(
-        &self,
-        n: u32,
-        chain: &Chain,
-        size: usize,
-        depth: u32,
-    ) -> Result<Encoder<'a>, DstError> {
+    /// `tasks` (how many subtrees share the BVH) sizes its buffers up front: twice an even
+    /// share at ~3 words per BVH node, so they rarely grow (unused capacity is never
+    /// touched, so over-reserving costs no page faults).
+    fn sub_encoder(&self, n: u32, chain: &Chain, tasks: usize) -> Result<Encoder<'a>, DstError> {
+        let size = if self.bvh.nodes[n as usize].is_leaf() && chain.is_empty() {
+            1
+        } else {
+            3
+        };
         let mut sub = Encoder {
             bvh: self.bvh,
             triangles: self.triangles,
             cfg: self.cfg,
-            words: Vec::new(),
-            indices: Vec::new(),
+            words: Vec::with_capacity(6 * self.bvh.nodes.len() / tasks + 16),
+            indices: Vec::with_capacity(2 * self.bvh.prim_ids.len() / tasks + 16),
             stats: DstStats::default(),
             visited: 0,
         };
         sub.reserve(size);
-        sub.emit(n, chain, 0, depth)?;
+        sub.emit(n, chain, 0, PARALLEL_DEPTH, &mut Vec::new().into_iter())?;
         Ok(sub)
     }
 
@@ -285,7 +324,13 @@ impl Dst {
         if !empty {
             let root_size = if bvh.nodes[0].is_leaf() { 1 } else { 3 };
             let at = enc.reserve(root_size);
-            enc.emit(0, &Chain::EMPTY, at, 0)?;
+            let mut tasks = Tasks::new();
+            enc.collect(0, 0, &mut tasks)?;
+            let done: Vec<_> = tasks
+                .par_iter()
+                .map(|(n, chain)| enc.sub_encoder(*n, chain, tasks.len()))
+                .collect();
+            enc.emit(0, &Chain::EMPTY, at, 0, &mut done.into_iter())?;
         }
         if enc.words.len() as u64 > super::OFFSET_LIMIT {
             return Err(DstError::OffsetOverflow {

@@ -13,6 +13,11 @@
 //! of carved faces (one DP per child prices all six split choices): a step carves one face or two (two on
 //! one axis = single-axis carving node, on two axes = dual-axis carving node); a lone face
 //! is carved by the cheaper node type with a ±∞ no-op partner plane.
+//!
+//! Speed: each state's options come from a table built at compile time ([`OPTIONS`]) in
+//! the order of the original nested loops, and the cheapest is selected without branches,
+//! with the same strict `<` and the same float expressions, so every decision (ties
+//! included) is the one the plain loops made (`tests/dst_convert_golden.rs`).
 
 use super::header::{AxisPair, Corner};
 use super::{DstConfig, DstCosts, Partitioning};
@@ -157,6 +162,9 @@ fn step_for(faces: &[usize], i: usize, j: Option<usize>, target: &Aabb, c: &DstC
 /// child enters the chain in state {f}, so one DP per child prices all 6 split choices.
 pub(super) struct ChainDp {
     faces: [usize; 6],
+    /// `bit_of[f]`: the state bit of face `f` (0 when `f` is not one of F), so the state a
+    /// split enters is one lookup.
+    bit_of: [u8; 6],
     k: usize,
     target: Aabb,
     cost: [f32; 64],
@@ -165,15 +173,102 @@ pub(super) struct ChainDp {
     base: f32,
 }
 
+/// Start of chain length `k`'s states in [`OptionTable::range`]: Σ_{k' < k} (2^k' + 1).
+const TABLE_START: [usize; 7] = {
+    let mut out = [0usize; 7];
+    let mut k = 1;
+    while k < 7 {
+        out[k] = out[k - 1] + (1 << (k - 1)) + 1;
+        k += 1;
+    }
+    out
+};
+
+/// The DP's options for every chain length `k` ≤ 6 and state `s`: option masks (one or two
+/// faces of the remaining set) `masks[range[TABLE_START[k] + s]..range[TABLE_START[k] + s + 1]]`.
+struct OptionTable {
+    masks: [u8; 1024],
+    range: [u16; 140],
+}
+
+/// The option table, built once at compile time (672 options in all).
+const OPTIONS: OptionTable = option_table(false);
+
+/// The option table when every pair node costs no more than a lone-face node (equal costs,
+/// the hardware preset): a lone face is then only ever carved as the last remaining face
+/// (the dominance rule in [`ChainDp::solve`]), so the other lone options, which the rule
+/// would reject anyway, are left out.
+const OPTIONS_PAIRS_CHEAP: OptionTable = option_table(true);
+
+/// Builds an option table; `pairs_cheap` keeps lone-face options only in states with one
+/// face remaining.
+const fn option_table(pairs_cheap: bool) -> OptionTable {
+    let mut t = OptionTable {
+        masks: [0; 1024],
+        range: [0; 140],
+    };
+    let mut n = 0usize;
+    let mut k = 0;
+    while k < 7 {
+        let full = (1usize << k) - 1;
+        let mut s = 0;
+        while s <= full {
+            t.range[TABLE_START[k] + s] = n as u16;
+            let rem = full & !s;
+            let lone = !pairs_cheap || rem.count_ones() == 1;
+            let mut i = 0;
+            while i < k {
+                if rem & 1 << i != 0 {
+                    if lone {
+                        t.masks[n] = 1 << i;
+                        n += 1;
+                    }
+                    let mut j = i + 1;
+                    while j < k {
+                        if rem & 1 << j != 0 {
+                            t.masks[n] = (1 << i | 1 << j) as u8;
+                            n += 1;
+                        }
+                        j += 1;
+                    }
+                }
+                i += 1;
+            }
+            s += 1;
+        }
+        t.range[TABLE_START[k] + full + 1] = n as u16;
+        k += 1;
+    }
+    t
+}
+
+/// What the DP loop of [`ChainDp::solve`] reads.
+struct DpInputs<'a> {
+    /// The state with every face of F carved.
+    full: usize,
+    /// [`TABLE_START`] of the chain length.
+    first: usize,
+    /// Surface area of the region in each state.
+    sa: &'a [f32; 64],
+    /// Node cost by option mask.
+    weight: &'a [f32; 64],
+    /// For a lone-face option mask: the faces whose pair node is no dearer.
+    cheap_partner: &'a [u8; 64],
+    /// `C_tri · n` of the leaf below when the chain may stop early (similar partitioning).
+    tri_weight: Option<f32>,
+}
+
 impl ChainDp {
     /// Solves the DP from `region` (the parent box) down to `target` (the child box).
     /// `leaf_tris` is `Some(n)` when the child is a leaf of `n` triangles and similar
     /// partitioning is on: the chain may then stop early, paying `C_tri · n · SA` of the
     /// looser region instead. Costs are SAH-weighted by the area of the region in which
     /// each node is tested.
+    #[inline(always)]
     pub fn solve(region: &Aabb, target: &Aabb, costs: &DstCosts, leaf_tris: Option<u32>) -> Self {
         let mut dp = ChainDp {
             faces: [0; 6],
+            bit_of: [0; 6],
             k: 0,
             target: *target,
             cost: [0.0; 64],
@@ -183,6 +278,7 @@ impl ChainDp {
         for f in 0..6 {
             if face(region, f) != face(target, f) {
                 dp.faces[dp.k] = f;
+                dp.bit_of[f] = 1 << dp.k;
                 dp.k += 1;
             }
         }
@@ -226,12 +322,14 @@ impl ChainDp {
             sa[s] = x * y + y * z + z * x;
         }
         dp.base = leaf_cost(sa[full]).unwrap_or(0.0);
-        // Pair costs, and for each face the partners whose pair node costs no more than a
+        // Option weights by option mask (one face = a lone-face node, two faces = a pair
+        // node), and for each lone face the partners whose pair node costs no more than a
         // lone-face node: while such a partner remains, carving the face alone is dominated
         // (the DP cost never grows when more faces are already carved), so it is skipped.
-        let mut pair = [[0f32; 6]; 6];
-        let mut cheap_partner = [0usize; 6];
+        let mut weight = [0f32; 64];
+        let mut cheap_partner = [0u8; 64];
         for i in 0..k {
+            weight[1 << i] = c_lone;
             for (j, &fj) in dp.faces[..k].iter().enumerate() {
                 if i == j {
                     continue;
@@ -241,51 +339,78 @@ impl ChainDp {
                 } else {
                     costs.dual_carve
                 };
-                pair[i][j] = c;
+                weight[1 << i | 1 << j] = c;
                 if c <= c_lone {
-                    cheap_partner[i] |= 1 << j;
+                    cheap_partner[1 << i] |= 1 << j;
                 }
             }
         }
-        for s in (0..full).rev() {
-            let stop = leaf_cost(sa[s]).map_or(f32::INFINITY, |c| c - dp.base);
-            let mut best = (stop, 0u8);
-            let rem = full & !s;
-            let mut rem_i = rem;
-            while rem_i != 0 {
-                let i = rem_i.trailing_zeros() as usize;
-                rem_i &= rem_i - 1;
-                if rem & cheap_partner[i] == 0 {
-                    let c = c_lone * sa[s] + dp.cost[s | 1 << i];
-                    if c < best.0 {
-                        best = (c, 1 << i);
-                    }
-                }
-                let mut rem_j = rem_i;
-                while rem_j != 0 {
-                    let j = rem_j.trailing_zeros() as usize;
-                    rem_j &= rem_j - 1;
-                    let c = pair[i][j] * sa[s] + dp.cost[s | 1 << i | 1 << j];
-                    if c < best.0 {
-                        best = (c, (1 << i | 1 << j) as u8);
-                    }
-                }
-            }
-            dp.cost[s] = best.0;
-            dp.choice[s] = best.1;
+        // The options of every state come from a table built at compile time, in the order
+        // of the original loops (lone i, then pairs (i, j > i), for i ascending), so ties
+        // go to the same option; the selection is branch-free.
+        let pairs_cheap = costs.single_carve <= c_lone && costs.dual_carve <= c_lone;
+        let inputs = DpInputs {
+            full,
+            first: TABLE_START[k],
+            sa: &sa,
+            weight: &weight,
+            cheap_partner: &cheap_partner,
+            tri_weight: leaf_tris.map(|n| costs.triangle * n as f32),
+        };
+        match (pairs_cheap, inputs.tri_weight.is_some()) {
+            (true, false) => dp.run::<true, false>(&inputs),
+            (true, true) => dp.run::<true, true>(&inputs),
+            (false, false) => dp.run::<false, false>(&inputs),
+            (false, true) => dp.run::<false, true>(&inputs),
         }
         dp
     }
 
+    /// The DP proper, over the states from `full - 1` down to 0, specialised on whether
+    /// every pair node is no dearer than a lone-face node (`PAIRS_CHEAP`: the option table
+    /// then holds no dominated lone option, so none needs the partner test) and on whether
+    /// the chain may stop early above a leaf (`STOP`, similar partitioning).
+    #[inline(always)]
+    fn run<const PAIRS_CHEAP: bool, const STOP: bool>(&mut self, d: &DpInputs) {
+        let table = if PAIRS_CHEAP {
+            &OPTIONS_PAIRS_CHEAP
+        } else {
+            &OPTIONS
+        };
+        let tri_weight = d.tri_weight.unwrap_or(0.0);
+        for s in (0..d.full).rev() {
+            let sa = d.sa[s];
+            let stop = if STOP {
+                tri_weight * sa - self.base
+            } else {
+                f32::INFINITY
+            };
+            let (mut best_c, mut best_t) = (stop, 0u8);
+            let rem = (d.full & !s) as u8;
+            let (lo, hi) = (
+                table.range[d.first + s] as usize,
+                table.range[d.first + s + 1] as usize,
+            );
+            for &t in &table.masks[lo..hi] {
+                let c = d.weight[t as usize] * sa + self.cost[s | t as usize];
+                let allowed = PAIRS_CHEAP || rem & d.cheap_partner[t as usize] == 0;
+                let better = (c < best_c) & allowed;
+                best_c = if better { c } else { best_c };
+                best_t = if better { t } else { best_t };
+            }
+            self.cost[s] = best_c;
+            self.choice[s] = best_t;
+        }
+    }
+
     /// The state entered when the split carves face `f` of the child (if it is one of F).
+    #[inline(always)]
     fn start(&self, carved_by_split: usize) -> usize {
-        self.faces[..self.k]
-            .iter()
-            .position(|&g| g == carved_by_split)
-            .map_or(0, |i| 1 << i)
+        self.bit_of[carved_by_split] as usize
     }
 
     /// Cost of the chain when the split carves face `f`.
+    #[inline(always)]
     pub fn cost(&self, carved_by_split: usize) -> f32 {
         self.cost[self.start(carved_by_split)] + self.base
     }

@@ -9,6 +9,7 @@
 //!  header ─▶ decode (C, L, A, B) ─┬─▶ component select: axis0, axis1 ─▶ (o, inv) × 2
 //!                                 ├─▶ plane swap by ray sign (1-D nodes) ─▶ q0, q1
 //!  FPADD ×2, FPMUL ×2:  t1 = (q0 − o0)·inv0,  t2 = (q1 − o1)·inv1
+//!  FPMUL ×2 (robustness): t_i ·= (exit_i ? 1 + 2γ₃ : 1)   (Ize 2013; not in Fig. 6)
 //!  FPCMP ×4: near = t_min ≤ t1, far = t_max ≥ t2, cut ≤, exit/entry steering
 //!  FPMIN3 / FPMAX3: t_max_out = min(t_max, t1?, t2?), t_min_out = max(t_min, t1?, t2?)
 //!  INTADD ×1: right = offset + left size;  near/far muxes;  return-code logic
@@ -16,12 +17,21 @@
 //!
 //! Units: 1 INTADD, 2 FPADD, 2 FPMUL, 3 FPMIN/MAX (one 3-way min + one 3-way max),
 //! 4 FPCMP, as in Table 2.
+//!
+//! Robustness addition (not in the paper's Fig. 6 or Table 2): each lane's plane distance
+//! goes through one more FPMUL by a constant, `1 + 2γ₃` when that plane is an exit for the
+//! ray (selected by the exit muxes) and `1.0` otherwise, making exit distances conservative
+//! as in Ize 2013 ("Robust BVH ray traversal", JCGT 2(2)). It matches the BVH slab test's
+//! widened far planes ([`dualsplit_geometry::widen_exit`]), so grazing rays through a box
+//! corner keep the hit the watertight triangle test accepts. It is still branch-free; a
+//! hardware unit could fold it into a constant multiplier (or skip it, trading the rare
+//! grazing miss for the area).
 
 use super::Dst;
 use super::header::HeaderOffset;
 use super::traverse::{Entry, RunResult, Tracer};
 use crate::observer::{NodeStep, Observer};
-use dualsplit_geometry::{Hit, Ray};
+use dualsplit_geometry::{EXIT_WIDEN, Hit, Ray};
 
 /// The pipeline's 2-bit return code, numbered as in the paper (Lin et al. 2020, §3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -126,13 +136,19 @@ pub fn step(i: &PipelineInput) -> PipelineOutput {
     let swap = !is_dual & neg0;
     let q0 = mux(swap, i.p1, i.p0);
     let q1 = mux(swap, i.p0, i.p1);
-    // ---- FPADD ×2, FPMUL ×2 --------------------------------------------------------------
-    let t1 = (q0 - o0) * inv0;
-    let t2 = (q1 - o1) * inv1;
     // ---- effective corner: which plane clamps t_max (exit) ------------------------------
+    // 1-D nodes: q0 is the exit plane, q1 the entry plane. Dual-axis nodes: a plane is an
+    // exit iff its "lower bound" bit equals the ray's sign on its axis (Fig. 2).
     let corner = w.corner();
     let exit0 = mux(is_dual, neg0 == corner.first_lower, true);
     let exit1 = mux(is_dual, neg1 == corner.second_lower, false);
+    // ---- FPADD ×2, FPMUL ×2 --------------------------------------------------------------
+    // Robustness addition to Fig. 6 (Ize 2013): one more FPMUL per lane multiplies the
+    // lane's distance by EXIT_WIDEN = 1 + 2γ₃ when it plays the exit role and by 1.0
+    // (exact) otherwise, the factor selected by the same exit muxes. The result is
+    // bit-identical to `widen_exit(plane_t)` in the software decoder and the BVH slab test.
+    let t1 = (q0 - o0) * inv0 * mux(exit0, EXIT_WIDEN, 1.0);
+    let t2 = (q1 - o1) * inv1 * mux(exit1, EXIT_WIDEN, 1.0);
     // ---- FPCMP: splitting-node child tests (NaN-permissive) --------
     let near_hit = le_or_nan(i.t_min, t1);
     let far_hit = le_or_nan(t2, i.t_max);

@@ -4,7 +4,11 @@
 //! Each stack entry carries its `[t_min, t_max]` (the region clip, kd-tree style). Sibling
 //! regions may overlap, so traversal continues after a hit; a popped entry is discarded
 //! when its `t_min` lies beyond `cull_limit(best_t)`, otherwise its `t_max` is clamped to
-//! it. Plane distances use [`RayPre::plane_t`]; every min/max is `f32::min/max` and every
+//! it. Plane distances use [`RayPre::plane_t`]; exit-role distances (a splitting node's
+//! `t1`, a carving plane that ends the interval for this ray's signs) are widened by
+//! [`dualsplit_geometry::EXIT_WIDEN`] (Ize 2013) exactly as the BVH slab test widens its far
+//! planes, so a ray through a box corner is never rounded away and the DST still reaches the
+//! same leaves as its BVH2. Every min/max is `f32::min/max` and every
 //! cull comparison is written `!(a > b)`, so a NaN distance (ray lying in a plane) never
 //! drops a child. Leaf triangles are tested on the ray's own interval `[ray.t_min, best_t]`.
 
@@ -14,7 +18,7 @@ use super::header::HeaderOffset;
 use super::pipeline::le_or_nan;
 use crate::image::MemoryImage;
 use crate::observer::{DstNodeKind, NodeStep, Observer};
-use dualsplit_geometry::{Hit, Ray, RayPre, Triangle, cull_limit};
+use dualsplit_geometry::{Hit, Ray, RayPre, Triangle, cull_limit, widen_exit};
 
 /// A traversal-stack entry: a node word index and its ray interval.
 #[derive(Clone, Copy, Debug, Default)]
@@ -233,12 +237,12 @@ impl Dst {
                     let a = w.axis();
                     let left = w.offset();
                     let right = left + w.left_size();
-                    // t1: where the ray leaves the near child's half-space; t2: where it
-                    // enters the far one (Lin et al. 2020, Fig. 3).
+                    // t1: where the ray leaves the near child's half-space (exit role,
+                    // widened); t2: where it enters the far one (Lin et al. 2020, Fig. 3).
                     let (near, far, t1, t2) = if tr.r.neg[a] {
-                        (right, left, tr.r.plane_t(a, p1), tr.r.plane_t(a, p0))
+                        (right, left, tr.r.exit_t(a, p1), tr.r.plane_t(a, p0))
                     } else {
-                        (left, right, tr.r.plane_t(a, p0), tr.r.plane_t(a, p1))
+                        (left, right, tr.r.exit_t(a, p0), tr.r.plane_t(a, p1))
                     };
                     let near_hit = le_or_nan(t_min, t1);
                     let far_hit = le_or_nan(t2, t_max);
@@ -272,10 +276,11 @@ impl Dst {
                     // Carving: exit planes clamp t_max, entry planes raise t_min.
                     let (lo, hi) = if kind == DstNodeKind::SingleCarve {
                         let a = w.axis();
+                        // t1: the exit plane after the sign swap (widened); t2: entry.
                         let (t1, t2) = if tr.r.neg[a] {
-                            (tr.r.plane_t(a, p1), tr.r.plane_t(a, p0))
+                            (tr.r.exit_t(a, p1), tr.r.plane_t(a, p0))
                         } else {
-                            (tr.r.plane_t(a, p0), tr.r.plane_t(a, p1))
+                            (tr.r.exit_t(a, p0), tr.r.plane_t(a, p1))
                         };
                         (t_min.max(t2), t_max.min(t1))
                     } else {
@@ -285,13 +290,14 @@ impl Dst {
                         let (mut lo, mut hi) = (t_min, t_max);
                         // A plane is an exit plane iff its "lower bound" bit equals the
                         // ray's sign on its axis (Lin et al. 2020, Fig. 2).
+                        // Exit planes are widened (`widen_exit`), entry planes are not.
                         if tr.r.neg[a0] == c.first_lower {
-                            hi = hi.min(ta);
+                            hi = hi.min(widen_exit(ta));
                         } else {
                             lo = lo.max(ta);
                         }
                         if tr.r.neg[a1] == c.second_lower {
-                            hi = hi.min(tb);
+                            hi = hi.min(widen_exit(tb));
                         } else {
                             lo = lo.max(tb);
                         }

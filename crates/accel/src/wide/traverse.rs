@@ -3,7 +3,9 @@
 //! the [`Observer`] every fetch and step (contract 2 of `docs/architecture.md`).
 //!
 //! Per internal node: fetch the node, slab-test every non-empty child box against
-//! `[ray.t_min, cull_limit(best_t)]`, report `NodeStep::Bvh`, sort the hit children by entry
+//! `[ray.t_min, cull_limit(best_t)]` ([`dualsplit_geometry::RayPre::slab`], whose far-plane
+//! exits are widened by `1 + 2γ₃` (Ize 2013) so a ray aimed at a vertex on a box corner is
+//! never rounded away), report `NodeStep::Bvh`, sort the hit children by entry
 //! distance (near first, ties in slot order), continue with the nearest and push the others
 //! far-first with their entry distance. A popped entry whose entry distance is beyond
 //! `cull_limit(best_t)` is discarded. Per leaf: fetch the leaf word, then the index run (its

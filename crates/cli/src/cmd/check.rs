@@ -5,8 +5,7 @@
 //! and the DST pipeline loop (dst) are all compared. Validation includes the DST rebuilding
 //! every BVH2 box from its planes. Exits nonzero on any failure.
 use crate::progress::Ctx;
-use anyhow::Context;
-use dualsplit_accel::{AccelKind, BuildConfig, CountingObserver, NoObserver, Structures};
+use dualsplit_accel::{AccelKind, CountingObserver, NoObserver};
 use dualsplit_render::RayKind;
 use rayon::prelude::*;
 use std::process::ExitCode;
@@ -26,13 +25,7 @@ const SHOW: usize = 5;
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
-    let sp = ctx.spinner(format!("loading {}", args.scene));
-    let scene = dualsplit_scene::load(&args.scene)
-        .with_context(|| format!("loading scene {}", args.scene))?;
-    sp.set_message("building BVH2, BVH4, BVH8, DST");
-    let s = Structures::try_build(&scene.triangles, &BuildConfig::default())
-        .with_context(|| format!("building the structures of {}", args.scene))?;
-    sp.finish_and_clear();
+    let (scene, s) = super::load_and_build(&args.scene, ctx)?;
     let mut failed = false;
     println!("{} ({} triangles)", scene.name, scene.triangles.len());
     println!("validation:");

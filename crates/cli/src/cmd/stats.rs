@@ -20,7 +20,7 @@
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::dst::{Dst, DstConfig, Partitioning};
-use dualsplit_accel::{AccelKind, BuildConfig, CountingObserver, Structures, stats::MIB};
+use dualsplit_accel::{AccelKind, CountingObserver, stats::MIB};
 use std::process::ExitCode;
 
 /// Arguments of `dualsplit stats`.
@@ -52,13 +52,7 @@ struct Variant {
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
-    let sp = ctx.spinner(format!("loading {}", args.scene));
-    let scene = dualsplit_scene::load(&args.scene)
-        .with_context(|| format!("loading scene {}", args.scene))?;
-    sp.set_message("building BVH2, BVH4, BVH8, DST");
-    let s = Structures::try_build(&scene.triangles, &BuildConfig::default())
-        .with_context(|| format!("building the structures of {}", args.scene))?;
-    sp.finish_and_clear();
+    let (scene, s) = super::load_and_build(&args.scene, ctx)?;
     let stats = s.stats();
     let (primary, _, diffuse) = super::rays::record(&scene, &s, args.rays, ctx);
     let rays: Vec<_> = primary.into_iter().chain(diffuse).collect();

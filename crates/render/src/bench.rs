@@ -1,0 +1,209 @@
+//! CPU traversal throughput: deterministic ray sets, checked against BVH2 before timing.
+//!
+//! Method (tinybvh's habit: check, then time):
+//!
+//! 1. [`ray_sets`] runs every pixel's [`PixelJob`] of a frame on BVH2 and keeps each ray with
+//!    BVH2's answer, split by [`RayKind`] (primary, shadow, diffuse), in pixel order. The rays
+//!    are exactly those the renderer traces, so shadow and diffuse rays start on surfaces.
+//! 2. [`measure`] first traces every ray of a set on the structure under test and compares
+//!    the answer with BVH2's bit for bit ([`TraceResult::bit_eq`]); the first mismatch is a
+//!    [`RenderError::Mismatch`], never a number.
+//! 3. Then it traces the whole set, in parallel over chunks of [`CHUNK`] rays on every core
+//!    (rayon), until [`MeasureConfig::min_seconds`] and [`MeasureConfig::min_repeats`] are
+//!    both reached, and reports rays per second over all repeats.
+//!
+//! This is the one place the library reads the wall clock: a throughput is a measurement of
+//! the machine, not a result of the algorithm. Nothing else depends on it.
+
+use crate::trace::{run_job, trace_query};
+use crate::{PixelJob, RayCounts, RayKind, RayQuery, RenderError, RenderSettings, TraceResult};
+use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_geometry::Ray;
+use dualsplit_scene::Scene;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Rays per parallel work item while timing.
+pub const CHUNK: usize = 1024;
+
+/// The rays of one kind from a frame, with BVH2's answers.
+#[derive(Clone, Debug)]
+pub struct RaySet {
+    /// Kind of every ray of the set.
+    pub kind: RayKind,
+    /// The rays, in pixel order (then issue order within a pixel).
+    pub rays: Vec<Ray>,
+    /// BVH2's answer to each ray.
+    pub expected: Vec<TraceResult>,
+}
+
+/// Builds the three ray sets (primary, shadow, diffuse; the *cast* workload's diffuse set is
+/// empty) of a frame of `settings` by running every pixel's job on BVH2.
+pub fn ray_sets(
+    scene: &Scene,
+    structures: &Structures,
+    settings: &RenderSettings,
+) -> Result<[RaySet; 3], RenderError> {
+    crate::validate(scene, settings)?;
+    let rows: Vec<Vec<(RayQuery, TraceResult)>> = (0..settings.height)
+        .into_par_iter()
+        .map(|y| {
+            let mut v = Vec::new();
+            let mut counts = RayCounts::default();
+            for x in 0..settings.width {
+                let job = PixelJob::new(scene, settings, x, y);
+                run_job(
+                    job,
+                    structures,
+                    AccelKind::Bvh2,
+                    &mut NoObserver,
+                    &mut counts,
+                    |q, r| v.push((*q, *r)),
+                );
+            }
+            v
+        })
+        .collect();
+    let mut sets = RayKind::ALL.map(|kind| RaySet {
+        kind,
+        rays: Vec::new(),
+        expected: Vec::new(),
+    });
+    for (q, r) in rows.into_iter().flatten() {
+        let s = &mut sets[q.kind as usize];
+        s.rays.push(q.ray);
+        s.expected.push(r);
+    }
+    Ok(sets)
+}
+
+/// How long to time a set.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeasureConfig {
+    /// Keep repeating the whole set until this much time has passed.
+    pub min_seconds: f64,
+    /// And at least this many repeats.
+    pub min_repeats: u32,
+}
+
+impl Default for MeasureConfig {
+    /// At least 1 s and 3 repeats.
+    fn default() -> Self {
+        Self {
+            min_seconds: 1.0,
+            min_repeats: 3,
+        }
+    }
+}
+
+/// A measured throughput.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Throughput {
+    /// Structure.
+    pub accel: AccelKind,
+    /// Ray kind.
+    pub ray_kind: RayKind,
+    /// Rays in the set.
+    pub rays: u64,
+    /// Times the whole set was traced.
+    pub repeats: u32,
+    /// Wall-clock seconds of all repeats.
+    pub seconds: f64,
+    /// Millions of rays per second: `rays · repeats / seconds / 10⁶`.
+    pub mrays_per_s: f64,
+    /// Threads rayon used.
+    pub threads: usize,
+}
+
+/// Traces every ray of `set` on `kind` and compares with BVH2's answers, bit for bit.
+pub fn verify(structures: &Structures, kind: AccelKind, set: &RaySet) -> Result<(), RenderError> {
+    let bad = set
+        .rays
+        .par_iter()
+        .zip(&set.expected)
+        .enumerate()
+        .find_first(|(_, (ray, want))| {
+            let q = RayQuery {
+                ray: **ray,
+                kind: set.kind,
+            };
+            !trace_query(structures, kind, &q, &mut NoObserver).bit_eq(want)
+        });
+    match bad {
+        None => Ok(()),
+        Some((index, (ray, want))) => {
+            let q = RayQuery {
+                ray: *ray,
+                kind: set.kind,
+            };
+            let got = trace_query(structures, kind, &q, &mut NoObserver);
+            Err(RenderError::Mismatch {
+                accel: kind.name(),
+                ray_kind: set.kind.name(),
+                index,
+                ray: format!("{ray:?}"),
+                expected: format!("{want:?}"),
+                got: format!("{got:?}"),
+            })
+        }
+    }
+}
+
+/// Verifies `set` on `kind` against BVH2 ([`verify`]), then times it ([`MeasureConfig`]).
+/// An empty set gives zero rays and zero throughput.
+pub fn measure(
+    structures: &Structures,
+    kind: AccelKind,
+    set: &RaySet,
+    cfg: &MeasureConfig,
+) -> Result<Throughput, RenderError> {
+    verify(structures, kind, set)?;
+    let threads = rayon::current_num_threads();
+    if set.rays.is_empty() {
+        return Ok(Throughput {
+            accel: kind,
+            ray_kind: set.kind,
+            rays: 0,
+            repeats: 0,
+            seconds: 0.0,
+            mrays_per_s: 0.0,
+            threads,
+        });
+    }
+    let start = Instant::now();
+    let mut repeats = 0u32;
+    let mut sink = 0u64;
+    loop {
+        sink += set
+            .rays
+            .par_chunks(CHUNK)
+            .map(|chunk| {
+                chunk
+                    .iter()
+                    .map(|ray| {
+                        let q = RayQuery {
+                            ray: *ray,
+                            kind: set.kind,
+                        };
+                        trace_query(structures, kind, &q, &mut NoObserver).is_hit() as u64
+                    })
+                    .sum::<u64>()
+            })
+            .sum::<u64>();
+        repeats += 1;
+        let s = start.elapsed().as_secs_f64();
+        if s >= cfg.min_seconds && repeats >= cfg.min_repeats {
+            std::hint::black_box(sink);
+            let rays = set.rays.len() as u64;
+            return Ok(Throughput {
+                accel: kind,
+                ray_kind: set.kind,
+                rays,
+                repeats,
+                seconds: s,
+                mrays_per_s: rays as f64 * repeats as f64 / s / 1e6,
+                threads,
+            });
+        }
+    }
+}

@@ -1,0 +1,171 @@
+//! [`render`]: a whole frame, parallel over square tiles on every core (rayon).
+//!
+//! Pixels are independent [`PixelJob`]s, so the tile order, the thread count and the work
+//! stealing change nothing: the image and the counters are the same bits on any machine
+//! with the same float semantics.
+
+use crate::trace::run_job;
+use crate::{Image, PixelJob, PixelRecord, RayCounts, RenderError, RenderSettings, trace_pixel};
+use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_scene::Scene;
+use rayon::prelude::*;
+
+/// Tile edge in pixels.
+pub const TILE: u32 = 16;
+
+/// A rendered frame: the linear image and the ray counters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// Linear radiance per pixel.
+    pub image: Image,
+    /// Rays by kind, hits and misses, over the whole frame.
+    pub counts: RayCounts,
+}
+
+/// Number of tiles [`render`] splits a frame into (the progress callback is called once per
+/// tile).
+pub fn tile_count(settings: &RenderSettings) -> u64 {
+    settings.width.div_ceil(TILE) as u64 * settings.height.div_ceil(TILE) as u64
+}
+
+/// Checks the settings, the scene's camera and its light; every renderer entry point calls it.
+pub fn validate(scene: &Scene, settings: &RenderSettings) -> Result<(), RenderError> {
+    let bad = |reason| RenderError::Settings {
+        width: settings.width,
+        height: settings.height,
+        spp: settings.spp,
+        reason,
+    };
+    if settings.width == 0 || settings.height == 0 {
+        return Err(bad("the image has no pixel"));
+    }
+    if settings.spp == 0 {
+        return Err(bad("at least one sample per pixel is needed"));
+    }
+    if settings.width.checked_mul(settings.height).is_none()
+        || settings.width > 1 << 16
+        || settings.height > 1 << 16
+    {
+        return Err(bad("at most 65536 pixels per side"));
+    }
+    let c = &scene.camera;
+    let cam_err = |reason| RenderError::Camera {
+        eye: c.eye.to_array(),
+        target: c.target.to_array(),
+        up: c.up.to_array(),
+        fov_y_deg: c.fov_y_deg,
+        reason,
+    };
+    if !(c.eye.is_finite() && c.target.is_finite() && c.up.is_finite() && c.fov_y_deg.is_finite()) {
+        return Err(cam_err("non-finite value"));
+    }
+    if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
+        return Err(cam_err(
+            "the field of view must lie strictly between 0° and 180°",
+        ));
+    }
+    let fwd = (c.target - c.eye).normalize_or_zero();
+    if fwd == glam::Vec3::ZERO {
+        return Err(cam_err("eye and target coincide"));
+    }
+    if fwd.cross(c.up).normalize_or_zero() == glam::Vec3::ZERO {
+        return Err(cam_err("the view direction is parallel to the up vector"));
+    }
+    let l = &scene.light;
+    if !(l.position.is_finite()
+        && l.radius.is_finite()
+        && l.radius >= 0.0
+        && l.intensity.is_finite()
+        && l.intensity >= 0.0)
+    {
+        return Err(RenderError::Light {
+            position: l.position.to_array(),
+            radius: l.radius,
+            intensity: l.intensity,
+        });
+    }
+    Ok(())
+}
+
+/// The pixel rectangles of the tiles, row-major.
+fn tiles(settings: &RenderSettings) -> Vec<(u32, u32, u32, u32)> {
+    let mut v = Vec::with_capacity(tile_count(settings) as usize);
+    for ty in (0..settings.height).step_by(TILE as usize) {
+        for tx in (0..settings.width).step_by(TILE as usize) {
+            v.push((
+                tx,
+                ty,
+                (tx + TILE).min(settings.width),
+                (ty + TILE).min(settings.height),
+            ));
+        }
+    }
+    v
+}
+
+/// Renders a frame of `scene` with `settings.workload` on structure `kind`, in parallel over
+/// [`TILE`]×[`TILE`] tiles; `progress` is called once per finished tile (from any thread).
+///
+/// Every [`AccelKind`] returns a bit-identical [`Frame`]: the structures return bit-identical
+/// hits (the geometry crate's robustness rules), and the jobs depend on nothing else.
+pub fn render(
+    scene: &Scene,
+    structures: &Structures,
+    kind: AccelKind,
+    settings: &RenderSettings,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Frame, RenderError> {
+    validate(scene, settings)?;
+    let done: Vec<(Vec<f32>, RayCounts)> = tiles(settings)
+        .into_par_iter()
+        .map(|(x0, y0, x1, y1)| {
+            let mut counts = RayCounts::default();
+            let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let job = PixelJob::new(scene, settings, x, y);
+                    px.push(run_job(
+                        job,
+                        structures,
+                        kind,
+                        &mut NoObserver,
+                        &mut counts,
+                        |_, _| {},
+                    ));
+                }
+            }
+            progress();
+            (px, counts)
+        })
+        .collect();
+    let mut image = Image::new(settings.width, settings.height);
+    let mut counts = RayCounts::default();
+    for ((x0, y0, x1, _), (px, c)) in tiles(settings).into_iter().zip(done) {
+        let w = (x1 - x0) as usize;
+        for (row, vals) in px.chunks(w).enumerate() {
+            let start = (y0 as usize + row) * settings.width as usize + x0 as usize;
+            image.pixels[start..start + w].copy_from_slice(vals);
+        }
+        counts.add(&c);
+    }
+    Ok(Frame { image, counts })
+}
+
+/// Traces every pixel of the frame with [`trace_pixel`] (in parallel over rows) and returns
+/// the records in row-major order. Memory grows with the ray count: meant for tests, the
+/// simulator's reference streams and small frames.
+pub fn render_records(
+    scene: &Scene,
+    structures: &Structures,
+    kind: AccelKind,
+    settings: &RenderSettings,
+) -> Result<Vec<PixelRecord>, RenderError> {
+    validate(scene, settings)?;
+    Ok((0..settings.height)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            (0..settings.width)
+                .map(move |x| trace_pixel(structures, kind, scene, settings, x, y, &mut NoObserver))
+        })
+        .collect())
+}
