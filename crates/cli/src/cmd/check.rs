@@ -67,27 +67,22 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         (RayKind::Shadow, &sets.1),
         (RayKind::Diffuse, &sets.2),
     ] {
+        // BVH2's answers, computed once per ray set.
+        let wants: Vec<Answer> = rays
+            .par_iter()
+            .map(|r| answer(&s, AccelKind::Bvh2, what, r, &mut NoObserver))
+            .collect();
         for kind in AccelKind::ALL {
             let bar = ctx.bar(rays.len() as u64, format!("{} {:?}", kind.name(), what));
             let (counts, bad) = rays
                 .par_chunks(1024)
-                .map(|chunk| {
+                .zip(wants.par_chunks(1024))
+                .map(|(chunk, want)| {
                     let mut c = CountingObserver::default();
                     let mut bad = Vec::new();
-                    for ray in chunk {
-                        if what == RayKind::Shadow {
-                            let want = s.any_hit(AccelKind::Bvh2, ray, &mut NoObserver);
-                            if s.any_hit(kind, ray, &mut c) != want {
-                                bad.push(*ray);
-                            }
-                        } else {
-                            let key = |h: Option<dualsplit_geometry::Hit>| {
-                                h.map(|h| (h.t.to_bits(), h.prim))
-                            };
-                            let want = key(s.closest_hit(AccelKind::Bvh2, ray, &mut NoObserver));
-                            if key(s.closest_hit(kind, ray, &mut c)) != want {
-                                bad.push(*ray);
-                            }
+                    for (ray, want) in chunk.iter().zip(want) {
+                        if answer(&s, kind, what, ray, &mut c) != *want {
+                            bad.push(*ray);
                         }
                     }
                     bar.inc(chunk.len() as u64);
@@ -128,5 +123,30 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     } else {
         println!("check passed");
         Ok(ExitCode::SUCCESS)
+    }
+}
+
+/// A ray's answer in comparable form: closest hit as (`t` bits, triangle id), or for shadow
+/// rays whether anything blocks the segment.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Answer {
+    Closest(Option<(u32, u32)>),
+    Occluded(bool),
+}
+
+fn answer(
+    s: &dualsplit_accel::Structures,
+    kind: AccelKind,
+    what: RayKind,
+    ray: &dualsplit_geometry::Ray,
+    obs: &mut impl dualsplit_accel::Observer,
+) -> Answer {
+    if what == RayKind::Shadow {
+        Answer::Occluded(s.any_hit(kind, ray, obs))
+    } else {
+        Answer::Closest(
+            s.closest_hit(kind, ray, obs)
+                .map(|h| (h.t.to_bits(), h.prim)),
+        )
     }
 }

@@ -71,8 +71,15 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             DstConfig::software().with_partitioning(Partitioning::Similar),
         ),
     ] {
-        let d = Dst::from_bvh2(&s.bvh2, &s.triangles, &cfg)
-            .with_context(|| format!("converting the DST ({name})"))?;
+        // The hardware/identical tree is the one `Structures` already built.
+        let converted;
+        let d = if cfg == *s.dst.config() {
+            &s.dst
+        } else {
+            converted = Dst::from_bvh2(&s.bvh2, &s.triangles, &cfg)
+                .with_context(|| format!("converting the DST ({name})"))?;
+            &converted
+        };
         let t = d.trace_stats(&rays);
         let bytes_total = d.stats().total_bytes;
         variants.push(Variant {
