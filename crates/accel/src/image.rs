@@ -201,6 +201,45 @@ pub(crate) fn is_degenerate_box(w: &[f32; 6]) -> bool {
     w[0] > w[3]
 }
 
+/// Boxes and packed word of a layout that keeps its child-type bits in the offset word
+/// (BVH2, BVH4): empty slots get the degenerate box, and slot `k` of a leaf child sets bit
+/// `leaf_bit(k)` of `offset_word`.
+pub(crate) fn encode_packed<const N: usize>(
+    children: &[(Aabb, ChildKind)],
+    offset_word: u32,
+    leaf_bit: impl Fn(usize) -> u32,
+) -> ([[f32; 6]; N], u32) {
+    assert!(
+        children.len() <= N,
+        "a {N}-wide node has at most {N} children"
+    );
+    let mut boxes = [box_words(Aabb::DEGENERATE); N];
+    let mut packed = offset_word;
+    for (k, &(b, kind)) in children.iter().enumerate() {
+        if kind == ChildKind::Empty {
+            continue;
+        }
+        boxes[k] = box_words(b);
+        if kind == ChildKind::Leaf {
+            packed |= 1 << leaf_bit(k);
+        }
+    }
+    (boxes, packed)
+}
+
+/// The kind of a slot in a packed layout: empty when its box is degenerate, else leaf when
+/// bit `leaf_bit` of `packed` is set.
+#[inline(always)]
+pub(crate) fn packed_kind(b: &[f32; 6], packed: u32, leaf_bit: u32) -> ChildKind {
+    if is_degenerate_box(b) {
+        ChildKind::Empty
+    } else if packed & (1 << leaf_bit) != 0 {
+        ChildKind::Leaf
+    } else {
+        ChildKind::Internal
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod test_support {
     use super::*;

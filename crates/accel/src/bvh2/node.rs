@@ -1,6 +1,6 @@
 //! The 52-byte BVH2 internal node (Lin et al. 2020, §4.2).
 
-use crate::image::{ChildKind, ImageError, NodeLayout, box_words, is_degenerate_box, words_box};
+use crate::image::{ChildKind, ImageError, NodeLayout, encode_packed, packed_kind, words_box};
 use dualsplit_geometry::Aabb;
 
 /// BVH2 internal node: two child boxes and one packed offset/type word, 52 bytes.
@@ -30,6 +30,11 @@ pub struct Node2 {
 
 const _: () = assert!(size_of::<Node2>() == 52);
 
+/// The packed-word bit that marks child `k` a leaf: bit 31 for child 0, bit 30 for child 1.
+fn leaf_bit(k: usize) -> u32 {
+    31 - k as u32
+}
+
 const OFFSET_MASK: u32 = (1 << 30) - 1;
 
 impl NodeLayout for Node2 {
@@ -39,21 +44,8 @@ impl NodeLayout for Node2 {
     const OFFSET_BITS: u32 = 30;
 
     fn encode(children: &[(Aabb, ChildKind)], offset: u32) -> Result<Self, ImageError> {
-        assert!(children.len() <= 2, "a BVH2 node has at most 2 children");
-        let mut n = Node2 {
-            boxes: [box_words(Aabb::DEGENERATE); 2],
-            packed: Self::check_offset(offset)?,
-        };
-        for (k, &(b, kind)) in children.iter().enumerate() {
-            if kind == ChildKind::Empty {
-                continue;
-            }
-            n.boxes[k] = box_words(b);
-            if kind == ChildKind::Leaf {
-                n.packed |= 1 << (31 - k);
-            }
-        }
-        Ok(n)
+        let (boxes, packed) = encode_packed::<2>(children, Self::check_offset(offset)?, leaf_bit);
+        Ok(Node2 { boxes, packed })
     }
 
     #[inline(always)]
@@ -63,13 +55,7 @@ impl NodeLayout for Node2 {
 
     #[inline(always)]
     fn kind(&self, k: usize) -> ChildKind {
-        if is_degenerate_box(&self.boxes[k]) {
-            ChildKind::Empty
-        } else if self.packed & (1 << (31 - k)) != 0 {
-            ChildKind::Leaf
-        } else {
-            ChildKind::Internal
-        }
+        packed_kind(&self.boxes[k], self.packed, leaf_bit(k))
     }
 
     #[inline(always)]

@@ -1,6 +1,6 @@
 //! The 100-byte BVH4 internal node (Lin et al. 2020, §4.2).
 
-use crate::image::{ChildKind, ImageError, NodeLayout, box_words, is_degenerate_box, words_box};
+use crate::image::{ChildKind, ImageError, NodeLayout, encode_packed, packed_kind, words_box};
 use dualsplit_geometry::Aabb;
 
 /// BVH4 internal node: four child boxes and one packed offset/type word, 100 bytes.
@@ -28,6 +28,11 @@ pub struct Node4 {
 
 const _: () = assert!(size_of::<Node4>() == 100);
 
+/// The packed-word bit that marks child `k` a leaf: bits 28–31 for children 0–3.
+fn leaf_bit(k: usize) -> u32 {
+    28 + k as u32
+}
+
 const OFFSET_MASK: u32 = (1 << 28) - 1;
 
 impl NodeLayout for Node4 {
@@ -37,21 +42,8 @@ impl NodeLayout for Node4 {
     const OFFSET_BITS: u32 = 28;
 
     fn encode(children: &[(Aabb, ChildKind)], offset: u32) -> Result<Self, ImageError> {
-        assert!(children.len() <= 4, "a BVH4 node has at most 4 children");
-        let mut n = Node4 {
-            boxes: [box_words(Aabb::DEGENERATE); 4],
-            packed: Self::check_offset(offset)?,
-        };
-        for (k, &(b, kind)) in children.iter().enumerate() {
-            if kind == ChildKind::Empty {
-                continue;
-            }
-            n.boxes[k] = box_words(b);
-            if kind == ChildKind::Leaf {
-                n.packed |= 1 << (28 + k);
-            }
-        }
-        Ok(n)
+        let (boxes, packed) = encode_packed::<4>(children, Self::check_offset(offset)?, leaf_bit);
+        Ok(Node4 { boxes, packed })
     }
 
     #[inline(always)]
@@ -61,13 +53,7 @@ impl NodeLayout for Node4 {
 
     #[inline(always)]
     fn kind(&self, k: usize) -> ChildKind {
-        if is_degenerate_box(&self.boxes[k]) {
-            ChildKind::Empty
-        } else if self.packed & (1 << (28 + k)) != 0 {
-            ChildKind::Leaf
-        } else {
-            ChildKind::Internal
-        }
+        packed_kind(&self.boxes[k], self.packed, leaf_bit(k))
     }
 
     #[inline(always)]
