@@ -1,7 +1,6 @@
 //! `dualsplit simulate`: one frame on the TRaX-style many-core model (Lin et al. 2020, §4).
 use crate::progress::Ctx;
 use anyhow::{Context, bail};
-use dualsplit_accel::{BuildConfig, Structures};
 use dualsplit_render::{RenderSettings, Workload};
 use dualsplit_sim::{SimAccel, SimConfig, SimResult, simulate};
 use std::process::ExitCode;
@@ -65,15 +64,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     cfg.validate()?;
 
-    let sp = ctx.spinner(format!("loading {}", args.scene));
-    let scene = dualsplit_scene::load(&args.scene)
-        .with_context(|| format!("loading scene {}", args.scene))?;
-    sp.set_message(format!(
-        "building structures ({} triangles)",
-        scene.triangles.len()
-    ));
-    let structures = Structures::build(&scene.triangles, &BuildConfig::high_quality());
-    sp.finish_and_clear();
+    let (scene, structures) = super::load_and_build(&args.scene, ctx)?;
     let settings = RenderSettings::new(args.res, args.res, workload);
 
     let sim_one = |accel: SimAccel| -> anyhow::Result<SimResult> {
