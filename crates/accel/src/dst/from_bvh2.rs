@@ -326,10 +326,16 @@ impl ChainDp {
                 dp.k += 1;
             }
         }
-        // Chains of at most two faces (three quarters of dragon_box's) are solved in closed
-        // form; longer ones by the DP, compiled once per chain length.
+        // Chains of at most two faces (three quarters of dragon_box's), and of three with
+        // cheap pairs, are solved in closed form; the others by the DP, compiled once per
+        // chain length.
+        let c_lone = costs.single_carve.min(costs.dual_carve);
+        let pairs_cheap = costs.single_carve <= c_lone && costs.dual_carve <= c_lone;
         match dp.k {
-            0..=2 => dp.fill_small(region, target, costs, leaf_tris),
+            0 => dp.fill_closed::<0>(region, target, costs, leaf_tris),
+            1 => dp.fill_closed::<1>(region, target, costs, leaf_tris),
+            2 => dp.fill_closed::<2>(region, target, costs, leaf_tris),
+            3 if pairs_cheap => dp.fill_closed::<3>(region, target, costs, leaf_tris),
             3 => dp.fill::<3>(region, target, costs, leaf_tris),
             4 => dp.fill::<4>(region, target, costs, leaf_tris),
             5 => dp.fill::<5>(region, target, costs, leaf_tris),
@@ -337,53 +343,52 @@ impl ChainDp {
         }
     }
 
-    /// [`ChainDp::solve`] for k ≤ 2 faces, in closed form: the DP of [`ChainDp::fill`]
-    /// written out state by state, with the same float expressions, the same options in
-    /// the same order and the same strict `<`, so it decides exactly what the DP decides
-    /// (ties included; `tests/dst_convert_golden.rs`).
+    /// [`ChainDp::solve`] in closed form for `K` ≤ 2 faces, and for `K` = 3 when every pair
+    /// node is no dearer than a lone-face node (the hardware preset): the DP of
+    /// [`ChainDp::fill`] written out state by state, with the same float expressions, the
+    /// same options in the same order and the same strict `<`, so it decides exactly what
+    /// the DP decides (ties included; `tests/dst_convert_golden.rs`).
     #[inline(always)]
-    fn fill_small(
+    fn fill_closed<const K: usize>(
         &mut self,
         region: &Aabb,
         target: &Aabb,
         costs: &DstCosts,
         leaf_tris: Option<u32>,
     ) {
-        let k = self.k;
-        let full = (1usize << k) - 1;
+        let full = (1usize << K) - 1;
         let c_lone = costs.single_carve.min(costs.dual_carve);
-        // Extent of the region on axis a when its faces in carve code c (bit 0: min face,
-        // bit 1: max face) are carved to `target`.
-        let ext = |a: usize, c: usize| {
-            let lo = if c & 1 == 1 {
-                target.min[a]
-            } else {
-                region.min[a]
-            };
-            let hi = if c & 2 == 2 {
-                target.max[a]
-            } else {
-                region.max[a]
-            };
-            (hi - lo).max(0.0)
-        };
-        // Surface area of the region in state s (the faces of s carved to `target`).
-        let face_mask = |s: usize| {
-            let mut m = 0usize;
-            for (i, &f) in self.faces[..k].iter().enumerate() {
-                m |= (s >> i & 1) << f;
+        // ext[a][c]: the region's extent on axis a with carve code c (bit 0: min face
+        // carved to `target`, bit 1: max face carved).
+        let mut ext = [[0f32; 4]; 3];
+        for (a, e) in ext.iter_mut().enumerate() {
+            let (rl, rh) = (region.min[a], region.max[a]);
+            let (tl, th) = (target.min[a], target.max[a]);
+            *e = [
+                (rh - rl).max(0.0),
+                (rh - tl).max(0.0),
+                (th - rl).max(0.0),
+                (th - tl).max(0.0),
+            ];
+        }
+        // Surface area of the region in every state (faces as a 6-bit mask, by doubling).
+        let mut fm = [0usize; 8];
+        for i in 0..K {
+            let b = 1 << i;
+            for s in 0..b {
+                fm[s | b] = fm[s] | 1 << self.faces[i];
             }
-            m
-        };
-        let sa = |s: usize| {
-            let m = face_mask(s);
-            let (x, y, z) = (ext(0, m & 3), ext(1, m >> 2 & 3), ext(2, m >> 4 & 3));
-            x * y + y * z + z * x
-        };
+        }
+        let mut sa = [0f32; 8];
+        for s in 0..=full {
+            let m = fm[s];
+            let (x, y, z) = (ext[0][m & 3], ext[1][m >> 2 & 3], ext[2][m >> 4 & 3]);
+            sa[s] = x * y + y * z + z * x;
+        }
         let tri_weight = leaf_tris.map(|n| costs.triangle * n as f32);
-        self.base = leaf_tris.map_or(0.0, |n| costs.triangle * n as f32 * sa(full));
+        self.base = leaf_tris.map_or(0.0, |n| costs.triangle * n as f32 * sa[full]);
         let base = self.base;
-        // The cheapest option of state s among `options` (mask, cost), the first on ties;
+        // The cheapest option of a state among `options` (mask, cost), the first on ties;
         // with similar partitioning the chain may also stop (choice 0).
         let best = |sa_s: f32, options: &[(u8, f32)]| {
             let mut b = (tri_weight.map_or(f32::INFINITY, |w| w * sa_s - base), 0u8);
@@ -394,41 +399,47 @@ impl ChainDp {
             }
             b
         };
-        // The cost of a pair node carving the two faces of local mask `t`.
-        let w_pair = |t: usize| {
-            let (i, j) = (t.trailing_zeros(), (t & (t - 1)).trailing_zeros());
-            if self.faces[i as usize] >> 1 == self.faces[j as usize] >> 1 {
+        // The cost of a pair node carving faces i and j.
+        let w_pair = |i: usize, j: usize| {
+            if self.faces[i] >> 1 == self.faces[j] >> 1 {
                 costs.single_carve
             } else {
                 costs.dual_carve
             }
         };
         self.cost[full] = 0.0;
-        match k {
+        match K {
             0 => {}
             1 => {
-                let sa0 = sa(0);
-                (self.cost[0], self.choice[0]) = best(sa0, &[(1, c_lone * sa0 + 0.0)]);
+                (self.cost[0], self.choice[0]) = best(sa[0], &[(1, c_lone * sa[0] + 0.0)]);
+            }
+            2 => {
+                for (s, rem) in [(2, 1), (1, 2)] {
+                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, c_lone * sa[s] + 0.0)]);
+                }
+                let w = w_pair(0, 1);
+                let pair = (3, w * sa[0] + 0.0);
+                (self.cost[0], self.choice[0]) = if w <= c_lone {
+                    // Carving a face alone is dominated while its partner remains.
+                    best(sa[0], &[pair])
+                } else {
+                    let lone = |t: u8| (t, c_lone * sa[0] + self.cost[t as usize]);
+                    best(sa[0], &[lone(1), pair, lone(2)])
+                };
             }
             _ => {
-                let (sa0, sa1, sa2) = (sa(0), sa(1), sa(2));
-                (self.cost[2], self.choice[2]) = best(sa2, &[(1, c_lone * sa2 + 0.0)]);
-                (self.cost[1], self.choice[1]) = best(sa1, &[(2, c_lone * sa1 + 0.0)]);
-                let w_pair = w_pair(3);
-                let pair = (3, w_pair * sa0 + 0.0);
-                (self.cost[0], self.choice[0]) = if w_pair <= c_lone {
-                    // Carving a face alone is dominated while its partner remains.
-                    best(sa0, &[pair])
-                } else {
-                    best(
-                        sa0,
-                        &[
-                            (1, c_lone * sa0 + self.cost[1]),
-                            pair,
-                            (2, c_lone * sa0 + self.cost[2]),
-                        ],
-                    )
-                };
+                // Every pair is cheap ([`OPTIONS_PAIRS_CHEAP`]): a last face is carved alone,
+                // two remaining faces as a pair, and from three the three pairs are tried.
+                for (s, rem) in [(6, 1), (5, 2), (3, 4)] {
+                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, c_lone * sa[s] + 0.0)]);
+                }
+                let w = [w_pair(0, 1), w_pair(0, 2), w_pair(1, 2)];
+                for (s, rem, w) in [(4, 3, w[0]), (2, 5, w[1]), (1, 6, w[2])] {
+                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, w * sa[s] + 0.0)]);
+                }
+                let pair = |t: u8, w: f32| (t, w * sa[0] + self.cost[t as usize]);
+                (self.cost[0], self.choice[0]) =
+                    best(sa[0], &[pair(3, w[0]), pair(5, w[1]), pair(6, w[2])]);
             }
         }
     }
