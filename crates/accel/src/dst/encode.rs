@@ -31,19 +31,34 @@ pub(super) const RUN_END: u32 = 1 << 31;
 /// independent rayon tasks, up to 2^PARALLEL_DEPTH of them.
 const PARALLEL_DEPTH: u32 = 8;
 
-/// What the plan pass decided at an internal BVH node, in the DST's child order.
+/// What the plan pass decided at an internal BVH node, in the DST's child order (32 bytes).
 #[derive(Clone, Copy, Debug)]
 struct Rec {
+    /// The incoming carving chains of the DST's left and right child.
+    chains: [Chain; 2],
+    /// Node words bump-allocated by the left subtree below its root slot (saturated: a
+    /// tree that large fails the offset check before emission).
+    left_words: u32,
+    /// Index entries of the left subtree (saturated likewise).
+    left_entries: u32,
     /// Split axis.
     axis: u8,
-    /// BVH nodes of the DST's left and right child.
-    children: [u32; 2],
-    /// Their incoming carving chains.
-    chains: [Chain; 2],
-    /// Node words bump-allocated by the left subtree below its root slot.
-    left_words: u64,
-    /// Index entries of the left subtree.
-    left_entries: u64,
+    /// The BVH node's second child is the DST's left child.
+    swap: bool,
+}
+
+impl Rec {
+    /// BVH nodes of the DST's left and right child of BVH node `n`.
+    #[inline(always)]
+    fn children(&self, bvh: &Bvh2, n: u32) -> [u32; 2] {
+        let [x, y] = bvh.nodes[n as usize].children();
+        if self.swap { [y, x] } else { [x, y] }
+    }
+
+    fn set_left(&mut self, size: Size) {
+        self.left_words = u32::try_from(size.words).unwrap_or(u32::MAX);
+        self.left_entries = u32::try_from(size.entries).unwrap_or(u32::MAX);
+    }
 }
 
 /// The plan of a subtree.
@@ -177,17 +192,17 @@ impl Encoder<'_> {
         }
         let p = plan_split(self.bvh, n, self.cfg, dps);
         Ok(Ok(Rec {
-            axis: p.axis as u8,
-            children: [p.left, p.right],
             chains: [p.left_chain, p.right_chain],
             left_words: 0,
             left_entries: 0,
+            axis: p.axis as u8,
+            swap: p.swap,
         }))
     }
 
     /// The words an internal node itself reserves: its chain, then both children's slots.
-    fn own_words(&self, rec: &Rec, chain: Chain) -> u64 {
-        let [l, r] = rec.children;
+    fn own_words(&self, n: u32, rec: &Rec, chain: Chain) -> u64 {
+        let [l, r] = rec.children(self.bvh, n);
         let [cl, cr] = rec.chains;
         (3 * chain.len() + slot_size(self.bvh, l, cl) + slot_size(self.bvh, r, cr)) as u64
     }
@@ -214,13 +229,13 @@ impl Encoder<'_> {
         };
         let slot = recs.len();
         recs.push(rec);
-        let l = self.plan_seq(rec.children[0], rec.chains[0], recs, budget, dps)?;
-        let r = self.plan_seq(rec.children[1], rec.chains[1], recs, budget, dps)?;
-        rec.left_words = l.words;
-        rec.left_entries = l.entries;
+        let [cl, cr] = rec.children(self.bvh, n);
+        let l = self.plan_seq(cl, rec.chains[0], recs, budget, dps)?;
+        let r = self.plan_seq(cr, rec.chains[1], recs, budget, dps)?;
+        rec.set_left(l);
         recs[slot] = rec;
         Ok(l.add(r).add(Size {
-            words: self.own_words(&rec, chain),
+            words: self.own_words(n, &rec, chain),
             entries: 0,
         }))
     }
@@ -240,15 +255,15 @@ impl Encoder<'_> {
             Err(leaf) => return Ok((Plan::Seq(Vec::new()), leaf)),
             Ok(rec) => rec,
         };
+        let [cl, cr] = rec.children(self.bvh, n);
         let (l, r) = rayon::join(
-            || self.plan(rec.children[0], rec.chains[0], depth + 1),
-            || self.plan(rec.children[1], rec.chains[1], depth + 1),
+            || self.plan(cl, rec.chains[0], depth + 1),
+            || self.plan(cr, rec.chains[1], depth + 1),
         );
         let ((lp, l), (rp, r)) = (l?, r?);
-        rec.left_words = l.words;
-        rec.left_entries = l.entries;
+        rec.set_left(l);
         let size = l.add(r).add(Size {
-            words: self.own_words(&rec, chain),
+            words: self.own_words(n, &rec, chain),
             entries: 0,
         });
         Ok((Plan::Par(rec, Box::new([lp, rp])), size))
@@ -344,9 +359,10 @@ impl Encoder<'_> {
     ) -> Result<(), DstError> {
         if let Some((slot, mut out)) = self.emit_head(n, chain, out, stats)? {
             let rec = recs.next().expect("one record per internal node");
-            let (l, r) = self.children_out(rec, &mut out, slot, stats)?;
-            self.emit(rec.children[0], rec.chains[0], l, recs, stats)?;
-            self.emit(rec.children[1], rec.chains[1], r, recs, stats)?;
+            let [cl, cr] = rec.children(self.bvh, n);
+            let (l, r) = self.children_out(rec, [cl, cr], &mut out, slot, stats)?;
+            self.emit(cl, rec.chains[0], l, recs, stats)?;
+            self.emit(cr, rec.chains[1], r, recs, stats)?;
         }
         Ok(())
     }
@@ -356,11 +372,11 @@ impl Encoder<'_> {
     fn children_out<'w>(
         &self,
         rec: &Rec,
+        [l, r]: [u32; 2],
         out: &mut Out<'w>,
         slot: &mut [u32],
         stats: &mut DstStats,
     ) -> Result<(Out<'w>, Out<'w>), DstError> {
-        let [l, r] = rec.children;
         let sl = slot_size(self.bvh, l, rec.chains[0]);
         let sr = slot_size(self.bvh, r, rec.chains[1]);
         let (pair, at) = out.take(sl + sr);
@@ -376,8 +392,8 @@ impl Encoder<'_> {
         let left = out.child(
             ls,
             Size {
-                words: rec.left_words,
-                entries: rec.left_entries,
+                words: rec.left_words as u64,
+                entries: rec.left_entries as u64,
             },
         );
         let right = Out {
@@ -399,10 +415,11 @@ impl Encoder<'_> {
                 let (slot, mut out) = self
                     .emit_head(n, chain, out, &mut stats)?
                     .expect("a parallel plan node is internal");
-                let (l, r) = self.children_out(rec, &mut out, slot, &mut stats)?;
+                let [cl, cr] = rec.children(self.bvh, n);
+                let (l, r) = self.children_out(rec, [cl, cr], &mut out, slot, &mut stats)?;
                 let (a, b) = rayon::join(
-                    || self.emit_plan(&children[0], rec.children[0], rec.chains[0], l),
-                    || self.emit_plan(&children[1], rec.children[1], rec.chains[1], r),
+                    || self.emit_plan(&children[0], cl, rec.chains[0], l),
+                    || self.emit_plan(&children[1], cr, rec.chains[1], r),
                 );
                 stats.add_counts(&a?);
                 stats.add_counts(&b?);

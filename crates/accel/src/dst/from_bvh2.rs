@@ -623,11 +623,10 @@ impl ChainDp {
 }
 
 /// The split chosen for an internal BVH node: axis, which BVH child is the left (lower)
-/// child, and both children's carving chains.
+/// child (`swap`: the second), and both children's carving chains.
 pub(super) struct SplitPlan {
     pub axis: usize,
-    pub left: u32,
-    pub right: u32,
+    pub swap: bool,
     pub left_chain: Chain,
     pub right_chain: Chain,
 }
@@ -670,15 +669,10 @@ pub(super) fn plan_split(bvh: &Bvh2, n: u32, cfg: &DstConfig, dps: &mut [ChainDp
         }
     }
     let (_, axis, swap) = best;
-    let (left, right, lo, hi) = if swap {
-        (y, x, &dy, &dx)
-    } else {
-        (x, y, &dx, &dy)
-    };
+    let (lo, hi) = if swap { (&dy, &dx) } else { (&dx, &dy) };
     SplitPlan {
         axis,
-        left,
-        right,
+        swap,
         left_chain: lo.chain(max_face(axis)),
         right_chain: hi.chain(min_face(axis)),
     }
