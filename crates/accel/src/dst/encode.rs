@@ -15,7 +15,7 @@
 //! The layout is the one a fully sequential depth-first emission with bump allocation
 //! gives, whatever the thread count (`tests/dst_convert_golden.rs`).
 
-use super::from_bvh2::{CarveKind, Chain, ChainDp, plan_split};
+use super::from_bvh2::{Chain, ChainDp, StepTable, plan_split, plane_values};
 use super::header::{HeaderOffset, OFFSET_LIMIT};
 use super::stats::DstStats;
 use super::{Dst, DstConfig, DstError};
@@ -137,6 +137,7 @@ struct Encoder<'a> {
     bvh: &'a Bvh2,
     triangles: usize,
     cfg: &'a DstConfig,
+    steps: StepTable,
 }
 
 impl Encoder<'_> {
@@ -307,8 +308,9 @@ impl Encoder<'_> {
         let is_leaf = node.is_leaf();
         let steps = chain.len();
         let mut slot = std::mem::take(&mut out.slot);
+        let planes = plane_values(&node.bounds);
         for i in 0..steps {
-            let step = chain.step(i, &node.bounds, &self.cfg.costs);
+            let step = self.steps.get(chain.faces(i));
             // A carving node's child is a carving or splitting node (3 words), or the leaf
             // is folded into it (L = 1).
             let fold = is_leaf && i + 1 == steps;
@@ -320,17 +322,14 @@ impl Encoder<'_> {
                 let (c, at) = out.take(3);
                 (at, Some(c))
             };
-            let h = match step.kind {
-                CarveKind::Single(axis) => {
-                    stats.single_carving += 1;
-                    HeaderOffset::single_carve(axis, fold, offset)?
-                }
-                CarveKind::Dual(pair, corner) => {
-                    stats.dual_carving += 1;
-                    HeaderOffset::dual_carve(pair, corner, fold, offset)?
-                }
-            };
-            put(slot, h, step.p0, step.p1);
+            if step.dual {
+                stats.dual_carving += 1;
+            } else {
+                stats.single_carving += 1;
+            }
+            let h = step.header.carve_pointing_at(fold, offset)?;
+            let [p0, p1] = step.planes.map(|p| planes[p as usize]);
+            put(slot, h, p0, p1);
             if let Some(c) = child {
                 slot = c;
             }
@@ -448,6 +447,7 @@ impl Dst {
             bvh,
             triangles: triangles.len(),
             cfg,
+            steps: StepTable::new(&cfg.costs)?,
         };
         let empty = bvh.prim_ids.is_empty() || bvh.nodes.is_empty();
         let (plan, root_slot, size) = if empty {

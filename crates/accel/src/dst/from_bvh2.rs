@@ -19,10 +19,10 @@
 //! with the same strict `<` and the same float expressions, so every decision (ties
 //! included) is the one the plain loops made (`tests/dst_convert_golden.rs`).
 
-use super::header::{AxisPair, Corner};
-use super::{DstConfig, DstCosts, Partitioning};
+use super::header::{AxisPair, Corner, HeaderOffset};
+use super::{DstConfig, DstCosts, DstError, Partitioning};
 use crate::build::Bvh2;
-use dualsplit_geometry::Aabb;
+use dualsplit_geometry::{Aabb, Vec3};
 
 /// A carving node the converter decided to emit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,16 +70,98 @@ impl Chain {
         self.0 = (self.0 & ((1 << 36) - 1)) | faces << (6 * n) | ((n + 1) as u64) << 36;
     }
 
-    /// Step `i`'s carving node, its planes taken from `target` (the box the chain carves
-    /// down to).
+    /// The faces step `i` carves, as a 6-bit mask (bit `f` = face `f`).
     #[inline(always)]
-    pub fn step(self, i: usize, target: &Aabb, costs: &DstCosts) -> CarveStep {
-        let m = (self.0 >> (6 * i)) & 63;
-        let fi = m.trailing_zeros() as usize;
-        let rest = m & !(1 << fi);
-        let fj = (rest != 0).then(|| rest.trailing_zeros() as usize);
-        step_for(fi, fj, target, costs)
+    pub fn faces(self, i: usize) -> usize {
+        (self.0 >> (6 * i)) as usize & 63
     }
+}
+
+/// Where a carving node's plane comes from: face 0–5 of the box the chain carves down to,
+/// or a ±∞ no-op plane.
+const PLUS_INF: u8 = 6;
+const MINUS_INF: u8 = 7;
+
+/// A carving node as a function of the faces it carves: its header (offset 0, L = 0),
+/// whether it is dual-axis, and the sources of P0 and P1 (a face 0–5, [`PLUS_INF`] or
+/// [`MINUS_INF`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct StepTemplate {
+    pub header: HeaderOffset,
+    pub dual: bool,
+    pub planes: [u8; 2],
+}
+
+/// The carving node of every face set a chain step can carve (one face or two), built once
+/// per conversion with [`step_for`], so emission is a lookup and two plane selects.
+pub(super) struct StepTable([StepTemplate; 64]);
+
+impl StepTable {
+    pub fn new(costs: &DstCosts) -> Result<Self, DstError> {
+        // A probe box whose coordinates are the face numbers: step_for's planes name their
+        // faces.
+        let probe = Aabb {
+            min: Vec3::new(0.0, 2.0, 4.0),
+            max: Vec3::new(1.0, 3.0, 5.0),
+        };
+        let source = |p: f32| {
+            if p == f32::INFINITY {
+                PLUS_INF
+            } else if p == f32::NEG_INFINITY {
+                MINUS_INF
+            } else {
+                p as u8
+            }
+        };
+        let mut table = [StepTemplate {
+            header: HeaderOffset::single_carve(0, false, 0)?,
+            dual: false,
+            planes: [PLUS_INF, MINUS_INF],
+        }; 64];
+        for (m, t) in table.iter_mut().enumerate() {
+            if !(1..=2).contains(&m.count_ones()) {
+                continue;
+            }
+            let fi = m.trailing_zeros() as usize;
+            let rest = m & !(1 << fi);
+            let fj = (rest != 0).then(|| rest.trailing_zeros() as usize);
+            let step = step_for(fi, fj, &probe, costs);
+            let (header, dual) = match step.kind {
+                CarveKind::Single(axis) => (HeaderOffset::single_carve(axis, false, 0)?, false),
+                CarveKind::Dual(pair, corner) => {
+                    (HeaderOffset::dual_carve(pair, corner, false, 0)?, true)
+                }
+            };
+            *t = StepTemplate {
+                header,
+                dual,
+                planes: [source(step.p0), source(step.p1)],
+            };
+        }
+        Ok(StepTable(table))
+    }
+
+    /// The template of the step carving face set `faces`.
+    #[inline(always)]
+    pub fn get(&self, faces: usize) -> &StepTemplate {
+        &self.0[faces]
+    }
+}
+
+/// The values [`StepTemplate::planes`] select from, for a chain carving down to `target`.
+#[inline(always)]
+pub(super) fn plane_values(target: &Aabb) -> [f32; 8] {
+    let (lo, hi) = (target.min, target.max);
+    [
+        lo.x,
+        hi.x,
+        lo.y,
+        hi.y,
+        lo.z,
+        hi.z,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+    ]
 }
 
 /// Face `f` of a box: axis `f >> 1`, the max face when `f & 1 == 1`.
