@@ -80,6 +80,27 @@ fn bvh2_build_and_image() -> BvhImage {
     BvhImage::encode(&wide, &bvh, &i.tris, &cfg, std::time::Duration::ZERO).expect("encoding")
 }
 
+/// The floor of any conversion on this machine: a fresh zeroed allocation the size of the
+/// hardware DST's image (nodes, index runs, triangles), one word written per 4 KiB page, so
+/// the first-touch page faults that writing the image costs are timed alone.
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn image_first_touch() -> Vec<u32> {
+    static WORDS: OnceLock<usize> = OnceLock::new();
+    let n = *WORDS.get_or_init(|| {
+        let i = input();
+        Dst::from_bvh2(&i.bvh, &i.tris, &DstConfig::hardware())
+            .expect("conversion")
+            .image()
+            .words
+            .len()
+    });
+    let mut words = vec![0u32; divan::black_box(n)];
+    for w in words.iter_mut().step_by(1024) {
+        *w = 1;
+    }
+    words
+}
+
 #[divan::bench(sample_count = 10, sample_size = 1)]
 fn dst_convert_hardware() -> Dst {
     let i = input();
