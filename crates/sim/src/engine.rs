@@ -13,7 +13,7 @@ use crate::Cycle;
 use crate::config::SimConfig;
 use crate::kernel::{Op, Pipe};
 use crate::memory::{Cache, Dram, Lookup};
-use crate::slots::Slots;
+use crate::slots::{BankSlots, Slots};
 use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -71,7 +71,7 @@ pub struct UnitStats {
 
 struct Tm {
     l1: Cache,
-    l1_banks: Vec<Slots>,
+    l1_banks: BankSlots,
     box_pipes: Vec<Slots>,
     tri_pipes: Vec<Slots>,
     dst_pipes: Vec<Slots>,
@@ -114,7 +114,7 @@ impl Chip {
     pub fn new(cfg: &SimConfig, box_pipes: u32) -> Self {
         let tm = || Tm {
             l1: Cache::new(cfg.l1.size_bytes, cfg.l1.line_bytes, cfg.l1.associativity),
-            l1_banks: vec![Slots::default(); cfg.l1.banks as usize],
+            l1_banks: BankSlots::new(cfg.l1.banks),
             box_pipes: vec![Slots::default(); box_pipes.max(1) as usize],
             tri_pipes: vec![Slots::default(); cfg.units.tri_pipes as usize],
             dst_pipes: vec![Slots::default(); cfg.units.dst_pipes as usize],
@@ -140,11 +140,12 @@ impl Chip {
     /// cycle the data is in the register.
     #[cfg(test)]
     fn load_word(&mut self, tm: usize, word: u64, slot: Cycle) -> Cycle {
-        self.load_word_fill(tm, word, slot).0
+        self.load_word_fill(tm, word, slot, 0).0
     }
 
-    /// As [`Chip::load_word`], also returning the fill cycle now in the line's L1 tag.
-    fn load_word_fill(&mut self, tm: usize, word: u64, slot: Cycle) -> (Cycle, Cycle) {
+    /// As [`Chip::load_word`], also returning the fill cycle now in the line's L1 tag;
+    /// `now` (≤ `slot`) is the current event time: no later access starts before it.
+    fn load_word_fill(&mut self, tm: usize, word: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
         let line = word >> self.line_word_shift;
         let l1_lat = self.cfg.l1.hit_latency;
         self.caches.l1_accesses += 1;
@@ -178,7 +179,7 @@ impl Chip {
                         fill.max(at)
                     }
                     Lookup::Absent => {
-                        let (done, _) = self.dram.read(line, at);
+                        let (done, _) = self.dram.read_at(line, at, now);
                         self.l2.install(line, done);
                         done
                     }
@@ -281,12 +282,12 @@ impl Thread {
                 self.wait(r, &mut chip.stalls);
             }
             self.pc += 1;
-            self.execute(op, chip);
+            self.execute(op, chip, now);
         }
         false
     }
 
-    fn execute(&mut self, op: Op, chip: &mut Chip) {
+    fn execute(&mut self, op: Op, chip: &mut Chip, now: Cycle) {
         let tm = self.tm;
         match op {
             Op::Issue { n, fpinv } => {
@@ -312,23 +313,29 @@ impl Thread {
                 // Line by line: the first word looks the line up (L1 tags, then L2/DRAM on a
                 // miss); later words of the same line see exactly what a second tag lookup
                 // would (hit once the fill has arrived, merged before). Every word takes its
-                // own L1 bank slot, one issue slot after the previous word's.
+                // own L1 bank slot, one issue slot after the previous word's; the banks of a
+                // line segment are placed in one run (`BankSlots::reserve_run`).
                 while w < end {
                     let seg_end = (((w >> shift) + 1) << shift).min(end);
-                    let slot = chip.tms[tm].l1_banks[(w & bank_mask) as usize].reserve(c);
-                    bank_stall += slot - c;
-                    let (mut r, fill) = chip.load_word_fill(tm, w, slot);
+                    let first = chip.tms[tm]
+                        .l1_banks
+                        .reserve_run(w & bank_mask, c, 1, now, 0);
+                    let slot = first.first;
+                    bank_stall += first.stall;
+                    let (mut r, fill) = chip.load_word_fill(tm, w, slot, now);
                     c = slot + 1;
                     if seg_end > w + 1 {
-                        let banks = &mut chip.tms[tm].l1_banks;
-                        let mut hits = 0;
-                        for v in w + 1..seg_end {
-                            let slot = banks[(v & bank_mask) as usize].reserve(c);
-                            bank_stall += slot - c;
-                            hits += u64::from(fill <= slot);
-                            c = slot + 1;
-                        }
                         let rest = seg_end - w - 1;
+                        let run = chip.tms[tm].l1_banks.reserve_run(
+                            (w + 1) & bank_mask,
+                            c,
+                            rest,
+                            now,
+                            fill,
+                        );
+                        bank_stall += run.stall;
+                        let hits = run.at_or_after;
+                        c = run.last + 1;
                         chip.caches.l1_accesses += rest;
                         chip.caches.l1_hits += hits;
                         chip.caches.l1_merged += rest - hits;
