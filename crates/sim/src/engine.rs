@@ -227,6 +227,21 @@ impl Thread {
         self.ready.max(self.t)
     }
 
+    /// Reads (without effect) the host memory the thread's next op will touch first: the
+    /// op itself and, for a load, its line's L1 tag. `run_chip` calls it for every thread
+    /// of a wake-up cycle before running them, so those host cache misses overlap instead
+    /// of coming one after another. Returns a value to keep the reads.
+    #[inline]
+    fn touch(&self, chip: &Chip) -> u64 {
+        match self.ops.get(self.pc) {
+            Some(&Op::Load { addr, .. }) => chip.tms[self.tm]
+                .l1
+                .peek(addr >> (2 + chip.line_word_shift)),
+            Some(_) => 1,
+            None => 0,
+        }
+    }
+
     /// Replaces the program (the previous one must be done).
     pub fn load_program(&mut self, ops: Vec<Op>) {
         self.ops = ops;
@@ -424,8 +439,9 @@ fn earliest(units: &mut [Slots], c: Cycle) -> Cycle {
 /// Supplies threads with work: called when a thread's program is done; returns the next
 /// program or `None` when there is no work left.
 pub trait WorkSource {
-    /// The next program for a thread (after its atomic increment).
-    fn next(&mut self, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>>;
+    /// The next program for thread `id` (its index in `run_chip`'s slice), whose previous
+    /// program is done.
+    fn next(&mut self, id: usize, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>>;
 }
 
 /// A timing wheel of thread wake-ups (notes §5.2): one bucket per cycle for the next
@@ -496,6 +512,11 @@ pub fn run_chip(chip: &mut Chip, threads: &mut [Thread], work: &mut dyn WorkSour
     let mut finish = vec![0; threads.len()];
     let mut spare = Vec::new();
     while let Some((now, mut ids)) = wheel.next_bucket(spare) {
+        let mut touched = 0;
+        for &id in &ids {
+            touched += threads[id as usize].touch(chip);
+        }
+        std::hint::black_box(touched);
         for &id in &ids {
             let th = &mut threads[id as usize];
             loop {
@@ -504,7 +525,7 @@ pub fn run_chip(chip: &mut Chip, threads: &mut [Thread], work: &mut dyn WorkSour
                     break;
                 }
                 // Program finished: the thread takes more work or retires once results are in.
-                match work.next(th, chip) {
+                match work.next(id as usize, th, chip) {
                     Some(ops) => {
                         th.load_program(ops);
                         if th.t > now {
@@ -534,7 +555,7 @@ mod tests {
 
     struct Programs(Vec<Vec<Op>>);
     impl WorkSource for Programs {
-        fn next(&mut self, t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
+        fn next(&mut self, _id: usize, t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
             // One program per thread.
             if t.ops.is_empty() { self.0.pop() } else { None }
         }
