@@ -228,15 +228,16 @@ impl Thread {
     }
 
     /// Reads (without effect) the host memory the thread's next op will touch first: the
-    /// op itself and, for a load, its line's L1 tag. `run_chip` calls it for every thread
+    /// op itself and, for a load, its line's L1 and L2 tags. `run_chip` calls it for every thread
     /// of a wake-up cycle before running them, so those host cache misses overlap instead
     /// of coming one after another. Returns a value to keep the reads.
     #[inline]
     fn touch(&self, chip: &Chip) -> u64 {
         match self.ops.get(self.pc) {
-            Some(&Op::Load { addr, .. }) => chip.tms[self.tm]
-                .l1
-                .peek(addr >> (2 + chip.line_word_shift)),
+            Some(&Op::Load { addr, .. }) => {
+                let line = addr >> (2 + chip.line_word_shift);
+                chip.tms[self.tm].l1.peek(line) ^ chip.l2.peek(line)
+            }
             Some(_) => 1,
             None => 0,
         }

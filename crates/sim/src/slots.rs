@@ -304,66 +304,115 @@ impl BankSlots {
 /// channel buses and activation spacing: a backed-up bank schedules its reads hundreds of
 /// nanoseconds ahead). Unlike [`Slots`], a far-future reservation never moves a window past
 /// earlier free cycles, so a read to an idle bank of the same channel still gets the first
-/// free cycle after its own ready time. Reservations are kept as sorted, disjoint, merged
-/// half-open intervals (a saturated bus is one long interval, so a search is a binary
-/// search plus a step or two). The owner says which cycles no request can reach any more
-/// ([`SparseSlots::forget_before`], from the current event time), so the list holds only
-/// the backlog ahead of the present.
-#[derive(Clone, Debug, Default)]
+/// free cycle after its own ready time. Every reservation is kept in a bitmap ring that
+/// grows to cover the furthest one; the owner says which cycles no request can reach any
+/// more ([`SparseSlots::forget_before`], from the current event time), and the ring
+/// recycles them, so it only spans the backlog ahead of the present. A search scans 64
+/// cycles per step (a saturated bus is a run of full words).
+#[derive(Clone, Debug)]
 pub struct SparseSlots {
-    taken: Vec<(Cycle, Cycle)>,
-    /// Intervals before this index end at or before the last `forget_before` floor.
-    head: usize,
+    /// First cycle covered (a multiple of 64); the ring covers `[lo, lo + 64 · words.len())`
+    /// and every reservation ever made at or after `lo` lies in it.
+    lo: Cycle,
+    /// `words[(x / 64) mod len]` bit `x mod 64`: cycle `x` is taken (power-of-two length).
+    words: Vec<u64>,
+    /// No request starts before this cycle (`forget_before`).
+    floor: Cycle,
+}
+
+impl Default for SparseSlots {
+    fn default() -> Self {
+        Self {
+            lo: 0,
+            words: vec![0; 16],
+            floor: 0,
+        }
+    }
 }
 
 impl SparseSlots {
-    /// Forgets reservations that end at or before `floor`: no later request starts before
-    /// `floor`, so they can no longer collide with one (results are unchanged).
+    /// Forgets reservations before `floor`: no later request starts before `floor`, so they
+    /// can no longer collide with one (results are unchanged).
     #[inline]
     pub fn forget_before(&mut self, floor: Cycle) {
-        while self.taken.get(self.head).is_some_and(|iv| iv.1 <= floor) {
-            self.head += 1;
+        self.floor = self.floor.max(floor);
+    }
+
+    #[inline]
+    fn end(&self) -> Cycle {
+        self.lo + ((self.words.len() as u64) << 6)
+    }
+
+    #[inline]
+    fn word(&self, x: Cycle) -> u64 {
+        self.words[(x >> 6) as usize & (self.words.len() - 1)]
+    }
+
+    /// Makes the ring cover cycle `hi` (recycling cycles before the floor, growing if that
+    /// is not enough).
+    fn cover(&mut self, hi: Cycle) {
+        if hi < self.end() {
+            return;
         }
-        if self.head >= 64 && self.head * 2 >= self.taken.len() {
-            self.taken.drain(..self.head);
-            self.head = 0;
+        let n = self.words.len();
+        let new_lo = (self.floor & !63).max(self.lo);
+        let (old_w, new_w) = (self.lo >> 6, new_lo >> 6);
+        for j in old_w..old_w + (new_w - old_w).min(n as u64) {
+            self.words[j as usize & (n - 1)] = 0;
+        }
+        self.lo = new_lo;
+        while hi >= self.end() {
+            let n = self.words.len();
+            let mut words = vec![0; n * 2];
+            for j in self.lo >> 6..(self.lo >> 6) + n as u64 {
+                words[j as usize & (2 * n - 1)] = self.words[j as usize & (n - 1)];
+            }
+            self.words = words;
         }
     }
 
-    /// First start `s ≥ c` where `[s, s + len)` overlaps no reservation, and the index of
-    /// the first interval ending after `s`'s predecessors.
-    fn find(&self, c: Cycle, len: u64) -> (Cycle, usize) {
-        let mut i = self.head + self.taken[self.head..].partition_point(|iv| iv.1 <= c);
+    /// Taken-bits of cycles `[s, s + len)`, `1 ≤ len ≤ 64`, `lo ≤ s < end` (bit i: s + i;
+    /// cycles past the ring are free).
+    #[inline]
+    fn window(&self, s: Cycle, len: u64) -> u64 {
+        let sh = s & 63;
+        let mut m = self.word(s) >> sh;
+        if sh + len > 64 && (s | 63) + 1 < self.end() {
+            m |= self.word(s + 64) << (64 - sh);
+        }
+        m & (u64::MAX >> (64 - len))
+    }
+
+    /// First start `s ≥ c` where `[s, s + len)` overlaps no reservation (`c ≥` the floor).
+    fn find(&self, c: Cycle, len: u64) -> Cycle {
+        debug_assert!(c >= self.lo && (1..=64).contains(&len));
         let mut s = c;
-        while let Some(&(lo, hi)) = self.taken.get(i) {
-            if lo >= s + len {
-                break;
+        let end = self.end();
+        if len == 1 {
+            while s < end {
+                let free = !self.word(s) >> (s & 63);
+                if free != 0 {
+                    return s + free.trailing_zeros() as u64;
+                }
+                s = (s | 63) + 1;
             }
-            s = s.max(hi);
-            i += 1;
+            return s;
         }
-        (s, i)
-    }
-
-    /// Marks `[s, s + len)` taken; `i` is the index of the first interval starting after it.
-    fn insert(&mut self, s: Cycle, len: u64, i: usize) {
-        let e = s + len;
-        let joins_prev = i > self.head && self.taken[i - 1].1 == s;
-        let joins_next = self.taken.get(i).is_some_and(|iv| iv.0 == e);
-        match (joins_prev, joins_next) {
-            (true, true) => {
-                self.taken[i - 1].1 = self.taken[i].1;
-                self.taken.remove(i);
+        while s < end {
+            let taken = self.window(s, len);
+            if taken == 0 {
+                return s;
             }
-            (true, false) => self.taken[i - 1].1 = e,
-            (false, true) => self.taken[i].0 = s,
-            (false, false) => self.taken.insert(i, (s, e)),
+            // Past the last taken cycle of the window.
+            s += 64 - taken.leading_zeros() as u64;
         }
+        s
     }
 
     /// The first free cycle at or after `c`, without reserving it.
     pub fn peek(&self, c: Cycle) -> Cycle {
-        self.find(c, 1).0
+        debug_assert!(c >= self.floor);
+        self.find(c.max(self.lo), 1)
     }
 
     /// Reserves the first free cycle at or after `c` and returns it.
@@ -371,12 +420,20 @@ impl SparseSlots {
         self.reserve_span(c, 1)
     }
 
-    /// Reserves a span of `len` cycles at the first start at or after `c` where it overlaps
-    /// no other span (spans are all `len` long, so starts end up at least `len` apart: a
-    /// minimum spacing such as t_RRD between activations).
+    /// Reserves a span of `len` cycles (`1 ≤ len ≤ 64`) at the first start at or after `c`
+    /// where it overlaps no other span (spans are all `len` long, so starts end up at least
+    /// `len` apart: a minimum spacing such as t_RRD between activations).
     pub fn reserve_span(&mut self, c: Cycle, len: u64) -> Cycle {
-        let (s, i) = self.find(c, len);
-        self.insert(s, len, i);
+        debug_assert!(c >= self.floor);
+        let s = self.find(c.max(self.lo), len);
+        self.cover(s + len - 1);
+        let sh = s & 63;
+        let m = u64::MAX >> (64 - len);
+        let n = self.words.len();
+        self.words[(s >> 6) as usize & (n - 1)] |= m << sh;
+        if sh + len > 64 {
+            self.words[((s >> 6) + 1) as usize & (n - 1)] |= m >> (64 - sh);
+        }
         s
     }
 }
@@ -563,6 +620,40 @@ mod bank_tests {
                 );
             }
             assert!(diag.span() >= 1200, "{}", diag.span());
+        }
+    }
+
+    /// `SparseSlots` against a plain set of taken cycles: spans of 1..=20 cycles requested
+    /// in a jittered order ahead of a rising floor, some far ahead (the ring grows), with
+    /// `peek` checked before each reservation.
+    #[test]
+    fn sparse_slots_match_a_set_of_taken_cycles() {
+        for seed in 0..8 {
+            let mut rng = Pcg32::new(seed, 9);
+            let mut set = BTreeSet::new();
+            let mut slots = SparseSlots::default();
+            let mut floor = 0;
+            let len = 1 + rng.below(20) as u64;
+            for i in 0..2000 {
+                floor += rng.below(14) as u64;
+                slots.forget_before(floor);
+                let far = if rng.below(50) == 0 { 5000 } else { 0 };
+                let c = floor + far + rng.below(300) as u64;
+                let free =
+                    |set: &BTreeSet<Cycle>, s: Cycle, l: u64| (s..s + l).all(|x| !set.contains(&x));
+                let mut p = c;
+                while !free(&set, p, 1) {
+                    p += 1;
+                }
+                assert_eq!(slots.peek(c), p, "seed {seed}, request {i}: peek");
+                let l = if i % 2 == 0 { len } else { 1 };
+                let mut s = c;
+                while !free(&set, s, l) {
+                    s += 1;
+                }
+                assert_eq!(slots.reserve_span(c, l), s, "seed {seed}, request {i}");
+                set.extend(s..s + l);
+            }
         }
     }
 }
