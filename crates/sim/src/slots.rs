@@ -119,7 +119,9 @@ pub struct BankSlots {
     lo: Cycle,
     /// 64-cycle words per diagonal (a power of two).
     words: usize,
-    /// `bits[d · words + (x / 64 mod words)]` bit `x mod 64`: bank `(d + x) mod banks` is
+    /// log2(banks).
+    bank_shift: u32,
+    /// `bits[(x / 64 mod words) · banks + d]` bit `x mod 64`: bank `(d + x) mod banks` is
     /// taken at cycle `x`.
     bits: Vec<u64>,
 }
@@ -144,6 +146,7 @@ impl BankSlots {
         let words = 8;
         Self {
             bank_mask: banks as u64 - 1,
+            bank_shift: banks.trailing_zeros(),
             lo: 0,
             words,
             bits: vec![0; banks as usize * words],
@@ -166,6 +169,7 @@ impl BankSlots {
 
     #[inline(never)]
     fn cover_slow(&mut self, hi: Cycle, now: Cycle) {
+        let banks = self.bank_mask as usize + 1;
         let new_lo = (now & !63).max(self.lo);
         let (old_w, new_w) = (self.lo >> 6, new_lo >> 6);
         // Words of cycles [lo, new_lo) are reused for [lo + span, new_lo + span).
@@ -173,35 +177,37 @@ impl BankSlots {
         let wm = self.words - 1;
         for j in old_w..old_w + n {
             let i = j as usize & wm;
-            for d in 0..=self.bank_mask as usize {
-                self.bits[d * self.words + i] = 0;
-            }
+            self.bits[i * banks..(i + 1) * banks].fill(0);
         }
         self.lo = new_lo;
         while hi >= self.lo + self.span() {
             let (w1, w2) = (self.words, self.words * 2);
             let mut bits = vec![0; self.bits.len() * 2];
             for j in self.lo >> 6..(self.lo >> 6) + w1 as u64 {
-                for d in 0..=self.bank_mask as usize {
-                    bits[d * w2 + (j as usize & (w2 - 1))] =
-                        self.bits[d * w1 + (j as usize & (w1 - 1))];
-                }
+                let (i1, i2) = (j as usize & (w1 - 1), j as usize & (w2 - 1));
+                bits[i2 * banks..(i2 + 1) * banks]
+                    .copy_from_slice(&self.bits[i1 * banks..(i1 + 1) * banks]);
             }
             self.bits = bits;
             self.words = w2;
         }
     }
 
+    /// Index in `bits` of diagonal `d`'s word `i`.
+    #[inline]
+    fn at(&self, i: usize, d: usize) -> usize {
+        (i << self.bank_shift) + d
+    }
+
     /// Taken-bits of diagonal `d` for cycles `[c, c + k)`, `1 ≤ k ≤ 64` (bit i: cycle c + i).
     #[inline]
     fn taken(&self, d: usize, c: Cycle, k: u64) -> u64 {
-        let row = d * self.words;
         let wm = self.words - 1;
         let i = (c >> 6) as usize & wm;
         let sh = c & 63;
-        let mut m = self.bits[row + i] >> sh;
+        let mut m = self.bits[self.at(i, d)] >> sh;
         if sh + k > 64 {
-            m |= self.bits[row + ((i + 1) & wm)] << (64 - sh);
+            m |= self.bits[self.at((i + 1) & wm, d)] << (64 - sh);
         }
         m & (u64::MAX >> (64 - k))
     }
@@ -209,14 +215,15 @@ impl BankSlots {
     /// Marks cycles `[c, c + k)` of diagonal `d` taken, `1 ≤ k ≤ 64`.
     #[inline]
     fn take(&mut self, d: usize, c: Cycle, k: u64) {
-        let row = d * self.words;
         let wm = self.words - 1;
         let i = (c >> 6) as usize & wm;
         let sh = c & 63;
         let m = u64::MAX >> (64 - k);
-        self.bits[row + i] |= m << sh;
+        let a = self.at(i, d);
+        self.bits[a] |= m << sh;
         if sh + k > 64 {
-            self.bits[row + ((i + 1) & wm)] |= m >> (64 - sh);
+            let b = self.at((i + 1) & wm, d);
+            self.bits[b] |= m >> (64 - sh);
         }
     }
 
@@ -399,12 +406,19 @@ impl SparseSlots {
             return s;
         }
         while s < end {
-            let taken = self.window(s, len);
-            if taken == 0 {
-                return s;
+            // Bit p of `starts`: cycles [s + p, s + p + len) are all free (doubling the run
+            // length each step; bits shifted in from past the window count as taken).
+            let mut starts = !self.window(s, 64);
+            let mut run = 1;
+            while run < len {
+                let step = run.min(len - run);
+                starts &= starts >> step;
+                run += step;
             }
-            // Past the last taken cycle of the window.
-            s += 64 - taken.leading_zeros() as u64;
+            if starts != 0 {
+                return s + starts.trailing_zeros() as u64;
+            }
+            s += 65 - len;
         }
         s
     }
