@@ -1,13 +1,19 @@
 //! The timing engine: TMs of in-order single-issue threads replaying macro-ops against
-//! reservation tables (next-free cycle per L1 bank, L2 bank, pipeline, shared unit, DRAM
-//! bank and bus), driven by a timing wheel of thread wake-up times (notes §5.2).
+//! reservation tables (L1 banks, L2 banks, pipelines, shared units, DRAM banks and buses;
+//! `slots.rs`), driven by a timing wheel of thread wake-up times (notes §5.2).
 //!
 //! A thread runs while its next operation can start at the current event time; when it must
 //! wait (for data, a busy unit, or because its issue slots run ahead), it goes back into the
 //! wheel at the cycle it can continue. Threads waking in the same cycle run in the order they
-//! were scheduled, so runs are
-//! deterministic. Operations reserve resources at their own start cycle; because events are
-//! processed in time order, reservations are made in (nearly) causal order.
+//! were scheduled, so runs are deterministic. Operations reserve resources at their own start
+//! cycle (never before the current event time); because events are processed in time order,
+//! reservations are made in (nearly) causal order.
+//!
+//! Host speed (docs/performance.md, "Simulator speed"): a load reserves the L1 banks of a
+//! whole line segment with one bitmap test (`BankSlots`); tables forget cycles before the
+//! current event time; before running a wake-up cycle's threads, `run_chip` reads each
+//! one's next op and L1/L2 tag so those host cache misses overlap. None of this changes a
+//! simulated result.
 
 use crate::Cycle;
 use crate::config::SimConfig;

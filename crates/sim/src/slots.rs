@@ -1,7 +1,10 @@
-//! A reservation table of one resource that accepts one operation per cycle: a 128-cycle
-//! bitmap window, so a request can take a free cycle *before* a later reservation (a plain
-//! next-free counter cannot fill such holes, which serialises threads whose issue cycles
-//! are slightly out of order; notes §5.2 "fluffy time").
+//! Reservation tables. [`Slots`]: one resource that accepts one operation per cycle, a
+//! 128-cycle bitmap window, so a request can take a free cycle *before* a later reservation
+//! (a plain next-free counter cannot fill such holes, which serialises threads whose issue
+//! cycles are slightly out of order; notes §5.2 "fluffy time"). [`BankSlots`]: the 16 word
+//! banks of one TM's L1, one bitmap per bank/cycle diagonal, so the words of a line segment
+//! are placed with one test. [`SparseSlots`]: DRAM buses and activation spacing, whose
+//! reservations can lie far ahead, in a growing bitmap ring.
 
 use crate::Cycle;
 
