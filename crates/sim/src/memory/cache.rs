@@ -15,11 +15,12 @@ pub enum Lookup {
     Absent,
 }
 
+/// One way's tag: the line it holds and the cycle its fill arrives (16 bytes, so a
+/// direct-mapped lookup touches one host cache line).
 #[derive(Clone, Copy, Debug)]
 struct Way {
     line: u64,
     fill: Cycle,
-    used: u64,
 }
 
 const INVALID: u64 = u64::MAX;
@@ -28,6 +29,8 @@ const INVALID: u64 = u64::MAX;
 #[derive(Clone, Debug)]
 pub struct Cache {
     ways: Vec<Way>,
+    /// LRU stamps, parallel to `ways` (empty when direct-mapped: nothing to choose).
+    used: Vec<u64>,
     assoc: usize,
     set_mask: u64,
     stamp: u64,
@@ -38,15 +41,16 @@ impl Cache {
     pub fn new(size_bytes: u64, line_bytes: u64, associativity: u32) -> Self {
         let assoc = associativity.max(1) as usize;
         let sets = (size_bytes / line_bytes / assoc as u64).max(1);
+        let n = sets as usize * assoc;
         Self {
             ways: vec![
                 Way {
                     line: INVALID,
-                    fill: 0,
-                    used: 0
+                    fill: 0
                 };
-                sets as usize * assoc
+                n
             ],
+            used: if assoc > 1 { vec![0; n] } else { Vec::new() },
             assoc,
             set_mask: sets - 1,
             stamp: 0,
@@ -62,31 +66,51 @@ impl Cache {
     #[inline]
     pub fn lookup(&mut self, line: u64) -> Lookup {
         let s = self.set(line);
+        if self.assoc == 1 {
+            let w = self.ways[s];
+            return if w.line == line {
+                Lookup::Present { fill: w.fill }
+            } else {
+                Lookup::Absent
+            };
+        }
         self.stamp += 1;
-        for w in &mut self.ways[s..s + self.assoc] {
+        for (i, w) in self.ways[s..s + self.assoc].iter().enumerate() {
             if w.line == line {
-                w.used = self.stamp;
+                self.used[s + i] = self.stamp;
                 return Lookup::Present { fill: w.fill };
             }
         }
         Lookup::Absent
     }
 
+    /// The tag word of `line`'s first way, read without effect (see `Thread::touch`).
+    #[inline]
+    pub fn peek(&self, line: u64) -> u64 {
+        self.ways[self.set(line)].line
+    }
+
     /// Installs `line` with its fill cycle, evicting the least recently used way.
     #[inline]
     pub fn install(&mut self, line: u64, fill: Cycle) {
         let s = self.set(line);
+        let new = Way { line, fill };
+        if self.assoc == 1 {
+            self.ways[s] = new;
+            return;
+        }
         self.stamp += 1;
-        let set = &mut self.ways[s..s + self.assoc];
-        let victim = set
-            .iter_mut()
-            .min_by_key(|w| if w.line == INVALID { 0 } else { w.used + 1 })
+        let victim = (s..s + self.assoc)
+            .min_by_key(|&i| {
+                if self.ways[i].line == INVALID {
+                    0
+                } else {
+                    self.used[i] + 1
+                }
+            })
             .expect("at least one way");
-        *victim = Way {
-            line,
-            fill,
-            used: self.stamp,
-        };
+        self.ways[victim] = new;
+        self.used[victim] = self.stamp;
     }
 }
 
