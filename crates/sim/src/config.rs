@@ -49,7 +49,7 @@ pub struct CacheConfig {
     /// (sequential interleaving by block address, Hennessy & Patterson, *Computer
     /// Architecture*, 5th ed., §2.2 "multibanked caches"); SimTRaX's word rule sends an L1
     /// miss to the bank of whichever word missed first, which for depth-first node layouts is
-    /// mostly word 0 of a line, so 8 of 128 banks took ≈ 45 % of the L2 traffic
+    /// mostly word 0 of a line, so the 8 banks ≡ 0 mod 16 took 35–45 % of the L2 traffic
     /// (`docs/simulator.md`, "TM scaling"). Ignored for the L1, which word loads make
     /// word-interleaved.
     #[serde(default = "line_interleaved_default")]
