@@ -11,25 +11,27 @@ use crate::SimAccel;
 use dualsplit_accel::{DstNodeKind, NodeStep, Observer};
 use serde::{Deserialize, Serialize};
 
-/// Instruction mix of one kernel step, by functional-unit class (energy and issue slots).
+/// Instruction mix of one kernel step, by functional-unit class (energy and issue slots);
+/// also the frame's totals in [`InstrCounts::mix`], hence 64-bit counters (a 512×512
+/// DST* path-traced frame issues more than 2^32 instructions).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Mix {
     /// Integer add, bitwise, compare-and-branch, move.
-    pub int: u32,
+    pub int: u64,
     /// FP add/sub.
-    pub fpadd: u32,
+    pub fpadd: u64,
     /// FP multiply.
-    pub fpmul: u32,
+    pub fpmul: u64,
     /// FP min/max/compare.
-    pub fpcmp: u32,
+    pub fpcmp: u64,
     /// FP reciprocal / inverse square root (shared unit, long latency).
-    pub fpinv: u32,
+    pub fpinv: u64,
     /// Local-store (stack) accesses.
-    pub local: u32,
+    pub local: u64,
 }
 
 impl Mix {
-    const fn new(int: u32, fpadd: u32, fpmul: u32, fpcmp: u32, fpinv: u32, local: u32) -> Self {
+    const fn new(int: u64, fpadd: u64, fpmul: u64, fpcmp: u64, fpinv: u64, local: u64) -> Self {
         Self {
             int,
             fpadd,
@@ -40,7 +42,7 @@ impl Mix {
         }
     }
     /// Instructions issued (each takes one issue slot of the thread).
-    pub const fn total(&self) -> u32 {
+    pub const fn total(&self) -> u64 {
         self.int + self.fpadd + self.fpmul + self.fpcmp + self.fpinv + self.local
     }
     fn add(&mut self, o: Mix) {
@@ -237,7 +239,7 @@ impl InstrCounts {
         self.mix_total() + self.loads + self.box_issues + self.tri_ops + self.dst_ops + self.atomics
     }
     fn mix_total(&self) -> u64 {
-        self.mix.total() as u64
+        self.mix.total()
     }
     /// Adds `o` into `self`.
     pub fn add(&mut self, o: &InstrCounts) {
@@ -277,12 +279,14 @@ impl<'a> Recorder<'a> {
     /// Appends instructions of mix `m` (merged into a preceding `Issue`).
     pub fn issue(&mut self, m: Mix) {
         self.counts.mix.add(m);
-        let n = m.total();
-        if let Some(Op::Issue { n: pn, fpinv }) = self.ops.last_mut() {
+        // One step's mix is a few dozen instructions: it fits an op's u32.
+        let n = m.total() as u32;
+        let fpinv = m.fpinv as u32;
+        if let Some(Op::Issue { n: pn, fpinv: pf }) = self.ops.last_mut() {
             *pn += n;
-            *fpinv += m.fpinv;
+            *pf += fpinv;
         } else {
-            self.ops.push(Op::Issue { n, fpinv: m.fpinv });
+            self.ops.push(Op::Issue { n, fpinv });
         }
     }
 
@@ -427,6 +431,21 @@ mod tests {
             // node 4 + 3 children × 2 + 2 hits × 2 + 1 sort pair × 3
             assert_eq!(r.counts.mix.total(), 4 + 6 + 4 + 3);
         }
+    }
+
+    #[test]
+    fn frame_totals_do_not_wrap_at_2_pow_32() {
+        // A 512×512 DST* path-traced frame issues ~6·10^9 instructions; model 2's u32
+        // counters wrapped (energy and issue utilisation came out too low).
+        let mut c = InstrCounts::default();
+        let big = InstrCounts {
+            mix: Mix::new(3_000_000_000, 0, 0, 0, 0, 2_000_000_000),
+            ..Default::default()
+        };
+        c.add(&big);
+        c.add(&big);
+        assert_eq!(c.mix.int, 6_000_000_000);
+        assert_eq!(c.total(), 10_000_000_000);
     }
 
     #[test]

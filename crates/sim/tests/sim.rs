@@ -210,8 +210,8 @@ fn dst_and_dst_sw_pixels_equal_the_renderers_and_use_their_units() {
         // DST* pays the decoder per node kind and outcome where DST pays the pipeline op's
         // return-code dispatch (pushes, pops and leaves cost both the same).
         assert_eq!(
-            sw.instructions.mix.total() as u64 + counter.hw_decode,
-            hw.instructions.mix.total() as u64 + counter.sw_decode
+            sw.instructions.mix.total() + counter.hw_decode,
+            hw.instructions.mix.total() + counter.sw_decode
         );
         assert_eq!(hw.units.box_ops, 0);
         assert_eq!(sw.units.dst_ops, 0);
@@ -240,8 +240,8 @@ impl Observer for DstSteps {
         if let NodeStep::Dst { kind, code, .. } = step {
             self.steps += 1;
             self.nodes += u64::from(kind != DstNodeKind::Leaf);
-            self.sw_decode += dst_sw_step(kind, code).total() as u64;
-            self.hw_decode += dst_hw_step(code).total() as u64;
+            self.sw_decode += dst_sw_step(kind, code).total();
+            self.hw_decode += dst_hw_step(code).total();
         }
     }
 }
