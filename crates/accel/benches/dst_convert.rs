@@ -7,7 +7,7 @@
 mod dst_common;
 
 use dualsplit_accel::dst::{Dst, DstConfig, Partitioning};
-use dualsplit_accel::{BuildConfig, Bvh2};
+use dualsplit_accel::{BuildConfig, Bvh2, BvhImage, WideBvh};
 use dualsplit_geometry::{Aabb, Triangle};
 use std::sync::OnceLock;
 
@@ -62,6 +62,43 @@ fn main() {
 fn bvh2_build() -> Bvh2 {
     let i = input();
     Bvh2::build(divan::black_box(&i.boxes), &BuildConfig::default())
+}
+
+/// The BVH2 build up to its byte-exact memory image (52-byte nodes, index runs, a copy of the
+/// triangles): the same kind of output as the conversion, which also writes an image with
+/// its own copy of the triangles.
+#[divan::bench(sample_count = 5, sample_size = 1)]
+fn bvh2_build_and_image() -> BvhImage {
+    let i = input();
+    let cfg = BuildConfig::default();
+    let boxes: Vec<Aabb> = divan::black_box(&i.tris)
+        .iter()
+        .map(|t| t.bounds())
+        .collect();
+    let bvh = Bvh2::build(&boxes, &cfg);
+    let wide = WideBvh::from_bvh2(&bvh);
+    BvhImage::encode(&wide, &bvh, &i.tris, &cfg, std::time::Duration::ZERO).expect("encoding")
+}
+
+/// The floor of any conversion on this machine: a fresh zeroed allocation the size of the
+/// hardware DST's image (nodes, index runs, triangles), one word written per 4 KiB page, so
+/// the first-touch page faults that writing the image costs are timed alone.
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn image_first_touch() -> Vec<u32> {
+    static WORDS: OnceLock<usize> = OnceLock::new();
+    let n = *WORDS.get_or_init(|| {
+        let i = input();
+        Dst::from_bvh2(&i.bvh, &i.tris, &DstConfig::hardware())
+            .expect("conversion")
+            .image()
+            .words
+            .len()
+    });
+    let mut words = vec![0u32; divan::black_box(n)];
+    for w in words.iter_mut().step_by(1024) {
+        *w = 1;
+    }
+    words
 }
 
 #[divan::bench(sample_count = 10, sample_size = 1)]

@@ -45,6 +45,14 @@ pub enum ReportError {
         /// The plotting backend's message.
         message: String,
     },
+    /// A scene's structures could not be built (an image offset overflowed).
+    #[error("{scene}: building the structures: {message}")]
+    Build {
+        /// The scene.
+        scene: String,
+        /// What failed.
+        message: String,
+    },
     /// A structure returned a different hit than BVH2 for some ray, so it is not timed.
     #[error("{structure} disagrees with BVH2 on {mismatches} of {rays} {ray_kind} rays")]
     Mismatch {

@@ -177,12 +177,18 @@ impl<'a> Producer<'a> {
     /// Produces the whole report for `scenes` (already loaded); `skipped` lists the scenes
     /// that could not be loaded.
     pub fn run(&self, scenes: &[Scene], skipped: Vec<Skipped>) -> Result<ReportData, ReportError> {
-        let structures: Vec<OnceLock<Structures>> =
+        let structures: Vec<OnceLock<Result<Structures, String>>> =
             scenes.iter().map(|_| OnceLock::new()).collect();
-        let get = |i: usize| {
-            structures[i].get_or_init(|| {
-                Structures::build(&scenes[i].triangles, &BuildConfig::high_quality())
-            })
+        // A scene whose structures cannot be built (an image offset overflow) fails the
+        // pieces that need them with a typed error instead of panicking.
+        let get = |i: usize| -> Result<&Structures, ReportError> {
+            structures[i]
+                .get_or_init(|| build(&scenes[i]))
+                .as_ref()
+                .map_err(|message| ReportError::Build {
+                    scene: scenes[i].name.clone(),
+                    message: message.clone(),
+                })
         };
         let hashes: Vec<String> = scenes.iter().map(|s| s.content_hash()).collect();
 
@@ -204,7 +210,7 @@ impl<'a> Producer<'a> {
             // cached, so it is measured again once the structure exists.
             cpu.push(self.cached(
                 &key,
-                || Ok(cpu_data(scene, self.settings.cpu_res)),
+                || cpu_data(scene, self.settings.cpu_res),
                 |c: &CpuData| c.sizes.iter().all(|s| s.bytes.is_ok()),
             )?);
             self.progress.advance(1);
@@ -216,7 +222,7 @@ impl<'a> Producer<'a> {
                 &format!("spp={RENDER_SPP}"),
                 (RENDER_RES, RENDER_RES),
             );
-            renders.push(self.cached(&key, || render_png_base64(scene, get(i)), |_| true)?);
+            renders.push(self.cached(&key, || render_png_base64(scene, get(i)?), |_| true)?);
             self.progress.advance(1);
         }
         self.progress.end();
@@ -267,8 +273,18 @@ impl<'a> Producer<'a> {
                         let Some(job) = job else { break };
                         // Until the accel crate builds a DST it dispatches DST to BVH2, and a
                         // "DST" simulation would be BVH2's: report that instead of simulating.
+                        let structures = match get(job.scene) {
+                            Ok(s) => s,
+                            Err(e) => {
+                                self.progress.advance(pixels);
+                                if let Ok(mut d) = done.lock() {
+                                    d.push((job, Err(format!("not simulated: {e}"))));
+                                }
+                                continue;
+                            }
+                        };
                         if matches!(job.accel, SimAccel::Dst | SimAccel::DstSw)
-                            && let Err(e) = structure_bytes(get(job.scene), AccelKind::Dst)
+                            && let Err(e) = structure_bytes(structures, AccelKind::Dst)
                         {
                             self.progress.advance(pixels);
                             if let Ok(mut d) = done.lock() {
@@ -283,7 +299,7 @@ impl<'a> Producer<'a> {
                         };
                         let result = (self.simulate)(
                             &scenes[job.scene],
-                            get(job.scene),
+                            structures,
                             job.accel,
                             &self.sim_settings(job.workload),
                             &self.sim_config(job.tms),
@@ -433,12 +449,20 @@ fn ray_set(scene: &Scene, structures: &Structures, res: u32) -> Vec<Traced> {
     out
 }
 
+/// Every structure of `scene` with the report's build settings; the error as text.
+fn build(scene: &Scene) -> Result<Structures, String> {
+    Structures::try_build(&scene.triangles, &BuildConfig::high_quality()).map_err(|e| e.to_string())
+}
+
 /// Host measurements of one scene: build times, sizes, and single-thread Mrays/s per
 /// structure and ray kind, each structure checked ray by ray against BVH2 before it is
 /// timed.
-pub fn cpu_data(scene: &Scene, cpu_res: u32) -> CpuData {
+pub fn cpu_data(scene: &Scene, cpu_res: u32) -> Result<CpuData, ReportError> {
     let t0 = Instant::now();
-    let structures = Structures::build(&scene.triangles, &BuildConfig::high_quality());
+    let structures = build(scene).map_err(|message| ReportError::Build {
+        scene: scene.name.clone(),
+        message,
+    })?;
     let all_structures_ms = t0.elapsed().as_secs_f64() * 1e3;
     let build_ms = structures
         .stats()
@@ -468,12 +492,12 @@ pub fn cpu_data(scene: &Scene, cpu_res: u32) -> CpuData {
             });
         }
     }
-    CpuData {
+    Ok(CpuData {
         sizes,
         build_ms,
         all_structures_ms,
         throughput,
-    }
+    })
 }
 
 fn time_set(

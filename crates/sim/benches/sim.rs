@@ -25,7 +25,7 @@ struct Synthetic {
 }
 
 impl WorkSource for Synthetic {
-    fn next(&mut self, _t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
+    fn next(&mut self, _id: usize, _t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
         if self.programs_left == 0 {
             return None;
         }

@@ -1,19 +1,25 @@
 //! The timing engine: TMs of in-order single-issue threads replaying macro-ops against
-//! reservation tables (next-free cycle per L1 bank, L2 bank, pipeline, shared unit, DRAM
-//! bank and bus), driven by a timing wheel of thread wake-up times (notes §5.2).
+//! reservation tables (L1 banks, L2 banks, pipelines, shared units, DRAM banks and buses;
+//! `slots.rs`), driven by a timing wheel of thread wake-up times (notes §5.2).
 //!
 //! A thread runs while its next operation can start at the current event time; when it must
 //! wait (for data, a busy unit, or because its issue slots run ahead), it goes back into the
 //! wheel at the cycle it can continue. Threads waking in the same cycle run in the order they
-//! were scheduled, so runs are
-//! deterministic. Operations reserve resources at their own start cycle; because events are
-//! processed in time order, reservations are made in (nearly) causal order.
+//! were scheduled, so runs are deterministic. Operations reserve resources at their own start
+//! cycle (never before the current event time); because events are processed in time order,
+//! reservations are made in (nearly) causal order.
+//!
+//! Host speed (docs/performance.md, "Simulator speed"): a load reserves the L1 banks of a
+//! whole line segment with one bitmap test (`BankSlots`); tables forget cycles before the
+//! current event time; before running a wake-up cycle's threads, `run_chip` reads each
+//! one's next op and L1/L2 tag so those host cache misses overlap. None of this changes a
+//! simulated result.
 
 use crate::Cycle;
 use crate::config::SimConfig;
 use crate::kernel::{Op, Pipe};
 use crate::memory::{Cache, Dram, Lookup};
-use crate::slots::Slots;
+use crate::slots::{BankSlots, Slots};
 use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -71,7 +77,7 @@ pub struct UnitStats {
 
 struct Tm {
     l1: Cache,
-    l1_banks: Vec<Slots>,
+    l1_banks: BankSlots,
     box_pipes: Vec<Slots>,
     tri_pipes: Vec<Slots>,
     dst_pipes: Vec<Slots>,
@@ -114,7 +120,7 @@ impl Chip {
     pub fn new(cfg: &SimConfig, box_pipes: u32) -> Self {
         let tm = || Tm {
             l1: Cache::new(cfg.l1.size_bytes, cfg.l1.line_bytes, cfg.l1.associativity),
-            l1_banks: vec![Slots::default(); cfg.l1.banks as usize],
+            l1_banks: BankSlots::new(cfg.l1.banks),
             box_pipes: vec![Slots::default(); box_pipes.max(1) as usize],
             tri_pipes: vec![Slots::default(); cfg.units.tri_pipes as usize],
             dst_pipes: vec![Slots::default(); cfg.units.dst_pipes as usize],
@@ -140,11 +146,12 @@ impl Chip {
     /// cycle the data is in the register.
     #[cfg(test)]
     fn load_word(&mut self, tm: usize, word: u64, slot: Cycle) -> Cycle {
-        self.load_word_fill(tm, word, slot).0
+        self.load_word_fill(tm, word, slot, 0).0
     }
 
-    /// As [`Chip::load_word`], also returning the fill cycle now in the line's L1 tag.
-    fn load_word_fill(&mut self, tm: usize, word: u64, slot: Cycle) -> (Cycle, Cycle) {
+    /// As [`Chip::load_word`], also returning the fill cycle now in the line's L1 tag;
+    /// `now` (≤ `slot`) is the current event time: no later access starts before it.
+    fn load_word_fill(&mut self, tm: usize, word: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
         let line = word >> self.line_word_shift;
         let l1_lat = self.cfg.l1.hit_latency;
         self.caches.l1_accesses += 1;
@@ -178,7 +185,7 @@ impl Chip {
                         fill.max(at)
                     }
                     Lookup::Absent => {
-                        let (done, _) = self.dram.read(line, at);
+                        let (done, _) = self.dram.read_at(line, at, now);
                         self.l2.install(line, done, s2);
                         done
                     }
@@ -224,6 +231,22 @@ impl Thread {
     /// Cycle when every outstanding result has arrived.
     pub fn results_ready(&self) -> Cycle {
         self.ready.max(self.t)
+    }
+
+    /// Reads (without effect) the host memory the thread's next op will touch first: the
+    /// op itself and, for a load, its line's L1 and L2 tags. `run_chip` calls it for every thread
+    /// of a wake-up cycle before running them, so those host cache misses overlap instead
+    /// of coming one after another. Returns a value to keep the reads.
+    #[inline]
+    fn touch(&self, chip: &Chip) -> u64 {
+        match self.ops.get(self.pc) {
+            Some(&Op::Load { addr, .. }) => {
+                let line = addr >> (2 + chip.line_word_shift);
+                chip.tms[self.tm].l1.peek(line) ^ chip.l2.peek(line)
+            }
+            Some(_) => 1,
+            None => 0,
+        }
     }
 
     /// Replaces the program (the previous one must be done).
@@ -281,12 +304,12 @@ impl Thread {
                 self.wait(r, &mut chip.stalls);
             }
             self.pc += 1;
-            self.execute(op, chip);
+            self.execute(op, chip, now);
         }
         false
     }
 
-    fn execute(&mut self, op: Op, chip: &mut Chip) {
+    fn execute(&mut self, op: Op, chip: &mut Chip, now: Cycle) {
         let tm = self.tm;
         match op {
             Op::Issue { n, fpinv } => {
@@ -312,23 +335,29 @@ impl Thread {
                 // Line by line: the first word looks the line up (L1 tags, then L2/DRAM on a
                 // miss); later words of the same line see exactly what a second tag lookup
                 // would (hit once the fill has arrived, merged before). Every word takes its
-                // own L1 bank slot, one issue slot after the previous word's.
+                // own L1 bank slot, one issue slot after the previous word's; the banks of a
+                // line segment are placed in one run (`BankSlots::reserve_run`).
                 while w < end {
                     let seg_end = (((w >> shift) + 1) << shift).min(end);
-                    let slot = chip.tms[tm].l1_banks[(w & bank_mask) as usize].reserve(c);
-                    bank_stall += slot - c;
-                    let (mut r, fill) = chip.load_word_fill(tm, w, slot);
+                    let first = chip.tms[tm]
+                        .l1_banks
+                        .reserve_run(w & bank_mask, c, 1, now, 0);
+                    let slot = first.first;
+                    bank_stall += first.stall;
+                    let (mut r, fill) = chip.load_word_fill(tm, w, slot, now);
                     c = slot + 1;
                     if seg_end > w + 1 {
-                        let banks = &mut chip.tms[tm].l1_banks;
-                        let mut hits = 0;
-                        for v in w + 1..seg_end {
-                            let slot = banks[(v & bank_mask) as usize].reserve(c);
-                            bank_stall += slot - c;
-                            hits += u64::from(fill <= slot);
-                            c = slot + 1;
-                        }
                         let rest = seg_end - w - 1;
+                        let run = chip.tms[tm].l1_banks.reserve_run(
+                            (w + 1) & bank_mask,
+                            c,
+                            rest,
+                            now,
+                            fill,
+                        );
+                        bank_stall += run.stall;
+                        let hits = run.at_or_after;
+                        c = run.last + 1;
                         chip.caches.l1_accesses += rest;
                         chip.caches.l1_hits += hits;
                         chip.caches.l1_merged += rest - hits;
@@ -417,8 +446,9 @@ fn earliest(units: &mut [Slots], c: Cycle) -> Cycle {
 /// Supplies threads with work: called when a thread's program is done; returns the next
 /// program or `None` when there is no work left.
 pub trait WorkSource {
-    /// The next program for a thread (after its atomic increment).
-    fn next(&mut self, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>>;
+    /// The next program for thread `id` (its index in `run_chip`'s slice), whose previous
+    /// program is done.
+    fn next(&mut self, id: usize, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>>;
 }
 
 /// A timing wheel of thread wake-ups (notes §5.2): one bucket per cycle for the next
@@ -489,6 +519,11 @@ pub fn run_chip(chip: &mut Chip, threads: &mut [Thread], work: &mut dyn WorkSour
     let mut finish = vec![0; threads.len()];
     let mut spare = Vec::new();
     while let Some((now, mut ids)) = wheel.next_bucket(spare) {
+        let mut touched = 0;
+        for &id in &ids {
+            touched ^= threads[id as usize].touch(chip);
+        }
+        std::hint::black_box(touched);
         for &id in &ids {
             let th = &mut threads[id as usize];
             loop {
@@ -497,7 +532,7 @@ pub fn run_chip(chip: &mut Chip, threads: &mut [Thread], work: &mut dyn WorkSour
                     break;
                 }
                 // Program finished: the thread takes more work or retires once results are in.
-                match work.next(th, chip) {
+                match work.next(id as usize, th, chip) {
                     Some(ops) => {
                         th.load_program(ops);
                         if th.t > now {
@@ -527,7 +562,7 @@ mod tests {
 
     struct Programs(Vec<Vec<Op>>);
     impl WorkSource for Programs {
-        fn next(&mut self, t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
+        fn next(&mut self, _id: usize, t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
             // One program per thread.
             if t.ops.is_empty() { self.0.pop() } else { None }
         }

@@ -16,9 +16,10 @@
 //!  energy.rs: counts × per-event energy, split like Table 6 ──▶ SimResult
 //! ```
 //!
-//! Ray paths do not depend on timing, so each pixel's rays are traced functionally when a
-//! simulated thread takes the pixel from the global counter, and the recorded macro-ops are
-//! then replayed by the timing model. Simulated hits are the renderer's hits by
+//! Ray paths do not depend on timing, so a pixel's rays are traced functionally, one ray at
+//! a time, by the simulated thread that took the pixel from the global counter (the next
+//! ray when the previous ray's ops have issued), and the recorded macro-ops are then
+//! replayed by the timing model. Simulated hits are the renderer's hits by
 //! construction ([`SimResult::radiance`] is the renderer's per-pixel value).
 //!
 //! ```no_run
@@ -43,7 +44,7 @@ mod workload;
 /// Version of the timing and energy model. Bump it whenever a change alters simulated results
 /// for the same inputs; the report's result cache includes it in every key, so stale cached
 /// frames are recomputed.
-pub const MODEL_VERSION: u32 = 3;
+pub const MODEL_VERSION: u32 = 4;
 
 pub use config::{CacheConfig, ConfigError, DramConfig, EnergyConfig, SimConfig, UnitConfig};
 pub use engine::{CacheStats, Stalls, UnitStats};

@@ -1,7 +1,10 @@
-//! A reservation table of one resource that accepts one operation per cycle: a 128-cycle
-//! bitmap window, so a request can take a free cycle *before* a later reservation (a plain
-//! next-free counter cannot fill such holes, which serialises threads whose issue cycles
-//! are slightly out of order; notes §5.2 "fluffy time").
+//! Reservation tables. [`Slots`]: one resource that accepts one operation per cycle, a
+//! 128-cycle bitmap window, so a request can take a free cycle *before* a later reservation
+//! (a plain next-free counter cannot fill such holes, which serialises threads whose issue
+//! cycles are slightly out of order; notes §5.2 "fluffy time"). [`BankSlots`]: the 16 word
+//! banks of one TM's L1, one bitmap per bank/cycle diagonal, so the words of a line segment
+//! are placed with one test. [`SparseSlots`]: DRAM buses and activation spacing, whose
+//! reservations can lie far ahead, in a growing bitmap ring.
 
 use crate::Cycle;
 
@@ -99,65 +102,334 @@ impl Slots {
     }
 }
 
-/// Reservations kept behind the request being served (requests arrive slightly out of
-/// order; anything older than this can no longer collide with a new one).
-const SPARSE_HISTORY: u64 = 4096;
+/// The word banks of one TM's L1 (one access per bank per cycle), stored along
+/// *diagonals*: word `w` of a load issued at cycle `x` uses bank `w mod banks`, and a load
+/// issues one word per cycle, so the consecutive words of a line segment that meet no
+/// conflict lie on one diagonal `d = (bank − cycle) mod banks`. Each diagonal is a bitmap
+/// over cycles, so a whole segment's bank-conflict check is one masked word test instead of
+/// one test per word (notes §5.2).
+///
+/// Semantics: a word takes the first cycle at or after its request at which its bank is
+/// free, exactly as one [`Slots`] per bank, but without a per-bank window: every
+/// reservation at or after the current event time `now` is remembered (the ring of cycles
+/// covered grows when a bank is booked further ahead than it covers). Requests are never
+/// earlier than `now`, so cycles before it are recycled.
+#[derive(Clone, Debug)]
+pub struct BankSlots {
+    /// `banks − 1` (power-of-two bank count).
+    bank_mask: u64,
+    /// First cycle covered (a multiple of 64); the ring covers `[lo, lo + 64 · words)`.
+    lo: Cycle,
+    /// 64-cycle words per diagonal (a power of two).
+    words: usize,
+    /// log2(banks).
+    bank_shift: u32,
+    /// `bits[(x / 64 mod words) · banks + d]` bit `x mod 64`: bank `(d + x) mod banks` is
+    /// taken at cycle `x`.
+    bits: Vec<u64>,
+}
+
+/// A run of consecutive words placed by [`BankSlots::reserve_run`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Placed {
+    /// Cycle of the first word.
+    pub first: Cycle,
+    /// Cycle of the last word.
+    pub last: Cycle,
+    /// Cycles the words waited for busy banks (summed over words).
+    pub stall: u64,
+    /// Words placed at or after the `from` cycle given to `reserve_run`.
+    pub at_or_after: u64,
+}
+
+impl BankSlots {
+    /// `banks` free banks (a power of two).
+    pub fn new(banks: u32) -> Self {
+        debug_assert!(banks.is_power_of_two());
+        let words = 8;
+        Self {
+            bank_mask: banks as u64 - 1,
+            bank_shift: banks.trailing_zeros(),
+            lo: 0,
+            words,
+            bits: vec![0; banks as usize * words],
+        }
+    }
+
+    fn span(&self) -> u64 {
+        64 * self.words as u64
+    }
+
+    /// Makes the ring cover `[c, hi]` (`now ≤ c`): recycles cycles before `now`, grows when
+    /// that is not enough.
+    #[inline]
+    fn cover(&mut self, hi: Cycle, now: Cycle) {
+        if hi < self.lo + self.span() {
+            return;
+        }
+        self.cover_slow(hi, now);
+    }
+
+    #[inline(never)]
+    fn cover_slow(&mut self, hi: Cycle, now: Cycle) {
+        let banks = self.bank_mask as usize + 1;
+        let new_lo = (now & !63).max(self.lo);
+        let (old_w, new_w) = (self.lo >> 6, new_lo >> 6);
+        // Words of cycles [lo, new_lo) are reused for [lo + span, new_lo + span).
+        let n = (new_w - old_w).min(self.words as u64);
+        let wm = self.words - 1;
+        for j in old_w..old_w + n {
+            let i = j as usize & wm;
+            self.bits[i * banks..(i + 1) * banks].fill(0);
+        }
+        self.lo = new_lo;
+        while hi >= self.lo + self.span() {
+            let (w1, w2) = (self.words, self.words * 2);
+            let mut bits = vec![0; self.bits.len() * 2];
+            for j in self.lo >> 6..(self.lo >> 6) + w1 as u64 {
+                let (i1, i2) = (j as usize & (w1 - 1), j as usize & (w2 - 1));
+                bits[i2 * banks..(i2 + 1) * banks]
+                    .copy_from_slice(&self.bits[i1 * banks..(i1 + 1) * banks]);
+            }
+            self.bits = bits;
+            self.words = w2;
+        }
+    }
+
+    /// Index in `bits` of diagonal `d`'s word `i`.
+    #[inline]
+    fn at(&self, i: usize, d: usize) -> usize {
+        (i << self.bank_shift) + d
+    }
+
+    /// Taken-bits of diagonal `d` for cycles `[c, c + k)`, `1 ≤ k ≤ 64` (bit i: cycle c + i).
+    #[inline]
+    fn taken(&self, d: usize, c: Cycle, k: u64) -> u64 {
+        let wm = self.words - 1;
+        let i = (c >> 6) as usize & wm;
+        let sh = c & 63;
+        let mut m = self.bits[self.at(i, d)] >> sh;
+        if sh + k > 64 {
+            m |= self.bits[self.at((i + 1) & wm, d)] << (64 - sh);
+        }
+        m & (u64::MAX >> (64 - k))
+    }
+
+    /// Marks cycles `[c, c + k)` of diagonal `d` taken, `1 ≤ k ≤ 64`.
+    #[inline]
+    fn take(&mut self, d: usize, c: Cycle, k: u64) {
+        let wm = self.words - 1;
+        let i = (c >> 6) as usize & wm;
+        let sh = c & 63;
+        let m = u64::MAX >> (64 - k);
+        let a = self.at(i, d);
+        self.bits[a] |= m << sh;
+        if sh + k > 64 {
+            let b = self.at((i + 1) & wm, d);
+            self.bits[b] |= m >> (64 - sh);
+        }
+    }
+
+    /// Places `n ≥ 1` consecutive words, the first on `bank`, each word one cycle after the
+    /// previous one's cycle at the earliest and at the first cycle its bank is free: the
+    /// same cycles as placing the words one by one on per-bank tables that remember every
+    /// reservation. `c ≥ now` (the current event time).
+    #[inline]
+    pub fn reserve_run(&mut self, bank: u64, c: Cycle, n: u64, now: Cycle, from: Cycle) -> Placed {
+        debug_assert!(n >= 1 && c >= now && c >= self.lo);
+        // Fast path (most runs): every word's bank is free in its cycle, one word test.
+        if n <= 64 && c + n <= self.lo + ((self.words as u64) << 6) {
+            let d = (bank.wrapping_sub(c) & self.bank_mask) as usize;
+            if self.taken(d, c, n) == 0 {
+                self.take(d, c, n);
+                return Placed {
+                    first: c,
+                    last: c + n - 1,
+                    stall: 0,
+                    at_or_after: (c + n).saturating_sub(c.max(from)).min(n),
+                };
+            }
+        }
+        self.reserve_run_slow(bank, c, n, now, from)
+    }
+
+    #[inline(never)]
+    fn reserve_run_slow(&mut self, bank: u64, c: Cycle, n: u64, now: Cycle, from: Cycle) -> Placed {
+        let mut bank = bank;
+        let mut c = c;
+        let mut left = n;
+        let mut stall = 0;
+        let mut at_or_after = 0;
+        let mut first = None;
+        loop {
+            let k = left.min(64);
+            self.cover(c + k - 1, now);
+            let d = (bank.wrapping_sub(c) & self.bank_mask) as usize;
+            let busy = self.taken(d, c, k);
+            let free = if busy == 0 {
+                k
+            } else {
+                busy.trailing_zeros() as u64
+            };
+            if free > 0 {
+                self.take(d, c, free);
+                first.get_or_insert(c);
+                at_or_after += (c + free).saturating_sub(c.max(from)).min(free);
+                bank += free;
+                c += free;
+                left -= free;
+                if left == 0 {
+                    return Placed {
+                        first: first.unwrap_or(c - n),
+                        last: c - 1,
+                        stall,
+                        at_or_after,
+                    };
+                }
+            }
+            if busy != 0 {
+                // The next word's bank is taken at `c`: its first free cycle after that.
+                let x = self.first_free(bank, c + 1, now);
+                stall += x - c;
+                c = x;
+            }
+        }
+    }
+
+    /// The first cycle at or after `c` at which `bank` is free.
+    fn first_free(&mut self, bank: u64, c: Cycle, now: Cycle) -> Cycle {
+        let mut x = c;
+        loop {
+            self.cover(x, now);
+            let d = (bank.wrapping_sub(x) & self.bank_mask) as usize;
+            if self.taken(d, x, 1) == 0 {
+                return x;
+            }
+            x += 1;
+        }
+    }
+}
 
 /// A reservation table for resources whose reservations can lie far in the future (DRAM
 /// channel buses and activation spacing: a backed-up bank schedules its reads hundreds of
 /// nanoseconds ahead). Unlike [`Slots`], a far-future reservation never moves a window past
 /// earlier free cycles, so a read to an idle bank of the same channel still gets the first
-/// free cycle after its own ready time. Reservations are kept as sorted, disjoint, merged
-/// half-open intervals (a saturated bus is one long interval, so a search is a binary
-/// search plus a step or two) and pruned `SPARSE_HISTORY` cycles behind each request.
-#[derive(Clone, Debug, Default)]
+/// free cycle after its own ready time. Every reservation is kept in a bitmap ring that
+/// grows to cover the furthest one; the owner says which cycles no request can reach any
+/// more ([`SparseSlots::forget_before`], from the current event time), and the ring
+/// recycles them, so it only spans the backlog ahead of the present. A search scans 64
+/// cycles per step (a saturated bus is a run of full words).
+#[derive(Clone, Debug)]
 pub struct SparseSlots {
-    taken: Vec<(Cycle, Cycle)>,
+    /// First cycle covered (a multiple of 64); the ring covers `[lo, lo + 64 · words.len())`
+    /// and every reservation ever made at or after `lo` lies in it.
+    lo: Cycle,
+    /// `words[(x / 64) mod len]` bit `x mod 64`: cycle `x` is taken (power-of-two length).
+    words: Vec<u64>,
+    /// No request starts before this cycle (`forget_before`).
+    floor: Cycle,
+}
+
+impl Default for SparseSlots {
+    fn default() -> Self {
+        Self {
+            lo: 0,
+            words: vec![0; 16],
+            floor: 0,
+        }
+    }
 }
 
 impl SparseSlots {
-    fn prune(&mut self, c: Cycle) {
-        let floor = c.saturating_sub(SPARSE_HISTORY);
-        let old = self.taken.partition_point(|iv| iv.1 < floor);
-        if old > 64 {
-            self.taken.drain(..old);
+    /// Forgets reservations before `floor`: no later request starts before `floor`, so they
+    /// can no longer collide with one (results are unchanged).
+    #[inline]
+    pub fn forget_before(&mut self, floor: Cycle) {
+        self.floor = self.floor.max(floor);
+    }
+
+    #[inline]
+    fn end(&self) -> Cycle {
+        self.lo + ((self.words.len() as u64) << 6)
+    }
+
+    #[inline]
+    fn word(&self, x: Cycle) -> u64 {
+        self.words[(x >> 6) as usize & (self.words.len() - 1)]
+    }
+
+    /// Makes the ring cover cycle `hi` (recycling cycles before the floor, growing if that
+    /// is not enough).
+    fn cover(&mut self, hi: Cycle) {
+        if hi < self.end() {
+            return;
+        }
+        let n = self.words.len();
+        let new_lo = (self.floor & !63).max(self.lo);
+        let (old_w, new_w) = (self.lo >> 6, new_lo >> 6);
+        for j in old_w..old_w + (new_w - old_w).min(n as u64) {
+            self.words[j as usize & (n - 1)] = 0;
+        }
+        self.lo = new_lo;
+        while hi >= self.end() {
+            let n = self.words.len();
+            let mut words = vec![0; n * 2];
+            for j in self.lo >> 6..(self.lo >> 6) + n as u64 {
+                words[j as usize & (2 * n - 1)] = self.words[j as usize & (n - 1)];
+            }
+            self.words = words;
         }
     }
 
-    /// First start `s ≥ c` where `[s, s + len)` overlaps no reservation, and the index of
-    /// the first interval ending after `s`'s predecessors.
-    fn find(&self, c: Cycle, len: u64) -> (Cycle, usize) {
-        let mut i = self.taken.partition_point(|iv| iv.1 <= c);
+    /// Taken-bits of cycles `[s, s + len)`, `1 ≤ len ≤ 64`, `lo ≤ s < end` (bit i: s + i;
+    /// cycles past the ring are free).
+    #[inline]
+    fn window(&self, s: Cycle, len: u64) -> u64 {
+        let sh = s & 63;
+        let mut m = self.word(s) >> sh;
+        if sh + len > 64 && (s | 63) + 1 < self.end() {
+            m |= self.word(s + 64) << (64 - sh);
+        }
+        m & (u64::MAX >> (64 - len))
+    }
+
+    /// First start `s ≥ c` where `[s, s + len)` overlaps no reservation (`c ≥` the floor).
+    fn find(&self, c: Cycle, len: u64) -> Cycle {
+        debug_assert!(c >= self.lo && (1..=64).contains(&len));
         let mut s = c;
-        while let Some(&(lo, hi)) = self.taken.get(i) {
-            if lo >= s + len {
-                break;
+        let end = self.end();
+        if len == 1 {
+            while s < end {
+                let free = !self.word(s) >> (s & 63);
+                if free != 0 {
+                    return s + free.trailing_zeros() as u64;
+                }
+                s = (s | 63) + 1;
             }
-            s = s.max(hi);
-            i += 1;
+            return s;
         }
-        (s, i)
-    }
-
-    /// Marks `[s, s + len)` taken; `i` is the index of the first interval starting after it.
-    fn insert(&mut self, s: Cycle, len: u64, i: usize) {
-        let e = s + len;
-        let joins_prev = i > 0 && self.taken[i - 1].1 == s;
-        let joins_next = self.taken.get(i).is_some_and(|iv| iv.0 == e);
-        match (joins_prev, joins_next) {
-            (true, true) => {
-                self.taken[i - 1].1 = self.taken[i].1;
-                self.taken.remove(i);
+        while s < end {
+            // Bit p of `starts`: cycles [s + p, s + p + len) are all free (doubling the run
+            // length each step; bits shifted in from past the window count as taken).
+            let mut starts = !self.window(s, 64);
+            let mut run = 1;
+            while run < len {
+                let step = run.min(len - run);
+                starts &= starts >> step;
+                run += step;
             }
-            (true, false) => self.taken[i - 1].1 = e,
-            (false, true) => self.taken[i].0 = s,
-            (false, false) => self.taken.insert(i, (s, e)),
+            if starts != 0 {
+                return s + starts.trailing_zeros() as u64;
+            }
+            s += 65 - len;
         }
+        s
     }
 
     /// The first free cycle at or after `c`, without reserving it.
     pub fn peek(&self, c: Cycle) -> Cycle {
-        self.find(c, 1).0
+        debug_assert!(c >= self.floor);
+        self.find(c.max(self.lo), 1)
     }
 
     /// Reserves the first free cycle at or after `c` and returns it.
@@ -165,13 +437,20 @@ impl SparseSlots {
         self.reserve_span(c, 1)
     }
 
-    /// Reserves a span of `len` cycles at the first start at or after `c` where it overlaps
-    /// no other span (spans are all `len` long, so starts end up at least `len` apart: a
-    /// minimum spacing such as t_RRD between activations).
+    /// Reserves a span of `len` cycles (`1 ≤ len ≤ 64`) at the first start at or after `c`
+    /// where it overlaps no other span (spans are all `len` long, so starts end up at least
+    /// `len` apart: a minimum spacing such as t_RRD between activations).
     pub fn reserve_span(&mut self, c: Cycle, len: u64) -> Cycle {
-        self.prune(c);
-        let (s, i) = self.find(c, len);
-        self.insert(s, len, i);
+        debug_assert!(c >= self.floor);
+        let s = self.find(c.max(self.lo), len);
+        self.cover(s + len - 1);
+        let sh = s & 63;
+        let m = u64::MAX >> (64 - len);
+        let n = self.words.len();
+        self.words[(s >> 6) as usize & (n - 1)] |= m << sh;
+        if sh + len > 64 {
+            self.words[((s >> 6) + 1) as usize & (n - 1)] |= m >> (64 - sh);
+        }
         s
     }
 }
@@ -233,6 +512,165 @@ mod tests {
         let mut full = Slots::default();
         for i in 0..300 {
             assert_eq!(full.reserve(0), i);
+        }
+    }
+}
+
+#[cfg(test)]
+mod bank_tests {
+    use super::*;
+    use dualsplit_geometry::Pcg32;
+    use std::collections::BTreeSet;
+
+    /// One bank's reservations, all remembered: the first free cycle at or after a request.
+    #[derive(Clone, Default)]
+    struct Ideal(BTreeSet<Cycle>);
+    impl Ideal {
+        fn reserve(&mut self, c: Cycle) -> Cycle {
+            let mut x = c;
+            while self.0.contains(&x) {
+                x += 1;
+            }
+            self.0.insert(x);
+            x
+        }
+    }
+
+    /// Places `n` words one by one on per-bank tables: (slots, stall).
+    fn word_by_word(
+        banks: &mut [impl FnMut(Cycle) -> Cycle],
+        bank: u64,
+        c: Cycle,
+        n: u64,
+    ) -> (Vec<Cycle>, u64) {
+        let mut x = c;
+        let mut stall = 0;
+        let mut slots = Vec::new();
+        for i in 0..n {
+            let s = banks[((bank + i) % banks.len() as u64) as usize](x);
+            stall += s - x;
+            slots.push(s);
+            x = s + 1;
+        }
+        (slots, stall)
+    }
+
+    fn check(p: Placed, slots: &[Cycle], stall: u64, from: Cycle, what: &str) {
+        assert_eq!(p.first, slots[0], "{what}");
+        assert_eq!(p.last, *slots.last().unwrap(), "{what}");
+        assert_eq!(p.stall, stall, "{what}");
+        let after = slots.iter().filter(|&&s| s >= from).count() as u64;
+        assert_eq!(p.at_or_after, after, "{what}");
+    }
+
+    /// Runs of words placed along diagonals land exactly where word-by-word placement with
+    /// every reservation remembered puts them, under heavy contention and with runs longer
+    /// than the ring (which then grows), for 16 and 4 banks.
+    #[test]
+    fn bank_runs_match_word_by_word_placement() {
+        for (seed, banks) in (0..100).flat_map(|s| [(s, 16u32), (s, 4)]) {
+            let mut rng = Pcg32::new(seed, 3);
+            let mut ideal = vec![Ideal::default(); banks as usize];
+            let mut diag = BankSlots::new(banks);
+            let mut now = 0;
+            for _ in 0..2000 {
+                now += (rng.below(6) == 0) as u64 * rng.below(200) as u64;
+                let c = now + rng.below(8) as u64;
+                let bank = rng.below(banks) as u64;
+                let n = 1 + rng.below(64) as u64;
+                let from = c + rng.below(80) as u64;
+                let mut fs: Vec<_> = ideal.iter_mut().map(|b| move |c| b.reserve(c)).collect();
+                let (slots, stall) = word_by_word(&mut fs, bank, c, n);
+                let p = diag.reserve_run(bank, c, n, now, from);
+                check(
+                    p,
+                    &slots,
+                    stall,
+                    from,
+                    &format!("seed {seed}, {banks} banks"),
+                );
+            }
+        }
+    }
+
+    /// Under light contention (no request far behind an earlier one on its bank) the
+    /// result is also that of one 128-cycle-window [`Slots`] per bank, the previous model.
+    #[test]
+    fn bank_runs_match_per_bank_windows_under_light_load() {
+        for seed in 0..100 {
+            let mut rng = Pcg32::new(seed, 5);
+            let mut windows = vec![Slots::default(); 16];
+            let mut diag = BankSlots::new(16);
+            let mut now = 0;
+            for _ in 0..2000 {
+                now += rng.below(3) as u64;
+                let c = now + rng.below(8) as u64;
+                let bank = rng.below(16) as u64;
+                let n = 1 + rng.below(20) as u64;
+                let from = c + rng.below(30) as u64;
+                let mut fs: Vec<_> = windows.iter_mut().map(|b| move |c| b.reserve(c)).collect();
+                let (slots, stall) = word_by_word(&mut fs, bank, c, n);
+                let p = diag.reserve_run(bank, c, n, now, from);
+                check(p, &slots, stall, from, &format!("seed {seed}"));
+            }
+        }
+    }
+
+    /// A backlog far beyond the ring's initial 512 cycles: the ring grows and keeps every
+    /// reservation; afterwards `now` moves on and old cycles are recycled.
+    #[test]
+    fn ring_grows_under_a_long_backlog_and_recycles() {
+        let mut ideal = vec![Ideal::default(); 16];
+        let mut diag = BankSlots::new(16);
+        for round in 0..3u64 {
+            let now = round * 5000;
+            for i in 0..300 {
+                let mut fs: Vec<_> = ideal.iter_mut().map(|b| move |c| b.reserve(c)).collect();
+                let (slots, stall) = word_by_word(&mut fs, i % 16, now, 64);
+                let p = diag.reserve_run(i % 16, now, 64, now, now + 100);
+                check(
+                    p,
+                    &slots,
+                    stall,
+                    now + 100,
+                    &format!("round {round}, load {i}"),
+                );
+            }
+            assert!(diag.span() >= 1200, "{}", diag.span());
+        }
+    }
+
+    /// `SparseSlots` against a plain set of taken cycles: spans of 1..=20 cycles requested
+    /// in a jittered order ahead of a rising floor, some far ahead (the ring grows), with
+    /// `peek` checked before each reservation.
+    #[test]
+    fn sparse_slots_match_a_set_of_taken_cycles() {
+        for seed in 0..8 {
+            let mut rng = Pcg32::new(seed, 9);
+            let mut set = BTreeSet::new();
+            let mut slots = SparseSlots::default();
+            let mut floor = 0;
+            let len = 1 + rng.below(20) as u64;
+            for i in 0..2000 {
+                floor += rng.below(14) as u64;
+                slots.forget_before(floor);
+                let far = if rng.below(50) == 0 { 5000 } else { 0 };
+                let c = floor + far + rng.below(300) as u64;
+                let free =
+                    |set: &BTreeSet<Cycle>, s: Cycle, l: u64| (s..s + l).all(|x| !set.contains(&x));
+                let mut p = c;
+                while !free(&set, p, 1) {
+                    p += 1;
+                }
+                assert_eq!(slots.peek(c), p, "seed {seed}, request {i}: peek");
+                let l = if i % 2 == 0 { len } else { 1 };
+                let mut s = c;
+                while !free(&set, s, l) {
+                    s += 1;
+                }
+                assert_eq!(slots.reserve_span(c, l), s, "seed {seed}, request {i}");
+                set.extend(s..s + l);
+            }
         }
     }
 }

@@ -19,6 +19,16 @@ const SHADOW_FINISH: Mix = Mix {
     local: 0,
 };
 
+/// The pixel a thread is working on: its job (the renderer's path state) and the Issue op
+/// held back from its last ray's program.
+struct Active<'a> {
+    px: u64,
+    job: PixelJob<'a>,
+    /// The trailing `Issue` of the previous ray's ops: the recorder merges the next ray's
+    /// set-up into it, exactly as when the whole pixel is recorded into one program.
+    carry: Option<Op>,
+}
+
 struct Pixels<'a> {
     scene: &'a Scene,
     structures: &'a Structures,
@@ -31,53 +41,86 @@ struct Pixels<'a> {
     radiance: Vec<f32>,
     progress: &'a (dyn Fn(u64, u64) + Sync),
     spare: Vec<Vec<Op>>,
+    /// Per thread: the pixel it is working on.
+    active: Vec<Option<Active<'a>>>,
 }
 
-impl Pixels<'_> {
-    fn trace_pixel(&mut self, px: u64, ops: &mut Vec<Op>) {
-        let w = self.settings.width as u64;
-        let (x, y) = ((px % w) as u32, (px / w) as u32);
+impl<'a> Pixels<'a> {
+    /// Records the next ray of `a`'s pixel into `ops` (which starts with the carried Issue);
+    /// false when the pixel has no ray left.
+    fn trace_ray(&mut self, a: &mut Active<'a>, ops: &mut Vec<Op>) -> bool {
+        let Some(q) = a.job.next_ray() else {
+            return false;
+        };
         let kind = self.accel.kind();
+        ops.extend(a.carry.take());
         let mut rec = Recorder::new(self.accel, ops);
-        rec.atomic();
-        let mut job = PixelJob::new(self.scene, self.settings, x, y);
-        while let Some(q) = job.next_ray() {
-            self.rays += 1;
-            rec.issue(crate::kernel::RAY_SETUP);
-            let result = match q.kind {
-                RayKind::Shadow => {
-                    let occ = self.structures.any_hit(kind, &q.ray, &mut rec);
-                    rec.issue(SHADOW_FINISH);
-                    TraceResult::Occluded(occ)
-                }
-                RayKind::Primary | RayKind::Diffuse => {
-                    let hit = self.structures.closest_hit(kind, &q.ray, &mut rec);
-                    rec.issue(crate::kernel::RAY_FINISH);
-                    TraceResult::Closest(hit)
-                }
-            };
-            job.submit(result);
-        }
+        self.rays += 1;
+        rec.issue(crate::kernel::RAY_SETUP);
+        let result = match q.kind {
+            RayKind::Shadow => {
+                let occ = self.structures.any_hit(kind, &q.ray, &mut rec);
+                rec.issue(SHADOW_FINISH);
+                TraceResult::Occluded(occ)
+            }
+            RayKind::Primary | RayKind::Diffuse => {
+                let hit = self.structures.closest_hit(kind, &q.ray, &mut rec);
+                rec.issue(crate::kernel::RAY_FINISH);
+                TraceResult::Closest(hit)
+            }
+        };
         self.counts.add(&rec.counts);
-        self.radiance[px as usize] = job.radiance();
+        a.job.submit(result);
+        if matches!(ops.last(), Some(Op::Issue { .. })) {
+            a.carry = ops.pop();
+        }
+        true
     }
 }
 
 impl WorkSource for Pixels<'_> {
-    fn next(&mut self, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>> {
+    /// Hands out one ray's ops at a time (a pixel's rays follow one another on the same
+    /// thread, the pixel taken from the global counter first): the same op sequence as the
+    /// whole pixel recorded at once, but a thread's program stays small, so the replay's
+    /// host memory traffic stays in cache.
+    fn next(&mut self, id: usize, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>> {
         let old = std::mem::take(&mut thread.ops);
         if old.capacity() > 0 {
             self.spare.push(old);
+        }
+        let mut ops = self.spare.pop().unwrap_or_default();
+        ops.clear();
+        if let Some(mut a) = self.active[id].take() {
+            if self.trace_ray(&mut a, &mut ops) {
+                self.active[id] = Some(a);
+                return Some(ops);
+            }
+            self.radiance[a.px as usize] = a.job.radiance();
+            if let Some(op) = a.carry {
+                // The pixel's last instructions.
+                ops.push(op);
+                return Some(ops);
+            }
         }
         if self.next >= self.total {
             return None;
         }
         thread.atomic(chip);
+        self.counts.atomics += 1;
         let px = self.next;
         self.next += 1;
-        let mut ops = self.spare.pop().unwrap_or_default();
-        ops.clear();
-        self.trace_pixel(px, &mut ops);
+        let w = self.settings.width as u64;
+        let (x, y) = ((px % w) as u32, (px / w) as u32);
+        let mut a = Active {
+            px,
+            job: PixelJob::new(self.scene, self.settings, x, y),
+            carry: None,
+        };
+        if self.trace_ray(&mut a, &mut ops) {
+            self.active[id] = Some(a);
+        } else {
+            self.radiance[px as usize] = a.job.radiance();
+        }
         if self.next.is_multiple_of(1024) || self.next == self.total {
             (self.progress)(self.next, self.total);
         }
@@ -110,6 +153,7 @@ pub(crate) fn run(
         radiance: vec![0.0; total as usize],
         progress,
         spare: Vec::new(),
+        active: (0..threads.len()).map(|_| None).collect(),
     };
     let cycles = run_chip(&mut chip, &mut threads, &mut work);
     let dram = chip.dram.stats();

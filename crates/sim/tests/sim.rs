@@ -284,7 +284,7 @@ mod synthetic {
         loads: u64,
     }
     impl WorkSource for Random {
-        fn next(&mut self, _t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
+        fn next(&mut self, _id: usize, _t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
             if self.left == 0 {
                 return None;
             }

@@ -2,10 +2,22 @@
 //! children of every splitting node adjacent (left, then right at left + left size), a
 //! carving node's child placed by bump allocation, leaves as runs in one triangle-index list
 //! (the last entry of a run has bit 31 set), then the triangles, 36 B each in id order.
+//!
+//! Two passes, both parallel (rayon) over the subtrees below depth [`PARALLEL_DEPTH`]:
+//!
+//! 1. **Plan**: every splitting decision ([`plan_split`]) in depth-first order, with the
+//!    number of node words and index entries each subtree will take. Decisions are kept as
+//!    compact records ([`Rec`], the chains packed in eight bytes each).
+//! 2. **Emit**: with every subtree's size known, the image is cut into disjoint slices
+//!    (`split_at_mut`), one per subtree, and each subtree writes its words and index runs
+//!    in place at their final addresses. Nothing is relocated or copied afterwards.
+//!
+//! The layout is the one a fully sequential depth-first emission with bump allocation
+//! gives, whatever the thread count (`tests/dst_convert_golden.rs`).
 
-use super::from_bvh2::{CarveKind, Chain, plan_split};
+use super::from_bvh2::{Chain, ChainDp, StepTable, plan_split, plane_values};
 use super::header::{HeaderOffset, OFFSET_LIMIT};
-use super::stats::{DstStats, bvh2_size_bytes};
+use super::stats::DstStats;
 use super::{Dst, DstConfig, DstError};
 use crate::build::Bvh2;
 use crate::image::MemoryImage;
@@ -15,86 +27,120 @@ use rayon::prelude::*;
 /// Bit 31 of an index entry: the last triangle of a leaf's run.
 pub(super) const RUN_END: u32 = 1 << 31;
 
-/// Subtrees entered below a splitting node at this depth (the root is at depth 0) are
-/// encoded as independent tasks in parallel (rayon), up to 2^PARALLEL_DEPTH of them; each is
-/// relocated once when the sequential top-level pass reaches it.
-const PARALLEL_DEPTH: u32 = 6;
+/// Subtrees below this depth (the root is at depth 0) are planned and emitted as
+/// independent rayon tasks, up to 2^PARALLEL_DEPTH of them.
+const PARALLEL_DEPTH: u32 = 8;
 
-/// The subtrees encoded in parallel, in depth-first order: BVH node and incoming chain.
-type Tasks = Vec<(u32, Chain)>;
+/// What the plan pass decided at an internal BVH node, in the DST's child order (32 bytes).
+#[derive(Clone, Copy, Debug)]
+struct Rec {
+    /// The incoming carving chains of the DST's left and right child.
+    chains: [Chain; 2],
+    /// Node words bump-allocated by the left subtree below its root slot (saturated: a
+    /// tree that large fails the offset check before emission).
+    left_words: u32,
+    /// Index entries of the left subtree (saturated likewise).
+    left_entries: u32,
+    /// Split axis.
+    axis: u8,
+    /// The BVH node's second child is the DST's left child.
+    swap: bool,
+}
+
+impl Rec {
+    /// BVH nodes of the DST's left and right child of BVH node `n`.
+    #[inline(always)]
+    fn children(&self, bvh: &Bvh2, n: u32) -> [u32; 2] {
+        let [x, y] = bvh.nodes[n as usize].children();
+        if self.swap { [y, x] } else { [x, y] }
+    }
+
+    fn set_left(&mut self, size: Size) {
+        self.left_words = u32::try_from(size.words).unwrap_or(u32::MAX);
+        self.left_entries = u32::try_from(size.entries).unwrap_or(u32::MAX);
+    }
+}
+
+/// The plan of a subtree.
+enum Plan {
+    /// Planned sequentially: the records of its internal nodes in depth-first order.
+    Seq(Vec<Rec>),
+    /// An internal node above the parallel cut: its record and its two children's plans.
+    Par(Rec, Box<[Plan; 2]>),
+}
+
+/// A subtree's size: node words bump-allocated below its root slot, and index entries.
+#[derive(Clone, Copy, Default)]
+struct Size {
+    words: u64,
+    entries: u64,
+}
+
+impl Size {
+    fn add(self, o: Size) -> Size {
+        Size {
+            words: self.words + o.words,
+            entries: self.entries + o.entries,
+        }
+    }
+}
+
+/// The output slices a subtree writes: its root slot (1 or 3 words, reserved by its
+/// parent), its bump-allocated node words, its index entries, and their absolute
+/// positions (node words from the start of the image, entries from the start of the list).
+struct Out<'w> {
+    slot: &'w mut [u32],
+    words: &'w mut [u32],
+    at: u64,
+    entries: &'w mut [u32],
+    entries_at: u64,
+}
+
+impl<'w> Out<'w> {
+    /// Takes the next `n` node words (bump allocation); returns them and their address.
+    fn take(&mut self, n: usize) -> (&'w mut [u32], u64) {
+        let (head, rest) = std::mem::take(&mut self.words).split_at_mut(n);
+        self.words = rest;
+        let at = self.at;
+        self.at += n as u64;
+        (head, at)
+    }
+
+    /// Splits off the outputs of a child subtree of `size` whose root slot is `slot`.
+    fn child(&mut self, slot: &'w mut [u32], size: Size) -> Out<'w> {
+        let (words, at) = self.take(size.words as usize);
+        let (entries, rest) = std::mem::take(&mut self.entries).split_at_mut(size.entries as usize);
+        self.entries = rest;
+        let entries_at = self.entries_at;
+        self.entries_at += size.entries;
+        Out {
+            slot,
+            words,
+            at,
+            entries,
+            entries_at,
+        }
+    }
+}
+
+/// Words of the root slot of BVH node `n` entered with `chain`: a plain leaf is one word,
+/// anything else a 3-word node.
+fn slot_size(bvh: &Bvh2, n: u32, chain: Chain) -> usize {
+    if bvh.nodes[n as usize].is_leaf() && chain.is_empty() {
+        1
+    } else {
+        3
+    }
+}
 
 struct Encoder<'a> {
     bvh: &'a Bvh2,
     triangles: usize,
     cfg: &'a DstConfig,
-    words: Vec<u32>,
-    indices: Vec<u32>,
-    stats: DstStats,
-    visited: usize,
+    steps: StepTable,
 }
 
-impl<'a> Encoder<'a> {
-    /// Bump-allocates `n` node words.
-    fn reserve(&mut self, n: usize) -> usize {
-        let at = self.words.len();
-        self.words.resize(at + n, 0);
-        at
-    }
-
-    /// Appends BVH leaf `n`'s triangles as one run; returns the run's first entry.
-    fn push_run(&mut self, n: u32) -> Result<u64, DstError> {
-        let node = &self.bvh.nodes[n as usize];
-        let (first, count) = (node.first as usize, node.count as usize);
-        let ids = self
-            .bvh
-            .prim_ids
-            .get(first..first + count)
-            .ok_or(DstError::BadBvhLink {
-                node: n,
-                child: node.first,
-                nodes: self.bvh.prim_ids.len(),
-            })?;
-        let start = self.indices.len() as u64;
-        for (i, &p) in ids.iter().enumerate() {
-            if p as usize >= self.triangles {
-                return Err(DstError::PrimOutOfRange {
-                    node: n,
-                    prim: p,
-                    triangles: self.triangles,
-                });
-            }
-            if p & RUN_END != 0 {
-                return Err(DstError::TriangleIdOverflow {
-                    given: p as u64,
-                    limit: RUN_END as u64,
-                });
-            }
-            self.indices
-                .push(if i + 1 == count { p | RUN_END } else { p });
-        }
-        self.stats.index_entries += count as u64;
-        Ok(start)
-    }
-
-    fn put(&mut self, at: usize, h: HeaderOffset, p0: f32, p1: f32) {
-        self.words[at] = h.bits();
-        self.words[at + 1] = p0.to_bits();
-        self.words[at + 2] = p1.to_bits();
-    }
-
-    fn check_node(&mut self, n: u32) -> Result<(), DstError> {
-        self.visited += 1;
-        let nodes = self.bvh.nodes.len();
-        if self.visited > nodes {
-            return Err(DstError::BadBvhLink {
-                node: n,
-                child: n,
-                nodes,
-            });
-        }
-        self.check_links(n)
-    }
-
+impl Encoder<'_> {
     /// Checks node `n`'s box and child links (what planning and emission index with).
     fn check_links(&self, n: u32) -> Result<(), DstError> {
         let nodes = self.bvh.nodes.len();
@@ -119,179 +165,274 @@ impl<'a> Encoder<'a> {
         Ok(())
     }
 
-    /// Lists, in depth-first order, the subtrees [`Encoder::emit`] takes from its task
-    /// results: both children of every splitting node at depth `PARALLEL_DEPTH - 1`.
-    fn collect(&self, n: u32, depth: u32, tasks: &mut Tasks) -> Result<(), DstError> {
-        self.check_links(n)?;
-        if self.bvh.nodes[n as usize].is_leaf() {
-            return Ok(());
-        }
-        let plan = plan_split(self.bvh, n, self.cfg);
-        if depth + 1 == PARALLEL_DEPTH {
-            tasks.push((plan.left, plan.left_chain));
-            tasks.push((plan.right, plan.right_chain));
-            return Ok(());
-        }
-        self.collect(plan.left, depth + 1, tasks)?;
-        self.collect(plan.right, depth + 1, tasks)
-    }
-
-    /// Emits BVH node `n` (entered with the carving `chain`) into the words reserved at `at`.
-    /// Subtrees at depth `PARALLEL_DEPTH` are not emitted here but taken, in depth-first
-    /// order, from `done` (encoded in parallel beforehand) and appended; the layout is the
-    /// one a fully sequential depth-first emission gives.
-    fn emit(
-        &mut self,
+    /// Plans BVH node `n` entered with `chain`: its record (internal nodes) and the size of
+    /// its subtree. Checks the links and leaf ranges that emission relies on.
+    fn plan_node(
+        &self,
         n: u32,
-        chain: &Chain,
-        mut at: usize,
-        depth: u32,
-        done: &mut std::vec::IntoIter<Result<Encoder<'a>, DstError>>,
-    ) -> Result<(), DstError> {
-        self.check_node(n)?;
-        let is_leaf = self.bvh.nodes[n as usize].is_leaf();
-        let steps = chain.steps();
-        for (i, step) in steps.iter().enumerate() {
-            let fold = is_leaf && i + 1 == steps.len();
-            // A carving node's child is a carving or splitting node (3 words), or the leaf
-            // is folded into it (L = 1).
-            let (offset, next) = if fold {
-                self.stats.carving_leaves += 1;
-                (self.push_run(n)?, at)
-            } else {
-                let c = self.reserve(3);
-                (c as u64, c)
-            };
-            let h = match step.kind {
-                CarveKind::Single(axis) => {
-                    self.stats.single_carving += 1;
-                    HeaderOffset::single_carve(axis, fold, offset)?
-                }
-                CarveKind::Dual(pair, corner) => {
-                    self.stats.dual_carving += 1;
-                    HeaderOffset::dual_carve(pair, corner, fold, offset)?
-                }
-            };
-            self.put(at, h, step.p0, step.p1);
-            at = next;
-        }
-        if is_leaf {
-            if steps.is_empty() {
-                self.stats.leaves += 1;
-                let first = self.push_run(n)?;
-                self.words[at] = HeaderOffset::leaf(first)?.bits();
-            }
-            return Ok(());
-        }
-        let plan = plan_split(self.bvh, n, self.cfg);
-        let size = |enc: &Self, c: u32, chain: &Chain| {
-            if enc.bvh.nodes[c as usize].is_leaf() && chain.is_empty() {
-                1
-            } else {
-                3
-            }
-        };
-        let (sl, sr) = (
-            size(self, plan.left, &plan.left_chain),
-            size(self, plan.right, &plan.right_chain),
-        );
-        let p = self.reserve(sl + sr);
-        self.stats.splitting += 1;
-        let (lb, rb) = (
-            self.bvh.nodes[plan.left as usize].bounds,
-            self.bvh.nodes[plan.right as usize].bounds,
-        );
-        let h = HeaderOffset::split(plan.axis, sl as u32, p as u64)?;
-        self.put(at, h, lb.max[plan.axis], rb.min[plan.axis]);
-        if depth + 1 == PARALLEL_DEPTH {
-            // Both subtrees were encoded in parallel into their own buffers; they are
-            // appended in a fixed order (the result does not depend on thread timing).
-            let mut next = || done.next().expect("one task result per collected subtree");
-            let l = next()?;
-            self.append(l, p)?;
-            let r = next()?;
-            return self.append(r, p + sl);
-        }
-        self.emit(plan.left, &plan.left_chain, p, depth + 1, done)?;
-        self.emit(plan.right, &plan.right_chain, p + sl, depth + 1, done)
-    }
-
-    /// Encodes the subtree of BVH node `n` into a fresh encoder whose root is at local word 0.
-    /// `tasks` (how many subtrees share the BVH) sizes its buffers up front: twice an even
-    /// share at ~3 words per BVH node, so they rarely grow (unused capacity is never
-    /// touched, so over-reserving costs no page faults).
-    fn sub_encoder(&self, n: u32, chain: &Chain, tasks: usize) -> Result<Encoder<'a>, DstError> {
-        let size = if self.bvh.nodes[n as usize].is_leaf() && chain.is_empty() {
-            1
-        } else {
-            3
-        };
-        let mut sub = Encoder {
-            bvh: self.bvh,
-            triangles: self.triangles,
-            cfg: self.cfg,
-            words: Vec::with_capacity(6 * self.bvh.nodes.len() / tasks + 16),
-            indices: Vec::with_capacity(2 * self.bvh.prim_ids.len() / tasks + 16),
-            stats: DstStats::default(),
-            visited: 0,
-        };
-        sub.reserve(size);
-        sub.emit(n, chain, 0, PARALLEL_DEPTH, &mut Vec::new().into_iter())?;
-        Ok(sub)
-    }
-
-    /// Appends a sub-encoder's output: its root node goes to the words reserved at `at`, the
-    /// rest after the current end; node offsets and index-run offsets are relocated.
-    fn append(&mut self, sub: Encoder<'a>, at: usize) -> Result<(), DstError> {
-        let root_size = if HeaderOffset::from_bits(sub.words[0]).is_plain_leaf() {
-            1
-        } else {
-            3
-        };
-        let base = self.words.len();
-        let index_base = self.indices.len() as u64;
-        let map = |local: u32| -> u64 {
-            if (local as usize) < root_size {
-                (at + local as usize) as u64
-            } else {
-                (base + local as usize - root_size) as u64
-            }
-        };
-        let mut words = sub.words;
-        let mut todo = vec![0u32];
-        while let Some(local) = todo.pop() {
-            let w = HeaderOffset::from_bits(words[local as usize]);
-            let off = w.offset();
-            let new = if w.is_leaf_flag() {
-                index_base + off as u64
-            } else {
-                todo.push(off);
-                if w.is_split() {
-                    todo.push(off + w.left_size());
-                }
-                map(off)
-            };
-            if new >= OFFSET_LIMIT {
-                return Err(DstError::OffsetOverflow {
-                    given: new,
-                    limit: OFFSET_LIMIT,
+        chain: Chain,
+        dps: &mut [ChainDp; 2],
+    ) -> Result<Result<Rec, Size>, DstError> {
+        self.check_links(n)?;
+        let node = &self.bvh.nodes[n as usize];
+        let steps = chain.len() as u64;
+        if node.is_leaf() {
+            let (first, count) = (node.first as usize, node.count as usize);
+            if first + count > self.bvh.prim_ids.len() {
+                return Err(DstError::BadBvhLink {
+                    node: n,
+                    child: node.first,
+                    nodes: self.bvh.prim_ids.len(),
                 });
             }
-            words[local as usize] = (w.bits() & !(OFFSET_LIMIT as u32 - 1)) | new as u32;
+            // The last carving node of a leaf's chain is the leaf (no word of its own).
+            return Ok(Err(Size {
+                words: 3 * steps.saturating_sub(1),
+                entries: count as u64,
+            }));
         }
-        self.words[at..at + root_size].copy_from_slice(&words[..root_size]);
-        self.words.extend_from_slice(&words[root_size..]);
-        self.indices.extend_from_slice(&sub.indices);
-        self.visited += sub.visited;
-        let (a, b) = (&mut self.stats, sub.stats);
-        a.splitting += b.splitting;
-        a.single_carving += b.single_carving;
-        a.dual_carving += b.dual_carving;
-        a.leaves += b.leaves;
-        a.carving_leaves += b.carving_leaves;
-        a.index_entries += b.index_entries;
+        let p = plan_split(self.bvh, n, self.cfg, dps);
+        Ok(Ok(Rec {
+            chains: [p.left_chain, p.right_chain],
+            left_words: 0,
+            left_entries: 0,
+            axis: p.axis as u8,
+            swap: p.swap,
+        }))
+    }
+
+    /// The words an internal node itself reserves: its chain, then both children's slots.
+    fn own_words(&self, n: u32, rec: &Rec, chain: Chain) -> u64 {
+        let [l, r] = rec.children(self.bvh, n);
+        let [cl, cr] = rec.chains;
+        (3 * chain.len() + slot_size(self.bvh, l, cl) + slot_size(self.bvh, r, cr)) as u64
+    }
+
+    /// Plan pass, sequential: appends the records of `n`'s subtree to `recs` in depth-first
+    /// order. `budget` counts the nodes still allowed (a cycle in a malformed BVH runs it
+    /// out instead of recursing forever).
+    fn plan_seq(
+        &self,
+        n: u32,
+        chain: Chain,
+        recs: &mut Vec<Rec>,
+        budget: &mut usize,
+        dps: &mut [ChainDp; 2],
+    ) -> Result<Size, DstError> {
+        *budget = budget.checked_sub(1).ok_or(DstError::BadBvhLink {
+            node: n,
+            child: n,
+            nodes: self.bvh.nodes.len(),
+        })?;
+        let mut rec = match self.plan_node(n, chain, dps)? {
+            Err(leaf) => return Ok(leaf),
+            Ok(rec) => rec,
+        };
+        let slot = recs.len();
+        recs.push(rec);
+        let [cl, cr] = rec.children(self.bvh, n);
+        let l = self.plan_seq(cl, rec.chains[0], recs, budget, dps)?;
+        let r = self.plan_seq(cr, rec.chains[1], recs, budget, dps)?;
+        rec.set_left(l);
+        recs[slot] = rec;
+        Ok(l.add(r).add(Size {
+            words: self.own_words(n, &rec, chain),
+            entries: 0,
+        }))
+    }
+
+    /// Plan pass: nodes above [`PARALLEL_DEPTH`] plan their two subtrees in parallel.
+    fn plan(&self, n: u32, chain: Chain, depth: u32) -> Result<(Plan, Size), DstError> {
+        if depth >= PARALLEL_DEPTH {
+            // About twice an even share of the internal nodes, so the records rarely move.
+            let mut recs = Vec::with_capacity(self.bvh.nodes.len() >> PARALLEL_DEPTH);
+            let mut budget = self.bvh.nodes.len();
+            let mut dps = [ChainDp::new(), ChainDp::new()];
+            let size = self.plan_seq(n, chain, &mut recs, &mut budget, &mut dps)?;
+            return Ok((Plan::Seq(recs), size));
+        }
+        let mut dps = [ChainDp::new(), ChainDp::new()];
+        let mut rec = match self.plan_node(n, chain, &mut dps)? {
+            Err(leaf) => return Ok((Plan::Seq(Vec::new()), leaf)),
+            Ok(rec) => rec,
+        };
+        let [cl, cr] = rec.children(self.bvh, n);
+        let (l, r) = rayon::join(
+            || self.plan(cl, rec.chains[0], depth + 1),
+            || self.plan(cr, rec.chains[1], depth + 1),
+        );
+        let ((lp, l), (rp, r)) = (l?, r?);
+        rec.set_left(l);
+        let size = l.add(r).add(Size {
+            words: self.own_words(n, &rec, chain),
+            entries: 0,
+        });
+        Ok((Plan::Par(rec, Box::new([lp, rp])), size))
+    }
+
+    /// Writes BVH leaf `n`'s triangles as one run at the start of `out.entries`.
+    fn write_run(&self, n: u32, out: &mut Out) -> Result<(), DstError> {
+        let node = &self.bvh.nodes[n as usize];
+        let (first, count) = (node.first as usize, node.count as usize);
+        let ids = &self.bvh.prim_ids[first..first + count];
+        for (i, (&p, e)) in ids.iter().zip(out.entries.iter_mut()).enumerate() {
+            if p as usize >= self.triangles {
+                return Err(DstError::PrimOutOfRange {
+                    node: n,
+                    prim: p,
+                    triangles: self.triangles,
+                });
+            }
+            if p & RUN_END != 0 {
+                return Err(DstError::TriangleIdOverflow {
+                    given: p as u64,
+                    limit: RUN_END as u64,
+                });
+            }
+            *e = if i + 1 == count { p | RUN_END } else { p };
+        }
         Ok(())
     }
+
+    /// Emits BVH node `n`'s incoming `chain` (and, for a leaf, the leaf itself) into
+    /// `out`. For an internal node, returns the slot its splitting node goes into and what
+    /// is left of `out` for its children.
+    fn emit_head<'w>(
+        &self,
+        n: u32,
+        chain: Chain,
+        mut out: Out<'w>,
+        stats: &mut DstStats,
+    ) -> Result<Option<(&'w mut [u32], Out<'w>)>, DstError> {
+        let node = &self.bvh.nodes[n as usize];
+        let is_leaf = node.is_leaf();
+        let steps = chain.len();
+        let mut slot = std::mem::take(&mut out.slot);
+        let planes = plane_values(&node.bounds);
+        for i in 0..steps {
+            let step = self.steps.get(chain.faces(i));
+            // A carving node's child is a carving or splitting node (3 words), or the leaf
+            // is folded into it (L = 1).
+            let fold = is_leaf && i + 1 == steps;
+            let (offset, child) = if fold {
+                stats.carving_leaves += 1;
+                self.write_run(n, &mut out)?;
+                (out.entries_at, None)
+            } else {
+                let (c, at) = out.take(3);
+                (at, Some(c))
+            };
+            if step.dual {
+                stats.dual_carving += 1;
+            } else {
+                stats.single_carving += 1;
+            }
+            let h = step.header.carve_pointing_at(fold, offset)?;
+            let [p0, p1] = step.planes.map(|p| planes[p as usize]);
+            put(slot, h, p0, p1);
+            if let Some(c) = child {
+                slot = c;
+            }
+        }
+        if !is_leaf {
+            return Ok(Some((slot, out)));
+        }
+        stats.index_entries += node.count as u64;
+        if steps == 0 {
+            stats.leaves += 1;
+            self.write_run(n, &mut out)?;
+            slot[0] = HeaderOffset::leaf(out.entries_at)?.bits();
+        }
+        Ok(None)
+    }
+
+    /// Emits the subtree of BVH node `n` entered with `chain`, sequentially; the records of
+    /// its internal nodes come from `recs` in depth-first order.
+    fn emit(
+        &self,
+        n: u32,
+        chain: Chain,
+        out: Out,
+        recs: &mut std::slice::Iter<Rec>,
+        stats: &mut DstStats,
+    ) -> Result<(), DstError> {
+        if let Some((slot, mut out)) = self.emit_head(n, chain, out, stats)? {
+            let rec = recs.next().expect("one record per internal node");
+            let [cl, cr] = rec.children(self.bvh, n);
+            let (l, r) = self.children_out(rec, [cl, cr], &mut out, slot, stats)?;
+            self.emit(cl, rec.chains[0], l, recs, stats)?;
+            self.emit(cr, rec.chains[1], r, recs, stats)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the splitting node `rec` into `slot`, reserves its children's slots and cuts
+    /// the rest of `out` into the two children's outputs.
+    fn children_out<'w>(
+        &self,
+        rec: &Rec,
+        [l, r]: [u32; 2],
+        out: &mut Out<'w>,
+        slot: &mut [u32],
+        stats: &mut DstStats,
+    ) -> Result<(Out<'w>, Out<'w>), DstError> {
+        let sl = slot_size(self.bvh, l, rec.chains[0]);
+        let sr = slot_size(self.bvh, r, rec.chains[1]);
+        let (pair, at) = out.take(sl + sr);
+        stats.splitting += 1;
+        let axis = rec.axis as usize;
+        let h = HeaderOffset::split(axis, sl as u32, at)?;
+        let (lb, rb) = (
+            self.bvh.nodes[l as usize].bounds,
+            self.bvh.nodes[r as usize].bounds,
+        );
+        put(slot, h, lb.max[axis], rb.min[axis]);
+        let (ls, rs) = pair.split_at_mut(sl);
+        let left = out.child(
+            ls,
+            Size {
+                words: rec.left_words as u64,
+                entries: rec.left_entries as u64,
+            },
+        );
+        let right = Out {
+            slot: rs,
+            words: std::mem::take(&mut out.words),
+            at: out.at,
+            entries: std::mem::take(&mut out.entries),
+            entries_at: out.entries_at,
+        };
+        Ok((left, right))
+    }
+
+    /// Emits a planned subtree; [`Plan::Par`] nodes emit their two subtrees in parallel.
+    fn emit_plan(&self, plan: &Plan, n: u32, chain: Chain, out: Out) -> Result<DstStats, DstError> {
+        let mut stats = DstStats::default();
+        match plan {
+            Plan::Seq(recs) => self.emit(n, chain, out, &mut recs.iter(), &mut stats)?,
+            Plan::Par(rec, children) => {
+                let (slot, mut out) = self
+                    .emit_head(n, chain, out, &mut stats)?
+                    .expect("a parallel plan node is internal");
+                let [cl, cr] = rec.children(self.bvh, n);
+                let (l, r) = self.children_out(rec, [cl, cr], &mut out, slot, &mut stats)?;
+                let (a, b) = rayon::join(
+                    || self.emit_plan(&children[0], cl, rec.chains[0], l),
+                    || self.emit_plan(&children[1], cr, rec.chains[1], r),
+                );
+                stats.add_counts(&a?);
+                stats.add_counts(&b?);
+            }
+        }
+        Ok(stats)
+    }
+}
+
+/// Writes a 12-byte node (header-offset word, P0, P1) into `slot`.
+fn put(slot: &mut [u32], h: HeaderOffset, p0: f32, p1: f32) {
+    slot[0] = h.bits();
+    slot[1] = p0.to_bits();
+    slot[2] = p1.to_bits();
 }
 
 impl Dst {
@@ -302,59 +443,71 @@ impl Dst {
     /// Errors: malformed BVH links, non-finite boxes, triangle ids out of range, and
     /// offsets beyond the 26-bit field ([`DstError::OffsetOverflow`]).
     pub fn from_bvh2(bvh: &Bvh2, triangles: &[Triangle], cfg: &DstConfig) -> Result<Dst, DstError> {
-        let mut enc = Encoder {
+        let enc = Encoder {
             bvh,
             triangles: triangles.len(),
             cfg,
-            // Room for the whole image, so appending the index list and triangles after
-            // the nodes never reallocates.
-            words: Vec::with_capacity(
-                bvh.nodes.len() * 3 + bvh.prim_ids.len() + triangles.len() * 9,
-            ),
-            indices: Vec::with_capacity(bvh.prim_ids.len()),
-            stats: DstStats::default(),
-            visited: 0,
+            steps: StepTable::new(&cfg.costs)?,
         };
         let empty = bvh.prim_ids.is_empty() || bvh.nodes.is_empty();
+        let (plan, root_slot, size) = if empty {
+            (Plan::Seq(Vec::new()), 0, Size::default())
+        } else {
+            let (plan, size) = enc.plan(0, Chain::EMPTY, 0)?;
+            (plan, slot_size(bvh, 0, Chain::EMPTY), size)
+        };
+        let n_nodes = root_slot as u64 + size.words;
+        if n_nodes > OFFSET_LIMIT {
+            return Err(DstError::OffsetOverflow {
+                given: n_nodes,
+                limit: OFFSET_LIMIT,
+            });
+        }
+        let (n_nodes, n_idx) = (n_nodes as usize, size.entries as usize);
+        // One zeroed allocation for the whole image (fresh pages, first touched by the
+        // threads that fill them); the triangles are copied in parallel.
+        let mut words = vec![0u32; n_nodes + n_idx + 9 * triangles.len()];
+        let (node_words, rest) = words.split_at_mut(n_nodes);
+        let (entries, tri_words) = rest.split_at_mut(n_idx);
+        let tri_src: &[u32] = bytemuck::cast_slice(triangles);
+        tri_words
+            .par_chunks_mut(1 << 16)
+            .zip(tri_src.par_chunks(1 << 16))
+            .for_each(|(d, s)| d.copy_from_slice(s));
+        let mut stats = if empty {
+            DstStats::default()
+        } else {
+            let (slot, node_words) = node_words.split_at_mut(root_slot);
+            let out = Out {
+                slot,
+                words: node_words,
+                at: root_slot as u64,
+                entries,
+                entries_at: 0,
+            };
+            enc.emit_plan(&plan, 0, Chain::EMPTY, out)?
+        };
         let scene_box = if empty {
             Aabb::EMPTY
         } else {
             bvh.nodes[0].bounds
         };
-        if !empty {
-            let root_size = if bvh.nodes[0].is_leaf() { 1 } else { 3 };
-            let at = enc.reserve(root_size);
-            let mut tasks = Tasks::new();
-            enc.collect(0, 0, &mut tasks)?;
-            let done: Vec<_> = tasks
-                .par_iter()
-                .map(|(n, chain)| enc.sub_encoder(*n, chain, tasks.len()))
-                .collect();
-            enc.emit(0, &Chain::EMPTY, at, 0, &mut done.into_iter())?;
-        }
-        if enc.words.len() as u64 > super::OFFSET_LIMIT {
-            return Err(DstError::OffsetOverflow {
-                given: enc.words.len() as u64,
-                limit: super::OFFSET_LIMIT,
-            });
-        }
-        let n_nodes = enc.words.len();
-        let n_idx = enc.indices.len();
-        let mut words = enc.words;
-        words.reserve_exact(n_idx + triangles.len() * 9);
-        words.extend_from_slice(&enc.indices);
-        words.extend_from_slice(bytemuck::cast_slice::<Triangle, u32>(triangles));
         let image = MemoryImage {
             nodes: 0..n_nodes,
             indices: n_nodes..n_nodes + n_idx,
             triangles: n_nodes + n_idx..words.len(),
             words,
         };
-        let mut stats = enc.stats;
         stats.node_bytes = image.node_bytes();
         stats.index_bytes = image.index_bytes();
         stats.total_bytes = stats.node_bytes + stats.index_bytes + 24;
-        stats.bvh2_bytes = if empty { 0 } else { bvh2_size_bytes(bvh) };
+        // The BVH2's size in the paper's layout (`stats::bvh2_size_bytes`): one 52-byte
+        // node per internal node, and every internal node became one splitting node.
+        stats.bvh2_bytes = if empty {
+            0
+        } else {
+            52 * stats.splitting + 4 * bvh.prim_ids.len() as u64
+        };
         Ok(Dst {
             image,
             scene_box,

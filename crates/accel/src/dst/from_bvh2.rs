@@ -19,10 +19,10 @@
 //! with the same strict `<` and the same float expressions, so every decision (ties
 //! included) is the one the plain loops made (`tests/dst_convert_golden.rs`).
 
-use super::header::{AxisPair, Corner};
-use super::{DstConfig, DstCosts, Partitioning};
+use super::header::{AxisPair, Corner, HeaderOffset};
+use super::{DstConfig, DstCosts, DstError, Partitioning};
 use crate::build::Bvh2;
-use dualsplit_geometry::Aabb;
+use dualsplit_geometry::{Aabb, Vec3};
 
 /// A carving node the converter decided to emit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,30 +41,127 @@ pub(super) struct CarveStep {
     pub p1: f32,
 }
 
-const NO_STEP: CarveStep = CarveStep {
-    kind: CarveKind::Single(0),
-    p0: f32::INFINITY,
-    p1: f32::NEG_INFINITY,
-};
-
-/// A carving chain, outermost node first (at most one node per face).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Chain {
-    steps: [CarveStep; 6],
-    len: u8,
-}
+/// A carving chain, outermost node first (at most one node per face), packed into eight
+/// bytes so the planning pass can keep every chain until emission: step `i` is the 6-bit
+/// mask of the faces it carves (bit `f` = face `f`) at bits `6i..6i+6`, the step count at
+/// bits 36..39. A step's carving node is rebuilt from its faces and the target box
+/// ([`Chain::step`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Chain(u64);
 
 impl Chain {
-    pub const EMPTY: Chain = Chain {
-        steps: [NO_STEP; 6],
-        len: 0,
-    };
-    pub fn steps(&self) -> &[CarveStep] {
-        &self.steps[..self.len as usize]
+    pub const EMPTY: Chain = Chain(0);
+
+    /// Number of carving nodes.
+    #[inline(always)]
+    pub fn len(self) -> usize {
+        (self.0 >> 36) as usize
     }
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
+
+    #[inline(always)]
+    pub fn is_empty(self) -> bool {
+        self.len() == 0
     }
+
+    /// Appends a step carving the faces in `faces` (one or two bits).
+    #[inline(always)]
+    fn push(&mut self, faces: u64) {
+        let n = self.len();
+        self.0 = (self.0 & ((1 << 36) - 1)) | faces << (6 * n) | ((n + 1) as u64) << 36;
+    }
+
+    /// The faces step `i` carves, as a 6-bit mask (bit `f` = face `f`).
+    #[inline(always)]
+    pub fn faces(self, i: usize) -> usize {
+        (self.0 >> (6 * i)) as usize & 63
+    }
+}
+
+/// Where a carving node's plane comes from: face 0–5 of the box the chain carves down to,
+/// or a ±∞ no-op plane.
+const PLUS_INF: u8 = 6;
+const MINUS_INF: u8 = 7;
+
+/// A carving node as a function of the faces it carves: its header (offset 0, L = 0),
+/// whether it is dual-axis, and the sources of P0 and P1 (a face 0–5, [`PLUS_INF`] or
+/// [`MINUS_INF`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct StepTemplate {
+    pub header: HeaderOffset,
+    pub dual: bool,
+    pub planes: [u8; 2],
+}
+
+/// The carving node of every face set a chain step can carve (one face or two), built once
+/// per conversion with [`step_for`], so emission is a lookup and two plane selects.
+pub(super) struct StepTable([StepTemplate; 64]);
+
+impl StepTable {
+    pub fn new(costs: &DstCosts) -> Result<Self, DstError> {
+        // A probe box whose coordinates are the face numbers: step_for's planes name their
+        // faces.
+        let probe = Aabb {
+            min: Vec3::new(0.0, 2.0, 4.0),
+            max: Vec3::new(1.0, 3.0, 5.0),
+        };
+        let source = |p: f32| {
+            if p == f32::INFINITY {
+                PLUS_INF
+            } else if p == f32::NEG_INFINITY {
+                MINUS_INF
+            } else {
+                p as u8
+            }
+        };
+        let mut table = [StepTemplate {
+            header: HeaderOffset::single_carve(0, false, 0)?,
+            dual: false,
+            planes: [PLUS_INF, MINUS_INF],
+        }; 64];
+        for (m, t) in table.iter_mut().enumerate() {
+            if !(1..=2).contains(&m.count_ones()) {
+                continue;
+            }
+            let fi = m.trailing_zeros() as usize;
+            let rest = m & !(1 << fi);
+            let fj = (rest != 0).then(|| rest.trailing_zeros() as usize);
+            let step = step_for(fi, fj, &probe, costs);
+            let (header, dual) = match step.kind {
+                CarveKind::Single(axis) => (HeaderOffset::single_carve(axis, false, 0)?, false),
+                CarveKind::Dual(pair, corner) => {
+                    (HeaderOffset::dual_carve(pair, corner, false, 0)?, true)
+                }
+            };
+            *t = StepTemplate {
+                header,
+                dual,
+                planes: [source(step.p0), source(step.p1)],
+            };
+        }
+        Ok(StepTable(table))
+    }
+
+    /// The template of the step carving face set `faces`.
+    #[inline(always)]
+    pub fn get(&self, faces: usize) -> &StepTemplate {
+        &self.0[faces]
+    }
+}
+
+/// The values [`StepTemplate::planes`] select from, for a chain carving down to `target`.
+#[inline(always)]
+pub(super) fn plane_values(target: &Aabb) -> [f32; 8] {
+    let (lo, hi) = (target.min, target.max);
+    [
+        lo.x,
+        hi.x,
+        lo.y,
+        hi.y,
+        lo.z,
+        hi.z,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+    ]
 }
 
 /// Face `f` of a box: axis `f >> 1`, the max face when `f & 1 == 1`.
@@ -77,12 +174,10 @@ fn face(b: &Aabb, f: usize) -> f32 {
     }
 }
 
-/// The carving node covering face set `t` (one or two faces of `faces`), with its cost.
-fn step_for(faces: &[usize], i: usize, j: Option<usize>, target: &Aabb, c: &DstCosts) -> CarveStep {
-    let fi = faces[i];
-    match j {
-        Some(j) => {
-            let fj = faces[j];
+/// The carving node that carves face `fi` (and face `fj > fi` when given) down to `target`.
+fn step_for(fi: usize, fj: Option<usize>, target: &Aabb, c: &DstCosts) -> CarveStep {
+    match fj {
+        Some(fj) => {
             let (a, b) = (fi >> 1, fj >> 1);
             if a == b {
                 CarveStep {
@@ -166,11 +261,25 @@ pub(super) struct ChainDp {
     /// split enters is one lookup.
     bit_of: [u8; 6],
     k: usize,
-    target: Aabb,
     cost: [f32; 64],
     choice: [u8; 64],
     /// Leaf cost in the full state (similar partitioning), added to every result.
     base: f32,
+    /// Working arrays of [`ChainDp::solve`].
+    scratch: Scratch,
+}
+
+/// Working arrays of one DP, kept between solves so that no array is cleared per BVH node
+/// (a DP reads only entries it wrote first; most chains have k ≤ 3 faces, i.e. ≤ 8 of the
+/// 64 states, so clearing dominated the planning time).
+struct Scratch {
+    /// Surface area of the region in each state.
+    sa: [f32; 64],
+    /// Node cost by option mask.
+    weight: [f32; 64],
+    /// For a lone-face option mask: the faces whose pair node is no dearer (only entries of
+    /// single-bit masks are ever written; the others stay 0).
+    cheap_partner: [u8; 64],
 }
 
 /// Start of chain length `k`'s states in [`OptionTable::range`]: Σ_{k' < k} (2^k' + 1).
@@ -259,22 +368,39 @@ struct DpInputs<'a> {
 }
 
 impl ChainDp {
+    /// A DP ready for [`ChainDp::solve`] (reused across nodes).
+    pub fn new() -> Self {
+        ChainDp {
+            faces: [0; 6],
+            bit_of: [0; 6],
+            k: 0,
+            cost: [0.0; 64],
+            choice: [0; 64],
+            base: 0.0,
+            scratch: Scratch {
+                sa: [0.0; 64],
+                weight: [0.0; 64],
+                cheap_partner: [0; 64],
+            },
+        }
+    }
+
     /// Solves the DP from `region` (the parent box) down to `target` (the child box).
     /// `leaf_tris` is `Some(n)` when the child is a leaf of `n` triangles and similar
     /// partitioning is on: the chain may then stop early, paying `C_tri · n · SA` of the
     /// looser region instead. Costs are SAH-weighted by the area of the region in which
     /// each node is tested.
     #[inline(always)]
-    pub fn solve(region: &Aabb, target: &Aabb, costs: &DstCosts, leaf_tris: Option<u32>) -> Self {
-        let mut dp = ChainDp {
-            faces: [0; 6],
-            bit_of: [0; 6],
-            k: 0,
-            target: *target,
-            cost: [0.0; 64],
-            choice: [0; 64],
-            base: 0.0,
-        };
+    pub fn solve(
+        &mut self,
+        region: &Aabb,
+        target: &Aabb,
+        costs: &DstCosts,
+        leaf_tris: Option<u32>,
+    ) {
+        let dp = self;
+        dp.k = 0;
+        dp.bit_of = [0; 6];
         for f in 0..6 {
             if face(region, f) != face(target, f) {
                 dp.faces[dp.k] = f;
@@ -282,88 +408,228 @@ impl ChainDp {
                 dp.k += 1;
             }
         }
-        let k = dp.k;
+        // Chains of at most two faces (three quarters of dragon_box's), and of three with
+        // cheap pairs, are solved in closed form; the others by the DP, compiled once per
+        // chain length.
+        let c_lone = costs.single_carve.min(costs.dual_carve);
+        let pairs_cheap = costs.single_carve <= c_lone && costs.dual_carve <= c_lone;
+        match dp.k {
+            0 => dp.fill_closed::<0>(region, target, costs, leaf_tris),
+            1 => dp.fill_closed::<1>(region, target, costs, leaf_tris),
+            2 => dp.fill_closed::<2>(region, target, costs, leaf_tris),
+            3 if pairs_cheap => dp.fill_closed::<3>(region, target, costs, leaf_tris),
+            3 => dp.fill::<3>(region, target, costs, leaf_tris),
+            4 => dp.fill::<4>(region, target, costs, leaf_tris),
+            5 => dp.fill::<5>(region, target, costs, leaf_tris),
+            _ => dp.fill::<6>(region, target, costs, leaf_tris),
+        }
+    }
+
+    /// [`ChainDp::solve`] in closed form for `K` ≤ 2 faces, and for `K` = 3 when every pair
+    /// node is no dearer than a lone-face node (the hardware preset): the DP of
+    /// [`ChainDp::fill`] written out state by state, with the same float expressions, the
+    /// same options in the same order and the same strict `<`, so it decides exactly what
+    /// the DP decides (ties included; `tests/dst_convert_golden.rs`).
+    #[inline(always)]
+    fn fill_closed<const K: usize>(
+        &mut self,
+        region: &Aabb,
+        target: &Aabb,
+        costs: &DstCosts,
+        leaf_tris: Option<u32>,
+    ) {
+        let full = (1usize << K) - 1;
+        let c_lone = costs.single_carve.min(costs.dual_carve);
+        // ext[a][c]: the region's extent on axis a with carve code c (bit 0: min face
+        // carved to `target`, bit 1: max face carved).
+        let mut ext = [[0f32; 4]; 3];
+        for (a, e) in ext.iter_mut().enumerate() {
+            let (rl, rh) = (region.min[a], region.max[a]);
+            let (tl, th) = (target.min[a], target.max[a]);
+            *e = [
+                (rh - rl).max(0.0),
+                (rh - tl).max(0.0),
+                (th - rl).max(0.0),
+                (th - tl).max(0.0),
+            ];
+        }
+        // Surface area of the region in every state (faces as a 6-bit mask, by doubling).
+        let mut fm = [0usize; 8];
+        for i in 0..K {
+            let b = 1 << i;
+            for s in 0..b {
+                fm[s | b] = fm[s] | 1 << self.faces[i];
+            }
+        }
+        let mut sa = [0f32; 8];
+        for s in 0..=full {
+            let m = fm[s];
+            let (x, y, z) = (ext[0][m & 3], ext[1][m >> 2 & 3], ext[2][m >> 4 & 3]);
+            sa[s] = x * y + y * z + z * x;
+        }
+        let tri_weight = leaf_tris.map(|n| costs.triangle * n as f32);
+        self.base = leaf_tris.map_or(0.0, |n| costs.triangle * n as f32 * sa[full]);
+        let base = self.base;
+        // The cheapest option of a state among `options` (mask, cost), the first on ties;
+        // with similar partitioning the chain may also stop (choice 0).
+        let best = |sa_s: f32, options: &[(u8, f32)]| {
+            let mut b = (tri_weight.map_or(f32::INFINITY, |w| w * sa_s - base), 0u8);
+            for &(t, c) in options {
+                if c < b.0 {
+                    b = (c, t);
+                }
+            }
+            b
+        };
+        // The cost of a pair node carving faces i and j.
+        let w_pair = |i: usize, j: usize| {
+            if self.faces[i] >> 1 == self.faces[j] >> 1 {
+                costs.single_carve
+            } else {
+                costs.dual_carve
+            }
+        };
+        self.cost[full] = 0.0;
+        match K {
+            0 => {}
+            1 => {
+                (self.cost[0], self.choice[0]) = best(sa[0], &[(1, c_lone * sa[0] + 0.0)]);
+            }
+            2 => {
+                for (s, rem) in [(2, 1), (1, 2)] {
+                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, c_lone * sa[s] + 0.0)]);
+                }
+                let w = w_pair(0, 1);
+                let pair = (3, w * sa[0] + 0.0);
+                (self.cost[0], self.choice[0]) = if w <= c_lone {
+                    // Carving a face alone is dominated while its partner remains.
+                    best(sa[0], &[pair])
+                } else {
+                    let lone = |t: u8| (t, c_lone * sa[0] + self.cost[t as usize]);
+                    best(sa[0], &[lone(1), pair, lone(2)])
+                };
+            }
+            _ => {
+                // Every pair is cheap ([`OPTIONS_PAIRS_CHEAP`]): a last face is carved alone,
+                // two remaining faces as a pair, and from three the three pairs are tried.
+                for (s, rem) in [(6, 1), (5, 2), (3, 4)] {
+                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, c_lone * sa[s] + 0.0)]);
+                }
+                let w = [w_pair(0, 1), w_pair(0, 2), w_pair(1, 2)];
+                for (s, rem, w) in [(4, 3, w[0]), (2, 5, w[1]), (1, 6, w[2])] {
+                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, w * sa[s] + 0.0)]);
+                }
+                let pair = |t: u8, w: f32| (t, w * sa[0] + self.cost[t as usize]);
+                (self.cost[0], self.choice[0]) =
+                    best(sa[0], &[pair(3, w[0]), pair(5, w[1]), pair(6, w[2])]);
+            }
+        }
+    }
+
+    /// [`ChainDp::solve`] for `K` = k faces to carve.
+    #[inline(always)]
+    fn fill<const K: usize>(
+        &mut self,
+        region: &Aabb,
+        target: &Aabb,
+        costs: &DstCosts,
+        leaf_tris: Option<u32>,
+    ) {
+        let dp = self;
+        let k = K;
         // Triangle cost of the leaf below (similar partitioning only; with identical bounds
         // the leaf's cost is the same for every choice and never matters).
         let leaf_cost = |sa: f32| leaf_tris.map(|n| costs.triangle * n as f32 * sa);
         let full = (1usize << k) - 1;
-        // Region extent on each axis for each of the 4 carve states of its two faces
-        // (bit 0: min face carved, bit 1: max face carved).
-        let mut ext = [[0f32; 4]; 3];
-        for (a, e) in ext.iter_mut().enumerate() {
-            for (code, slot) in e.iter_mut().enumerate() {
-                let lo = if code & 1 == 1 {
+        let c_lone = costs.single_carve.min(costs.dual_carve);
+        let Scratch {
+            sa,
+            weight,
+            cheap_partner,
+        } = &mut dp.scratch;
+        // The faces of F are in ascending order, so each axis's faces are consecutive bits
+        // of a state: s = s_x | s_y << m_x | s_z << (m_x + m_y), where s_a holds the m_a ≤ 2
+        // faces of axis a (min face first). `axis[a][s_a]` is the region's extent on axis a
+        // in sub-state s_a, and the states are enumerated in order by three nested loops.
+        let mut m = [0usize; 3];
+        let mut axis = [[0f32; 4]; 3];
+        for a in 0..3 {
+            let (lo, hi) = (dp.bit_of[2 * a] != 0, dp.bit_of[2 * a + 1] != 0);
+            m[a] = lo as usize + hi as usize;
+            for (sub, e) in axis[a][..1 << m[a]].iter_mut().enumerate() {
+                // Which of the axis's two faces sub-state `sub` has carved.
+                let (min_carved, max_carved) = if lo {
+                    (sub & 1 == 1, sub & 2 == 2)
+                } else {
+                    (false, sub & 1 == 1)
+                };
+                let lo = if min_carved {
                     target.min[a]
                 } else {
                     region.min[a]
                 };
-                let hi = if code & 2 == 2 {
+                let hi = if max_carved {
                     target.max[a]
                 } else {
                     region.max[a]
                 };
-                *slot = (hi - lo).max(0.0);
+                *e = (hi - lo).max(0.0);
             }
         }
-        // codes[s]: the carved faces of state s as a 6-bit mask (bit 2a + side).
-        let c_lone = costs.single_carve.min(costs.dual_carve);
-        let mut codes = [0u8; 64];
-        let mut sa = [0f32; 64];
-        for s in 0..=full {
-            if s > 0 {
-                codes[s] = codes[s & (s - 1)] | 1 << dp.faces[s.trailing_zeros() as usize];
+        let mut s = 0;
+        for &z in &axis[2][..1 << m[2]] {
+            for &y in &axis[1][..1 << m[1]] {
+                for &x in &axis[0][..1 << m[0]] {
+                    sa[s] = x * y + y * z + z * x;
+                    s += 1;
+                }
             }
-            let c = codes[s];
-            let (x, y, z) = (
-                ext[0][(c & 3) as usize],
-                ext[1][(c >> 2 & 3) as usize],
-                ext[2][(c >> 4 & 3) as usize],
-            );
-            sa[s] = x * y + y * z + z * x;
         }
         dp.base = leaf_cost(sa[full]).unwrap_or(0.0);
         // Option weights by option mask (one face = a lone-face node, two faces = a pair
         // node), and for each lone face the partners whose pair node costs no more than a
         // lone-face node: while such a partner remains, carving the face alone is dominated
         // (the DP cost never grows when more faces are already carved), so it is skipped.
-        let mut weight = [0f32; 64];
-        let mut cheap_partner = [0u8; 64];
+        let pairs_cheap = costs.single_carve <= c_lone && costs.dual_carve <= c_lone;
         for i in 0..k {
             weight[1 << i] = c_lone;
-            for (j, &fj) in dp.faces[..k].iter().enumerate() {
-                if i == j {
-                    continue;
-                }
-                let c = if dp.faces[i] >> 1 == fj >> 1 {
+            cheap_partner[1 << i] = 0;
+        }
+        for i in 0..k {
+            for j in i + 1..k {
+                let c = if dp.faces[i] >> 1 == dp.faces[j] >> 1 {
                     costs.single_carve
                 } else {
                     costs.dual_carve
                 };
                 weight[1 << i | 1 << j] = c;
-                if c <= c_lone {
+                // (Not read when every pair is cheap: no lone option is then dominated.)
+                if !pairs_cheap && c <= c_lone {
                     cheap_partner[1 << i] |= 1 << j;
+                    cheap_partner[1 << j] |= 1 << i;
                 }
             }
         }
         // The options of every state come from a table built at compile time, in the order
         // of the original loops (lone i, then pairs (i, j > i), for i ascending), so ties
         // go to the same option; the selection is branch-free.
-        let pairs_cheap = costs.single_carve <= c_lone && costs.dual_carve <= c_lone;
         let inputs = DpInputs {
             full,
             first: TABLE_START[k],
-            sa: &sa,
-            weight: &weight,
-            cheap_partner: &cheap_partner,
+            sa,
+            weight,
+            cheap_partner,
             tri_weight: leaf_tris.map(|n| costs.triangle * n as f32),
         };
+        // The full state needs no more carving.
+        dp.cost[full] = 0.0;
+        let out = (&mut dp.cost, &mut dp.choice, dp.base);
         match (pairs_cheap, inputs.tri_weight.is_some()) {
-            (true, false) => dp.run::<true, false>(&inputs),
-            (true, true) => dp.run::<true, true>(&inputs),
-            (false, false) => dp.run::<false, false>(&inputs),
-            (false, true) => dp.run::<false, true>(&inputs),
+            (true, false) => Self::run::<true, false>(out, &inputs),
+            (true, true) => Self::run::<true, true>(out, &inputs),
+            (false, false) => Self::run::<false, false>(out, &inputs),
+            (false, true) => Self::run::<false, true>(out, &inputs),
         }
-        dp
     }
 
     /// The DP proper, over the states from `full - 1` down to 0, specialised on whether
@@ -371,7 +637,10 @@ impl ChainDp {
     /// then holds no dominated lone option, so none needs the partner test) and on whether
     /// the chain may stop early above a leaf (`STOP`, similar partitioning).
     #[inline(always)]
-    fn run<const PAIRS_CHEAP: bool, const STOP: bool>(&mut self, d: &DpInputs) {
+    fn run<const PAIRS_CHEAP: bool, const STOP: bool>(
+        (cost, choice, base): (&mut [f32; 64], &mut [u8; 64], f32),
+        d: &DpInputs,
+    ) {
         let table = if PAIRS_CHEAP {
             &OPTIONS_PAIRS_CHEAP
         } else {
@@ -381,7 +650,7 @@ impl ChainDp {
         for s in (0..d.full).rev() {
             let sa = d.sa[s];
             let stop = if STOP {
-                tri_weight * sa - self.base
+                tri_weight * sa - base
             } else {
                 f32::INFINITY
             };
@@ -392,14 +661,14 @@ impl ChainDp {
                 table.range[d.first + s + 1] as usize,
             );
             for &t in &table.masks[lo..hi] {
-                let c = d.weight[t as usize] * sa + self.cost[s | t as usize];
+                let c = d.weight[t as usize] * sa + cost[s | t as usize];
                 let allowed = PAIRS_CHEAP || rem & d.cheap_partner[t as usize] == 0;
                 let better = (c < best_c) & allowed;
                 best_c = if better { c } else { best_c };
                 best_t = if better { t } else { best_t };
             }
-            self.cost[s] = best_c;
-            self.choice[s] = best_t;
+            cost[s] = best_c;
+            choice[s] = best_t;
         }
     }
 
@@ -416,7 +685,7 @@ impl ChainDp {
     }
 
     /// The cheapest chain when the split carves face `f`, outermost node first.
-    pub fn chain(&self, carved_by_split: usize, costs: &DstCosts) -> Chain {
+    pub fn chain(&self, carved_by_split: usize) -> Chain {
         let full = (1usize << self.k) - 1;
         let mut chain = Chain::EMPTY;
         let mut s = self.start(carved_by_split);
@@ -424,10 +693,11 @@ impl ChainDp {
             let t = self.choice[s] as usize;
             let i = t.trailing_zeros() as usize;
             let rest = t & !(1 << i);
-            let j = (rest != 0).then(|| rest.trailing_zeros() as usize);
-            chain.steps[chain.len as usize] =
-                step_for(&self.faces[..self.k], i, j, &self.target, costs);
-            chain.len += 1;
+            let mut faces = 1u64 << self.faces[i];
+            if rest != 0 {
+                faces |= 1 << self.faces[rest.trailing_zeros() as usize];
+            }
+            chain.push(faces);
             s |= t;
         }
         chain
@@ -435,11 +705,10 @@ impl ChainDp {
 }
 
 /// The split chosen for an internal BVH node: axis, which BVH child is the left (lower)
-/// child, and both children's carving chains.
+/// child (`swap`: the second), and both children's carving chains.
 pub(super) struct SplitPlan {
     pub axis: usize,
-    pub left: u32,
-    pub right: u32,
+    pub swap: bool,
     pub left_chain: Chain,
     pub right_chain: Chain,
 }
@@ -462,17 +731,19 @@ const fn min_face(axis: usize) -> usize {
 /// region is exactly its box: for each axis and order, the split plane carves the left
 /// child's max face and the right child's min face; the rest is left to the children's
 /// chains. Picks the cheapest (first in axis, then order, on ties).
-pub(super) fn plan_split(bvh: &Bvh2, n: u32, cfg: &DstConfig) -> SplitPlan {
+/// `dps` are reused working DPs (see [`ChainDp::new`]).
+pub(super) fn plan_split(bvh: &Bvh2, n: u32, cfg: &DstConfig, dps: &mut [ChainDp; 2]) -> SplitPlan {
     let node = &bvh.nodes[n as usize];
     let b = node.bounds;
     let [x, y] = node.children();
     let (bx, by) = (bvh.nodes[x as usize].bounds, bvh.nodes[y as usize].bounds);
-    let dx = ChainDp::solve(&b, &bx, &cfg.costs, leaf_tris(bvh, x, cfg));
-    let dy = ChainDp::solve(&b, &by, &cfg.costs, leaf_tris(bvh, y, cfg));
+    let [dx, dy] = dps;
+    dx.solve(&b, &bx, &cfg.costs, leaf_tris(bvh, x, cfg));
+    dy.solve(&b, &by, &cfg.costs, leaf_tris(bvh, y, cfg));
     let mut best = (f32::INFINITY, 0usize, false);
     for axis in 0..3 {
         for swap in [false, true] {
-            let (lo, hi) = if swap { (&dy, &dx) } else { (&dx, &dy) };
+            let (lo, hi) = if swap { (&*dy, &*dx) } else { (&*dx, &*dy) };
             let c = lo.cost(max_face(axis)) + hi.cost(min_face(axis));
             if c < best.0 {
                 best = (c, axis, swap);
@@ -480,16 +751,11 @@ pub(super) fn plan_split(bvh: &Bvh2, n: u32, cfg: &DstConfig) -> SplitPlan {
         }
     }
     let (_, axis, swap) = best;
-    let (left, right, lo, hi) = if swap {
-        (y, x, &dy, &dx)
-    } else {
-        (x, y, &dx, &dy)
-    };
+    let (lo, hi) = if swap { (&dy, &dx) } else { (&dx, &dy) };
     SplitPlan {
         axis,
-        left,
-        right,
-        left_chain: lo.chain(max_face(axis), &cfg.costs),
-        right_chain: hi.chain(min_face(axis), &cfg.costs),
+        swap,
+        left_chain: lo.chain(max_face(axis)),
+        right_chain: hi.chain(min_face(axis)),
     }
 }

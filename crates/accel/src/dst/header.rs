@@ -196,6 +196,17 @@ impl HeaderOffset {
         ))
     }
 
+    /// This carving node (built with offset 0 and L = 0) pointing at `offset`: a child word,
+    /// or with `leaf_flag` the first entry of an index run. Lets a converter build a
+    /// carving node's header once and point copies of it anywhere.
+    #[inline(always)]
+    pub fn carve_pointing_at(self, leaf_flag: bool, offset: u64) -> Result<Self, DstError> {
+        debug_assert!(self.0 & BIT_C != 0 && self.0 & (BIT_L | OFFSET_MASK) == 0);
+        Ok(Self(
+            self.0 | ((leaf_flag as u32) << 26) | check_offset(offset)?,
+        ))
+    }
+
     /// The raw word.
     #[inline(always)]
     pub fn bits(self) -> u32 {

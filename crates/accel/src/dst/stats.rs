@@ -33,6 +33,16 @@ pub struct DstStats {
 }
 
 impl DstStats {
+    /// Adds `o`'s node and entry counts (not the byte totals) to these.
+    pub(super) fn add_counts(&mut self, o: &DstStats) {
+        self.splitting += o.splitting;
+        self.single_carving += o.single_carving;
+        self.dual_carving += o.dual_carving;
+        self.leaves += o.leaves;
+        self.carving_leaves += o.carving_leaves;
+        self.index_entries += o.index_entries;
+    }
+
     /// Internal (12-byte) nodes.
     pub fn internal_nodes(&self) -> u64 {
         self.splitting + self.single_carving + self.dual_carving

@@ -14,7 +14,7 @@
 //!   the same set has taken its tag (`inflight`, SimTRaX's per-L1 list of in-flight lines
 //!   and L2's pending list), so it is never requested twice.
 //!
-//! (Model version 2 and earlier wrote the new tag at request time: the replaced line vanished
+//! (Model versions ≤ 3 wrote the new tag at request time: the replaced line vanished
 //! for the whole miss latency and an in-flight line whose tag was taken by a later conflicting
 //! miss was requested again. Under load the two fed each other — longer latencies, more
 //! re-requests of the top-of-tree lines, hotter L2 banks — which is why TM scaling broke
@@ -35,12 +35,15 @@ pub enum Lookup {
     Absent,
 }
 
+/// One way's tag: the line it holds and the cycle its fill arrives (16 bytes, so a
+/// direct-mapped lookup touches one host cache line).
+/// One way's tag: the line it holds once its fill arrives, and the line it replaced, still
+/// readable until then (32 bytes: a direct-mapped lookup touches one host cache line).
 #[derive(Clone, Copy, Debug)]
 struct Way {
     /// The line this way holds once `fill` has arrived.
     line: u64,
     fill: Cycle,
-    used: u64,
     /// The line replaced by `line`, still readable before `fill` (its own fill cycle).
     prev: u64,
     prev_fill: Cycle,
@@ -55,6 +58,8 @@ const INFLIGHT_PRUNE: usize = 64;
 #[derive(Clone, Debug)]
 pub struct Cache {
     ways: Vec<Way>,
+    /// LRU stamps, parallel to `ways` (empty when direct-mapped: nothing to choose).
+    used: Vec<u64>,
     assoc: usize,
     set_mask: u64,
     stamp: u64,
@@ -68,17 +73,18 @@ impl Cache {
     pub fn new(size_bytes: u64, line_bytes: u64, associativity: u32) -> Self {
         let assoc = associativity.max(1) as usize;
         let sets = (size_bytes / line_bytes / assoc as u64).max(1);
+        let n = sets as usize * assoc;
         Self {
             ways: vec![
                 Way {
                     line: INVALID,
                     fill: 0,
-                    used: 0,
                     prev: INVALID,
                     prev_fill: 0,
                 };
-                sets as usize * assoc
+                n
             ],
+            used: if assoc > 1 { vec![0; n] } else { Vec::new() },
             assoc,
             set_mask: sets - 1,
             stamp: 0,
@@ -98,17 +104,28 @@ impl Cache {
     #[inline]
     pub fn lookup(&mut self, line: u64, now: Cycle) -> Lookup {
         let s = self.set(line);
-        self.stamp += 1;
-        let set = &mut self.ways[s..s + self.assoc];
-        for w in set.iter_mut() {
+        if self.assoc == 1 {
+            let w = self.ways[s];
             if w.line == line {
-                w.used = self.stamp;
                 return Lookup::Present { fill: w.fill };
             }
-        }
-        for w in set.iter() {
             if w.prev == line && now < w.fill {
                 return Lookup::Present { fill: w.prev_fill };
+            }
+        } else {
+            self.stamp += 1;
+            for i in s..s + self.assoc {
+                if self.ways[i].line == line {
+                    self.used[i] = self.stamp;
+                    return Lookup::Present {
+                        fill: self.ways[i].fill,
+                    };
+                }
+            }
+            for w in &self.ways[s..s + self.assoc] {
+                if w.prev == line && now < w.fill {
+                    return Lookup::Present { fill: w.prev_fill };
+                }
             }
         }
         if !self.inflight.is_empty()
@@ -120,32 +137,48 @@ impl Cache {
         Lookup::Absent
     }
 
+    /// The tag word of `line`'s first way, read without effect (see `Thread::touch`).
+    #[inline]
+    pub fn peek(&self, line: u64) -> u64 {
+        self.ways[self.set(line)].line
+    }
+
     /// Reserves the least recently used way of `line`'s set for a miss made at cycle `now`
     /// whose fill arrives at `fill`. The line it replaces stays readable until then; if that
     /// line is itself still in flight, it moves to the in-flight list.
     #[inline]
     pub fn install(&mut self, line: u64, fill: Cycle, now: Cycle) {
         let s = self.set(line);
-        self.stamp += 1;
-        let set = &mut self.ways[s..s + self.assoc];
-        let victim = set
-            .iter_mut()
-            .min_by_key(|w| if w.line == INVALID { 0 } else { w.used + 1 })
-            .expect("at least one way");
+        let victim = if self.assoc == 1 {
+            s
+        } else {
+            self.stamp += 1;
+            let v = (s..s + self.assoc)
+                .min_by_key(|&i| {
+                    if self.ways[i].line == INVALID {
+                        0
+                    } else {
+                        self.used[i] + 1
+                    }
+                })
+                .expect("at least one way");
+            self.used[v] = self.stamp;
+            v
+        };
+        let w = &mut self.ways[victim];
         let mut moved = None;
-        if victim.line != INVALID {
-            if victim.fill <= now {
-                victim.prev = victim.line;
-                victim.prev_fill = victim.fill;
+        if w.line != INVALID {
+            if w.fill <= now {
+                w.prev = w.line;
+                w.prev_fill = w.fill;
             } else {
                 // Still in flight: the older resident (`prev`) stays readable, the in-flight
                 // line keeps its MSHR entry.
-                moved = Some((victim.line, victim.fill));
+                moved = Some((w.line, w.fill));
             }
         }
-        victim.line = line;
-        victim.fill = fill;
-        victim.used = self.stamp;
+        w.line = line;
+        w.fill = fill;
         if let Some((l, f)) = moved {
             self.inflight.insert(l, f);
             if self.inflight.len() >= self.prune_at {

@@ -142,10 +142,20 @@ impl Dram {
     /// Reads `line` arriving at core cycle `arrive`; returns the core cycle its data has
     /// arrived and how the bank was found.
     pub fn read(&mut self, line: u64, arrive: Cycle) -> (Cycle, DramAccess) {
+        self.read_at(line, arrive, 0)
+    }
+
+    /// As [`Dram::read`], when no read will ever arrive before core cycle `now` (the
+    /// engine's current event time, `now ≤ arrive`): the channel's reservation tables then
+    /// forget what ended before it. The result is the same as `read`'s.
+    pub fn read_at(&mut self, line: u64, arrive: Cycle, now: Cycle) -> (Cycle, DramAccess) {
+        debug_assert!(now <= arrive);
         let c = &self.cfg;
         let tpc = c.ticks_per_cycle;
         let (chi, bi, row) = self.map(line);
         let ch = &mut self.channels[chi];
+        ch.bus.forget_before(now * tpc / c.t_burst);
+        ch.acts.forget_before(now * tpc);
         let mut a = arrive * tpc;
         while let Some(&Reverse(d)) = ch.inflight.peek() {
             if d <= a {
