@@ -26,7 +26,7 @@ pub fn split(
         + m.local as f64 * e.local_store_nj)
         * nj;
     // Loads, pipeline issues and atomics use the integer unit for address arithmetic.
-    let int_ops = m.int as u64 + counts.loads + counts.atomics;
+    let int_ops = m.int + counts.loads + counts.atomics;
     let compute_j = (int_ops as f64 * e.int_nj
         + m.fpadd as f64 * e.fpadd_nj
         + m.fpmul as f64 * e.fpmul_nj

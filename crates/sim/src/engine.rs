@@ -155,7 +155,7 @@ impl Chip {
         let line = word >> self.line_word_shift;
         let l1_lat = self.cfg.l1.hit_latency;
         self.caches.l1_accesses += 1;
-        match self.tms[tm].l1.lookup(line) {
+        match self.tms[tm].l1.lookup(line, slot) {
             Lookup::Present { fill } if fill <= slot => {
                 self.caches.l1_hits += 1;
                 (slot + l1_lat, fill)
@@ -175,7 +175,7 @@ impl Chip {
                 self.caches.l2_bank_wait += s2 - slot;
                 self.caches.l2_accesses += 1;
                 let at = s2 + l1_lat + self.cfg.l2.hit_latency;
-                let ready = match self.l2.lookup(line) {
+                let ready = match self.l2.lookup(line, s2) {
                     Lookup::Present { fill } if fill <= s2 => {
                         self.caches.l2_hits += 1;
                         at
@@ -186,11 +186,11 @@ impl Chip {
                     }
                     Lookup::Absent => {
                         let (done, _) = self.dram.read_at(line, at, now);
-                        self.l2.install(line, done);
+                        self.l2.install(line, done, s2);
                         done
                     }
                 };
-                self.tms[tm].l1.install(line, ready);
+                self.tms[tm].l1.install(line, ready, slot);
                 (ready, ready)
             }
         }
@@ -631,6 +631,33 @@ mod tests {
                 "line_interleaved = {by_line}"
             );
         }
+    }
+
+    #[test]
+    fn a_conflicting_miss_replaces_a_line_only_when_its_fill_arrives() {
+        // SimTRaX installs lines at their arrival (L1Cache/L2Cache UpdateCache) and finds
+        // lines in flight on its pending lists; model 2 wrote the tag at request time.
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        // Line 0 cold: 134 (L1 1 + L2 3 + closed row 30).
+        assert_eq!(chip.load_word(0, 0, 100), 134);
+        // Line 1024 (word 16384) maps to the same L1 set (64 KB direct-mapped): a closed-row
+        // read on channel 8, 34 cycles.
+        assert_eq!(chip.load_word(0, 16384, 200), 234);
+        // Line 0 is still in the L1 until 234: a 1-cycle hit, no L2 access.
+        assert_eq!(chip.load_word(0, 1, 202), 203);
+        assert_eq!(chip.caches.l2_accesses, 2);
+        // Line 2048 (same set, channel 0 bank 1, closed row: data at tick 470, rounded up to
+        // the 2 ns burst grid, 472 + 4 = 476 ticks) takes the set's tag while 1024 is still in
+        // flight; 1024 stays on the in-flight list and a miss to it merges.
+        assert_eq!(chip.load_word(0, 32768, 203), 238);
+        assert_eq!(chip.load_word(0, 16385, 205), 234);
+        assert_eq!(chip.caches.l2_accesses, 3);
+        assert_eq!(chip.caches.l1_merged, 1);
+        // Once 2048 has arrived, line 0 is gone: an L1 miss, L2 hit (1 + 3).
+        assert_eq!(chip.load_word(0, 2, 240), 244);
+        assert_eq!(chip.caches.l2_accesses, 4);
+        assert_eq!(chip.dram.stats().reads, 3);
     }
 
     #[test]

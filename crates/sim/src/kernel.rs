@@ -11,25 +11,27 @@ use crate::SimAccel;
 use dualsplit_accel::{DstNodeKind, NodeStep, Observer};
 use serde::{Deserialize, Serialize};
 
-/// Instruction mix of one kernel step, by functional-unit class (energy and issue slots).
+/// Instruction mix of one kernel step, by functional-unit class (energy and issue slots);
+/// also the frame's totals in [`InstrCounts::mix`], hence 64-bit counters (a 512×512
+/// DST* path-traced frame issues more than 2^32 instructions).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Mix {
     /// Integer add, bitwise, compare-and-branch, move.
-    pub int: u32,
+    pub int: u64,
     /// FP add/sub.
-    pub fpadd: u32,
+    pub fpadd: u64,
     /// FP multiply.
-    pub fpmul: u32,
+    pub fpmul: u64,
     /// FP min/max/compare.
-    pub fpcmp: u32,
+    pub fpcmp: u64,
     /// FP reciprocal / inverse square root (shared unit, long latency).
-    pub fpinv: u32,
+    pub fpinv: u64,
     /// Local-store (stack) accesses.
-    pub local: u32,
+    pub local: u64,
 }
 
 impl Mix {
-    const fn new(int: u32, fpadd: u32, fpmul: u32, fpcmp: u32, fpinv: u32, local: u32) -> Self {
+    const fn new(int: u64, fpadd: u64, fpmul: u64, fpcmp: u64, fpinv: u64, local: u64) -> Self {
         Self {
             int,
             fpadd,
@@ -40,7 +42,7 @@ impl Mix {
         }
     }
     /// Instructions issued (each takes one issue slot of the thread).
-    pub const fn total(&self) -> u32 {
+    pub const fn total(&self) -> u64 {
         self.int + self.fpadd + self.fpmul + self.fpcmp + self.fpinv + self.local
     }
     fn add(&mut self, o: Mix) {
@@ -81,42 +83,91 @@ pub const BVH_PER_HIT: Mix = Mix::new(2, 0, 0, 0, 0, 0);
 /// One compare-exchange of the entry-distance sort.
 pub const BVH_SORT_PAIR: Mix = Mix::new(2, 0, 0, 1, 0, 0);
 
-/// DST on the dual-split pipeline: branch on the 2-bit code, move next offset / new t_min
-/// t_max into place (Lin et al. 2020, §3, Fig. 6).
-pub const DST_HW_STEP: Mix = Mix::new(3, 0, 0, 0, 0, 0);
-
-/// DST decoded in software (DST*), per node kind (Lin et al. 2020, §3, Figs. 2–4): the
-/// header decode (shift/mask of the 6-bit header, type test and branch: 5 int), axis
-/// select of origin and inverse direction (2 int), plane distances `(p - o[a]) * inv[a]`
-/// (fpadd + fpmul per plane), near/far ordering by the direction sign (1 cmp, 2 int), the
-/// interval update and child decisions, and the child offset arithmetic.
-pub fn dst_sw_step(kind: DstNodeKind, code: u8) -> Mix {
-    match kind {
-        // 2 planes on one axis: header 5, axis 2, 2×(sub, mul), sign order 1 cmp + 2 int,
-        // t_min/t_max against both planes: 4 cmp + 3 branches, offsets 3 int.
-        DstNodeKind::Split => Mix::new(15, 2, 2, 5, 0, 0),
-        // slab on one axis: header 5, axis 2, 2×(sub, mul), order 1 cmp + 2 int,
-        // t_min = max, t_max = min (2), empty test 1 cmp + branch, offset 2.
-        DstNodeKind::SingleCarve => Mix::new(12, 2, 2, 4, 0, 0),
-        // one plane on each of two axes: header 5, two axis selects 4, 2×(sub, mul),
-        // corner type decides which side of each plane (2 cmp + 4 int), interval update 2,
-        // empty test 1 cmp + branch, offset 2.
-        DstNodeKind::DualCarve => Mix::new(16, 2, 2, 5, 0, 0),
-        // Leaf word: header decode 5 (shift, mask, type test, branch, offset mask). The
-        // triangle run's set-up is the leaf entry that follows (`LEAF`, reported by the
-        // traversal as `NodeStep::Leaf`), so it is not counted twice here.
-        DstNodeKind::Leaf => Mix::new(5, 0, 0, 0, 0, 0),
+/// DST on the dual-split pipeline, per return code (Lin et al. 2020, §3, Fig. 6): the
+/// pipeline instruction itself is the `Pipe` op; around it, the branch chain on the 2-bit
+/// return code and the moves of its outputs (`docs/simulator.md` writes the sequence out):
+///
+/// ```text
+///         dst   rc, …            ; pipeline op (header, p0, p1, ray, t_min, t_max)
+///         beqz  rc, POP          ; code 0: 1
+///         slti  t, rc, 2
+///         beqz  t, NOT1
+///         add   node, base, off  ; code 1: next node
+///         mov   tmin, tmin_out
+///         mov   tmax, tmax_out
+///         j     LOOP             ; code 1: 7
+/// NOT1:   slti  t, rc, 3
+///         beqz  t, LEAFRUN       ; code 3: 5 (the run set-up is `LEAF`)
+///         (push off_stack, tmin_out, tmax)   ; `DST_PUSH`
+///         add   node, base, off
+///         mov   tmax, tmax_out
+///         j     LOOP             ; code 2: 8
+/// ```
+pub fn dst_hw_step(code: u8) -> Mix {
+    match code {
+        0 => Mix::new(1, 0, 0, 0, 0, 0),
+        1 => Mix::new(7, 0, 0, 0, 0, 0),
+        2 => Mix::new(8, 0, 0, 0, 0, 0),
+        _ => Mix::new(5, 0, 0, 0, 0, 0),
     }
-    .with_code(code)
 }
 
-impl Mix {
-    fn with_code(mut self, code: u8) -> Self {
-        // Code 0 (miss) leaves through an early branch: no offset arithmetic for the child.
-        if code == 0 {
-            self.int = self.int.saturating_sub(2);
+/// DST stack push: the entry is the node and its ray interval `[t_min, t_max]` (Lin et al.
+/// 2020, §3, Fig. 3): three local-store stores and the pointer bump.
+pub const DST_PUSH: Mix = Mix::new(1, 0, 0, 0, 0, 3);
+/// DST stack pop: decrement, empty test, three local-store loads, `t_min` against the cull
+/// limit and branch, `t_max = min(t_max, limit)`.
+pub const DST_POP: Mix = Mix::new(3, 0, 0, 2, 0, 3);
+
+/// DST decoded in software (DST*), per node kind and outcome (Lin et al. 2020, §3, Figs.
+/// 2–4): the header is dispatched with sign-bit branches (C is bit 31; L is tested as
+/// `sll 5; bltz`), the axis is extracted with shifts and masks, the ray's origin and inverse
+/// direction components are loaded from the thread's local store by axis index (registers
+/// cannot be indexed), each plane costs `sub, mul` (`(p − o[a])·inv[a]`), an exit-role
+/// distance one more `mul` (`widen_exit`), the role by the direction's sign is a branch,
+/// min/max and the interval tests are FP compares, and a child is addressed from the 26-bit
+/// offset (and B, the left size, for the right child). Every instruction is written out in
+/// `docs/simulator.md` ("DST* decoder sequences").
+pub fn dst_sw_step(kind: DstNodeKind, code: u8) -> Mix {
+    let hit = code != 0;
+    match kind {
+        // dispatch 3, axis 1, index 2 + 2 local loads, 2 × (sub, mul), sign select (bltz,
+        // mov, j, mul widen), 2 tests (2 cmp, 2 branches); then code 0: j POP (12 int);
+        // a hit: offsets 7 (and, sll, add; srl, andi, sll, add), near/far address select 3
+        // (bltz, 2 mov), t_max = min / t_min = max (1 cmp), mov node, j LOOP (23 int); code 2
+        // adds the pushed entry's t_min = max(t_min, t2) (1 cmp).
+        DstNodeKind::Split => match code {
+            0 => Mix::new(12, 2, 3, 2, 0, 2),
+            1 => Mix::new(23, 2, 3, 3, 0, 2),
+            _ => Mix::new(23, 2, 3, 4, 0, 2),
+        },
+        // dispatch 5 (bltz, srl, andi, addi, bnez), axis 2 (srl, andi), index 2 + 2 local,
+        // 2 × (sub, mul), sign select 3 + mul, lo = max, hi = min (2 cmp), empty test (1 cmp,
+        // 1 branch); code 0: j POP (14 int); a hit: commit t_min/t_max (2 mov), leaf flag
+        // (sll, bltz), offset (and, sll, add), j (21 int).
+        DstNodeKind::SingleCarve => {
+            if hit {
+                Mix::new(21, 2, 3, 3, 0, 2)
+            } else {
+                Mix::new(14, 2, 3, 3, 0, 2)
+            }
         }
-        self
+        // dispatch 5, axis pair 3 (srl, andi, addi), index 2 × (sll, add) + 4 local, 2 ×
+        // (sub, mul), lo/hi = t_min/t_max (2 mov), per plane: sign bit, corner bit (srl, srl,
+        // andi), bne (4 int), then exit: mul widen, min, j / entry: max (2 planes: 9 int,
+        // 1 mul, 2 cmp on average), empty test (1 cmp, 1 branch); code 0: j POP (25 int);
+        // a hit: commit 2, leaf flag 2, offset 3, j (32 int).
+        DstNodeKind::DualCarve => {
+            if hit {
+                Mix::new(32, 2, 3, 3, 0, 4)
+            } else {
+                Mix::new(25, 2, 3, 3, 0, 4)
+            }
+        }
+        // Leaf word: dispatch 3 (bltz, sll, bltz taken) and the offset mask (and). The run's
+        // set-up is the leaf entry that follows (`LEAF`, reported by the traversal as
+        // `NodeStep::Leaf`), so it is not counted twice here.
+        DstNodeKind::Leaf => Mix::new(4, 0, 0, 0, 0, 0),
     }
 }
 
@@ -188,7 +239,7 @@ impl InstrCounts {
         self.mix_total() + self.loads + self.box_issues + self.tri_ops + self.dst_ops + self.atomics
     }
     fn mix_total(&self) -> u64 {
-        self.mix.total() as u64
+        self.mix.total()
     }
     /// Adds `o` into `self`.
     pub fn add(&mut self, o: &InstrCounts) {
@@ -228,12 +279,14 @@ impl<'a> Recorder<'a> {
     /// Appends instructions of mix `m` (merged into a preceding `Issue`).
     pub fn issue(&mut self, m: Mix) {
         self.counts.mix.add(m);
-        let n = m.total();
-        if let Some(Op::Issue { n: pn, fpinv }) = self.ops.last_mut() {
+        // One step's mix is a few dozen instructions: it fits an op's u32.
+        let n = m.total() as u32;
+        let fpinv = m.fpinv as u32;
+        if let Some(Op::Issue { n: pn, fpinv: pf }) = self.ops.last_mut() {
             *pn += n;
-            *fpinv += m.fpinv;
+            *pf += fpinv;
         } else {
-            self.ops.push(Op::Issue { n, fpinv: m.fpinv });
+            self.ops.push(Op::Issue { n, fpinv });
         }
     }
 
@@ -255,6 +308,10 @@ impl<'a> Recorder<'a> {
     /// Records the global atomic increment that hands a pixel to the thread.
     pub fn atomic(&mut self) {
         self.counts.atomics += 1;
+    }
+
+    fn is_dst(&self) -> bool {
+        matches!(self.accel, SimAccel::Dst | SimAccel::DstSw)
     }
 
     fn parallel_boxes(&self) -> bool {
@@ -307,7 +364,7 @@ impl Observer for Recorder<'_> {
                 }
                 if self.accel == SimAccel::Dst {
                     self.pipe(Pipe::DualSplit, 1, false);
-                    self.issue(DST_HW_STEP);
+                    self.issue(dst_hw_step(code));
                 } else {
                     self.issue(dst_sw_step(kind, code));
                 }
@@ -327,12 +384,12 @@ impl Observer for Recorder<'_> {
 
     #[inline]
     fn push(&mut self) {
-        self.issue(PUSH);
+        self.issue(if self.is_dst() { DST_PUSH } else { PUSH });
     }
 
     #[inline]
     fn pop(&mut self) {
-        self.issue(POP);
+        self.issue(if self.is_dst() { DST_POP } else { POP });
     }
 }
 
@@ -377,6 +434,21 @@ mod tests {
     }
 
     #[test]
+    fn frame_totals_do_not_wrap_at_2_pow_32() {
+        // A 512×512 DST* path-traced frame issues ~6·10^9 instructions; model 2's u32
+        // counters wrapped (energy and issue utilisation came out too low).
+        let mut c = InstrCounts::default();
+        let big = InstrCounts {
+            mix: Mix::new(3_000_000_000, 0, 0, 0, 0, 2_000_000_000),
+            ..Default::default()
+        };
+        c.add(&big);
+        c.add(&big);
+        assert_eq!(c.mix.int, 6_000_000_000);
+        assert_eq!(c.total(), 10_000_000_000);
+    }
+
+    #[test]
     fn dst_hw_is_one_pipeline_op_and_sw_is_instructions() {
         let step = NodeStep::Dst {
             kind: DstNodeKind::Split,
@@ -387,11 +459,18 @@ mod tests {
         let mut r = Recorder::new(SimAccel::Dst, &mut ops);
         r.step(step);
         assert_eq!(r.counts.dst_ops, 1);
-        assert_eq!(r.counts.mix.total(), DST_HW_STEP.total());
+        // Code 2: the branch chain to the "both children" case, next node, t_max, jump.
+        assert_eq!(r.counts.mix.total(), 8);
         let mut ops = Vec::new();
         let mut r = Recorder::new(SimAccel::DstSw, &mut ops);
         r.step(step);
         assert_eq!(r.counts.dst_ops, 0);
-        assert_eq!(r.counts.mix.total(), 24);
+        // 23 int, 2 local loads, 2 sub, 3 mul, 4 min/max/compare.
+        assert_eq!(r.counts.mix.total(), 34);
+        assert_eq!(r.counts.mix.local, 2);
+        // The stack entries of both DSTs carry [t_min, t_max]: 3 local-store accesses.
+        r.push();
+        r.pop();
+        assert_eq!(r.counts.mix.local, 2 + 3 + 3);
     }
 }

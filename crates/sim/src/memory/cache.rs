@@ -1,31 +1,60 @@
 //! A set-associative cache of 64-byte lines with fill times in the tags (LRU replacement;
-//! associativity 1 is SimTRaX's direct-mapped cache, notes §1.4).
+//! associativity 1 is SimTRaX's direct-mapped cache, notes §1.4), plus the list of lines in
+//! flight (the MSHRs).
+//!
+//! A miss is *reserved* when it is made (it learns its fill cycle at once, notes §5.2), but
+//! the line it brings is only *installed* when that fill arrives, as in SimTRaX ("lines are
+//! installed in L2 and L1 at their arrival cycle", notes §1.4) and in any cache with miss
+//! status holding registers (Kroft 1981):
+//!
+//! * the line a miss replaces stays readable until the new line's fill arrives (`prev`), so a
+//!   hot line (the top of a tree) is not lost for the whole miss latency of a conflicting
+//!   line;
+//! * a line still in flight is found by every later miss to it, even after another miss to
+//!   the same set has taken its tag (`inflight`, SimTRaX's per-L1 list of in-flight lines
+//!   and L2's pending list), so it is never requested twice.
+//!
+//! (Model versions ≤ 3 wrote the new tag at request time: the replaced line vanished
+//! for the whole miss latency and an in-flight line whose tag was taken by a later conflicting
+//! miss was requested again. Under load the two fed each other — longer latencies, more
+//! re-requests of the top-of-tree lines, hotter L2 banks — which is why TM scaling broke
+//! down at 128 TMs; see `docs/simulator.md`, "TM scaling".)
 
 use crate::Cycle;
+use std::collections::HashMap;
 
 /// The result of a tag lookup.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Lookup {
-    /// The line is present; its data is (or will be) there at `fill`.
+    /// The line is present or in flight; its data is (or will be) there at `fill`.
     Present {
         /// Cycle the line's fill arrives (≤ now for a plain hit).
         fill: Cycle,
     },
-    /// The line is absent.
+    /// The line is absent and not in flight.
     Absent,
 }
 
 /// One way's tag: the line it holds and the cycle its fill arrives (16 bytes, so a
 /// direct-mapped lookup touches one host cache line).
+/// One way's tag: the line it holds once its fill arrives, and the line it replaced, still
+/// readable until then (32 bytes: a direct-mapped lookup touches one host cache line).
 #[derive(Clone, Copy, Debug)]
 struct Way {
+    /// The line this way holds once `fill` has arrived.
     line: u64,
     fill: Cycle,
+    /// The line replaced by `line`, still readable before `fill` (its own fill cycle).
+    prev: u64,
+    prev_fill: Cycle,
 }
 
 const INVALID: u64 = u64::MAX;
 
-/// Tags of a set-associative cache.
+/// In-flight entries are pruned once the table has grown past this many (amortised).
+const INFLIGHT_PRUNE: usize = 64;
+
+/// Tags of a set-associative cache, with the in-flight (MSHR) list.
 #[derive(Clone, Debug)]
 pub struct Cache {
     ways: Vec<Way>,
@@ -34,6 +63,9 @@ pub struct Cache {
     assoc: usize,
     set_mask: u64,
     stamp: u64,
+    /// Lines in flight whose way has since been taken by a later miss: line → fill cycle.
+    inflight: HashMap<u64, Cycle>,
+    prune_at: usize,
 }
 
 impl Cache {
@@ -46,7 +78,9 @@ impl Cache {
             ways: vec![
                 Way {
                     line: INVALID,
-                    fill: 0
+                    fill: 0,
+                    prev: INVALID,
+                    prev_fill: 0,
                 };
                 n
             ],
@@ -54,6 +88,8 @@ impl Cache {
             assoc,
             set_mask: sets - 1,
             stamp: 0,
+            inflight: HashMap::new(),
+            prune_at: INFLIGHT_PRUNE,
         }
     }
 
@@ -62,24 +98,41 @@ impl Cache {
         (line & self.set_mask) as usize * self.assoc
     }
 
-    /// Looks up `line` (a line number: byte address / 64), updating LRU state on a hit.
+    /// Looks up `line` (a line number: byte address / 64) at cycle `now`, updating LRU state
+    /// on a hit. A line replaced by a miss still in flight is a hit until that fill arrives;
+    /// a line in flight is `Present` with its future fill cycle (the caller merges).
     #[inline]
-    pub fn lookup(&mut self, line: u64) -> Lookup {
+    pub fn lookup(&mut self, line: u64, now: Cycle) -> Lookup {
         let s = self.set(line);
         if self.assoc == 1 {
             let w = self.ways[s];
-            return if w.line == line {
-                Lookup::Present { fill: w.fill }
-            } else {
-                Lookup::Absent
-            };
-        }
-        self.stamp += 1;
-        for (i, w) in self.ways[s..s + self.assoc].iter().enumerate() {
             if w.line == line {
-                self.used[s + i] = self.stamp;
                 return Lookup::Present { fill: w.fill };
             }
+            if w.prev == line && now < w.fill {
+                return Lookup::Present { fill: w.prev_fill };
+            }
+        } else {
+            self.stamp += 1;
+            for i in s..s + self.assoc {
+                if self.ways[i].line == line {
+                    self.used[i] = self.stamp;
+                    return Lookup::Present {
+                        fill: self.ways[i].fill,
+                    };
+                }
+            }
+            for w in &self.ways[s..s + self.assoc] {
+                if w.prev == line && now < w.fill {
+                    return Lookup::Present { fill: w.prev_fill };
+                }
+            }
+        }
+        if !self.inflight.is_empty()
+            && let Some(&fill) = self.inflight.get(&line)
+            && fill > now
+        {
+            return Lookup::Present { fill };
         }
         Lookup::Absent
     }
@@ -90,27 +143,49 @@ impl Cache {
         self.ways[self.set(line)].line
     }
 
-    /// Installs `line` with its fill cycle, evicting the least recently used way.
+    /// Reserves the least recently used way of `line`'s set for a miss made at cycle `now`
+    /// whose fill arrives at `fill`. The line it replaces stays readable until then; if that
+    /// line is itself still in flight, it moves to the in-flight list.
     #[inline]
-    pub fn install(&mut self, line: u64, fill: Cycle) {
+    pub fn install(&mut self, line: u64, fill: Cycle, now: Cycle) {
         let s = self.set(line);
-        let new = Way { line, fill };
-        if self.assoc == 1 {
-            self.ways[s] = new;
-            return;
+        let victim = if self.assoc == 1 {
+            s
+        } else {
+            self.stamp += 1;
+            let v = (s..s + self.assoc)
+                .min_by_key(|&i| {
+                    if self.ways[i].line == INVALID {
+                        0
+                    } else {
+                        self.used[i] + 1
+                    }
+                })
+                .expect("at least one way");
+            self.used[v] = self.stamp;
+            v
+        };
+        let w = &mut self.ways[victim];
+        let mut moved = None;
+        if w.line != INVALID {
+            if w.fill <= now {
+                w.prev = w.line;
+                w.prev_fill = w.fill;
+            } else {
+                // Still in flight: the older resident (`prev`) stays readable, the in-flight
+                // line keeps its MSHR entry.
+                moved = Some((w.line, w.fill));
+            }
         }
-        self.stamp += 1;
-        let victim = (s..s + self.assoc)
-            .min_by_key(|&i| {
-                if self.ways[i].line == INVALID {
-                    0
-                } else {
-                    self.used[i] + 1
-                }
-            })
-            .expect("at least one way");
-        self.ways[victim] = new;
-        self.used[victim] = self.stamp;
+        w.line = line;
+        w.fill = fill;
+        if let Some((l, f)) = moved {
+            self.inflight.insert(l, f);
+            if self.inflight.len() >= self.prune_at {
+                self.inflight.retain(|_, f| *f > now);
+                self.prune_at = (2 * self.inflight.len()).max(INFLIGHT_PRUNE);
+            }
+        }
     }
 }
 
@@ -119,24 +194,44 @@ mod tests {
     use super::*;
 
     #[test]
-    fn direct_mapped_conflict_evicts() {
+    fn direct_mapped_conflict_evicts_when_the_new_line_arrives() {
         let mut c = Cache::new(1024, 64, 1); // 16 sets
-        c.install(3, 10);
-        assert_eq!(c.lookup(3), Lookup::Present { fill: 10 });
-        c.install(3 + 16, 20);
-        assert_eq!(c.lookup(3), Lookup::Absent);
-        assert_eq!(c.lookup(19), Lookup::Present { fill: 20 });
+        c.install(3, 10, 0);
+        assert_eq!(c.lookup(3, 10), Lookup::Present { fill: 10 });
+        // A conflicting miss at cycle 12, filled at 20: line 3 is still there until 20.
+        c.install(3 + 16, 20, 12);
+        assert_eq!(c.lookup(3, 19), Lookup::Present { fill: 10 });
+        assert_eq!(c.lookup(3, 20), Lookup::Absent);
+        assert_eq!(c.lookup(19, 15), Lookup::Present { fill: 20 });
+        assert_eq!(c.lookup(19, 20), Lookup::Present { fill: 20 });
+    }
+
+    #[test]
+    fn a_line_in_flight_is_found_after_its_tag_is_taken() {
+        let mut c = Cache::new(1024, 64, 1);
+        c.install(3, 10, 0);
+        // Line 19 in flight until 100; line 35 (same set) missed at 20, in flight until 50.
+        c.install(19, 100, 11);
+        c.install(35, 50, 20);
+        // 19 is still pending: merged, not requested again.
+        assert_eq!(c.lookup(19, 30), Lookup::Present { fill: 100 });
+        assert_eq!(c.lookup(35, 30), Lookup::Present { fill: 50 });
+        // Line 3 stays readable until the way's latest fill (35 at 50).
+        assert_eq!(c.lookup(3, 30), Lookup::Present { fill: 10 });
+        assert_eq!(c.lookup(3, 50), Lookup::Absent);
+        // After its fill, 19 (displaced) is gone.
+        assert_eq!(c.lookup(19, 100), Lookup::Absent);
     }
 
     #[test]
     fn two_way_keeps_both_and_evicts_lru() {
         let mut c = Cache::new(1024, 64, 2); // 8 sets
-        c.install(1, 0);
-        c.install(9, 0);
-        assert!(matches!(c.lookup(1), Lookup::Present { .. }));
-        c.install(17, 0); // evicts 9, the least recently used
-        assert!(matches!(c.lookup(1), Lookup::Present { .. }));
-        assert_eq!(c.lookup(9), Lookup::Absent);
-        assert!(matches!(c.lookup(17), Lookup::Present { .. }));
+        c.install(1, 0, 0);
+        c.install(9, 0, 0);
+        assert!(matches!(c.lookup(1, 1), Lookup::Present { .. }));
+        c.install(17, 5, 1); // replaces 9, the least recently used, at cycle 5
+        assert!(matches!(c.lookup(1, 6), Lookup::Present { .. }));
+        assert_eq!(c.lookup(9, 6), Lookup::Absent);
+        assert!(matches!(c.lookup(17, 6), Lookup::Present { .. }));
     }
 }
