@@ -36,16 +36,18 @@ const PARALLEL_DEPTH: u32 = 8;
 struct Rec {
     /// The incoming carving chains of the DST's left and right child.
     chains: [Chain; 2],
+    /// Index entries of the left subtree.
+    left_entries: u64,
     /// Node words bump-allocated by the left subtree below its root slot (saturated: a
-    /// tree that large fails the offset check before emission).
+    /// tree that large fails the 2^26-word offset check before emission).
     left_words: u32,
-    /// Index entries of the left subtree (saturated likewise).
-    left_entries: u32,
     /// Split axis.
     axis: u8,
     /// The BVH node's second child is the DST's left child.
     swap: bool,
 }
+
+const _: () = assert!(std::mem::size_of::<Rec>() == 32);
 
 impl Rec {
     /// BVH nodes of the DST's left and right child of BVH node `n`.
@@ -57,7 +59,7 @@ impl Rec {
 
     fn set_left(&mut self, size: Size) {
         self.left_words = u32::try_from(size.words).unwrap_or(u32::MAX);
-        self.left_entries = u32::try_from(size.entries).unwrap_or(u32::MAX);
+        self.left_entries = size.entries;
     }
 }
 
@@ -194,8 +196,8 @@ impl Encoder<'_> {
         let p = plan_split(self.bvh, n, self.cfg, dps);
         Ok(Ok(Rec {
             chains: [p.left_chain, p.right_chain],
-            left_words: 0,
             left_entries: 0,
+            left_words: 0,
             axis: p.axis as u8,
             swap: p.swap,
         }))
@@ -392,7 +394,7 @@ impl Encoder<'_> {
             ls,
             Size {
                 words: rec.left_words as u64,
-                entries: rec.left_entries as u64,
+                entries: rec.left_entries,
             },
         );
         let right = Out {
