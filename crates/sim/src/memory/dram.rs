@@ -113,7 +113,46 @@ pub struct Dram {
     col_bits: u32,
     ch_bits: u32,
     bank_bits: u32,
+    /// Divisions by t_burst and by ticks_per_cycle.
+    burst: Divisor,
+    tpc: Divisor,
     stats: DramStats,
+}
+
+/// Division by a timing constant: a shift when it is a power of two (t_burst = 4 and
+/// ticks_per_cycle = 2 in the shipped configs), otherwise a division. A 64-bit division
+/// costs tens of cycles on the host and `read_at` makes several per DRAM read.
+#[derive(Clone, Copy, Debug)]
+struct Divisor {
+    d: u64,
+    shift: Option<u32>,
+}
+
+impl Divisor {
+    fn new(d: u64) -> Self {
+        Self {
+            d,
+            shift: d.is_power_of_two().then(|| d.trailing_zeros()),
+        }
+    }
+
+    /// `x / d`.
+    #[inline(always)]
+    fn div(self, x: u64) -> u64 {
+        match self.shift {
+            Some(s) => x >> s,
+            None => x / self.d,
+        }
+    }
+
+    /// `x.div_ceil(d)`.
+    #[inline(always)]
+    fn div_ceil(self, x: u64) -> u64 {
+        match self.shift {
+            Some(s) => (x >> s) + u64::from(x & (self.d - 1) != 0),
+            None => x.div_ceil(self.d),
+        }
+    }
 }
 
 impl Dram {
@@ -126,6 +165,8 @@ impl Dram {
             col_bits: (cfg.row_bytes / 64).trailing_zeros(),
             ch_bits: cfg.channels.trailing_zeros(),
             bank_bits: cfg.banks_per_channel.trailing_zeros(),
+            burst: Divisor::new(cfg.t_burst),
+            tpc: Divisor::new(cfg.ticks_per_cycle),
             stats: DramStats::default(),
         }
     }
@@ -154,7 +195,7 @@ impl Dram {
         let tpc = c.ticks_per_cycle;
         let (chi, bi, row) = self.map(line);
         let ch = &mut self.channels[chi];
-        ch.bus.forget_before(now * tpc / c.t_burst);
+        ch.bus.forget_before(self.burst.div(now * tpc));
         ch.acts.forget_before(now * tpc);
         let mut a = arrive * tpc;
         while let Some(&Reverse(d)) = ch.inflight.peek() {
@@ -166,7 +207,7 @@ impl Dram {
         }
         if ch.inflight.len() >= c.read_queue as usize {
             let Reverse(d) = ch.inflight.pop().expect("queue is full");
-            self.stats.queue_wait_cycles += (d - a).div_ceil(tpc);
+            self.stats.queue_wait_cycles += self.tpc.div_ceil(d - a);
             a = d;
         }
         let bank = &mut self.banks[chi * c.banks_per_channel as usize + bi];
@@ -186,7 +227,7 @@ impl Dram {
                     continue;
                 }
                 // The column command waits for its data-bus slot (t_CAS before it).
-                let slot = ch.bus.peek((col + c.t_cas).div_ceil(c.t_burst));
+                let slot = ch.bus.peek(self.burst.div_ceil(col + c.t_cas));
                 if slot * c.t_burst - c.t_cas <= e.close {
                     hit = Some(slot);
                     break;
@@ -233,7 +274,7 @@ impl Dram {
         // The data bus takes the first free burst slot once the data is ready; a read whose
         // row is open can use a slot before a conflicting read reserved earlier, which is
         // the effect of FR-FCFS on the bus.
-        let data = ch.bus.reserve((col + c.t_cas).div_ceil(c.t_burst)) * c.t_burst;
+        let data = ch.bus.reserve(self.burst.div_ceil(col + c.t_cas)) * c.t_burst;
         let done = data + c.t_burst;
         ch.inflight.push(Reverse(done));
         self.finish(arrive, done, kind)
@@ -241,7 +282,7 @@ impl Dram {
 
     /// Counts a read arriving at core cycle `arrive` whose data is complete at tick `done`.
     fn finish(&mut self, arrive: Cycle, done: u64, kind: DramAccess) -> (Cycle, DramAccess) {
-        let done_cycle = done.div_ceil(self.cfg.ticks_per_cycle);
+        let done_cycle = self.tpc.div_ceil(done);
         let s = &mut self.stats;
         s.reads += 1;
         match kind {
@@ -349,6 +390,17 @@ mod tests {
         // (13 ticks) after bank 0's first: act 13, column 41, data at 69 rounded to the
         // burst grid 72, done 76 ticks = cycle 38 (not behind bank 0's far-future bursts).
         assert_eq!(d.read(128 * 16, 0), (38, DramAccess::Closed));
+    }
+
+    #[test]
+    fn divisor_equals_plain_division() {
+        for d in [1u64, 2, 3, 4, 5, 8, 12, 16] {
+            let div = Divisor::new(d);
+            for x in (0..200).chain([u64::MAX - 1, u64::MAX]) {
+                assert_eq!(div.div(x), x / d, "{x} / {d}");
+                assert_eq!(div.div_ceil(x), x.div_ceil(d), "{x} div_ceil {d}");
+            }
+        }
     }
 
     #[test]
