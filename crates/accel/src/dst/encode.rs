@@ -203,11 +203,18 @@ impl Encoder<'_> {
         }))
     }
 
-    /// The words an internal node itself reserves: its chain, then both children's slots.
-    fn own_words(&self, n: u32, rec: &Rec, chain: Chain) -> u64 {
-        let [l, r] = rec.children(self.bvh, n);
-        let [cl, cr] = rec.chains;
-        (3 * chain.len() + slot_size(self.bvh, l, cl) + slot_size(self.bvh, r, cr)) as u64
+    /// Completes internal node `n`'s record once its subtrees are planned (`l`, `r`: their
+    /// sizes) and returns the size of its own subtree: its chain's words, both children's
+    /// slots, and everything below.
+    fn close(&self, n: u32, chain: Chain, rec: &mut Rec, l: Size, r: Size) -> Size {
+        rec.set_left(l);
+        let [cl, cr] = rec.children(self.bvh, n);
+        let [ch_l, ch_r] = rec.chains;
+        let own = 3 * chain.len() + slot_size(self.bvh, cl, ch_l) + slot_size(self.bvh, cr, ch_r);
+        l.add(r).add(Size {
+            words: own as u64,
+            entries: 0,
+        })
     }
 
     /// Plan pass, sequential: appends the records of `n`'s subtree to `recs` in depth-first
@@ -235,12 +242,9 @@ impl Encoder<'_> {
         let [cl, cr] = rec.children(self.bvh, n);
         let l = self.plan_seq(cl, rec.chains[0], recs, budget, dps)?;
         let r = self.plan_seq(cr, rec.chains[1], recs, budget, dps)?;
-        rec.set_left(l);
+        let size = self.close(n, chain, &mut rec, l, r);
         recs[slot] = rec;
-        Ok(l.add(r).add(Size {
-            words: self.own_words(n, &rec, chain),
-            entries: 0,
-        }))
+        Ok(size)
     }
 
     /// Plan pass: nodes above [`PARALLEL_DEPTH`] plan their two subtrees in parallel.
@@ -264,11 +268,7 @@ impl Encoder<'_> {
             || self.plan(cr, rec.chains[1], depth + 1),
         );
         let ((lp, l), (rp, r)) = (l?, r?);
-        rec.set_left(l);
-        let size = l.add(r).add(Size {
-            words: self.own_words(n, &rec, chain),
-            entries: 0,
-        });
+        let size = self.close(n, chain, &mut rec, l, r);
         Ok((Plan::Par(rec, Box::new([lp, rp])), size))
     }
 
@@ -397,14 +397,11 @@ impl Encoder<'_> {
                 entries: rec.left_entries,
             },
         );
-        let right = Out {
-            slot: rs,
-            words: std::mem::take(&mut out.words),
-            at: out.at,
-            entries: std::mem::take(&mut out.entries),
-            entries_at: out.entries_at,
+        let rest = Size {
+            words: out.words.len() as u64,
+            entries: out.entries.len() as u64,
         };
-        Ok((left, right))
+        Ok((left, out.child(rs, rest)))
     }
 
     /// Emits a planned subtree; [`Plan::Par`] nodes emit their two subtrees in parallel.
