@@ -367,6 +367,37 @@ struct DpInputs<'a> {
     tri_weight: Option<f32>,
 }
 
+/// Surface area of the region in every state s < 2^K (the faces `faces[i]` with bit i of s
+/// carved from `region` to `target`) into `sa[s]`: the extents of each axis for its four
+/// carve codes, the states' face masks by doubling, then x·y + y·z + z·x per state.
+#[inline(always)]
+fn state_areas<const K: usize>(faces: &[usize; 6], region: &Aabb, target: &Aabb, sa: &mut [f32]) {
+    // ext[a][c]: the region's extent on axis a with carve code c (bit 0: min face carved to
+    // `target`, bit 1: max face carved).
+    let mut ext = [[0f32; 4]; 3];
+    for (a, e) in ext.iter_mut().enumerate() {
+        let (rl, rh) = (region.min[a], region.max[a]);
+        let (tl, th) = (target.min[a], target.max[a]);
+        *e = [
+            (rh - rl).max(0.0),
+            (rh - tl).max(0.0),
+            (th - rl).max(0.0),
+            (th - tl).max(0.0),
+        ];
+    }
+    let mut fm = [0usize; 64];
+    for (i, &f) in faces[..K].iter().enumerate() {
+        let b = 1 << i;
+        for s in 0..b {
+            fm[s | b] = fm[s] | 1 << f;
+        }
+    }
+    for (out, &m) in sa[..1 << K].iter_mut().zip(&fm) {
+        let (x, y, z) = (ext[0][m & 3], ext[1][m >> 2 & 3], ext[2][m >> 4 & 3]);
+        *out = x * y + y * z + z * x;
+    }
+}
+
 impl ChainDp {
     /// A DP ready for [`ChainDp::solve`] (reused across nodes).
     pub fn new() -> Self {
@@ -440,33 +471,8 @@ impl ChainDp {
     ) {
         let full = (1usize << K) - 1;
         let c_lone = costs.single_carve.min(costs.dual_carve);
-        // ext[a][c]: the region's extent on axis a with carve code c (bit 0: min face
-        // carved to `target`, bit 1: max face carved).
-        let mut ext = [[0f32; 4]; 3];
-        for (a, e) in ext.iter_mut().enumerate() {
-            let (rl, rh) = (region.min[a], region.max[a]);
-            let (tl, th) = (target.min[a], target.max[a]);
-            *e = [
-                (rh - rl).max(0.0),
-                (rh - tl).max(0.0),
-                (th - rl).max(0.0),
-                (th - tl).max(0.0),
-            ];
-        }
-        // Surface area of the region in every state (faces as a 6-bit mask, by doubling).
-        let mut fm = [0usize; 8];
-        for i in 0..K {
-            let b = 1 << i;
-            for s in 0..b {
-                fm[s | b] = fm[s] | 1 << self.faces[i];
-            }
-        }
         let mut sa = [0f32; 8];
-        for s in 0..=full {
-            let m = fm[s];
-            let (x, y, z) = (ext[0][m & 3], ext[1][m >> 2 & 3], ext[2][m >> 4 & 3]);
-            sa[s] = x * y + y * z + z * x;
-        }
+        state_areas::<K>(&self.faces, region, target, &mut sa);
         let tri_weight = leaf_tris.map(|n| costs.triangle * n as f32);
         self.base = leaf_tris.map_or(0.0, |n| costs.triangle * n as f32 * sa[full]);
         let base = self.base;
@@ -547,44 +553,7 @@ impl ChainDp {
             weight,
             cheap_partner,
         } = &mut dp.scratch;
-        // The faces of F are in ascending order, so each axis's faces are consecutive bits
-        // of a state: s = s_x | s_y << m_x | s_z << (m_x + m_y), where s_a holds the m_a ≤ 2
-        // faces of axis a (min face first). `axis[a][s_a]` is the region's extent on axis a
-        // in sub-state s_a, and the states are enumerated in order by three nested loops.
-        let mut m = [0usize; 3];
-        let mut axis = [[0f32; 4]; 3];
-        for a in 0..3 {
-            let (lo, hi) = (dp.bit_of[2 * a] != 0, dp.bit_of[2 * a + 1] != 0);
-            m[a] = lo as usize + hi as usize;
-            for (sub, e) in axis[a][..1 << m[a]].iter_mut().enumerate() {
-                // Which of the axis's two faces sub-state `sub` has carved.
-                let (min_carved, max_carved) = if lo {
-                    (sub & 1 == 1, sub & 2 == 2)
-                } else {
-                    (false, sub & 1 == 1)
-                };
-                let lo = if min_carved {
-                    target.min[a]
-                } else {
-                    region.min[a]
-                };
-                let hi = if max_carved {
-                    target.max[a]
-                } else {
-                    region.max[a]
-                };
-                *e = (hi - lo).max(0.0);
-            }
-        }
-        let mut s = 0;
-        for &z in &axis[2][..1 << m[2]] {
-            for &y in &axis[1][..1 << m[1]] {
-                for &x in &axis[0][..1 << m[0]] {
-                    sa[s] = x * y + y * z + z * x;
-                    s += 1;
-                }
-            }
-        }
+        state_areas::<K>(&dp.faces, region, target, sa);
         dp.base = leaf_cost(sa[full]).unwrap_or(0.0);
         // Option weights by option mask (one face = a lone-face node, two faces = a pair
         // node), and for each lone face the partners whose pair node costs no more than a
