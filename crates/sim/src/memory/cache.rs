@@ -21,7 +21,7 @@
 //! down at 128 TMs; see `docs/simulator.md`, "TM scaling".)
 
 use crate::Cycle;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 /// The result of a tag lookup.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -64,7 +64,9 @@ pub struct Cache {
     set_mask: u64,
     stamp: u64,
     /// Lines in flight whose way has since been taken by a later miss: line → fill cycle.
-    inflight: HashMap<u64, Cycle>,
+    /// (Fx hashing: the list is probed on every miss that the set does not answer, and
+    /// SipHash's resistance to chosen keys buys nothing for line numbers.)
+    inflight: FxHashMap<u64, Cycle>,
     prune_at: usize,
 }
 
@@ -88,7 +90,7 @@ impl Cache {
             assoc,
             set_mask: sets - 1,
             stamp: 0,
-            inflight: HashMap::new(),
+            inflight: FxHashMap::default(),
             prune_at: INFLIGHT_PRUNE,
         }
     }
