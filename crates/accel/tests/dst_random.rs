@@ -3,6 +3,9 @@
 //! traversal and the pipeline loop, for both cost presets and both partitioning modes.
 
 mod dst_common;
+#[path = "../../geometry/tests/common/grazing.rs"]
+mod grazing;
+use grazing::{GRAZING_CASES, grazing_case};
 
 use dst_common::{build, build_with, check_all, random_rays};
 use dualsplit_accel::BuildConfig;
@@ -162,30 +165,8 @@ fn regression_proptest_grazing_seed() {
 /// which hits that triangle.
 #[test]
 fn regression_ray_at_corner_vertex() {
-    const CASES: [([[f32; 3]; 3], [u32; 3], usize); 4] = [
-        (
-            [[4.0, -0.0, 2.0], [4.0, 2.0, 2.0], [1.0, -1.0, 1.0]],
-            [1057123824, 3226476036, 1077493544],
-            2,
-        ),
-        (
-            [[-3.0, 3.0, -0.0], [-4.0, 2.0, -1.0], [2.0, 1.0, -2.0]],
-            [3217441944, 3222153514, 3228377840],
-            2,
-        ),
-        (
-            [[3.0, 2.0, -2.0], [-3.0, -1.0, -2.0], [-1.0, 0.0, -3.0]],
-            [3207833408, 1076492226, 3213691328],
-            1,
-        ),
-        (
-            [[-3.0, 3.0, -1.0], [-0.0, -2.0, 2.0], [4.0, -3.0, -0.0]],
-            [3227753434, 1077816614, 3173895040],
-            0,
-        ),
-    ];
-    for (i, (v, o, k)) in CASES.into_iter().enumerate() {
-        let target = Triangle::new(Vec3::from(v[0]), Vec3::from(v[1]), Vec3::from(v[2]));
+    for i in 0..GRAZING_CASES.len() {
+        let (target, ray) = grazing_case(i);
         let mut tris = vec![target];
         for j in 1..8 {
             let off = Vec3::new(40.0 * j as f32, 0.0, 0.0);
@@ -195,12 +176,6 @@ fn regression_ray_at_corner_vertex() {
                 target.v[2] + off,
             ));
         }
-        let o = Vec3::new(
-            f32::from_bits(o[0]),
-            f32::from_bits(o[1]),
-            f32::from_bits(o[2]),
-        );
-        let ray = dualsplit_geometry::Ray::new(o, target.v[k] - o);
         let oracle = dst_common::oracle_closest(&tris, &ray);
         assert_eq!(
             oracle.map(|h| h.prim),
@@ -219,7 +194,7 @@ fn regression_ray_at_corner_vertex() {
             check_all(
                 &b,
                 &tris,
-                &dualsplit_geometry::Ray::segment(o, ray.dir, 0.0, hit_t),
+                &dualsplit_geometry::Ray::segment(ray.origin, ray.dir, 0.0, hit_t),
             );
         }
     }
