@@ -7,6 +7,7 @@
 mod dst_common;
 
 use dualsplit_accel::dst::{Dst, DstConfig, Partitioning};
+use dualsplit_accel::image::Words;
 use dualsplit_accel::{BuildConfig, Bvh2, BvhImage, WideBvh};
 use dualsplit_geometry::{Aabb, Triangle};
 use std::sync::OnceLock;
@@ -80,21 +81,36 @@ fn bvh2_build_and_image() -> BvhImage {
     BvhImage::encode(&wide, &bvh, &i.tris, &cfg, std::time::Duration::ZERO).expect("encoding")
 }
 
-/// The floor of any conversion on this machine: a fresh zeroed allocation the size of the
-/// hardware DST's image (nodes, index runs, triangles), one word written per 4 KiB page, so
-/// the first-touch page faults that writing the image costs are timed alone.
-#[divan::bench(sample_count = 10, sample_size = 1)]
-fn image_first_touch() -> Vec<u32> {
+/// Words in the hardware DST's image (nodes, index runs, triangles).
+fn image_words() -> usize {
     static WORDS: OnceLock<usize> = OnceLock::new();
-    let n = *WORDS.get_or_init(|| {
+    *WORDS.get_or_init(|| {
         let i = input();
         Dst::from_bvh2(&i.bvh, &i.tris, &DstConfig::hardware())
             .expect("conversion")
             .image()
             .words
             .len()
-    });
-    let mut words = vec![0u32; divan::black_box(n)];
+    })
+}
+
+/// The page-fault floor of writing an image as a plain vector: a fresh zeroed allocation
+/// the size of the hardware DST's image, one word written per 4 KiB page, so the first-touch
+/// page faults are timed alone.
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn image_first_touch() -> Vec<u32> {
+    let mut words = vec![0u32; divan::black_box(image_words())];
+    for w in words.iter_mut().step_by(1024) {
+        *w = 1;
+    }
+    words
+}
+
+/// The same floor for the image storage the converter uses ([`Words::zeroed`]: a mapping
+/// with the transparent-huge-page advice).
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn image_first_touch_words() -> Words {
+    let mut words = Words::zeroed(divan::black_box(image_words()));
     for w in words.iter_mut().step_by(1024) {
         *w = 1;
     }

@@ -32,15 +32,19 @@
 //! Runs are laid out in the depth-first order of the leaves. All offsets are absolute word
 //! indices; the triangle of id `i` is at word `triangles.start + 9·i`.
 
+mod words;
+
 use crate::observer::Observer;
 use dualsplit_geometry::{Aabb, Triangle, Vec3};
+use rayon::prelude::*;
 use std::ops::Range;
+pub use words::{MAPPED_MIN_BYTES, Words};
 
 /// A structure's memory image: words plus the word ranges of its three regions.
 #[derive(Clone, Debug, Default)]
 pub struct MemoryImage {
     /// The image, as little-endian 32-bit words (f32 values stored as their bits).
-    pub words: Vec<u32>,
+    pub words: Words,
     /// Word range of the node region.
     pub nodes: Range<usize>,
     /// Word range of the triangle-index region.
@@ -50,6 +54,30 @@ pub struct MemoryImage {
 }
 
 impl MemoryImage {
+    /// An image of `nodes` node words and `indices` index words, zeroed for the encoder to
+    /// fill, followed by the triangle region holding a copy of `triangles` (one allocation;
+    /// the copy runs in parallel).
+    pub fn with_triangles(nodes: usize, indices: usize, triangles: &[Triangle]) -> MemoryImage {
+        let tri_start = nodes + indices;
+        let mut words = Words::zeroed(tri_start + 9 * triangles.len());
+        let src: &[u32] = bytemuck::cast_slice(triangles);
+        words[tri_start..]
+            .par_chunks_mut(1 << 16)
+            .zip(src.par_chunks(1 << 16))
+            .for_each(|(d, s)| d.copy_from_slice(s));
+        MemoryImage {
+            nodes: 0..nodes,
+            indices: nodes..tri_start,
+            triangles: tri_start..words.len(),
+            words,
+        }
+    }
+
+    /// The node and index regions, writable (what an encoder fills).
+    pub fn node_and_index_words_mut(&mut self) -> &mut [u32] {
+        &mut self.words[..self.indices.end]
+    }
+
     /// Byte address of word `i`.
     #[inline(always)]
     pub fn addr(word: usize) -> u64 {
@@ -82,13 +110,6 @@ impl MemoryImage {
         let w = self.triangles.start + 9 * prim as usize;
         obs.fetch(Self::addr(w), 36);
         self.triangle_slice()[prim as usize]
-    }
-    /// Appends the triangle region (36 B per triangle, id order) and records its range.
-    pub fn push_triangles(&mut self, triangles: &[Triangle]) {
-        let start = self.words.len();
-        self.words
-            .extend_from_slice(bytemuck::cast_slice::<Triangle, u32>(triangles));
-        self.triangles = start..self.words.len();
     }
 }
 

@@ -22,7 +22,6 @@ use super::{Dst, DstConfig, DstError};
 use crate::build::Bvh2;
 use crate::image::MemoryImage;
 use dualsplit_geometry::{Aabb, Triangle};
-use rayon::prelude::*;
 
 /// Bit 31 of an index entry: the last triangle of a leaf's run.
 pub(super) const RUN_END: u32 = 1 << 31;
@@ -463,16 +462,10 @@ impl Dst {
             });
         }
         let (n_nodes, n_idx) = (n_nodes as usize, size.entries as usize);
-        // One zeroed allocation for the whole image (fresh pages, first touched by the
-        // threads that fill them); the triangles are copied in parallel.
-        let mut words = vec![0u32; n_nodes + n_idx + 9 * triangles.len()];
-        let (node_words, rest) = words.split_at_mut(n_nodes);
-        let (entries, tri_words) = rest.split_at_mut(n_idx);
-        let tri_src: &[u32] = bytemuck::cast_slice(triangles);
-        tri_words
-            .par_chunks_mut(1 << 16)
-            .zip(tri_src.par_chunks(1 << 16))
-            .for_each(|(d, s)| d.copy_from_slice(s));
+        // One allocation for the whole image (fresh pages, first touched by the threads
+        // that fill them; huge pages where the kernel allows, see `image::Words`).
+        let mut image = MemoryImage::with_triangles(n_nodes, n_idx, triangles);
+        let (node_words, entries) = image.node_and_index_words_mut().split_at_mut(n_nodes);
         let mut stats = if empty {
             DstStats::default()
         } else {
@@ -490,12 +483,6 @@ impl Dst {
             Aabb::EMPTY
         } else {
             bvh.nodes[0].bounds
-        };
-        let image = MemoryImage {
-            nodes: 0..n_nodes,
-            indices: n_nodes..n_nodes + n_idx,
-            triangles: n_nodes + n_idx..words.len(),
-            words,
         };
         stats.node_bytes = image.node_bytes();
         stats.index_bytes = image.index_bytes();
