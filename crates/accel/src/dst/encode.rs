@@ -232,40 +232,41 @@ impl Encoder<'_> {
         Ok(())
     }
 
-    /// Plans BVH node `n` entered with `chain`: its record (internal nodes) and the size of
-    /// its subtree. Checks the links and leaf ranges that emission relies on.
-    fn plan_node(
-        &self,
-        n: u32,
-        chain: Chain,
-        dps: &mut [ChainDp; 2],
-    ) -> Result<Result<Rec, Size>, DstError> {
+    /// Checks BVH node `n`'s links (and a leaf's triangle range, which emission relies on);
+    /// for a leaf entered with `chain`, returns its size.
+    fn check_node(&self, n: u32, chain: Chain) -> Result<Option<Size>, DstError> {
         self.check_links(n)?;
         let node = &self.bvh.nodes[n as usize];
-        let steps = chain.len() as u64;
-        if node.is_leaf() {
-            let (first, count) = (node.first as usize, node.count as usize);
-            if first + count > self.bvh.prim_ids.len() {
-                return Err(DstError::BadBvhLink {
-                    node: n,
-                    child: node.first,
-                    nodes: self.bvh.prim_ids.len(),
-                });
-            }
-            // The last carving node of a leaf's chain is the leaf (no word of its own).
-            return Ok(Err(Size {
-                words: 3 * steps.saturating_sub(1),
-                entries: count as u64,
-            }));
+        if !node.is_leaf() {
+            return Ok(None);
         }
+        let (first, count) = (node.first as usize, node.count as usize);
+        if first + count > self.bvh.prim_ids.len() {
+            return Err(DstError::BadBvhLink {
+                node: n,
+                child: node.first,
+                nodes: self.bvh.prim_ids.len(),
+            });
+        }
+        // The last carving node of a leaf's chain is the leaf (no word of its own).
+        Ok(Some(Size {
+            words: 3 * (chain.len() as u64).saturating_sub(1),
+            entries: count as u64,
+        }))
+    }
+
+    /// The record of internal BVH node `n` (its subtree sizes are filled in by
+    /// [`Encoder::close`]).
+    #[inline(always)]
+    fn new_rec(&self, n: u32, dps: &mut [ChainDp; 2]) -> Rec {
         let p = plan_split(self.bvh, n, self.cfg, dps);
-        Ok(Ok(Rec {
+        Rec {
             chains: [p.left_chain, p.right_chain],
             left_entries: 0,
             left_words: 0,
             axis: p.axis as u8,
             swap: p.swap,
-        }))
+        }
     }
 
     /// Completes internal node `n`'s record once its subtrees are planned (`l`, `r`: their
@@ -298,18 +299,16 @@ impl Encoder<'_> {
             child: n,
             nodes: self.bvh.nodes.len(),
         })?;
-        let mut rec = match self.plan_node(n, chain, dps)? {
-            Err(leaf) => return Ok(leaf),
-            Ok(rec) => rec,
-        };
+        if let Some(leaf) = self.check_node(n, chain)? {
+            return Ok(leaf);
+        }
         let slot = recs.len();
-        recs.push(rec);
-        let [cl, cr] = rec.children(self.bvh, n);
-        let l = self.plan_seq(cl, rec.chains[0], recs, budget, dps)?;
-        let r = self.plan_seq(cr, rec.chains[1], recs, budget, dps)?;
-        let size = self.close(n, chain, &mut rec, l, r);
-        recs[slot] = rec;
-        Ok(size)
+        recs.push(self.new_rec(n, dps));
+        let rec = &recs[slot];
+        let ([cl, cr], [ch_l, ch_r]) = (rec.children(self.bvh, n), rec.chains);
+        let l = self.plan_seq(cl, ch_l, recs, budget, dps)?;
+        let r = self.plan_seq(cr, ch_r, recs, budget, dps)?;
+        Ok(self.close(n, chain, &mut recs[slot], l, r))
     }
 
     /// Plan pass: nodes above [`PARALLEL_DEPTH`] plan their two subtrees in parallel.
@@ -322,11 +321,10 @@ impl Encoder<'_> {
             let size = self.plan_seq(n, chain, &mut recs, &mut budget, &mut dps)?;
             return Ok((Plan::Seq(recs), size));
         }
-        let mut dps = [ChainDp::new(), ChainDp::new()];
-        let mut rec = match self.plan_node(n, chain, &mut dps)? {
-            Err(leaf) => return Ok((Plan::Seq(Vec::new()), leaf)),
-            Ok(rec) => rec,
-        };
+        if let Some(leaf) = self.check_node(n, chain)? {
+            return Ok((Plan::Seq(Vec::new()), leaf));
+        }
+        let mut rec = self.new_rec(n, &mut [ChainDp::new(), ChainDp::new()]);
         let [cl, cr] = rec.children(self.bvh, n);
         let (l, r) = rayon::join(
             || self.plan(cl, rec.chains[0], depth + 1),
