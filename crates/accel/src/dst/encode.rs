@@ -337,6 +337,7 @@ impl Encoder<'_> {
 
     /// Writes BVH leaf `n`'s triangles as one run at the cursor's next entries; returns the
     /// run's position in the index list.
+    #[inline(always)]
     fn write_run(&self, n: u32, cur: &mut Cursor) -> Result<u64, DstError> {
         let node = &self.bvh.nodes[n as usize];
         let (first, count) = (node.first as usize, node.count as usize);
@@ -365,6 +366,7 @@ impl Encoder<'_> {
 
     /// Emits BVH node `n`'s incoming `chain` into `slot` (and, for a leaf, the leaf
     /// itself). For an internal node, returns the slot its splitting node goes into.
+    #[inline(always)]
     fn emit_head(
         &self,
         n: u32,
@@ -434,6 +436,7 @@ impl Encoder<'_> {
 
     /// Writes the splitting node `rec` into `slot` and allocates its children's slots;
     /// returns where they start and the left slot's size.
+    #[inline(always)]
     fn split_node(
         &self,
         rec: &Rec,

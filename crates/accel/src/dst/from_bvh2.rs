@@ -367,9 +367,11 @@ struct DpInputs<'a> {
     tri_weight: Option<f32>,
 }
 
-/// Surface area of the region in every state s < 2^K (the faces `faces[i]` with bit i of s
-/// carved from `region` to `target`) into `sa[s]`: the extents of each axis for its four
-/// carve codes, the states' face masks by doubling, then x·y + y·z + z·x per state.
+/// Surface area of the region in every state s < 2^K − 1 (the faces `faces[i]` with bit i of
+/// s carved from `region` to `target`) into `sa[s]`, and in the full state when `with_full`
+/// (only a leaf's triangle cost reads it, in similar partitioning): the extents of each axis
+/// for its four carve codes, the states' face masks by doubling, then x·y + y·z + z·x per
+/// state.
 #[inline(always)]
 fn state_areas<const K: usize>(faces: &[usize; 6], region: &Aabb, target: &Aabb, sa: &mut [f32]) {
     // ext[a][c]: the region's extent on axis a with carve code c (bit 0: min face carved to
