@@ -656,6 +656,7 @@ impl ChainDp {
     }
 
     /// The cheapest chain when the split carves face `f`, outermost node first.
+    #[inline(always)]
     pub fn chain(&self, carved_by_split: usize) -> Chain {
         let full = (1usize << self.k) - 1;
         let mut chain = Chain::EMPTY;
