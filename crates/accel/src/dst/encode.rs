@@ -20,8 +20,8 @@ use super::header::{HeaderOffset, OFFSET_LIMIT};
 use super::stats::DstStats;
 use super::{Dst, DstConfig, DstError};
 use crate::build::Bvh2;
-use crate::image::MemoryImage;
-use dualsplit_geometry::{Aabb, Triangle};
+use crate::image::{MemoryImage, SharedTriangles};
+use dualsplit_geometry::Aabb;
 
 /// Bit 31 of an index entry: the last triangle of a leaf's run.
 pub(super) const RUN_END: u32 = 1 << 31;
@@ -495,7 +495,12 @@ impl Dst {
     ///
     /// Errors: malformed BVH links, non-finite boxes, triangle ids out of range, and
     /// offsets beyond the 26-bit field ([`DstError::OffsetOverflow`]).
-    pub fn from_bvh2(bvh: &Bvh2, triangles: &[Triangle], cfg: &DstConfig) -> Result<Dst, DstError> {
+    pub fn from_bvh2(
+        bvh: &Bvh2,
+        triangles: impl Into<SharedTriangles>,
+        cfg: &DstConfig,
+    ) -> Result<Dst, DstError> {
+        let triangles = triangles.into();
         let enc = Encoder {
             bvh,
             triangles: triangles.len(),
@@ -517,8 +522,9 @@ impl Dst {
             });
         }
         let (n_nodes, n_idx) = (n_nodes as usize, size.entries as usize);
-        // One allocation for the whole image (fresh pages, first touched by the threads
-        // that fill them; huge pages where the kernel allows, see `image::Words`).
+        // One allocation for the node and index regions (fresh pages, first touched by
+        // the threads that fill them; huge pages where the kernel allows, see
+        // `image::Words`); the triangle region is the scene's, shared.
         let mut image = MemoryImage::with_triangles(n_nodes, n_idx, triangles);
         let (node_words, entries) = image.node_and_index_words_mut().split_at_mut(n_nodes);
         let mut stats = if empty {

@@ -1,8 +1,7 @@
 //! Writes a [`WideBvh`] into a byte-exact [`MemoryImage`] (layout in [`crate::image`]).
 
 use super::{WideBvh, WideChild};
-use crate::image::{ChildKind, ImageError, MemoryImage, NodeLayout};
-use dualsplit_geometry::Triangle;
+use crate::image::{ChildKind, ImageError, MemoryImage, NodeLayout, SharedTriangles};
 
 /// Bit 31 of an index-list entry: the last triangle of a leaf's run.
 pub const LAST_IN_RUN: u32 = 1 << 31;
@@ -13,7 +12,7 @@ pub const LAST_IN_RUN: u32 = 1 << 31;
 pub fn encode<L: NodeLayout>(
     wide: &WideBvh,
     prim_ids: &[u32],
-    triangles: &[Triangle],
+    triangles: SharedTriangles,
 ) -> Result<MemoryImage, ImageError> {
     assert!(wide.arity <= L::ARITY, "tree wider than the node layout");
     let leaves = wide.leaf_count();
