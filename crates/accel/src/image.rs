@@ -31,6 +31,14 @@
 //!
 //! Runs are laid out in the depth-first order of the leaves. All offsets are absolute word
 //! indices; the triangle of id `i` is at word `triangles.start + 9·i`.
+//!
+//! ## Storage
+//!
+//! The node and index regions are [`MemoryImage::words`] ([`Words`]: one allocation, huge
+//! pages where the kernel allows). The triangle region has its addresses like the others,
+//! but its data is the scene's triangles shared by every image of the scene
+//! ([`SharedTriangles`]) rather than a copy per image; [`MemoryImage::to_bytes`] gives the
+//! whole image, and traversal and the simulator see the same bytes at the same addresses.
 
 mod words;
 

@@ -1,7 +1,8 @@
 //! Emission of the DST memory image (dst-spec §3): node words depth-first with the two
 //! children of every splitting node adjacent (left, then right at left + left size), a
 //! carving node's child placed by bump allocation, leaves as runs in one triangle-index list
-//! (the last entry of a run has bit 31 set), then the triangles, 36 B each in id order.
+//! (the last entry of a run has bit 31 set), then the triangle region (the scene's
+//! triangles, shared with the other images: [`crate::image::SharedTriangles`]).
 //!
 //! Two passes, both parallel (rayon) over the subtrees below depth [`PARALLEL_DEPTH`]:
 //!
@@ -9,11 +10,14 @@
 //!    number of node words and index entries each subtree will take. Decisions are kept as
 //!    compact records ([`Rec`], the chains packed in eight bytes each).
 //! 2. **Emit**: with every subtree's size known, the image is cut into disjoint slices
-//!    (`split_at_mut`), one per subtree, and each subtree writes its words and index runs
-//!    in place at their final addresses. Nothing is relocated or copied afterwards.
+//!    (`split_at_mut`) at the parallel cut, one per subtree, and each subtree writes its
+//!    words and index runs in place at their final addresses through a [`Cursor`] (bump
+//!    indices; slots are word indices). Nothing is relocated or copied afterwards.
 //!
-//! The layout is the one a fully sequential depth-first emission with bump allocation
-//! gives, whatever the thread count (`tests/dst_convert_golden.rs`).
+//! The image's words live in one allocation ([`crate::image::Words`]: huge pages where the
+//! kernel allows, so first-touch page faults do not dominate). The layout is the one a fully
+//! sequential depth-first emission with bump allocation gives, whatever the thread count
+//! (`tests/dst_convert_golden.rs`).
 
 use super::from_bvh2::{Chain, ChainDp, StepTable, plan_split, plane_values};
 use super::header::{HeaderOffset, OFFSET_LIMIT};
