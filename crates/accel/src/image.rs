@@ -58,7 +58,7 @@ pub type SharedTriangles = Arc<[Triangle]>;
 /// (right after the indices), but its data is shared between the images of one scene
 /// instead of copied into each (for dragon_box, 31 MB once instead of once per structure).
 /// [`MemoryImage::to_bytes`] gives the whole image as one byte string.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Default)]
 pub struct MemoryImage {
     /// The node and index regions, as little-endian 32-bit words (f32 values stored as
     /// their bits); word `i` of the image for `i < indices.end`.
@@ -71,6 +71,19 @@ pub struct MemoryImage {
     pub triangles: Range<usize>,
     /// The triangle region's data.
     pub triangle_data: SharedTriangles,
+}
+
+impl std::fmt::Debug for MemoryImage {
+    /// The regions and sizes (not the contents: a scene's image has millions of words).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MemoryImage")
+            .field("words", &self.words)
+            .field("nodes", &self.nodes)
+            .field("indices", &self.indices)
+            .field("triangles", &self.triangles)
+            .field("triangle_count", &self.triangle_data.len())
+            .finish()
+    }
 }
 
 impl MemoryImage {
