@@ -373,7 +373,13 @@ struct DpInputs<'a> {
 /// for its four carve codes, the states' face masks by doubling, then x·y + y·z + z·x per
 /// state.
 #[inline(always)]
-fn state_areas<const K: usize>(faces: &[usize; 6], region: &Aabb, target: &Aabb, sa: &mut [f32]) {
+fn state_areas<const K: usize>(
+    faces: &[usize; 6],
+    region: &Aabb,
+    target: &Aabb,
+    with_full: bool,
+    sa: &mut [f32],
+) {
     // ext[a][c]: the region's extent on axis a with carve code c (bit 0: min face carved to
     // `target`, bit 1: max face carved).
     let mut ext = [[0f32; 4]; 3];
@@ -394,9 +400,16 @@ fn state_areas<const K: usize>(faces: &[usize; 6], region: &Aabb, target: &Aabb,
             fm[s | b] = fm[s] | 1 << f;
         }
     }
-    for (out, &m) in sa[..1 << K].iter_mut().zip(&fm) {
+    let area = |m: usize| {
         let (x, y, z) = (ext[0][m & 3], ext[1][m >> 2 & 3], ext[2][m >> 4 & 3]);
-        *out = x * y + y * z + z * x;
+        x * y + y * z + z * x
+    };
+    let full = (1 << K) - 1;
+    for s in 0..full {
+        sa[s] = area(fm[s]);
+    }
+    if with_full || K == 0 {
+        sa[full] = area(fm[full]);
     }
 }
 
@@ -476,7 +489,7 @@ impl ChainDp {
         let full = (1usize << K) - 1;
         let c_lone = costs.single_carve.min(costs.dual_carve);
         let mut sa = [0f32; 8];
-        state_areas::<K>(&self.faces, region, target, &mut sa);
+        state_areas::<K>(&self.faces, region, target, leaf_tris.is_some(), &mut sa);
         let tri_weight = leaf_tris.map(|n| costs.triangle * n as f32);
         self.base = leaf_tris.map_or(0.0, |n| costs.triangle * n as f32 * sa[full]);
         let base = self.base;
@@ -557,7 +570,7 @@ impl ChainDp {
             weight,
             cheap_partner,
         } = &mut dp.scratch;
-        state_areas::<K>(&dp.faces, region, target, sa);
+        state_areas::<K>(&dp.faces, region, target, leaf_tris.is_some(), sa);
         dp.base = leaf_cost(sa[full]).unwrap_or(0.0);
         // Option weights by option mask (one face = a lone-face node, two faces = a pair
         // node), and for each lone face the partners whose pair node costs no more than a
