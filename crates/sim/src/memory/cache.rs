@@ -68,6 +68,14 @@ pub struct Cache {
     /// SipHash's resistance to chosen keys buys nothing for line numbers.)
     inflight: FxHashMap<u64, Cycle>,
     prune_at: usize,
+    /// A one-hash Bloom filter over the in-flight list's lines (bit set ⇒ the line may be
+    /// on it; clear ⇒ it is not), rebuilt when the list is pruned, and the latest fill on
+    /// the list: most misses are answered by one bit test instead of a hash-table probe
+    /// (host speed only; the answer is the list's).
+    filter: Vec<u64>,
+    /// log2 of the filter's bit count (the hash keeps this many top bits).
+    filter_bits: u32,
+    inflight_until: Cycle,
 }
 
 impl Cache {
@@ -76,6 +84,8 @@ impl Cache {
         let assoc = associativity.max(1) as usize;
         let sets = (size_bytes / line_bytes / assoc as u64).max(1);
         let n = sets as usize * assoc;
+        // One filter bit per set, 4096 to 65 536 bits.
+        let filter_bits = sets.next_power_of_two().trailing_zeros().clamp(12, 16);
         Self {
             ways: vec![
                 Way {
@@ -92,7 +102,18 @@ impl Cache {
             stamp: 0,
             inflight: FxHashMap::default(),
             prune_at: INFLIGHT_PRUNE,
+            filter: vec![0; 1 << (filter_bits - 6)],
+            filter_bits,
+            inflight_until: 0,
         }
+    }
+
+    /// Word and bit of `line` in the in-flight filter (Fibonacci hashing: lines of one set
+    /// share their low bits, so those cannot be used directly).
+    #[inline]
+    fn filter_bit(&self, line: u64) -> (usize, u64) {
+        let h = line.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.filter_bits);
+        ((h >> 6) as usize, 1 << (h & 63))
     }
 
     #[inline]
@@ -130,7 +151,9 @@ impl Cache {
                 }
             }
         }
-        if !self.inflight.is_empty()
+        if now < self.inflight_until
+            && let (i, bit) = self.filter_bit(line)
+            && self.filter[i] & bit != 0
             && let Some(&fill) = self.inflight.get(&line)
             && fill > now
         {
@@ -183,9 +206,19 @@ impl Cache {
         w.fill = fill;
         if let Some((l, f)) = moved {
             self.inflight.insert(l, f);
+            let (i, bit) = self.filter_bit(l);
+            self.filter[i] |= bit;
+            self.inflight_until = self.inflight_until.max(f);
             if self.inflight.len() >= self.prune_at {
                 self.inflight.retain(|_, f| *f > now);
                 self.prune_at = (2 * self.inflight.len()).max(INFLIGHT_PRUNE);
+                self.filter.fill(0);
+                self.inflight_until = 0;
+                for (&l, &f) in &self.inflight {
+                    let (i, bit) = self.filter_bit(l);
+                    self.filter[i] |= bit;
+                    self.inflight_until = self.inflight_until.max(f);
+                }
             }
         }
     }
@@ -223,6 +256,41 @@ mod tests {
         assert_eq!(c.lookup(3, 50), Lookup::Absent);
         // After its fill, 19 (displaced) is gone.
         assert_eq!(c.lookup(19, 100), Lookup::Absent);
+    }
+
+    /// The in-flight filter never hides a line on the list: random conflicting misses
+    /// (many lines per set, fills far ahead so the list grows and is pruned) with lookups
+    /// compared to a probe of the list itself.
+    #[test]
+    fn the_in_flight_filter_answers_as_the_list() {
+        for assoc in [1, 2] {
+            let mut rng = dualsplit_geometry::Pcg32::new(assoc as u64, 11);
+            let mut c = Cache::new(64 * 64, 64, assoc); // 64 lines
+            let mut now = 0;
+            let mut found = 0;
+            for i in 0..20_000 {
+                now += rng.below(3) as u64;
+                let line = rng.below(4096) as u64;
+                let set = c.set(line);
+                let in_set = c.ways[set..set + c.assoc]
+                    .iter()
+                    .any(|w| w.line == line || (w.prev == line && now < w.fill));
+                let listed = c.inflight.get(&line).copied().filter(|&f| f > now);
+                let got = c.lookup(line, now);
+                if !in_set {
+                    let want = listed.map_or(Lookup::Absent, |fill| Lookup::Present { fill });
+                    assert_eq!(got, want, "assoc {assoc}, step {i}, line {line}");
+                    found += u64::from(listed.is_some());
+                }
+                if got == Lookup::Absent {
+                    c.install(line, now + 1 + rng.below(500) as u64, now);
+                }
+            }
+            assert!(
+                found > 100,
+                "assoc {assoc}: only {found} lines found on the list"
+            );
+        }
     }
 
     #[test]
