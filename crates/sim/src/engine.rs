@@ -199,8 +199,11 @@ impl Chip {
     }
 }
 
-/// A thread's program and position in it.
+/// A thread's program and position in it. Aligned to a host cache line: the record is
+/// 64 bytes and the thread array is large enough to be `mmap`ed (page + 16 bytes), where
+/// every unaligned record would straddle two lines.
 #[derive(Clone, Debug)]
+#[repr(align(64))]
 pub struct Thread {
     tm: usize,
     /// The cycle of its next issue slot.
@@ -693,6 +696,15 @@ mod tests {
             assert!(v.next_bucket().is_none(), "seed {seed}");
             assert!(steps > 20_000, "seed {seed}: {steps}");
         }
+    }
+
+    /// A thread record and a reservation table each fit one host cache line (64 bytes).
+    #[test]
+    fn host_records_fit_a_cache_line() {
+        assert_eq!(std::mem::size_of::<Thread>(), 64);
+        assert_eq!(std::mem::align_of::<Thread>(), 64);
+        assert_eq!(std::mem::size_of::<Slots>(), 32);
+        assert_eq!(std::mem::align_of::<Slots>(), 32);
     }
 
     #[test]

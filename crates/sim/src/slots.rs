@@ -10,8 +10,10 @@ use crate::Cycle;
 
 const WINDOW: u64 = 128;
 
-/// Occupied cycles of one resource.
+/// Occupied cycles of one resource. 32 bytes, aligned so a table never straddles two host
+/// cache lines.
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(align(32))]
 pub struct Slots {
     base: Cycle,
     mask: u128,
