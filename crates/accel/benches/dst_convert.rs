@@ -7,12 +7,13 @@
 mod dst_common;
 
 use dualsplit_accel::dst::{Dst, DstConfig, Partitioning};
-use dualsplit_accel::{BuildConfig, Bvh2, BvhImage, WideBvh};
-use dualsplit_geometry::{Aabb, Triangle};
+use dualsplit_accel::image::Words;
+use dualsplit_accel::{BuildConfig, Bvh2, BvhImage, SharedTriangles, WideBvh};
+use dualsplit_geometry::Aabb;
 use std::sync::OnceLock;
 
 struct Input {
-    tris: Vec<Triangle>,
+    tris: SharedTriangles,
     boxes: Vec<Aabb>,
     bvh: Bvh2,
 }
@@ -20,7 +21,7 @@ struct Input {
 fn input() -> &'static Input {
     static INPUT: OnceLock<Input> = OnceLock::new();
     INPUT.get_or_init(|| {
-        let tris = dst_common::load_shipped(&scene_name());
+        let tris: SharedTriangles = dst_common::load_shipped(&scene_name()).into();
         let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
         let bvh = Bvh2::build(&boxes, &BuildConfig::default());
         Input { tris, boxes, bvh }
@@ -44,7 +45,7 @@ fn main() {
     // Correctness before timing: the converted trees validate against their BVH2.
     let i = input();
     for cfg in [DstConfig::hardware(), DstConfig::software()] {
-        let dst = Dst::from_bvh2(&i.bvh, &i.tris, &cfg).expect("conversion");
+        let dst = Dst::from_bvh2(&i.bvh, i.tris.clone(), &cfg).expect("conversion");
         dst.validate(&i.bvh).expect("valid DST");
         let s = dst.stats();
         eprintln!(
@@ -77,24 +78,40 @@ fn bvh2_build_and_image() -> BvhImage {
         .collect();
     let bvh = Bvh2::build(&boxes, &cfg);
     let wide = WideBvh::from_bvh2(&bvh);
-    BvhImage::encode(&wide, &bvh, &i.tris, &cfg, std::time::Duration::ZERO).expect("encoding")
+    BvhImage::encode(&wide, &bvh, i.tris.clone(), &cfg, std::time::Duration::ZERO)
+        .expect("encoding")
 }
 
-/// The floor of any conversion on this machine: a fresh zeroed allocation the size of the
-/// hardware DST's image (nodes, index runs, triangles), one word written per 4 KiB page, so
-/// the first-touch page faults that writing the image costs are timed alone.
-#[divan::bench(sample_count = 10, sample_size = 1)]
-fn image_first_touch() -> Vec<u32> {
+/// Words the hardware DST's image allocates (nodes and index runs; the triangles are shared).
+fn image_words() -> usize {
     static WORDS: OnceLock<usize> = OnceLock::new();
-    let n = *WORDS.get_or_init(|| {
+    *WORDS.get_or_init(|| {
         let i = input();
-        Dst::from_bvh2(&i.bvh, &i.tris, &DstConfig::hardware())
+        Dst::from_bvh2(&i.bvh, i.tris.clone(), &DstConfig::hardware())
             .expect("conversion")
             .image()
             .words
             .len()
-    });
-    let mut words = vec![0u32; divan::black_box(n)];
+    })
+}
+
+/// The page-fault floor of writing an image as a plain vector: a fresh zeroed allocation
+/// the size of the hardware DST's node and index regions, one word written per 4 KiB page,
+/// so the first-touch page faults are timed alone.
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn image_first_touch() -> Vec<u32> {
+    let mut words = vec![0u32; divan::black_box(image_words())];
+    for w in words.iter_mut().step_by(1024) {
+        *w = 1;
+    }
+    words
+}
+
+/// The same floor for the image storage the converter uses ([`Words::zeroed`]: a mapping
+/// with the transparent-huge-page advice).
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn image_first_touch_words() -> Words {
+    let mut words = Words::zeroed(divan::black_box(image_words()));
     for w in words.iter_mut().step_by(1024) {
         *w = 1;
     }
@@ -104,18 +121,28 @@ fn image_first_touch() -> Vec<u32> {
 #[divan::bench(sample_count = 10, sample_size = 1)]
 fn dst_convert_hardware() -> Dst {
     let i = input();
-    Dst::from_bvh2(divan::black_box(&i.bvh), &i.tris, &DstConfig::hardware()).unwrap()
+    Dst::from_bvh2(
+        divan::black_box(&i.bvh),
+        i.tris.clone(),
+        &DstConfig::hardware(),
+    )
+    .unwrap()
 }
 
 #[divan::bench(sample_count = 10, sample_size = 1)]
 fn dst_convert_software() -> Dst {
     let i = input();
-    Dst::from_bvh2(divan::black_box(&i.bvh), &i.tris, &DstConfig::software()).unwrap()
+    Dst::from_bvh2(
+        divan::black_box(&i.bvh),
+        i.tris.clone(),
+        &DstConfig::software(),
+    )
+    .unwrap()
 }
 
 #[divan::bench(sample_count = 10, sample_size = 1)]
 fn dst_convert_similar() -> Dst {
     let i = input();
     let cfg = DstConfig::hardware().with_partitioning(Partitioning::Similar);
-    Dst::from_bvh2(divan::black_box(&i.bvh), &i.tris, &cfg).unwrap()
+    Dst::from_bvh2(divan::black_box(&i.bvh), i.tris.clone(), &cfg).unwrap()
 }

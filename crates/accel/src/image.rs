@@ -31,25 +31,80 @@
 //!
 //! Runs are laid out in the depth-first order of the leaves. All offsets are absolute word
 //! indices; the triangle of id `i` is at word `triangles.start + 9·i`.
+//!
+//! ## Storage
+//!
+//! The node and index regions are [`MemoryImage::words`] ([`Words`]: one allocation, huge
+//! pages where the kernel allows). The triangle region has its addresses like the others,
+//! but its data is the scene's triangles shared by every image of the scene
+//! ([`SharedTriangles`]) rather than a copy per image; [`MemoryImage::to_bytes`] gives the
+//! whole image, and traversal and the simulator see the same bytes at the same addresses.
+
+mod words;
 
 use crate::observer::Observer;
 use dualsplit_geometry::{Aabb, Triangle, Vec3};
 use std::ops::Range;
+use std::sync::Arc;
+pub use words::{MAPPED_MIN_BYTES, Words};
 
-/// A structure's memory image: words plus the word ranges of its three regions.
-#[derive(Clone, Debug, Default)]
+/// The scene's triangles in id order, shared (not copied) by every image built from them.
+pub type SharedTriangles = Arc<[Triangle]>;
+
+/// A structure's memory image: the word ranges of its three regions, the words of the node
+/// and index regions, and the triangle region's data.
+///
+/// The triangle region is the scene's triangles, byte for byte and at its own addresses
+/// (right after the indices), but its data is shared between the images of one scene
+/// instead of copied into each (for dragon_box, 31 MB once instead of once per structure).
+/// [`MemoryImage::to_bytes`] gives the whole image as one byte string.
+#[derive(Clone, Default)]
 pub struct MemoryImage {
-    /// The image, as little-endian 32-bit words (f32 values stored as their bits).
-    pub words: Vec<u32>,
+    /// The node and index regions, as little-endian 32-bit words (f32 values stored as
+    /// their bits); word `i` of the image for `i < indices.end`.
+    pub words: Words,
     /// Word range of the node region.
     pub nodes: Range<usize>,
     /// Word range of the triangle-index region.
     pub indices: Range<usize>,
-    /// Word range of the triangle region.
+    /// Word range of the triangle region (36 B per triangle, id order).
     pub triangles: Range<usize>,
+    /// The triangle region's data.
+    pub triangle_data: SharedTriangles,
+}
+
+impl std::fmt::Debug for MemoryImage {
+    /// The regions and sizes (not the contents: a scene's image has millions of words).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MemoryImage")
+            .field("words", &self.words)
+            .field("nodes", &self.nodes)
+            .field("indices", &self.indices)
+            .field("triangles", &self.triangles)
+            .field("triangle_count", &self.triangle_data.len())
+            .finish()
+    }
 }
 
 impl MemoryImage {
+    /// An image of `nodes` node words and `indices` index words, zeroed for the encoder to
+    /// fill, followed by the triangle region holding `triangles` (shared, not copied).
+    pub fn with_triangles(nodes: usize, indices: usize, triangles: SharedTriangles) -> MemoryImage {
+        let tri_start = nodes + indices;
+        MemoryImage {
+            words: Words::zeroed(tri_start),
+            nodes: 0..nodes,
+            indices: nodes..tri_start,
+            triangles: tri_start..tri_start + 9 * triangles.len(),
+            triangle_data: triangles,
+        }
+    }
+
+    /// The node and index regions, writable (what an encoder fills).
+    pub fn node_and_index_words_mut(&mut self) -> &mut [u32] {
+        &mut self.words[..self.indices.end]
+    }
+
     /// Byte address of word `i`.
     #[inline(always)]
     pub fn addr(word: usize) -> u64 {
@@ -67,14 +122,19 @@ impl MemoryImage {
     pub fn triangle_bytes(&self) -> u64 {
         (self.triangles.len() * 4) as u64
     }
-    /// The whole image as bytes (little-endian).
+    /// The whole image as bytes (little-endian): nodes, indices, triangles.
     pub fn to_bytes(&self) -> Vec<u8> {
-        self.words.iter().flat_map(|w| w.to_le_bytes()).collect()
+        let tris: &[u32] = bytemuck::cast_slice(&self.triangle_data);
+        self.words
+            .iter()
+            .chain(tris)
+            .flat_map(|w| w.to_le_bytes())
+            .collect()
     }
     /// The triangle region viewed as triangles (id order).
     #[inline]
     pub fn triangle_slice(&self) -> &[Triangle] {
-        bytemuck::cast_slice(&self.words[self.triangles.clone()])
+        &self.triangle_data
     }
     /// Triangle `prim`, read from the image, reporting the 36-byte fetch to `obs`.
     #[inline(always)]
@@ -82,13 +142,6 @@ impl MemoryImage {
         let w = self.triangles.start + 9 * prim as usize;
         obs.fetch(Self::addr(w), 36);
         self.triangle_slice()[prim as usize]
-    }
-    /// Appends the triangle region (36 B per triangle, id order) and records its range.
-    pub fn push_triangles(&mut self, triangles: &[Triangle]) {
-        let start = self.words.len();
-        self.words
-            .extend_from_slice(bytemuck::cast_slice::<Triangle, u32>(triangles));
-        self.triangles = start..self.words.len();
     }
 }
 

@@ -19,7 +19,7 @@ pub mod validate;
 pub mod wide;
 
 pub use build::{BuildConfig, Bvh2, Bvh2Node};
-pub use image::{ImageError, MemoryImage};
+pub use image::{ImageError, MemoryImage, SharedTriangles};
 pub use observer::{CountingObserver, DstNodeKind, NoObserver, NodeStep, Observer};
 pub use stats::StructureStats;
 pub use validate::ValidationReport;
@@ -98,8 +98,8 @@ pub enum AccelError {
 /// }
 /// ```
 pub struct Structures {
-    /// The scene's triangles (ids are indices).
-    pub triangles: Vec<Triangle>,
+    /// The scene's triangles (ids are indices), shared by every structure's image.
+    pub triangles: SharedTriangles,
     /// The source BVH2 (logical).
     pub bvh2: Bvh2,
     /// The encoded BVH2 (52-byte nodes); its `time` is the BVH2 build time.
@@ -138,25 +138,26 @@ impl Structures {
         cfg: &BuildConfig,
         dst_cfg: &dst::DstConfig,
     ) -> Result<Self, AccelError> {
+        let shared = SharedTriangles::from(triangles);
         let t0 = Instant::now();
         let boxes: Vec<Aabb> = triangles.iter().map(|t| t.bounds()).collect();
         let bvh2 = Bvh2::build(&boxes, cfg);
         let build_time = t0.elapsed();
         let wide2 = WideBvh::from_bvh2(&bvh2);
-        let bvh2_image = BvhImage::encode(&wide2, &bvh2, triangles, cfg, build_time)?;
+        let bvh2_image = BvhImage::encode(&wide2, &bvh2, shared.clone(), cfg, build_time)?;
         let t0 = Instant::now();
         let wide4 = WideBvh::collapse_bvh4(&bvh2);
         let t4 = t0.elapsed();
-        let bvh4 = BvhImage::encode(&wide4, &bvh2, triangles, cfg, t4)?;
+        let bvh4 = BvhImage::encode(&wide4, &bvh2, shared.clone(), cfg, t4)?;
         let t0 = Instant::now();
         let wide8 = WideBvh::collapse_bvh8(&bvh2, &CollapseConfig::default());
         let t8 = t0.elapsed();
-        let bvh8 = BvhImage::encode(&wide8, &bvh2, triangles, cfg, t8)?;
+        let bvh8 = BvhImage::encode(&wide8, &bvh2, shared.clone(), cfg, t8)?;
         let t0 = Instant::now();
-        let dst = dst::Dst::from_bvh2(&bvh2, triangles, dst_cfg)?;
+        let dst = dst::Dst::from_bvh2(&bvh2, shared.clone(), dst_cfg)?;
         let dst_convert_ms = t0.elapsed().as_secs_f64() * 1e3;
         let s = Self {
-            triangles: triangles.to_vec(),
+            triangles: shared,
             bvh2,
             bvh2_image,
             bvh4,

@@ -1,7 +1,8 @@
 //! Emission of the DST memory image (dst-spec §3): node words depth-first with the two
 //! children of every splitting node adjacent (left, then right at left + left size), a
 //! carving node's child placed by bump allocation, leaves as runs in one triangle-index list
-//! (the last entry of a run has bit 31 set), then the triangles, 36 B each in id order.
+//! (the last entry of a run has bit 31 set), then the triangle region (the scene's
+//! triangles, shared with the other images: [`crate::image::SharedTriangles`]).
 //!
 //! Two passes, both parallel (rayon) over the subtrees below depth [`PARALLEL_DEPTH`]:
 //!
@@ -9,20 +10,22 @@
 //!    number of node words and index entries each subtree will take. Decisions are kept as
 //!    compact records ([`Rec`], the chains packed in eight bytes each).
 //! 2. **Emit**: with every subtree's size known, the image is cut into disjoint slices
-//!    (`split_at_mut`), one per subtree, and each subtree writes its words and index runs
-//!    in place at their final addresses. Nothing is relocated or copied afterwards.
+//!    (`split_at_mut`) at the parallel cut, one per subtree, and each subtree writes its
+//!    words and index runs in place at their final addresses through a [`Cursor`] (bump
+//!    indices; slots are word indices). Nothing is relocated or copied afterwards.
 //!
-//! The layout is the one a fully sequential depth-first emission with bump allocation
-//! gives, whatever the thread count (`tests/dst_convert_golden.rs`).
+//! The image's words live in one allocation ([`crate::image::Words`]: huge pages where the
+//! kernel allows, so first-touch page faults do not dominate). The layout is the one a fully
+//! sequential depth-first emission with bump allocation gives, whatever the thread count
+//! (`tests/dst_convert_golden.rs`).
 
 use super::from_bvh2::{Chain, ChainDp, StepTable, plan_split, plane_values};
 use super::header::{HeaderOffset, OFFSET_LIMIT};
 use super::stats::DstStats;
 use super::{Dst, DstConfig, DstError};
 use crate::build::Bvh2;
-use crate::image::MemoryImage;
-use dualsplit_geometry::{Aabb, Triangle};
-use rayon::prelude::*;
+use crate::image::{MemoryImage, SharedTriangles};
+use dualsplit_geometry::Aabb;
 
 /// Bit 31 of an index entry: the last triangle of a leaf's run.
 pub(super) const RUN_END: u32 = 1 << 31;
@@ -98,30 +101,96 @@ struct Out<'w> {
     entries_at: u64,
 }
 
-impl<'w> Out<'w> {
-    /// Takes the next `n` node words (bump allocation); returns them and their address.
-    fn take(&mut self, n: usize) -> (&'w mut [u32], u64) {
-        let (head, rest) = std::mem::take(&mut self.words).split_at_mut(n);
-        self.words = rest;
-        let at = self.at;
-        self.at += n as u64;
-        (head, at)
+/// [`Slot`] of a subtree's root, which lives in [`Out::slot`] rather than in its words.
+const ROOT: usize = usize::MAX;
+
+/// A slot to be written: [`ROOT`] or the index of its first word in [`Cursor::words`].
+type Slot = usize;
+
+/// Sequential emission into one subtree's [`Out`]: node words and index entries are
+/// bump-allocated by moving `next` and `next_entry`, and slots are word indices, so nothing
+/// is split or moved per node.
+struct Cursor<'w> {
+    out: Out<'w>,
+    /// Words of `out.words` allocated so far.
+    next: usize,
+    /// Entries of `out.entries` written so far.
+    next_entry: usize,
+}
+
+impl<'w> Cursor<'w> {
+    fn new(out: Out<'w>) -> Self {
+        Cursor {
+            out,
+            next: 0,
+            next_entry: 0,
+        }
     }
 
-    /// Splits off the outputs of a child subtree of `size` whose root slot is `slot`.
-    fn child(&mut self, slot: &'w mut [u32], size: Size) -> Out<'w> {
-        let (words, at) = self.take(size.words as usize);
-        let (entries, rest) = std::mem::take(&mut self.entries).split_at_mut(size.entries as usize);
-        self.entries = rest;
-        let entries_at = self.entries_at;
-        self.entries_at += size.entries;
-        Out {
-            slot,
-            words,
-            at,
-            entries,
-            entries_at,
+    /// Allocates `n` node words; returns their index in the cursor's words.
+    #[inline(always)]
+    fn take(&mut self, n: usize) -> usize {
+        let i = self.next;
+        self.next += n;
+        i
+    }
+
+    /// Absolute word address of index `i` of the cursor's words.
+    #[inline(always)]
+    fn addr(&self, i: usize) -> u64 {
+        self.out.at + i as u64
+    }
+
+    /// Absolute index-list position of the next entry.
+    #[inline(always)]
+    fn entry_addr(&self) -> u64 {
+        self.out.entries_at + self.next_entry as u64
+    }
+
+    /// The words of slot `slot` (from its start to the end of its region).
+    #[inline(always)]
+    fn slot(&mut self, slot: Slot) -> &mut [u32] {
+        if slot == ROOT {
+            self.out.slot
+        } else {
+            &mut self.out.words[slot..]
         }
+    }
+
+    /// Writes a 12-byte node (header-offset word, P0, P1) into `slot`.
+    #[inline(always)]
+    fn put(&mut self, slot: Slot, h: HeaderOffset, p0: f32, p1: f32) {
+        self.slot(slot)[..3].copy_from_slice(&[h.bits(), p0.to_bits(), p1.to_bits()]);
+    }
+
+    /// Splits what is left after the pair of child slots at `pair` (`sl` + `sr` words) into
+    /// the outputs of the left child (its root slot and `left` of the rest) and the right
+    /// child (its root slot and everything else).
+    fn into_children(self, pair: usize, sl: usize, left: Size) -> (Out<'w>, Out<'w>) {
+        let at = self.out.at;
+        let (_, rest) = self.out.words.split_at_mut(pair);
+        let (ls, rest) = rest.split_at_mut(sl);
+        let (rs, rest) = rest.split_at_mut(self.next - pair - sl);
+        let (lw, rw) = rest.split_at_mut(left.words as usize);
+        let (le, re) = self.out.entries[self.next_entry..].split_at_mut(left.entries as usize);
+        let entries_at = self.out.entries_at + self.next_entry as u64;
+        let words_at = at + self.next as u64;
+        (
+            Out {
+                slot: ls,
+                words: lw,
+                at: words_at,
+                entries: le,
+                entries_at,
+            },
+            Out {
+                slot: rs,
+                words: rw,
+                at: words_at + left.words,
+                entries: re,
+                entries_at: entries_at + left.entries,
+            },
+        )
     }
 }
 
@@ -167,40 +236,41 @@ impl Encoder<'_> {
         Ok(())
     }
 
-    /// Plans BVH node `n` entered with `chain`: its record (internal nodes) and the size of
-    /// its subtree. Checks the links and leaf ranges that emission relies on.
-    fn plan_node(
-        &self,
-        n: u32,
-        chain: Chain,
-        dps: &mut [ChainDp; 2],
-    ) -> Result<Result<Rec, Size>, DstError> {
+    /// Checks BVH node `n`'s links (and a leaf's triangle range, which emission relies on);
+    /// for a leaf entered with `chain`, returns its size.
+    fn check_node(&self, n: u32, chain: Chain) -> Result<Option<Size>, DstError> {
         self.check_links(n)?;
         let node = &self.bvh.nodes[n as usize];
-        let steps = chain.len() as u64;
-        if node.is_leaf() {
-            let (first, count) = (node.first as usize, node.count as usize);
-            if first + count > self.bvh.prim_ids.len() {
-                return Err(DstError::BadBvhLink {
-                    node: n,
-                    child: node.first,
-                    nodes: self.bvh.prim_ids.len(),
-                });
-            }
-            // The last carving node of a leaf's chain is the leaf (no word of its own).
-            return Ok(Err(Size {
-                words: 3 * steps.saturating_sub(1),
-                entries: count as u64,
-            }));
+        if !node.is_leaf() {
+            return Ok(None);
         }
+        let (first, count) = (node.first as usize, node.count as usize);
+        if first + count > self.bvh.prim_ids.len() {
+            return Err(DstError::BadBvhLink {
+                node: n,
+                child: node.first,
+                nodes: self.bvh.prim_ids.len(),
+            });
+        }
+        // The last carving node of a leaf's chain is the leaf (no word of its own).
+        Ok(Some(Size {
+            words: 3 * (chain.len() as u64).saturating_sub(1),
+            entries: count as u64,
+        }))
+    }
+
+    /// The record of internal BVH node `n` (its subtree sizes are filled in by
+    /// [`Encoder::close`]).
+    #[inline(always)]
+    fn new_rec(&self, n: u32, dps: &mut [ChainDp; 2]) -> Rec {
         let p = plan_split(self.bvh, n, self.cfg, dps);
-        Ok(Ok(Rec {
+        Rec {
             chains: [p.left_chain, p.right_chain],
             left_entries: 0,
             left_words: 0,
             axis: p.axis as u8,
             swap: p.swap,
-        }))
+        }
     }
 
     /// Completes internal node `n`'s record once its subtrees are planned (`l`, `r`: their
@@ -233,18 +303,16 @@ impl Encoder<'_> {
             child: n,
             nodes: self.bvh.nodes.len(),
         })?;
-        let mut rec = match self.plan_node(n, chain, dps)? {
-            Err(leaf) => return Ok(leaf),
-            Ok(rec) => rec,
-        };
+        if let Some(leaf) = self.check_node(n, chain)? {
+            return Ok(leaf);
+        }
         let slot = recs.len();
-        recs.push(rec);
-        let [cl, cr] = rec.children(self.bvh, n);
-        let l = self.plan_seq(cl, rec.chains[0], recs, budget, dps)?;
-        let r = self.plan_seq(cr, rec.chains[1], recs, budget, dps)?;
-        let size = self.close(n, chain, &mut rec, l, r);
-        recs[slot] = rec;
-        Ok(size)
+        recs.push(self.new_rec(n, dps));
+        let rec = &recs[slot];
+        let ([cl, cr], [ch_l, ch_r]) = (rec.children(self.bvh, n), rec.chains);
+        let l = self.plan_seq(cl, ch_l, recs, budget, dps)?;
+        let r = self.plan_seq(cr, ch_r, recs, budget, dps)?;
+        Ok(self.close(n, chain, &mut recs[slot], l, r))
     }
 
     /// Plan pass: nodes above [`PARALLEL_DEPTH`] plan their two subtrees in parallel.
@@ -257,11 +325,10 @@ impl Encoder<'_> {
             let size = self.plan_seq(n, chain, &mut recs, &mut budget, &mut dps)?;
             return Ok((Plan::Seq(recs), size));
         }
-        let mut dps = [ChainDp::new(), ChainDp::new()];
-        let mut rec = match self.plan_node(n, chain, &mut dps)? {
-            Err(leaf) => return Ok((Plan::Seq(Vec::new()), leaf)),
-            Ok(rec) => rec,
-        };
+        if let Some(leaf) = self.check_node(n, chain)? {
+            return Ok((Plan::Seq(Vec::new()), leaf));
+        }
+        let mut rec = self.new_rec(n, &mut [ChainDp::new(), ChainDp::new()]);
         let [cl, cr] = rec.children(self.bvh, n);
         let (l, r) = rayon::join(
             || self.plan(cl, rec.chains[0], depth + 1),
@@ -272,12 +339,16 @@ impl Encoder<'_> {
         Ok((Plan::Par(rec, Box::new([lp, rp])), size))
     }
 
-    /// Writes BVH leaf `n`'s triangles as one run at the start of `out.entries`.
-    fn write_run(&self, n: u32, out: &mut Out) -> Result<(), DstError> {
+    /// Writes BVH leaf `n`'s triangles as one run at the cursor's next entries; returns the
+    /// run's position in the index list.
+    #[inline(always)]
+    fn write_run(&self, n: u32, cur: &mut Cursor) -> Result<u64, DstError> {
         let node = &self.bvh.nodes[n as usize];
         let (first, count) = (node.first as usize, node.count as usize);
         let ids = &self.bvh.prim_ids[first..first + count];
-        for (i, (&p, e)) in ids.iter().zip(out.entries.iter_mut()).enumerate() {
+        let at = cur.entry_addr();
+        let run = &mut cur.out.entries[cur.next_entry..cur.next_entry + count];
+        for (i, (&p, e)) in ids.iter().zip(run).enumerate() {
             if p as usize >= self.triangles {
                 return Err(DstError::PrimOutOfRange {
                     node: n,
@@ -293,23 +364,24 @@ impl Encoder<'_> {
             }
             *e = if i + 1 == count { p | RUN_END } else { p };
         }
-        Ok(())
+        cur.next_entry += count;
+        Ok(at)
     }
 
-    /// Emits BVH node `n`'s incoming `chain` (and, for a leaf, the leaf itself) into
-    /// `out`. For an internal node, returns the slot its splitting node goes into and what
-    /// is left of `out` for its children.
-    fn emit_head<'w>(
+    /// Emits BVH node `n`'s incoming `chain` into `slot` (and, for a leaf, the leaf
+    /// itself). For an internal node, returns the slot its splitting node goes into.
+    #[inline(always)]
+    fn emit_head(
         &self,
         n: u32,
         chain: Chain,
-        mut out: Out<'w>,
+        mut slot: Slot,
+        cur: &mut Cursor,
         stats: &mut DstStats,
-    ) -> Result<Option<(&'w mut [u32], Out<'w>)>, DstError> {
+    ) -> Result<Option<Slot>, DstError> {
         let node = &self.bvh.nodes[n as usize];
         let is_leaf = node.is_leaf();
         let steps = chain.len();
-        let mut slot = std::mem::take(&mut out.slot);
         let planes = plane_values(&node.bounds);
         for i in 0..steps {
             let step = self.steps.get(chain.faces(i));
@@ -318,11 +390,10 @@ impl Encoder<'_> {
             let fold = is_leaf && i + 1 == steps;
             let (offset, child) = if fold {
                 stats.carving_leaves += 1;
-                self.write_run(n, &mut out)?;
-                (out.entries_at, None)
+                (self.write_run(n, cur)?, slot)
             } else {
-                let (c, at) = out.take(3);
-                (at, Some(c))
+                let c = cur.take(3);
+                (cur.addr(c), c)
             };
             if step.dual {
                 stats.dual_carving += 1;
@@ -331,90 +402,84 @@ impl Encoder<'_> {
             }
             let h = step.header.carve_pointing_at(fold, offset)?;
             let [p0, p1] = step.planes.map(|p| planes[p as usize]);
-            put(slot, h, p0, p1);
-            if let Some(c) = child {
-                slot = c;
-            }
+            cur.put(slot, h, p0, p1);
+            slot = child;
         }
         if !is_leaf {
-            return Ok(Some((slot, out)));
+            return Ok(Some(slot));
         }
         stats.index_entries += node.count as u64;
         if steps == 0 {
             stats.leaves += 1;
-            self.write_run(n, &mut out)?;
-            slot[0] = HeaderOffset::leaf(out.entries_at)?.bits();
+            let at = self.write_run(n, cur)?;
+            cur.slot(slot)[0] = HeaderOffset::leaf(at)?.bits();
         }
         Ok(None)
     }
 
-    /// Emits the subtree of BVH node `n` entered with `chain`, sequentially; the records of
-    /// its internal nodes come from `recs` in depth-first order.
+    /// Emits the subtree of BVH node `n` entered with `chain` into `slot`, sequentially;
+    /// the records of its internal nodes come from `recs` in depth-first order.
     fn emit(
         &self,
         n: u32,
         chain: Chain,
-        out: Out,
+        slot: Slot,
+        cur: &mut Cursor,
         recs: &mut std::slice::Iter<Rec>,
         stats: &mut DstStats,
     ) -> Result<(), DstError> {
-        if let Some((slot, mut out)) = self.emit_head(n, chain, out, stats)? {
+        if let Some(slot) = self.emit_head(n, chain, slot, cur, stats)? {
             let rec = recs.next().expect("one record per internal node");
             let [cl, cr] = rec.children(self.bvh, n);
-            let (l, r) = self.children_out(rec, [cl, cr], &mut out, slot, stats)?;
-            self.emit(cl, rec.chains[0], l, recs, stats)?;
-            self.emit(cr, rec.chains[1], r, recs, stats)?;
+            let (pair, sl) = self.split_node(rec, [cl, cr], slot, cur, stats)?;
+            self.emit(cl, rec.chains[0], pair, cur, recs, stats)?;
+            self.emit(cr, rec.chains[1], pair + sl, cur, recs, stats)?;
         }
         Ok(())
     }
 
-    /// Writes the splitting node `rec` into `slot`, reserves its children's slots and cuts
-    /// the rest of `out` into the two children's outputs.
-    fn children_out<'w>(
+    /// Writes the splitting node `rec` into `slot` and allocates its children's slots;
+    /// returns where they start and the left slot's size.
+    #[inline(always)]
+    fn split_node(
         &self,
         rec: &Rec,
         [l, r]: [u32; 2],
-        out: &mut Out<'w>,
-        slot: &mut [u32],
+        slot: Slot,
+        cur: &mut Cursor,
         stats: &mut DstStats,
-    ) -> Result<(Out<'w>, Out<'w>), DstError> {
+    ) -> Result<(usize, usize), DstError> {
         let sl = slot_size(self.bvh, l, rec.chains[0]);
         let sr = slot_size(self.bvh, r, rec.chains[1]);
-        let (pair, at) = out.take(sl + sr);
+        let pair = cur.take(sl + sr);
         stats.splitting += 1;
         let axis = rec.axis as usize;
-        let h = HeaderOffset::split(axis, sl as u32, at)?;
+        let h = HeaderOffset::split(axis, sl as u32, cur.addr(pair))?;
         let (lb, rb) = (
             self.bvh.nodes[l as usize].bounds,
             self.bvh.nodes[r as usize].bounds,
         );
-        put(slot, h, lb.max[axis], rb.min[axis]);
-        let (ls, rs) = pair.split_at_mut(sl);
-        let left = out.child(
-            ls,
-            Size {
-                words: rec.left_words as u64,
-                entries: rec.left_entries,
-            },
-        );
-        let rest = Size {
-            words: out.words.len() as u64,
-            entries: out.entries.len() as u64,
-        };
-        Ok((left, out.child(rs, rest)))
+        cur.put(slot, h, lb.max[axis], rb.min[axis]);
+        Ok((pair, sl))
     }
 
     /// Emits a planned subtree; [`Plan::Par`] nodes emit their two subtrees in parallel.
     fn emit_plan(&self, plan: &Plan, n: u32, chain: Chain, out: Out) -> Result<DstStats, DstError> {
         let mut stats = DstStats::default();
+        let mut cur = Cursor::new(out);
         match plan {
-            Plan::Seq(recs) => self.emit(n, chain, out, &mut recs.iter(), &mut stats)?,
+            Plan::Seq(recs) => self.emit(n, chain, ROOT, &mut cur, &mut recs.iter(), &mut stats)?,
             Plan::Par(rec, children) => {
-                let (slot, mut out) = self
-                    .emit_head(n, chain, out, &mut stats)?
+                let slot = self
+                    .emit_head(n, chain, ROOT, &mut cur, &mut stats)?
                     .expect("a parallel plan node is internal");
                 let [cl, cr] = rec.children(self.bvh, n);
-                let (l, r) = self.children_out(rec, [cl, cr], &mut out, slot, &mut stats)?;
+                let (pair, sl) = self.split_node(rec, [cl, cr], slot, &mut cur, &mut stats)?;
+                let left = Size {
+                    words: rec.left_words as u64,
+                    entries: rec.left_entries,
+                };
+                let (l, r) = cur.into_children(pair, sl, left);
                 let (a, b) = rayon::join(
                     || self.emit_plan(&children[0], cl, rec.chains[0], l),
                     || self.emit_plan(&children[1], cr, rec.chains[1], r),
@@ -427,13 +492,6 @@ impl Encoder<'_> {
     }
 }
 
-/// Writes a 12-byte node (header-offset word, P0, P1) into `slot`.
-fn put(slot: &mut [u32], h: HeaderOffset, p0: f32, p1: f32) {
-    slot[0] = h.bits();
-    slot[1] = p0.to_bits();
-    slot[2] = p1.to_bits();
-}
-
 impl Dst {
     /// Converts a BVH2 over `triangles` into a DST (Lin et al. 2020, §4.2). In
     /// [`super::Partitioning::Identical`] mode the region entering every splitting node and
@@ -441,7 +499,12 @@ impl Dst {
     ///
     /// Errors: malformed BVH links, non-finite boxes, triangle ids out of range, and
     /// offsets beyond the 26-bit field ([`DstError::OffsetOverflow`]).
-    pub fn from_bvh2(bvh: &Bvh2, triangles: &[Triangle], cfg: &DstConfig) -> Result<Dst, DstError> {
+    pub fn from_bvh2(
+        bvh: &Bvh2,
+        triangles: impl Into<SharedTriangles>,
+        cfg: &DstConfig,
+    ) -> Result<Dst, DstError> {
+        let triangles = triangles.into();
         let enc = Encoder {
             bvh,
             triangles: triangles.len(),
@@ -463,16 +526,11 @@ impl Dst {
             });
         }
         let (n_nodes, n_idx) = (n_nodes as usize, size.entries as usize);
-        // One zeroed allocation for the whole image (fresh pages, first touched by the
-        // threads that fill them); the triangles are copied in parallel.
-        let mut words = vec![0u32; n_nodes + n_idx + 9 * triangles.len()];
-        let (node_words, rest) = words.split_at_mut(n_nodes);
-        let (entries, tri_words) = rest.split_at_mut(n_idx);
-        let tri_src: &[u32] = bytemuck::cast_slice(triangles);
-        tri_words
-            .par_chunks_mut(1 << 16)
-            .zip(tri_src.par_chunks(1 << 16))
-            .for_each(|(d, s)| d.copy_from_slice(s));
+        // One allocation for the node and index regions (fresh pages, first touched by
+        // the threads that fill them; huge pages where the kernel allows, see
+        // `image::Words`); the triangle region is the scene's, shared.
+        let mut image = MemoryImage::with_triangles(n_nodes, n_idx, triangles);
+        let (node_words, entries) = image.node_and_index_words_mut().split_at_mut(n_nodes);
         let mut stats = if empty {
             DstStats::default()
         } else {
@@ -490,12 +548,6 @@ impl Dst {
             Aabb::EMPTY
         } else {
             bvh.nodes[0].bounds
-        };
-        let image = MemoryImage {
-            nodes: 0..n_nodes,
-            indices: n_nodes..n_nodes + n_idx,
-            triangles: n_nodes + n_idx..words.len(),
-            words,
         };
         stats.node_bytes = image.node_bytes();
         stats.index_bytes = image.index_bytes();

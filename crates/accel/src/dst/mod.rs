@@ -26,7 +26,9 @@
 //! ];
 //! let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
 //! let bvh = Bvh2::build(&boxes, &BuildConfig::default());
-//! let dst = Dst::from_bvh2(&bvh, &tris, &DstConfig::hardware()).unwrap();
+//! // The image shares the triangles: pass a `SharedTriangles` (`Arc<[Triangle]>`) to share
+//! // one copy between structures, or a slice / Vec to have one made.
+//! let dst = Dst::from_bvh2(&bvh, &tris[..], &DstConfig::hardware()).unwrap();
 //! dst.validate(&bvh).unwrap();
 //! let hit = dst.closest_hit(&Ray::new(Vec3::ZERO, Vec3::Z), &mut NoObserver).unwrap();
 //! assert_eq!((hit.t, hit.prim), (2.0, 0));
@@ -266,6 +268,6 @@ impl Dst {
     /// The triangles, read from the image's triangle region.
     #[inline]
     pub fn triangles(&self) -> &[Triangle] {
-        bytemuck::cast_slice(&self.image.words[self.image.triangles.clone()])
+        self.image.triangle_slice()
     }
 }

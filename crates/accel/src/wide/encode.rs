@@ -1,8 +1,7 @@
 //! Writes a [`WideBvh`] into a byte-exact [`MemoryImage`] (layout in [`crate::image`]).
 
 use super::{WideBvh, WideChild};
-use crate::image::{ChildKind, ImageError, MemoryImage, NodeLayout};
-use dualsplit_geometry::Triangle;
+use crate::image::{ChildKind, ImageError, MemoryImage, NodeLayout, SharedTriangles};
 
 /// Bit 31 of an index-list entry: the last triangle of a leaf's run.
 pub const LAST_IN_RUN: u32 = 1 << 31;
@@ -13,7 +12,7 @@ pub const LAST_IN_RUN: u32 = 1 << 31;
 pub fn encode<L: NodeLayout>(
     wide: &WideBvh,
     prim_ids: &[u32],
-    triangles: &[Triangle],
+    triangles: SharedTriangles,
 ) -> Result<MemoryImage, ImageError> {
     assert!(wide.arity <= L::ARITY, "tree wider than the node layout");
     let leaves = wide.leaf_count();
@@ -27,30 +26,24 @@ pub fn encode<L: NodeLayout>(
             WideChild::Node(_) => 0,
         })
         .sum();
+    let mut img = MemoryImage::with_triangles(node_words, index_words, triangles);
     let mut e = Encoder {
         wide,
         prim_ids,
-        words: vec![0u32; node_words + index_words],
+        words: img.node_and_index_words_mut(),
         next_node: L::WORDS,
         next_index: node_words,
     };
     e.emit::<L>(0, 0)?;
     debug_assert_eq!(e.next_node, node_words);
     debug_assert_eq!(e.next_index, node_words + index_words);
-    let mut img = MemoryImage {
-        words: e.words,
-        nodes: 0..node_words,
-        indices: node_words..node_words + index_words,
-        triangles: 0..0,
-    };
-    img.push_triangles(triangles);
     Ok(img)
 }
 
 struct Encoder<'a> {
     wide: &'a WideBvh,
     prim_ids: &'a [u32],
-    words: Vec<u32>,
+    words: &'a mut [u32],
     next_node: usize,
     next_index: usize,
 }

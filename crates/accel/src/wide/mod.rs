@@ -28,7 +28,7 @@ use crate::image::{ImageError, MemoryImage};
 use crate::observer::Observer;
 use crate::validate::{ValidationReport, validate_image};
 use crate::{BuildConfig, Bvh2};
-use dualsplit_geometry::{Aabb, Hit, Ray, Triangle};
+use dualsplit_geometry::{Aabb, Hit, Ray};
 use std::time::Duration;
 
 /// A child of a [`WideNode`].
@@ -154,14 +154,16 @@ pub struct BvhImage {
 }
 
 impl BvhImage {
-    /// Encodes `wide` (arity 2, 4 or 8) over `bvh`'s `prim_ids` and `triangles`.
+    /// Encodes `wide` (arity 2, 4 or 8) over `bvh`'s `prim_ids` and `triangles` (shared by
+    /// the image, not copied, when given as [`crate::image::SharedTriangles`]).
     pub fn encode(
         wide: &WideBvh,
         bvh: &Bvh2,
-        triangles: &[Triangle],
+        triangles: impl Into<crate::image::SharedTriangles>,
         cfg: &BuildConfig,
         time: Duration,
     ) -> Result<Self, ImageError> {
+        let triangles = triangles.into();
         let image = match wide.arity {
             2 => encode::encode::<Node2>(wide, &bvh.prim_ids, triangles)?,
             4 => encode::encode::<Node4>(wide, &bvh.prim_ids, triangles)?,

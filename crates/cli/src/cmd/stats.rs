@@ -76,7 +76,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         let d = if cfg == *s.dst.config() {
             &s.dst
         } else {
-            converted = Dst::from_bvh2(&s.bvh2, &s.triangles, &cfg)
+            converted = Dst::from_bvh2(&s.bvh2, s.triangles.clone(), &cfg)
                 .with_context(|| format!("converting the DST ({name})"))?;
             &converted
         };

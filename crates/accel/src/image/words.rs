@@ -1,0 +1,147 @@
+//! The storage of a memory image: 32-bit words that are either a heap vector or, for large
+//! images, an anonymous memory mapping advised to use transparent huge pages.
+//!
+//! Why: a fresh image is written once, front to back, by the encoder. On Linux every first
+//! touch of a 4 KiB page is a page fault (zeroing included); a 53 MB dragon_box DST image
+//! took ≈ 13 900 of them per conversion, about a quarter of the conversion's time
+//! (`docs/performance.md`, "DST on the CPU"). With `MADV_HUGEPAGE` the kernel backs the
+//! mapping with 2 MiB pages where it can (27 faults for the same image). Where huge pages
+//! are unavailable or the mapping fails, the words simply live in a `Vec`; the contents and
+//! every reader are the same either way (readers see a `&[u32]`).
+
+use memmap2::MmapMut;
+use std::fmt;
+use std::ops::{Deref, DerefMut};
+
+/// Images of at least this many bytes are mapped with the huge-page advice (one huge page).
+pub const MAPPED_MIN_BYTES: usize = 2 << 20;
+
+/// The words of a [`super::MemoryImage`]; dereferences to `[u32]`.
+pub struct Words(Buf);
+
+enum Buf {
+    Heap(Vec<u32>),
+    /// An anonymous mapping of exactly `4 · len` bytes (page-aligned, zero-filled).
+    Mapped(MmapMut),
+}
+
+impl Words {
+    /// `n` zeroed words; large buffers ([`MAPPED_MIN_BYTES`]) are an anonymous mapping with
+    /// the transparent-huge-page advice, falling back to a vector if mapping fails.
+    pub fn zeroed(n: usize) -> Words {
+        if n.saturating_mul(4) >= MAPPED_MIN_BYTES
+            && let Ok(map) = MmapMut::map_anon(n * 4)
+        {
+            // Advice is a hint: a kernel without transparent huge pages keeps 4 KiB pages.
+            #[cfg(target_os = "linux")]
+            let _ = map.advise(memmap2::Advice::HugePage);
+            return Words(Buf::Mapped(map));
+        }
+        Words(Buf::Heap(vec![0; n]))
+    }
+
+    /// Whether the words live in a memory mapping (large images) rather than a vector.
+    pub fn is_mapped(&self) -> bool {
+        matches!(self.0, Buf::Mapped(_))
+    }
+
+    /// The words as a vector (copies a mapped buffer).
+    pub fn into_vec(self) -> Vec<u32> {
+        match self.0 {
+            Buf::Heap(v) => v,
+            Buf::Mapped(_) => self.to_vec(),
+        }
+    }
+}
+
+impl Deref for Words {
+    type Target = [u32];
+    #[inline(always)]
+    fn deref(&self) -> &[u32] {
+        match &self.0 {
+            Buf::Heap(v) => v,
+            // Page-aligned and 4·len bytes long, so the cast cannot fail.
+            Buf::Mapped(m) => bytemuck::cast_slice(&m[..]),
+        }
+    }
+}
+
+impl DerefMut for Words {
+    #[inline(always)]
+    fn deref_mut(&mut self) -> &mut [u32] {
+        match &mut self.0 {
+            Buf::Heap(v) => v,
+            Buf::Mapped(m) => bytemuck::cast_slice_mut(&mut m[..]),
+        }
+    }
+}
+
+impl From<Vec<u32>> for Words {
+    fn from(v: Vec<u32>) -> Words {
+        Words(Buf::Heap(v))
+    }
+}
+
+impl Default for Words {
+    fn default() -> Words {
+        Words(Buf::Heap(Vec::new()))
+    }
+}
+
+impl Clone for Words {
+    /// A copy with the same storage choice as [`Words::zeroed`] would make.
+    fn clone(&self) -> Words {
+        let mut w = Words::zeroed(self.len());
+        w.copy_from_slice(self);
+        w
+    }
+}
+
+impl PartialEq for Words {
+    fn eq(&self, other: &Words) -> bool {
+        **self == **other
+    }
+}
+
+impl Eq for Words {}
+
+impl fmt::Debug for Words {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Words")
+            .field("len", &self.len())
+            .field("mapped", &self.is_mapped())
+            .finish()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn small_buffers_are_vectors_and_large_ones_are_zeroed_mappings() {
+        let small = Words::zeroed(10);
+        assert!(!small.is_mapped());
+        assert_eq!(&small[..], &[0; 10]);
+        let n = MAPPED_MIN_BYTES / 4 + 3;
+        let mut big = Words::zeroed(n);
+        #[cfg(unix)]
+        assert!(big.is_mapped());
+        assert_eq!(big.len(), n);
+        assert!(big.iter().all(|&w| w == 0));
+        big[n - 1] = 7;
+        big[0] = 9;
+        let copy = big.clone();
+        assert_eq!(copy, big);
+        assert_eq!((copy[0], copy[n - 1]), (9, 7));
+        assert_eq!(big.into_vec().len(), n);
+        assert_eq!(Words::zeroed(0).len(), 0);
+    }
+
+    #[test]
+    fn vectors_convert_both_ways() {
+        let w = Words::from(vec![1, 2, 3]);
+        assert_eq!(&w[..], &[1, 2, 3]);
+        assert_eq!(w.into_vec(), vec![1, 2, 3]);
+    }
+}
