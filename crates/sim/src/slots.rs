@@ -10,8 +10,10 @@ use crate::Cycle;
 
 const WINDOW: u64 = 128;
 
-/// Occupied cycles of one resource.
+/// Occupied cycles of one resource. 32 bytes, aligned so a table never straddles two host
+/// cache lines.
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(align(32))]
 pub struct Slots {
     base: Cycle,
     mask: u128,
@@ -317,8 +319,9 @@ impl BankSlots {
 /// free cycle after its own ready time. Every reservation is kept in a bitmap ring that
 /// grows to cover the furthest one; the owner says which cycles no request can reach any
 /// more ([`SparseSlots::forget_before`], from the current event time), and the ring
-/// recycles them, so it only spans the backlog ahead of the present. A search scans 64
-/// cycles per step (a saturated bus is a run of full words).
+/// recycles them, so it only spans the backlog ahead of the present. A search skips taken
+/// words 64 cycles per step (a saturated bus is a run of full words) and otherwise walks the
+/// gaps ([`SparseSlots::find`]).
 #[derive(Clone, Debug)]
 pub struct SparseSlots {
     /// First cycle covered (a multiple of 64); the ring covers `[lo, lo + 64 · words.len())`
@@ -394,36 +397,34 @@ impl SparseSlots {
     }
 
     /// First start `s ≥ c` where `[s, s + len)` overlaps no reservation (`c ≥` the floor).
+    ///
+    /// Walks the gaps: the first free cycle from `s` (whole taken words are skipped 64
+    /// cycles at a time), then the first taken cycle `x` in `[s, s + len)`; if there is
+    /// one, no start in `[s, x]` fits (each such span contains `x`), so the search goes on
+    /// from `x + 1`. A saturated backlog (runs of taken words) costs one step per word, a
+    /// fragmented one one step per gap.
     fn find(&self, c: Cycle, len: u64) -> Cycle {
         debug_assert!(c >= self.lo && (1..=64).contains(&len));
         let mut s = c;
         let end = self.end();
-        if len == 1 {
+        loop {
             while s < end {
                 let free = !self.word(s) >> (s & 63);
                 if free != 0 {
-                    return s + free.trailing_zeros() as u64;
+                    s += free.trailing_zeros() as u64;
+                    break;
                 }
                 s = (s | 63) + 1;
             }
-            return s;
-        }
-        while s < end {
-            // Bit p of `starts`: cycles [s + p, s + p + len) are all free (doubling the run
-            // length each step; bits shifted in from past the window count as taken).
-            let mut starts = !self.window(s, 64);
-            let mut run = 1;
-            while run < len {
-                let step = run.min(len - run);
-                starts &= starts >> step;
-                run += step;
+            if s >= end || len == 1 {
+                return s;
             }
-            if starts != 0 {
-                return s + starts.trailing_zeros() as u64;
+            let taken = self.window(s, len);
+            if taken == 0 {
+                return s;
             }
-            s += 65 - len;
+            s += taken.trailing_zeros() as u64 + 1;
         }
-        s
     }
 
     /// The first free cycle at or after `c`, without reserving it.
@@ -478,6 +479,26 @@ mod tests {
         assert_eq!(a.reserve_span(60, 13), 60);
         assert_eq!(a.reserve_span(99_990, 13), 100_013);
         assert_eq!(a.reserve_span(99_980, 13), 99_980);
+    }
+
+    /// The gap walk: gaps shorter than the span are skipped one by one, whole taken words
+    /// at once, and a gap of exactly the span's length fits.
+    #[test]
+    fn sparse_span_search_skips_short_gaps_and_full_words() {
+        let mut s = SparseSlots::default();
+        // One taken cycle every 10 up to 1000: no gap of 13 before 991.
+        for x in (0..1000).step_by(10) {
+            assert_eq!(s.reserve(x), x);
+        }
+        assert_eq!(s.reserve_span(0, 13), 991);
+        assert_eq!(s.reserve_span(0, 9), 1);
+        // Cycles 2000..2200 all taken, then a gap of exactly 13, then taken again.
+        for x in (2000..2200).chain(2213..2300) {
+            assert_eq!(s.reserve(x), x);
+        }
+        assert_eq!(s.reserve_span(1995, 13), 2200);
+        assert_eq!(s.reserve_span(1995, 1), 1995);
+        assert_eq!(s.reserve_span(1990, 13), 2300);
     }
 
     #[test]

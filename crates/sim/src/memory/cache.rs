@@ -35,21 +35,156 @@ pub enum Lookup {
     Absent,
 }
 
-/// One way's tag: the line it holds and the cycle its fill arrives (16 bytes, so a
-/// direct-mapped lookup touches one host cache line).
 /// One way's tag: the line it holds once its fill arrives, and the line it replaced, still
-/// readable until then (32 bytes: a direct-mapped lookup touches one host cache line).
+/// readable until then. Stored as 32-bit words (16 bytes a way) while every line number and
+/// fill cycle fits, as 64-bit words (32 bytes) from the first one that does not ([`Ways`]).
 #[derive(Clone, Copy, Debug)]
-struct Way {
+struct Way<W> {
     /// The line this way holds once `fill` has arrived.
-    line: u64,
-    fill: Cycle,
+    line: W,
+    fill: W,
     /// The line replaced by `line`, still readable before `fill` (its own fill cycle).
-    prev: u64,
-    prev_fill: Cycle,
+    prev: W,
+    prev_fill: W,
 }
 
-const INVALID: u64 = u64::MAX;
+/// A tag word: a line number or a cycle.
+trait Word: Copy + Eq {
+    /// No line.
+    const INVALID: Self;
+    const ZERO: Self;
+    /// `x` as a word, if it fits and is not `INVALID`.
+    fn fit(x: u64) -> Option<Self>;
+    fn get(self) -> u64;
+}
+
+impl Word for u32 {
+    const INVALID: u32 = u32::MAX;
+    const ZERO: u32 = 0;
+    #[inline]
+    fn fit(x: u64) -> Option<u32> {
+        u32::try_from(x).ok().filter(|&v| v != u32::MAX)
+    }
+    #[inline]
+    fn get(self) -> u64 {
+        u64::from(self)
+    }
+}
+
+impl Word for u64 {
+    const INVALID: u64 = u64::MAX;
+    const ZERO: u64 = 0;
+    #[inline]
+    fn fit(x: u64) -> Option<u64> {
+        Some(x)
+    }
+    #[inline]
+    fn get(self) -> u64 {
+        self
+    }
+}
+
+impl<W: Word> Way<W> {
+    const EMPTY: Self = Way {
+        line: W::INVALID,
+        fill: W::ZERO,
+        prev: W::INVALID,
+        prev_fill: W::ZERO,
+    };
+}
+
+/// The tag array: 16-byte ways halve the host memory a lookup streams through (64 L1 tag
+/// arrays and the L2's, several MB, far beyond the host's L2 cache), and every frame so
+/// far fits them (line numbers and cycles below 2^32 − 1); the first install that does not
+/// fit converts the array to 64-bit words, so results never depend on the width.
+#[derive(Clone, Debug)]
+enum Ways {
+    Narrow(Vec<Way<u32>>),
+    Wide(Vec<Way<u64>>),
+}
+
+/// Finds `line` in set `s` (see [`Cache::lookup`]): the fill cycle of a present line or of
+/// a replaced line still readable at `now`.
+#[inline]
+fn find<W: Word>(
+    ways: &[Way<W>],
+    used: &mut [u64],
+    stamp: u64,
+    s: usize,
+    assoc: usize,
+    line: u64,
+    now: Cycle,
+) -> Option<Cycle> {
+    // A line that does not fit was never installed in a narrow array.
+    let line = W::fit(line)?;
+    if assoc == 1 {
+        let w = ways[s];
+        if w.line == line {
+            return Some(w.fill.get());
+        }
+        if w.prev == line && now < w.fill.get() {
+            return Some(w.prev_fill.get());
+        }
+        return None;
+    }
+    for i in s..s + assoc {
+        if ways[i].line == line {
+            used[i] = stamp;
+            return Some(ways[i].fill.get());
+        }
+    }
+    ways[s..s + assoc]
+        .iter()
+        .find(|w| w.prev == line && now < w.fill.get())
+        .map(|w| w.prev_fill.get())
+}
+
+/// Puts `line` (filled at `fill`, missed at `now`) into the least recently used way of set
+/// `s` (see [`Cache::install`]); returns the replaced line and its fill if it was still in
+/// flight.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn replace<W: Word>(
+    ways: &mut [Way<W>],
+    used: &mut [u64],
+    stamp: u64,
+    s: usize,
+    assoc: usize,
+    line: W,
+    fill: W,
+    now: Cycle,
+) -> Option<(u64, Cycle)> {
+    let victim = if assoc == 1 {
+        s
+    } else {
+        let v = (s..s + assoc)
+            .min_by_key(|&i| {
+                if ways[i].line == W::INVALID {
+                    0
+                } else {
+                    used[i] + 1
+                }
+            })
+            .expect("at least one way");
+        used[v] = stamp;
+        v
+    };
+    let w = &mut ways[victim];
+    let mut moved = None;
+    if w.line != W::INVALID {
+        if w.fill.get() <= now {
+            w.prev = w.line;
+            w.prev_fill = w.fill;
+        } else {
+            // Still in flight: the older resident (`prev`) stays readable, the in-flight
+            // line keeps its MSHR entry.
+            moved = Some((w.line.get(), w.fill.get()));
+        }
+    }
+    w.line = line;
+    w.fill = fill;
+    moved
+}
 
 /// In-flight entries are pruned once the table has grown past this many (amortised).
 const INFLIGHT_PRUNE: usize = 64;
@@ -57,7 +192,7 @@ const INFLIGHT_PRUNE: usize = 64;
 /// Tags of a set-associative cache, with the in-flight (MSHR) list.
 #[derive(Clone, Debug)]
 pub struct Cache {
-    ways: Vec<Way>,
+    ways: Ways,
     /// LRU stamps, parallel to `ways` (empty when direct-mapped: nothing to choose).
     used: Vec<u64>,
     assoc: usize,
@@ -68,6 +203,14 @@ pub struct Cache {
     /// SipHash's resistance to chosen keys buys nothing for line numbers.)
     inflight: FxHashMap<u64, Cycle>,
     prune_at: usize,
+    /// A one-hash Bloom filter over the in-flight list's lines (bit set ⇒ the line may be
+    /// on it; clear ⇒ it is not), rebuilt when the list is pruned, and the latest fill on
+    /// the list: most misses are answered by one bit test instead of a hash-table probe
+    /// (host speed only; the answer is the list's).
+    filter: Vec<u64>,
+    /// log2 of the filter's bit count (the hash keeps this many top bits).
+    filter_bits: u32,
+    inflight_until: Cycle,
 }
 
 impl Cache {
@@ -76,23 +219,28 @@ impl Cache {
         let assoc = associativity.max(1) as usize;
         let sets = (size_bytes / line_bytes / assoc as u64).max(1);
         let n = sets as usize * assoc;
+        // One filter bit per set, 4096 to 65 536 bits.
+        let filter_bits = sets.next_power_of_two().trailing_zeros().clamp(12, 16);
         Self {
-            ways: vec![
-                Way {
-                    line: INVALID,
-                    fill: 0,
-                    prev: INVALID,
-                    prev_fill: 0,
-                };
-                n
-            ],
+            ways: Ways::Narrow(vec![Way::EMPTY; n]),
             used: if assoc > 1 { vec![0; n] } else { Vec::new() },
             assoc,
             set_mask: sets - 1,
             stamp: 0,
             inflight: FxHashMap::default(),
             prune_at: INFLIGHT_PRUNE,
+            filter: vec![0; 1 << (filter_bits - 6)],
+            filter_bits,
+            inflight_until: 0,
         }
+    }
+
+    /// Word and bit of `line` in the in-flight filter (Fibonacci hashing: lines of one set
+    /// share their low bits, so those cannot be used directly).
+    #[inline]
+    fn filter_bit(&self, line: u64) -> (usize, u64) {
+        let h = line.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.filter_bits);
+        ((h >> 6) as usize, 1 << (h & 63))
     }
 
     #[inline]
@@ -106,31 +254,20 @@ impl Cache {
     #[inline]
     pub fn lookup(&mut self, line: u64, now: Cycle) -> Lookup {
         let s = self.set(line);
-        if self.assoc == 1 {
-            let w = self.ways[s];
-            if w.line == line {
-                return Lookup::Present { fill: w.fill };
-            }
-            if w.prev == line && now < w.fill {
-                return Lookup::Present { fill: w.prev_fill };
-            }
-        } else {
+        if self.assoc > 1 {
             self.stamp += 1;
-            for i in s..s + self.assoc {
-                if self.ways[i].line == line {
-                    self.used[i] = self.stamp;
-                    return Lookup::Present {
-                        fill: self.ways[i].fill,
-                    };
-                }
-            }
-            for w in &self.ways[s..s + self.assoc] {
-                if w.prev == line && now < w.fill {
-                    return Lookup::Present { fill: w.prev_fill };
-                }
-            }
         }
-        if !self.inflight.is_empty()
+        let (assoc, stamp) = (self.assoc, self.stamp);
+        let found = match &self.ways {
+            Ways::Narrow(w) => find(w, &mut self.used, stamp, s, assoc, line, now),
+            Ways::Wide(w) => find(w, &mut self.used, stamp, s, assoc, line, now),
+        };
+        if let Some(fill) = found {
+            return Lookup::Present { fill };
+        }
+        if now < self.inflight_until
+            && let (i, bit) = self.filter_bit(line)
+            && self.filter[i] & bit != 0
             && let Some(&fill) = self.inflight.get(&line)
             && fill > now
         {
@@ -142,7 +279,36 @@ impl Cache {
     /// The tag word of `line`'s first way, read without effect (see `Thread::touch`).
     #[inline]
     pub fn peek(&self, line: u64) -> u64 {
-        self.ways[self.set(line)].line
+        let s = self.set(line);
+        match &self.ways {
+            Ways::Narrow(w) => w[s].line.get(),
+            Ways::Wide(w) => w[s].line,
+        }
+    }
+
+    /// Takes the tag array out as 64-bit words (exact: every narrow word widens to itself,
+    /// `INVALID` to `INVALID`); the caller puts it back.
+    fn take_wide(&mut self) -> Vec<Way<u64>> {
+        match std::mem::replace(&mut self.ways, Ways::Wide(Vec::new())) {
+            Ways::Wide(w) => w,
+            Ways::Narrow(w) => {
+                let wide = |x: u32| {
+                    if x == u32::INVALID {
+                        u64::INVALID
+                    } else {
+                        u64::from(x)
+                    }
+                };
+                w.iter()
+                    .map(|w| Way {
+                        line: wide(w.line),
+                        fill: u64::from(w.fill),
+                        prev: wide(w.prev),
+                        prev_fill: u64::from(w.prev_fill),
+                    })
+                    .collect()
+            }
+        }
     }
 
     /// Reserves the least recently used way of `line`'s set for a miss made at cycle `now`
@@ -151,41 +317,38 @@ impl Cache {
     #[inline]
     pub fn install(&mut self, line: u64, fill: Cycle, now: Cycle) {
         let s = self.set(line);
-        let victim = if self.assoc == 1 {
-            s
-        } else {
+        if self.assoc > 1 {
             self.stamp += 1;
-            let v = (s..s + self.assoc)
-                .min_by_key(|&i| {
-                    if self.ways[i].line == INVALID {
-                        0
-                    } else {
-                        self.used[i] + 1
-                    }
-                })
-                .expect("at least one way");
-            self.used[v] = self.stamp;
-            v
-        };
-        let w = &mut self.ways[victim];
-        let mut moved = None;
-        if w.line != INVALID {
-            if w.fill <= now {
-                w.prev = w.line;
-                w.prev_fill = w.fill;
-            } else {
-                // Still in flight: the older resident (`prev`) stays readable, the in-flight
-                // line keeps its MSHR entry.
-                moved = Some((w.line, w.fill));
-            }
         }
-        w.line = line;
-        w.fill = fill;
+        let (assoc, stamp) = (self.assoc, self.stamp);
+        let moved = match (&mut self.ways, u32::fit(line), u32::fit(fill)) {
+            (Ways::Narrow(w), Some(l), Some(f)) => {
+                replace(w, &mut self.used, stamp, s, assoc, l, f, now)
+            }
+            (Ways::Wide(w), ..) => replace(w, &mut self.used, stamp, s, assoc, line, fill, now),
+            (Ways::Narrow(_), ..) => {
+                // The first line or cycle beyond 32 bits.
+                let mut w = self.take_wide();
+                let moved = replace(&mut w, &mut self.used, stamp, s, assoc, line, fill, now);
+                self.ways = Ways::Wide(w);
+                moved
+            }
+        };
         if let Some((l, f)) = moved {
             self.inflight.insert(l, f);
+            let (i, bit) = self.filter_bit(l);
+            self.filter[i] |= bit;
+            self.inflight_until = self.inflight_until.max(f);
             if self.inflight.len() >= self.prune_at {
                 self.inflight.retain(|_, f| *f > now);
                 self.prune_at = (2 * self.inflight.len()).max(INFLIGHT_PRUNE);
+                self.filter.fill(0);
+                self.inflight_until = 0;
+                for (&l, &f) in &self.inflight {
+                    let (i, bit) = self.filter_bit(l);
+                    self.filter[i] |= bit;
+                    self.inflight_until = self.inflight_until.max(f);
+                }
             }
         }
     }
@@ -223,6 +386,81 @@ mod tests {
         assert_eq!(c.lookup(3, 50), Lookup::Absent);
         // After its fill, 19 (displaced) is gone.
         assert_eq!(c.lookup(19, 100), Lookup::Absent);
+    }
+
+    /// The in-flight filter never hides a line on the list: random conflicting misses
+    /// (many lines per set, fills far ahead so the list grows and is pruned) with lookups
+    /// compared to a probe of the list itself.
+    #[test]
+    fn the_in_flight_filter_answers_as_the_list() {
+        for assoc in [1, 2] {
+            let mut rng = dualsplit_geometry::Pcg32::new(assoc as u64, 11);
+            let mut c = Cache::new(64 * 64, 64, assoc); // 64 lines
+            let mut now = 0;
+            let mut found = 0;
+            for i in 0..20_000 {
+                now += rng.below(3) as u64;
+                let line = rng.below(4096) as u64;
+                let set = c.set(line);
+                let Ways::Narrow(ways) = &c.ways else {
+                    panic!("the test's lines and cycles fit 32 bits")
+                };
+                let in_set = ways[set..set + c.assoc]
+                    .iter()
+                    .any(|w| w.line.get() == line || (w.prev.get() == line && now < w.fill.get()));
+                let listed = c.inflight.get(&line).copied().filter(|&f| f > now);
+                let got = c.lookup(line, now);
+                if !in_set {
+                    let want = listed.map_or(Lookup::Absent, |fill| Lookup::Present { fill });
+                    assert_eq!(got, want, "assoc {assoc}, step {i}, line {line}");
+                    found += u64::from(listed.is_some());
+                }
+                if got == Lookup::Absent {
+                    c.install(line, now + 1 + rng.below(500) as u64, now);
+                }
+            }
+            assert!(
+                found > 100,
+                "assoc {assoc}: only {found} lines found on the list"
+            );
+        }
+    }
+
+    /// 16-byte (narrow) and 32-byte (wide) tag arrays answer alike, and an install beyond
+    /// 32 bits (a line, then a fill cycle) converts a narrow array on the fly without
+    /// changing an answer.
+    #[test]
+    fn narrow_and_wide_tags_answer_alike() {
+        for (assoc, by_line) in [(1, true), (1, false), (2, true), (4, false)] {
+            let mut rng = dualsplit_geometry::Pcg32::new(assoc as u64, 13);
+            let mut narrow = Cache::new(64 * 64, 64, assoc);
+            let mut wide = Cache::new(64 * 64, 64, assoc);
+            wide.ways = Ways::Wide(wide.take_wide());
+            let mut now = 0;
+            for i in 0..30_000 {
+                now += rng.below(3) as u64;
+                let far = 1u64 << 33;
+                let line = match (i, rng.below(8)) {
+                    (20_000.., 0) if by_line => far + rng.below(64) as u64,
+                    _ => rng.below(1024) as u64,
+                };
+                let at = |c: &mut Cache| c.lookup(line, now);
+                let got = at(&mut narrow);
+                assert_eq!(got, at(&mut wide), "assoc {assoc}, step {i}, line {line}");
+                if got == Lookup::Absent {
+                    let mut fill = now + 1 + rng.below(300) as u64;
+                    if i >= 25_000 && !by_line {
+                        fill += far;
+                    }
+                    narrow.install(line, fill, now);
+                    wide.install(line, fill, now);
+                }
+                let is_wide = matches!(narrow.ways, Ways::Wide(_));
+                let from = if by_line { 20_000 } else { 25_000 };
+                assert!(!is_wide || i >= from, "widened at step {i}");
+            }
+            assert!(matches!(narrow.ways, Ways::Wide(_)), "assoc {assoc}");
+        }
     }
 
     #[test]
