@@ -6,6 +6,14 @@ use dualsplit_accel::{AccelKind, BuildConfig, MemoryImage, Structures};
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
 use std::sync::Arc;
 
+/// Every image a `Structures` holds (both DST kinds read the same image).
+const KINDS: [AccelKind; 4] = [
+    AccelKind::Bvh2,
+    AccelKind::Bvh4,
+    AccelKind::Bvh8,
+    AccelKind::Dst,
+];
+
 fn random_triangles(n: usize, seed: u64) -> Vec<Triangle> {
     let mut rng = Pcg32::new(seed, 1);
     let mut p = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0;
@@ -34,12 +42,7 @@ fn structures_share_one_copy_of_the_triangles() {
     let tris = random_triangles(3000, 7);
     let s = Structures::build(&tris, &BuildConfig::default());
     assert_eq!(&s.triangles[..], &tris[..]);
-    for kind in [
-        AccelKind::Bvh2,
-        AccelKind::Bvh4,
-        AccelKind::Bvh8,
-        AccelKind::Dst,
-    ] {
+    for kind in KINDS {
         let img = s.image(kind);
         assert!(
             Arc::ptr_eq(&img.triangle_data, &s.triangles),
@@ -53,12 +56,7 @@ fn structures_share_one_copy_of_the_triangles() {
 fn the_triangle_region_follows_the_indices_at_its_own_addresses() {
     let tris = random_triangles(500, 11);
     let s = Structures::build(&tris, &BuildConfig::default());
-    for kind in [
-        AccelKind::Bvh2,
-        AccelKind::Bvh4,
-        AccelKind::Bvh8,
-        AccelKind::Dst,
-    ] {
+    for kind in KINDS {
         let img = s.image(kind);
         assert_eq!(img.nodes.start, 0, "{kind:?}");
         assert_eq!(img.nodes.end, img.indices.start, "{kind:?}");
