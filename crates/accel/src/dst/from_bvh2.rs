@@ -408,7 +408,7 @@ fn state_areas<const K: usize>(
     for s in 0..full {
         sa[s] = area(fm[s]);
     }
-    if with_full || K == 0 {
+    if with_full {
         sa[full] = area(fm[full]);
     }
 }
