@@ -34,7 +34,7 @@ impl WorkSource for Synthetic {
         for v in 0..self.visits_per_program {
             let node = self.rng.below(16 * 1024 * 1024 / 52) as u64;
             ops.push(Op::Load {
-                addr: node * 52,
+                word: (node * 13) as u32,
                 words: 13,
             });
             ops.push(Op::Pipe {
@@ -46,7 +46,7 @@ impl WorkSource for Synthetic {
             if v % 8 == 7 {
                 let tri = self.rng.below(1 << 20) as u64;
                 ops.push(Op::Load {
-                    addr: (1 << 26) + tri * 36,
+                    word: ((1 << 24) + tri * 9) as u32,
                     words: 9,
                 });
                 ops.push(Op::Pipe {
