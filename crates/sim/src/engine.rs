@@ -14,8 +14,8 @@
 //! current event time; before running a wake-up cycle's threads, `run_chip` reads each
 //! one's next op and L1/L2 tag so those host cache misses overlap; the wheel's buckets are
 //! intrusive lists through one link per thread, and cache tags are 16 bytes while lines and
-//! cycles fit 32 bits (`memory::cache`), so the host memory the replay streams through stays
-//! small. None of this changes a simulated result.
+//! cycles fit 32 bits (`memory::cache`), and ops are 8 bytes (`kernel::Op`), so the host
+//! memory the replay streams through stays small. None of this changes a simulated result.
 
 use crate::Cycle;
 use crate::config::SimConfig;
