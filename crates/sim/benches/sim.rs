@@ -25,16 +25,22 @@ struct Synthetic {
 }
 
 impl WorkSource for Synthetic {
-    fn next(&mut self, _id: usize, _t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
+    /// Reuses the thread's finished program buffer, as the real workload does, sized for
+    /// the whole program (3 ops per visit, 2 more every 8th), so the generator does not
+    /// reallocate and copy inside the measured replay.
+    fn next(&mut self, _id: usize, t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
         if self.programs_left == 0 {
             return None;
         }
         self.programs_left -= 1;
-        let mut ops = Vec::with_capacity(self.visits_per_program as usize * 3);
+        let v = self.visits_per_program as usize;
+        let mut ops = std::mem::take(&mut t.ops);
+        ops.clear();
+        ops.reserve_exact(3 * v + 2 * (v / 8));
         for v in 0..self.visits_per_program {
             let node = self.rng.below(16 * 1024 * 1024 / 52) as u64;
             ops.push(Op::Load {
-                addr: node * 52,
+                word: (node * 13) as u32,
                 words: 13,
             });
             ops.push(Op::Pipe {
@@ -46,7 +52,7 @@ impl WorkSource for Synthetic {
             if v % 8 == 7 {
                 let tri = self.rng.below(1 << 20) as u64;
                 ops.push(Op::Load {
-                    addr: (1 << 26) + tri * 36,
+                    word: ((1 << 24) + tri * 9) as u32,
                     words: 9,
                 });
                 ops.push(Op::Pipe {

@@ -14,8 +14,8 @@
 //! current event time; before running a wake-up cycle's threads, `run_chip` reads each
 //! one's next op and L1/L2 tag so those host cache misses overlap; the wheel's buckets are
 //! intrusive lists through one link per thread, and cache tags are 16 bytes while lines and
-//! cycles fit 32 bits (`memory::cache`), so the host memory the replay streams through stays
-//! small. None of this changes a simulated result.
+//! cycles fit 32 bits (`memory::cache`), and ops are 8 bytes (`kernel::Op`), so the host
+//! memory the replay streams through stays small. None of this changes a simulated result.
 
 use crate::Cycle;
 use crate::config::SimConfig;
@@ -245,8 +245,8 @@ impl Thread {
     #[inline]
     fn touch(&self, chip: &Chip) -> u64 {
         match self.ops.get(self.pc) {
-            Some(&Op::Load { addr, .. }) => {
-                let line = addr >> (2 + chip.line_word_shift);
+            Some(&Op::Load { word, .. }) => {
+                let line = word as u64 >> chip.line_word_shift;
                 chip.tms[self.tm].l1.peek(line) ^ chip.l2.peek(line)
             }
             Some(_) => 1,
@@ -327,14 +327,14 @@ impl Thread {
                     self.result(s + lat, Cause::Fpinv);
                     c = s + 1;
                 }
-                self.t = c + (n - fpinv) as Cycle;
+                self.t = c + (n - fpinv as u32) as Cycle;
             }
-            Op::Load { addr, words } => {
+            Op::Load { word, words } => {
                 let mut c = self.t;
                 let bank_mask = chip.l1_bank_mask;
                 let shift = chip.line_word_shift;
                 let l1_lat = chip.cfg.l1.hit_latency;
-                let mut w = addr / 4;
+                let mut w = word as u64;
                 let end = w + words as u64;
                 let mut bank_stall = 0;
                 // Line by line: the first word looks the line up (L1 tags, then L2/DRAM on a
@@ -804,7 +804,7 @@ mod tests {
     fn thread_load_then_use_waits_for_data() {
         let cfg = SimConfig::lin2020();
         // Load at cycle 0 (cold: 34), use at 34, one issue: finish 35.
-        let (end, chip) = one_thread(&cfg, 1, vec![Op::Load { addr: 0, words: 1 }, use_data()]);
+        let (end, chip) = one_thread(&cfg, 1, vec![Op::Load { word: 0, words: 1 }, use_data()]);
         assert_eq!(end, 35);
         assert_eq!(chip.stalls.memory, 33);
     }
@@ -817,13 +817,13 @@ mod tests {
         let mut chip = Chip::new(&cfg, 1);
         let mut th = vec![Thread::new(0), Thread::new(0)];
         let progs = vec![
-            vec![Op::Load { addr: 64, words: 1 }],
-            vec![Op::Load { addr: 0, words: 1 }],
+            vec![Op::Load { word: 16, words: 1 }],
+            vec![Op::Load { word: 0, words: 1 }],
         ];
         run_chip(&mut chip, &mut th, &mut Programs(progs));
         assert_eq!(chip.stalls.l1_bank, 1);
         // A single 16-word line load spans all 16 banks without conflict.
-        let (_, chip) = one_thread(&cfg, 1, vec![Op::Load { addr: 0, words: 16 }]);
+        let (_, chip) = one_thread(&cfg, 1, vec![Op::Load { word: 0, words: 16 }]);
         assert_eq!(chip.stalls.l1_bank, 0);
     }
 

@@ -183,22 +183,28 @@ pub enum Pipe {
 }
 
 /// A macro-operation of a simulated thread (notes §5.2).
+///
+/// Eight bytes (a one-byte tag and narrow fields), so that the replay's op buffers take
+/// half the host cache lines of a 16-byte op (`docs/performance.md`, "Simulator speed").
+/// The narrow fields are checked where ops are made ([`Op::load`], [`Recorder`]): a value
+/// that does not fit is an [`OpRangeError`], never a silent wrap.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Op {
     /// `n` single-issue instructions that use the results of earlier loads/pipeline ops;
     /// `fpinv` of them go to the shared reciprocal unit.
     Issue {
+        /// Of which reciprocal / inverse-square-root ops.
+        fpinv: u16,
         /// Instructions.
         n: u32,
-        /// Of which reciprocal / inverse-square-root ops.
-        fpinv: u32,
     },
-    /// `words` non-blocking word loads from byte address `addr` (one issue slot each).
+    /// `words` non-blocking word loads from word address `word` (byte address / 4; one
+    /// issue slot each). A 32-bit word address covers 16 GiB of simulated memory.
     Load {
-        /// Byte address of the first word (word-aligned).
-        addr: u64,
         /// Consecutive words.
-        words: u32,
+        words: u16,
+        /// Word address of the first word (byte address / 4).
+        word: u32,
     },
     /// `n` operations on a pipeline; `parallel` sends them to `n` pipes in one issue slot
     /// (the "+" configurations), otherwise one issue slot each on the TM's pipes.
@@ -209,6 +215,48 @@ pub enum Op {
         n: u8,
         /// All at once on parallel pipes.
         parallel: bool,
+    },
+}
+
+const _: () = assert!(std::mem::size_of::<Op>() == 8, "Op must stay 8 bytes");
+
+impl Op {
+    /// A load of `words` words from word-aligned byte address `addr`, checked against the
+    /// op's field widths (word address below 2^32, i.e. 16 GiB; at most 65 535 words).
+    pub fn load(addr: u64, words: u64) -> Result<Op, OpRangeError> {
+        let word = u32::try_from(addr / 4).map_err(|_| OpRangeError::Address { addr })?;
+        let words = u16::try_from(words).map_err(|_| OpRangeError::Words { words })?;
+        Ok(Op::Load { words, word })
+    }
+}
+
+/// A traversal step that does not fit an 8-byte [`Op`] (a scene image beyond 16 GiB, a
+/// fetch of more than 65 535 words, or an instruction run beyond the counters' widths).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum OpRangeError {
+    /// The byte address's word index does not fit 32 bits.
+    #[error("load at byte address {addr:#x} is beyond the simulator's 16 GiB address space")]
+    Address {
+        /// Byte address of the load.
+        addr: u64,
+    },
+    /// More words in one fetch than a load op holds.
+    #[error("a fetch of {words} words exceeds the 65 535 words of one load op")]
+    Words {
+        /// Words fetched.
+        words: u64,
+    },
+    /// More reciprocal ops in one merged instruction run than an issue op holds.
+    #[error("{fpinv} reciprocal ops in one instruction run exceed the 65 535 of one issue op")]
+    Fpinv {
+        /// Reciprocal ops of the run.
+        fpinv: u64,
+    },
+    /// More instructions in one merged run than an issue op holds.
+    #[error("{n} instructions in one run exceed the 2^32 − 1 of one issue op")]
+    Issue {
+        /// Instructions of the run.
+        n: u64,
     },
 }
 
@@ -263,6 +311,8 @@ pub struct Recorder<'a> {
     pub counts: InstrCounts,
     /// Byte address added to every fetch (where the image lives in simulated memory).
     pub base: u64,
+    /// The first step that did not fit an [`Op`] (the program is then incomplete).
+    pub error: Option<OpRangeError>,
 }
 
 impl<'a> Recorder<'a> {
@@ -273,21 +323,34 @@ impl<'a> Recorder<'a> {
             ops,
             counts: InstrCounts::default(),
             base: 0,
+            error: None,
         }
     }
 
     /// Appends instructions of mix `m` (merged into a preceding `Issue`).
     pub fn issue(&mut self, m: Mix) {
         self.counts.mix.add(m);
-        // One step's mix is a few dozen instructions: it fits an op's u32.
-        let n = m.total() as u32;
-        let fpinv = m.fpinv as u32;
-        if let Some(Op::Issue { n: pn, fpinv: pf }) = self.ops.last_mut() {
-            *pn += n;
-            *pf += fpinv;
-        } else {
-            self.ops.push(Op::Issue { n, fpinv });
+        // Merged into a preceding `Issue`: the sums are checked against the op's widths.
+        let (pn, pf) = match self.ops.last() {
+            Some(&Op::Issue { n, fpinv }) => (n as u64, fpinv as u64),
+            _ => (0, 0),
+        };
+        let (n, fpinv) = (pn + m.total(), pf + m.fpinv);
+        let op = match (u32::try_from(n), u16::try_from(fpinv)) {
+            (Ok(n), Ok(fpinv)) => Op::Issue { n, fpinv },
+            (Err(_), _) => return self.fail(OpRangeError::Issue { n }),
+            (_, Err(_)) => return self.fail(OpRangeError::Fpinv { fpinv }),
+        };
+        match self.ops.last_mut() {
+            Some(last @ Op::Issue { .. }) => *last = op,
+            _ => self.ops.push(op),
         }
+    }
+
+    /// Keeps the first range error.
+    #[cold]
+    fn fail(&mut self, e: OpRangeError) {
+        self.error.get_or_insert(e);
     }
 
     fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool) {
@@ -332,10 +395,10 @@ impl Observer for Recorder<'_> {
             return;
         }
         self.counts.loads += words;
-        self.ops.push(Op::Load {
-            addr: first,
-            words: words as u32,
-        });
+        match Op::load(first, words) {
+            Ok(op) => self.ops.push(op),
+            Err(e) => self.fail(e),
+        }
     }
 
     #[inline]
@@ -408,11 +471,62 @@ mod tests {
             ops,
             vec![
                 Op::Load {
-                    addr: 52,
+                    word: 13,
                     words: 13
                 },
-                Op::Load { addr: 4, words: 2 }
+                Op::Load { word: 1, words: 2 }
             ]
+        );
+    }
+
+    #[test]
+    fn ops_are_8_bytes_and_out_of_range_values_are_errors() {
+        assert_eq!(std::mem::size_of::<Op>(), 8);
+        let top = 4 * u32::MAX as u64;
+        assert_eq!(
+            Op::load(top, 65_535),
+            Ok(Op::Load {
+                word: u32::MAX,
+                words: 65_535
+            })
+        );
+        assert_eq!(
+            Op::load(top + 4, 1),
+            Err(OpRangeError::Address { addr: top + 4 })
+        );
+        assert_eq!(
+            Op::load(0, 65_536),
+            Err(OpRangeError::Words { words: 65_536 })
+        );
+        // The recorder keeps the first error instead of wrapping.
+        let mut ops = Vec::new();
+        let mut r = Recorder::new(SimAccel::Bvh2, &mut ops);
+        r.fetch(8, 4);
+        assert_eq!(r.error, None);
+        r.fetch(top + 8, 4);
+        r.fetch(0, 4 * 70_000);
+        assert_eq!(r.error, Some(OpRangeError::Address { addr: top + 8 }));
+        // Merged issue runs: reciprocal ops beyond u16, instructions beyond u32.
+        let mut ops = Vec::new();
+        let mut r = Recorder::new(SimAccel::Bvh2, &mut ops);
+        let inv = Mix::new(0, 0, 0, 0, 30_000, 0);
+        r.issue(inv);
+        r.issue(inv);
+        assert_eq!(r.error, None);
+        r.issue(inv);
+        assert_eq!(r.error, Some(OpRangeError::Fpinv { fpinv: 90_000 }));
+        let mut ops = Vec::new();
+        let mut r = Recorder::new(SimAccel::Bvh2, &mut ops);
+        let big = Mix::new(3_000_000_000, 0, 0, 0, 0, 0);
+        r.issue(big);
+        r.issue(big);
+        assert_eq!(r.error, Some(OpRangeError::Issue { n: 6_000_000_000 }));
+        assert_eq!(
+            ops,
+            vec![Op::Issue {
+                n: 3_000_000_000,
+                fpinv: 0
+            }]
         );
     }
 

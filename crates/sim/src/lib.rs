@@ -235,6 +235,9 @@ pub enum SimError {
         /// Requested height.
         height: u32,
     },
+    /// A traversal step does not fit the replay's 8-byte ops (e.g. an image beyond 16 GiB).
+    #[error(transparent)]
+    Op(#[from] kernel::OpRangeError),
 }
 
 /// Simulates one frame of `settings` on `scene` with configuration `accel`; `progress` is
@@ -254,7 +257,5 @@ pub fn simulate(
             height: settings.height,
         });
     }
-    Ok(workload::run(
-        scene, structures, accel, settings, cfg, progress,
-    ))
+    workload::run(scene, structures, accel, settings, cfg, progress)
 }

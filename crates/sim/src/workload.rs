@@ -3,8 +3,8 @@
 //! 2020, §4.3–4.4; notes §5.2).
 
 use crate::engine::{Chip, Thread, WorkSource, run_chip};
-use crate::kernel::{Mix, Op, Recorder};
-use crate::{SimAccel, SimConfig, SimResult, energy};
+use crate::kernel::{Mix, Op, OpRangeError, Recorder};
+use crate::{SimAccel, SimConfig, SimError, SimResult, energy};
 use dualsplit_accel::Structures;
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult};
 use dualsplit_scene::Scene;
@@ -43,6 +43,8 @@ struct Pixels<'a> {
     spare: Vec<Vec<Op>>,
     /// Per thread: the pixel it is working on.
     active: Vec<Option<Active<'a>>>,
+    /// The first traversal step that did not fit an op: no work is handed out after it.
+    error: Option<OpRangeError>,
 }
 
 impl<'a> Pixels<'a> {
@@ -70,6 +72,9 @@ impl<'a> Pixels<'a> {
             }
         };
         self.counts.add(&rec.counts);
+        if let Some(e) = rec.error {
+            self.error.get_or_insert(e);
+        }
         a.job.submit(result);
         if matches!(ops.last(), Some(Op::Issue { .. })) {
             a.carry = ops.pop();
@@ -84,6 +89,9 @@ impl WorkSource for Pixels<'_> {
     /// whole pixel recorded at once, but a thread's program stays small, so the replay's
     /// host memory traffic stays in cache.
     fn next(&mut self, id: usize, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>> {
+        if self.error.is_some() {
+            return None;
+        }
         let old = std::mem::take(&mut thread.ops);
         if old.capacity() > 0 {
             self.spare.push(old);
@@ -93,7 +101,7 @@ impl WorkSource for Pixels<'_> {
         if let Some(mut a) = self.active[id].take() {
             if self.trace_ray(&mut a, &mut ops) {
                 self.active[id] = Some(a);
-                return Some(ops);
+                return self.error.is_none().then_some(ops);
             }
             self.radiance[a.px as usize] = a.job.radiance();
             if let Some(op) = a.carry {
@@ -124,7 +132,7 @@ impl WorkSource for Pixels<'_> {
         if self.next.is_multiple_of(1024) || self.next == self.total {
             (self.progress)(self.next, self.total);
         }
-        Some(ops)
+        self.error.is_none().then_some(ops)
     }
 }
 
@@ -135,7 +143,7 @@ pub(crate) fn run(
     settings: &RenderSettings,
     cfg: &SimConfig,
     progress: &(dyn Fn(u64, u64) + Sync),
-) -> SimResult {
+) -> Result<SimResult, SimError> {
     let total = settings.width as u64 * settings.height as u64;
     let mut chip = Chip::new(cfg, accel.box_pipes(cfg));
     let mut threads: Vec<Thread> = (0..cfg.tms * cfg.tps_per_tm)
@@ -154,8 +162,12 @@ pub(crate) fn run(
         progress,
         spare: Vec::new(),
         active: (0..threads.len()).map(|_| None).collect(),
+        error: None,
     };
     let cycles = run_chip(&mut chip, &mut threads, &mut work);
+    if let Some(e) = work.error {
+        return Err(e.into());
+    }
     let dram = chip.dram.stats();
     let c = &chip.caches;
     let ratio = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
@@ -168,7 +180,7 @@ pub(crate) fn run(
         dst_pipe: chip.units.dst_ops as f64 / (cyc_units * cfg.units.dst_pipes as f64),
         issue: counts.total() as f64 / (cyc_units * cfg.tps_per_tm as f64),
     };
-    SimResult {
+    Ok(SimResult {
         accel: Some(accel),
         tms: cfg.tms,
         threads: cfg.tms * cfg.tps_per_tm,
@@ -189,5 +201,5 @@ pub(crate) fn run(
         utilisation,
         stalls: chip.stalls,
         radiance: work.radiance,
-    }
+    })
 }

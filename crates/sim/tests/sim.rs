@@ -293,7 +293,7 @@ mod synthetic {
             for _ in 0..20 {
                 let node = self.rng.below(1 << 16) as u64;
                 ops.push(Op::Load {
-                    addr: node * 52,
+                    word: (node * 13) as u32,
                     words: 13,
                 });
                 self.loads += 13;
