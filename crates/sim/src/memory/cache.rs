@@ -203,14 +203,66 @@ pub struct Cache {
     /// SipHash's resistance to chosen keys buys nothing for line numbers.)
     inflight: FxHashMap<u64, Cycle>,
     prune_at: usize,
-    /// A one-hash Bloom filter over the in-flight list's lines (bit set ⇒ the line may be
-    /// on it; clear ⇒ it is not), rebuilt when the list is pruned, and the latest fill on
-    /// the list: most misses are answered by one bit test instead of a hash-table probe
-    /// (host speed only; the answer is the list's).
-    filter: Vec<u64>,
-    /// log2 of the filter's bit count (the hash keeps this many top bits).
-    filter_bits: u32,
-    inflight_until: Cycle,
+    /// What may be on `inflight` (host speed only; the answer is the list's).
+    filter: InflightFilter,
+}
+
+/// A one-hash Bloom filter over the in-flight list's lines (bit set ⇒ the line may be on
+/// it; clear ⇒ it is not), rebuilt when the list is pruned, and the latest fill on the
+/// list: most misses are answered by one bit test instead of a hash-table probe.
+#[derive(Clone, Debug)]
+struct InflightFilter {
+    bits: Vec<u64>,
+    /// log2 of the bit count (the hash keeps this many top bits).
+    log2: u32,
+    /// The latest fill of a listed line: nothing is in flight from then on.
+    until: Cycle,
+}
+
+impl InflightFilter {
+    /// One bit per set, 4096 to 65 536 bits.
+    fn new(sets: u64) -> Self {
+        let log2 = sets.next_power_of_two().trailing_zeros().clamp(12, 16);
+        InflightFilter {
+            bits: vec![0; 1 << (log2 - 6)],
+            log2,
+            until: 0,
+        }
+    }
+
+    /// Word and bit of `line` (Fibonacci hashing: lines of one set share their low bits,
+    /// so those cannot be used directly).
+    #[inline]
+    fn bit(&self, line: u64) -> (usize, u64) {
+        let h = line.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.log2);
+        ((h >> 6) as usize, 1 << (h & 63))
+    }
+
+    /// Records `line`, in flight until `fill`.
+    #[inline]
+    fn note(&mut self, line: u64, fill: Cycle) {
+        let (i, bit) = self.bit(line);
+        self.bits[i] |= bit;
+        self.until = self.until.max(fill);
+    }
+
+    /// Whether `line` may be on the list at `now`.
+    #[inline]
+    fn may_hold(&self, line: u64, now: Cycle) -> bool {
+        now < self.until && {
+            let (i, bit) = self.bit(line);
+            self.bits[i] & bit != 0
+        }
+    }
+
+    /// Forgets everything and records `list` again.
+    fn rebuild(&mut self, list: &FxHashMap<u64, Cycle>) {
+        self.bits.fill(0);
+        self.until = 0;
+        for (&l, &f) in list {
+            self.note(l, f);
+        }
+    }
 }
 
 impl Cache {
@@ -219,8 +271,6 @@ impl Cache {
         let assoc = associativity.max(1) as usize;
         let sets = (size_bytes / line_bytes / assoc as u64).max(1);
         let n = sets as usize * assoc;
-        // One filter bit per set, 4096 to 65 536 bits.
-        let filter_bits = sets.next_power_of_two().trailing_zeros().clamp(12, 16);
         Self {
             ways: Ways::Narrow(vec![Way::EMPTY; n]),
             used: if assoc > 1 { vec![0; n] } else { Vec::new() },
@@ -229,18 +279,8 @@ impl Cache {
             stamp: 0,
             inflight: FxHashMap::default(),
             prune_at: INFLIGHT_PRUNE,
-            filter: vec![0; 1 << (filter_bits - 6)],
-            filter_bits,
-            inflight_until: 0,
+            filter: InflightFilter::new(sets),
         }
-    }
-
-    /// Word and bit of `line` in the in-flight filter (Fibonacci hashing: lines of one set
-    /// share their low bits, so those cannot be used directly).
-    #[inline]
-    fn filter_bit(&self, line: u64) -> (usize, u64) {
-        let h = line.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.filter_bits);
-        ((h >> 6) as usize, 1 << (h & 63))
     }
 
     #[inline]
@@ -265,9 +305,7 @@ impl Cache {
         if let Some(fill) = found {
             return Lookup::Present { fill };
         }
-        if now < self.inflight_until
-            && let (i, bit) = self.filter_bit(line)
-            && self.filter[i] & bit != 0
+        if self.filter.may_hold(line, now)
             && let Some(&fill) = self.inflight.get(&line)
             && fill > now
         {
@@ -336,19 +374,11 @@ impl Cache {
         };
         if let Some((l, f)) = moved {
             self.inflight.insert(l, f);
-            let (i, bit) = self.filter_bit(l);
-            self.filter[i] |= bit;
-            self.inflight_until = self.inflight_until.max(f);
+            self.filter.note(l, f);
             if self.inflight.len() >= self.prune_at {
                 self.inflight.retain(|_, f| *f > now);
                 self.prune_at = (2 * self.inflight.len()).max(INFLIGHT_PRUNE);
-                self.filter.fill(0);
-                self.inflight_until = 0;
-                for (&l, &f) in &self.inflight {
-                    let (i, bit) = self.filter_bit(l);
-                    self.filter[i] |= bit;
-                    self.inflight_until = self.inflight_until.max(f);
-                }
+                self.filter.rebuild(&self.inflight);
             }
         }
     }
