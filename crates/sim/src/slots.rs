@@ -64,38 +64,6 @@ impl Slots {
         }
     }
 
-    /// Reserves `len` consecutive free cycles starting at the first possible cycle at or
-    /// after `c` and returns the start: reservations made this way are at least `len` apart
-    /// (a minimum spacing such as t_RRD between activations). `len` ≤ 64.
-    pub fn reserve_span(&mut self, c: Cycle, len: u64) -> Cycle {
-        debug_assert!((1..=WINDOW / 2).contains(&len));
-        if c >= self.base + WINDOW {
-            let nb = c - WINDOW / 2;
-            let shift = nb - self.base;
-            self.mask = if shift >= WINDOW {
-                0
-            } else {
-                self.mask >> shift
-            };
-            self.base = nb;
-        }
-        let span: u128 = (1u128 << len) - 1;
-        let mut s = c.max(self.base);
-        loop {
-            if s + len > self.base + WINDOW {
-                self.mask >>= WINDOW / 2;
-                self.base += WINDOW / 2;
-                continue;
-            }
-            let off = s - self.base;
-            if (self.mask >> off) & span == 0 {
-                self.mask |= span << off;
-                return s;
-            }
-            s += 1;
-        }
-    }
-
     /// The first free cycle at or after `c`, without reserving it.
     #[inline]
     pub fn peek(&self, c: Cycle) -> Cycle {
@@ -514,7 +482,8 @@ mod tests {
 
     #[test]
     fn spans_keep_their_spacing_and_fill_gaps() {
-        let mut s = Slots::default();
+        // Spans (t_RRD between activations) live in the DRAM's `SparseSlots`.
+        let mut s = SparseSlots::default();
         assert_eq!(s.reserve_span(100, 13), 100);
         assert_eq!(s.reserve_span(100, 13), 113);
         // A gap of 13 before 100 is usable; one of 12 is not.
