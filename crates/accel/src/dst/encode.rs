@@ -212,9 +212,9 @@ struct Encoder<'a> {
 }
 
 impl Encoder<'_> {
-    /// Checks node `n`'s box and child links (what planning and emission index with).
-    fn check_links(&self, n: u32) -> Result<(), DstError> {
-        let nodes = self.bvh.nodes.len();
+    /// Checks BVH node `n`'s box and child links, or a leaf's triangle range (what planning
+    /// and emission index with); for a leaf entered with `chain`, returns its size.
+    fn check_node(&self, n: u32, chain: Chain) -> Result<Option<Size>, DstError> {
         let node = &self.bvh.nodes[n as usize];
         if !node.bounds.is_finite() {
             return Err(DstError::NonFiniteBounds {
@@ -223,6 +223,7 @@ impl Encoder<'_> {
             });
         }
         if !node.is_leaf() {
+            let nodes = self.bvh.nodes.len();
             for c in node.children() {
                 if c == 0 || c as usize >= nodes {
                     return Err(DstError::BadBvhLink {
@@ -232,16 +233,6 @@ impl Encoder<'_> {
                     });
                 }
             }
-        }
-        Ok(())
-    }
-
-    /// Checks BVH node `n`'s links (and a leaf's triangle range, which emission relies on);
-    /// for a leaf entered with `chain`, returns its size.
-    fn check_node(&self, n: u32, chain: Chain) -> Result<Option<Size>, DstError> {
-        self.check_links(n)?;
-        let node = &self.bvh.nodes[n as usize];
-        if !node.is_leaf() {
             return Ok(None);
         }
         let (first, count) = (node.first as usize, node.count as usize);
