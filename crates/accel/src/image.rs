@@ -100,11 +100,6 @@ impl MemoryImage {
         }
     }
 
-    /// The node and index regions, writable (what an encoder fills).
-    pub fn node_and_index_words_mut(&mut self) -> &mut [u32] {
-        &mut self.words[..self.indices.end]
-    }
-
     /// Byte address of word `i`.
     #[inline(always)]
     pub fn addr(word: usize) -> u64 {

@@ -521,7 +521,7 @@ impl Dst {
         // the threads that fill them; huge pages where the kernel allows, see
         // `image::Words`); the triangle region is the scene's, shared.
         let mut image = MemoryImage::with_triangles(n_nodes, n_idx, triangles);
-        let (node_words, entries) = image.node_and_index_words_mut().split_at_mut(n_nodes);
+        let (node_words, entries) = image.words.split_at_mut(n_nodes);
         let mut stats = if empty {
             DstStats::default()
         } else {

@@ -30,7 +30,7 @@ pub fn encode<L: NodeLayout>(
     let mut e = Encoder {
         wide,
         prim_ids,
-        words: img.node_and_index_words_mut(),
+        words: &mut img.words,
         next_node: L::WORDS,
         next_index: node_words,
     };
