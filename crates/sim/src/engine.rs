@@ -254,6 +254,42 @@ impl Thread {
         }
     }
 
+    /// Plays ahead the wake-ups of a thread going to sleep until `t` that would do nothing
+    /// but move it to a later bucket (see [`run_chip_with`]), and returns their cycles:
+    /// hop `k` is where the thread's wake-up at hop `k − 1` (at `t` for the first) would
+    /// have pushed it; the last hop is its next real wake-up, `[0, ..]` when there is
+    /// nothing to skip. Two kinds of wake-up are skipped, both touching only the thread's
+    /// own state:
+    ///
+    /// * its next op is not a load and needs a result due later (`ready > t`): the thread
+    ///   only waits (the stall is counted now; the counters are sums);
+    /// * its next op is an `Issue` without reciprocals, not the program's last, whose
+    ///   operands are there: it reserves nothing, so it is executed now (`t += n`).
+    ///
+    /// The ops looked at are usually in the host cache line of the op just executed. (Not
+    /// looking past a line boundary saved those misses but skipped fewer wake-ups: more
+    /// instructions, the same misses, slower; docs/performance.md, "Fourth round".)
+    #[inline]
+    fn skip_ahead(&mut self, stalls: &mut Stalls) -> [Cycle; HOPS] {
+        let mut hops = [0; HOPS];
+        for hop in &mut hops {
+            match self.ops.get(self.pc) {
+                Some(Op::Load { .. }) | None => break,
+                Some(_) if self.ready > self.t => {
+                    let r = self.ready;
+                    self.wait(r, stalls);
+                }
+                Some(&Op::Issue { n, fpinv: 0 }) if n > 0 && self.pc + 1 < self.ops.len() => {
+                    self.pc += 1;
+                    self.t += n as Cycle;
+                }
+                Some(_) => break,
+            }
+            *hop = self.t;
+        }
+        hops
+    }
+
     /// Replaces the program (the previous one must be done).
     pub fn load_program(&mut self, ops: Vec<Op>) {
         self.ops = ops;
@@ -468,6 +504,9 @@ struct Wheel {
     ends: Vec<(u32, u32)>,
     /// Per thread: the thread after it in its bucket.
     next: Vec<u32>,
+    /// Per thread: where its entry forwards it, hop by hop (see [`Wheel::push_forward`]),
+    /// `[0, ..]` for a wake-up.
+    forward: Vec<[Cycle; HOPS]>,
     now: Cycle,
     in_wheel: usize,
     overflow: BinaryHeap<Reverse<(Cycle, u32)>>,
@@ -475,12 +514,17 @@ struct Wheel {
 
 const WHEEL: u64 = 4096;
 const NONE: u32 = u32::MAX;
+/// Most wake-ups one forward entry skips ([`Thread::skip_ahead`]): a wait for operands,
+/// then an instruction run. Nothing skippable follows such a run: it needed its operands
+/// and produces none, and consecutive runs are merged into one `Issue` by the recorder.
+const HOPS: usize = 2;
 
 impl Wheel {
     fn new(threads: usize) -> Self {
         Self {
             ends: vec![(NONE, NONE); WHEEL as usize],
             next: vec![NONE; threads],
+            forward: vec![[0; HOPS]; threads],
             now: 0,
             in_wheel: 0,
             overflow: BinaryHeap::new(),
@@ -494,6 +538,36 @@ impl Wheel {
         } else {
             self.overflow.push(Reverse((t, id)));
         }
+    }
+
+    /// A forward entry: thread `id` has nothing to do at `t` but move on to `hops[0]`, then
+    /// (if not 0) from there to `hops[1]`, and so on (increasing cycles after `t`). When a
+    /// bucket holding a forward entry is handed out, its holder calls
+    /// [`Wheel::take_forward`] and pushes the thread to the next hop at its place in the
+    /// bucket, exactly where the thread would have pushed itself had it been woken and run;
+    /// it is neither touched nor run. Plain [`Wheel::push`] when `hops[0]` is 0.
+    fn push_forward(&mut self, t: Cycle, hops: [Cycle; HOPS], id: u32) {
+        debug_assert!(hops[0] == 0 || hops[0] > t);
+        debug_assert!(hops.windows(2).all(|h| h[1] == 0 || h[1] > h[0]));
+        self.forward[id as usize] = hops;
+        self.push(t, id);
+    }
+
+    /// True when thread `id`'s entry just handed out is a forward.
+    #[inline]
+    fn is_forward(&self, id: u32) -> bool {
+        self.forward[id as usize][0] != 0
+    }
+
+    /// The next hop of thread `id`'s forward entry just handed out (the entry is then one
+    /// hop shorter), or `None` when the entry is a wake-up.
+    #[inline]
+    fn take_forward(&mut self, id: u32) -> Option<Cycle> {
+        let h = &mut self.forward[id as usize];
+        let to = h[0];
+        h.copy_within(1.., 0);
+        h[HOPS - 1] = 0;
+        (to != 0).then_some(to)
     }
 
     /// Appends thread `id` to bucket `b`'s list.
@@ -545,23 +619,57 @@ impl Wheel {
 
 /// Runs every thread to completion; returns the cycle the last result arrived.
 pub fn run_chip(chip: &mut Chip, threads: &mut [Thread], work: &mut dyn WorkSource) -> Cycle {
+    run_chip_with(chip, threads, work, true)
+}
+
+/// [`run_chip`], with forward wake-ups (`forwards`) or without (the tests compare both).
+///
+/// A thread that goes to sleep until its next issue slot `t` often has nothing to do
+/// there but go back to sleep: its next op is not a load and waits for a result due later
+/// (after a 13-word load, the node's data), or it is a run of plain instructions that
+/// reserves nothing (after a pipeline op's result). Such wake-ups are played ahead when the
+/// thread goes to sleep ([`Thread::skip_ahead`]), and the thread is scheduled as a forward
+/// entry at `t` ([`Wheel::push_forward`]): at each skipped cycle the wheel moves it on to
+/// the next one in the same place in the bucket as the wake-up would have, without reading
+/// the thread's record or op, so every bucket's order, hence every result, stays exact.
+fn run_chip_with(
+    chip: &mut Chip,
+    threads: &mut [Thread],
+    work: &mut dyn WorkSource,
+    forwards: bool,
+) -> Cycle {
     let mut wheel = Wheel::new(threads.len());
     for i in 0..threads.len() as u32 {
         wheel.push(0, i);
     }
     let mut finish = vec![0; threads.len()];
     let mut ids = Vec::new();
+    let sleep = |th: &mut Thread, wheel: &mut Wheel, stalls: &mut Stalls, id: u32| {
+        let t = th.t;
+        if forwards {
+            let hops = th.skip_ahead(stalls);
+            wheel.push_forward(t, hops, id);
+        } else {
+            wheel.push(t, id);
+        }
+    };
     while let Some(now) = wheel.next_bucket(&mut ids) {
         let mut touched = 0;
         for &id in &ids {
-            touched ^= threads[id as usize].touch(chip);
+            if !wheel.is_forward(id) {
+                touched ^= threads[id as usize].touch(chip);
+            }
         }
         std::hint::black_box(touched);
         for &id in &ids {
+            if let Some(to) = wheel.take_forward(id) {
+                wheel.push(to, id);
+                continue;
+            }
             let th = &mut threads[id as usize];
             loop {
                 if th.run(chip, now) {
-                    wheel.push(th.t, id);
+                    sleep(th, &mut wheel, &mut chip.stalls, id);
                     break;
                 }
                 // Program finished: the thread takes more work or retires once results are in.
@@ -569,7 +677,7 @@ pub fn run_chip(chip: &mut Chip, threads: &mut [Thread], work: &mut dyn WorkSour
                     Some(ops) => {
                         th.load_program(ops);
                         if th.t > now {
-                            wheel.push(th.t, id);
+                            sleep(th, &mut wheel, &mut chip.stalls, id);
                             break;
                         }
                     }
@@ -695,6 +803,136 @@ mod tests {
             }
             assert!(v.next_bucket().is_none(), "seed {seed}");
             assert!(steps > 20_000, "seed {seed}: {steps}");
+        }
+    }
+
+    /// Forward entries hand out every wake-up in the same order as a wheel without them,
+    /// where a thread with nothing to do is woken at each hop and pushes itself on: random
+    /// delays (some beyond the wheel) and random chains of 0–2 hops, so buckets mix real
+    /// wake-ups, forwards and their targets.
+    #[test]
+    fn forward_entries_keep_the_order_of_plain_wake_ups() {
+        for seed in 0..10 {
+            let mut rng = dualsplit_geometry::Pcg32::new(seed, 11);
+            let n = 300;
+            let mut w = Wheel::new(n);
+            let mut v = VecWheel {
+                buckets: vec![Vec::new(); WHEEL as usize],
+                now: 0,
+                in_wheel: 0,
+                overflow: BinaryHeap::new(),
+            };
+            // The reference's pending hops per thread (it wakes the thread at each).
+            let mut plan: Vec<Vec<Cycle>> = vec![Vec::new(); n];
+            for id in 0..n as u32 {
+                w.push(0, id);
+                v.push(0, id);
+            }
+            let delay = |rng: &mut dualsplit_geometry::Pcg32| match rng.below(10) {
+                0 => WHEEL + rng.below(3 * WHEEL as u32) as u64,
+                1 => WHEEL - 1 - rng.below(4) as u64,
+                _ => 1 + rng.below(40) as u64,
+            };
+            let (mut ids, mut steps, mut real, mut forwards) = (Vec::new(), 0, 0, 0);
+            while let Some(now) = w.next_bucket(&mut ids) {
+                let (vnow, vids) = v.next_bucket().expect("reference wheel ran dry first");
+                assert_eq!((now, &ids), (vnow, &vids), "seed {seed}, step {steps}");
+                steps += 1;
+                for &id in &ids {
+                    let to = w.take_forward(id);
+                    let p = &mut plan[id as usize];
+                    assert_eq!(to, (!p.is_empty()).then(|| p[0]), "seed {seed}, {id}");
+                    if let Some(to) = to {
+                        p.remove(0);
+                        w.push(to, id);
+                        v.push(to, id);
+                        forwards += 1;
+                        continue;
+                    }
+                    real += 1;
+                    if real < 20_000 {
+                        let t = now + delay(&mut rng);
+                        let mut hops = [0; HOPS];
+                        let mut at = t;
+                        for h in hops.iter_mut().take(rng.below(HOPS as u32 + 1) as usize) {
+                            at += delay(&mut rng);
+                            *h = at;
+                            p.push(at);
+                        }
+                        w.push_forward(t, hops, id);
+                        v.push(t, id);
+                    }
+                }
+                ids.clear();
+            }
+            assert!(v.next_bucket().is_none(), "seed {seed}");
+            assert!(
+                real > 20_000 && forwards > 10_000,
+                "seed {seed}: {real} {forwards}"
+            );
+        }
+    }
+
+    /// Random programs of every op kind on 4 TMs × 8 threads (loads that hit, merge and
+    /// miss, serial and parallel pipeline ops, reciprocal and plain instruction runs,
+    /// atomics between programs): with forward entries every counter and the end cycle
+    /// equal those of the plain wake-ups.
+    #[test]
+    fn forwards_change_no_result() {
+        struct Random(dualsplit_geometry::Pcg32, Vec<u32>);
+        impl WorkSource for Random {
+            fn next(&mut self, id: usize, t: &mut Thread, c: &mut Chip) -> Option<Vec<Op>> {
+                if self.1[id] == 0 {
+                    return None;
+                }
+                self.1[id] -= 1;
+                let r = &mut self.0;
+                if r.below(2) == 0 {
+                    t.atomic(c);
+                }
+                let mut ops = Vec::new();
+                for _ in 0..1 + r.below(40) {
+                    ops.push(match r.below(4) {
+                        0 => Op::Load {
+                            word: r.below(1 << 16),
+                            words: 1 + r.below(20) as u16,
+                        },
+                        1 => Op::Pipe {
+                            pipe: [Pipe::Box, Pipe::Triangle, Pipe::DualSplit][r.below(3) as usize],
+                            n: 1 + r.below(4) as u8,
+                            parallel: r.below(2) == 0,
+                        },
+                        _ => {
+                            let n = r.below(20);
+                            let fpinv = if r.below(4) == 0 { r.below(n + 1) } else { 0 };
+                            Op::Issue {
+                                n,
+                                fpinv: fpinv as u16,
+                            }
+                        }
+                    });
+                }
+                Some(ops)
+            }
+        }
+        let mut cfg = SimConfig::lin2020();
+        cfg.tms = 4;
+        cfg.tps_per_tm = 8;
+        for seed in 0..20 {
+            let run = |forwards| {
+                let mut chip = Chip::new(&cfg, 4);
+                let mut th: Vec<Thread> = (0..32).map(|i| Thread::new(i / 8)).collect();
+                let mut work = Random(dualsplit_geometry::Pcg32::new(seed, 3), vec![6; 32]);
+                let end = run_chip_with(&mut chip, &mut th, &mut work, forwards);
+                let dram = chip.dram.stats();
+                (end, chip.stalls, chip.caches, chip.units, dram)
+            };
+            let plain = run(false);
+            assert!(
+                plain.1.memory > 0 && plain.1.pipeline_latency > 0,
+                "{plain:?}"
+            );
+            assert_eq!(run(true), plain, "seed {seed}");
         }
     }
 
