@@ -584,9 +584,12 @@ impl Wheel {
         self.in_wheel += 1;
     }
 
-    /// Moves the threads of the next cycle with events into `ids` (in the order they were
-    /// scheduled) and returns that cycle.
-    fn next_bucket(&mut self, ids: &mut Vec<u32>) -> Option<Cycle> {
+    /// Detaches the list of the next cycle with events and returns that cycle and the
+    /// list's first thread; the list is walked in place with [`Wheel::after`] (in the order
+    /// the threads were scheduled), and [`Wheel::taken`] is called once for each of its
+    /// threads before the next call. Walking the links instead of copying them into a
+    /// vector saves a store, a capacity test and a reload per entry.
+    fn next_bucket(&mut self) -> Option<(Cycle, u32)> {
         if self.in_wheel == 0 {
             let &Reverse((t, _)) = self.overflow.peek()?;
             self.now = t;
@@ -604,16 +607,24 @@ impl Wheel {
             let (first, _) = self.ends[b];
             if first != NONE {
                 self.ends[b] = (NONE, NONE);
-                let mut id = first;
-                while id != NONE {
-                    ids.push(id);
-                    id = self.next[id as usize];
-                }
-                self.in_wheel -= ids.len();
-                return Some(self.now);
+                return Some((self.now, first));
             }
             self.now += 1;
         }
+    }
+
+    /// The thread after `id` in a detached list (`NONE` at its end). Valid until `id` is
+    /// pushed again, so it is read before `id` is run. A push never lands in the detached
+    /// list: it is for a later cycle, and a thread is in the wheel at most once.
+    #[inline]
+    fn after(&self, id: u32) -> u32 {
+        self.next[id as usize]
+    }
+
+    /// One thread of the detached list has been handed out.
+    #[inline]
+    fn taken(&mut self) {
+        self.in_wheel -= 1;
     }
 }
 
@@ -643,7 +654,6 @@ fn run_chip_with(
         wheel.push(0, i);
     }
     let mut finish = vec![0; threads.len()];
-    let mut ids = Vec::new();
     let sleep = |th: &mut Thread, wheel: &mut Wheel, stalls: &mut Stalls, id: u32| {
         let t = th.t;
         if forwards {
@@ -653,17 +663,23 @@ fn run_chip_with(
             wheel.push(t, id);
         }
     };
-    while let Some(now) = wheel.next_bucket(&mut ids) {
+    while let Some((now, first)) = wheel.next_bucket() {
         let mut touched = 0;
-        for &id in &ids {
+        let mut id = first;
+        while id != NONE {
             if !wheel.is_forward(id) {
                 touched ^= threads[id as usize].touch(chip);
             }
+            id = wheel.after(id);
         }
         std::hint::black_box(touched);
-        for &id in &ids {
+        let mut id = first;
+        while id != NONE {
+            let next = wheel.after(id);
+            wheel.taken();
             if let Some(to) = wheel.take_forward(id) {
                 wheel.push(to, id);
+                id = next;
                 continue;
             }
             let th = &mut threads[id as usize];
@@ -687,8 +703,8 @@ fn run_chip_with(
                     }
                 }
             }
+            id = next;
         }
-        ids.clear();
     }
     let end = finish.iter().copied().max().unwrap_or(0);
     chip.stalls.idle = finish.iter().map(|&f| end - f).sum();
@@ -717,6 +733,19 @@ mod tests {
 
     fn use_data() -> Op {
         Op::Issue { n: 1, fpinv: 0 }
+    }
+
+    impl Wheel {
+        /// The next cycle's threads in order, as `run_chip` walks them.
+        fn take_bucket(&mut self, ids: &mut Vec<u32>) -> Option<Cycle> {
+            let (now, mut id) = self.next_bucket()?;
+            while id != NONE {
+                ids.push(id);
+                id = self.after(id);
+                self.taken();
+            }
+            Some(now)
+        }
     }
 
     /// The previous wheel: one vector per bucket.
@@ -784,7 +813,7 @@ mod tests {
             }
             let mut ids = Vec::new();
             let mut steps = 0;
-            while let Some(now) = w.next_bucket(&mut ids) {
+            while let Some(now) = w.take_bucket(&mut ids) {
                 let (vnow, vids) = v.next_bucket().expect("vector wheel ran dry first");
                 assert_eq!((now, &ids), (vnow, &vids), "seed {seed}, step {steps}");
                 steps += 1;
@@ -834,7 +863,7 @@ mod tests {
                 _ => 1 + rng.below(40) as u64,
             };
             let (mut ids, mut steps, mut real, mut forwards) = (Vec::new(), 0, 0, 0);
-            while let Some(now) = w.next_bucket(&mut ids) {
+            while let Some(now) = w.take_bucket(&mut ids) {
                 let (vnow, vids) = v.next_bucket().expect("reference wheel ran dry first");
                 assert_eq!((now, &ids), (vnow, &vids), "seed {seed}, step {steps}");
                 steps += 1;
