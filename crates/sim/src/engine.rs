@@ -255,10 +255,10 @@ impl Thread {
     }
 
     /// Plays ahead the wake-ups of a thread going to sleep until `t` that would do nothing
-    /// but move it to a later bucket (see [`run_chip_with`]), and returns their cycles:
-    /// hop `k` is where the thread's wake-up at hop `k − 1` (at `t` for the first) would
-    /// have pushed it; the last hop is its next real wake-up, `[0, ..]` when there is
-    /// nothing to skip. Two kinds of wake-up are skipped, both touching only the thread's
+    /// but move it to a later bucket (see [`run_chip_with`]), and returns them as delays:
+    /// hop `k` is how much later than the wake-up at hop `k − 1` (at `t` for the first)
+    /// that wake-up would have pushed it; after the last hop comes its next real wake-up.
+    /// `[0, ..]` when there is nothing to skip. Two kinds of wake-up are skipped, both touching only the thread's
     /// own state:
     ///
     /// * its next op is not a load and needs a result due later (`ready > t`): the thread
@@ -270,22 +270,27 @@ impl Thread {
     /// looking past a line boundary saved those misses but skipped fewer wake-ups: more
     /// instructions, the same misses, slower; docs/performance.md, "Fourth round".)
     #[inline]
-    fn skip_ahead(&mut self, stalls: &mut Stalls) -> [Cycle; HOPS] {
+    fn skip_ahead(&mut self, stalls: &mut Stalls) -> [u32; HOPS] {
         let mut hops = [0; HOPS];
         for hop in &mut hops {
             match self.ops.get(self.pc) {
                 Some(Op::Load { .. }) | None => break,
                 Some(_) if self.ready > self.t => {
+                    // A wait beyond 2^32 cycles is left to a plain wake-up.
+                    let Ok(d) = u32::try_from(self.ready - self.t) else {
+                        break;
+                    };
                     let r = self.ready;
                     self.wait(r, stalls);
+                    *hop = d;
                 }
                 Some(&Op::Issue { n, fpinv: 0 }) if n > 0 && self.pc + 1 < self.ops.len() => {
                     self.pc += 1;
                     self.t += n as Cycle;
+                    *hop = n;
                 }
                 Some(_) => break,
             }
-            *hop = self.t;
         }
         hops
     }
@@ -496,20 +501,29 @@ pub trait WorkSource {
 /// `WHEEL` cycles, an overflow heap beyond. Within a cycle, threads run in the order they
 /// were scheduled (deterministic).
 ///
-/// A bucket is an intrusive FIFO list through `next` (a thread is in the wheel at most
-/// once), so scheduling a wake-up writes two small arrays that stay in the host's cache
-/// (40 KB for 2048 threads) instead of one of 4096 separately allocated vectors.
+/// A bucket is an intrusive FIFO list through each thread's [`Link`] (a thread is in the
+/// wheel at most once), so scheduling a wake-up writes two small arrays that stay in the
+/// host's cache (56 KB for 2048 threads) instead of one of 4096 separately allocated
+/// vectors.
 struct Wheel {
     /// Per bucket: (first, last) thread of its list, `NONE` when empty.
     ends: Vec<(u32, u32)>,
-    /// Per thread: the thread after it in its bucket.
-    next: Vec<u32>,
-    /// Per thread: where its entry forwards it, hop by hop (see [`Wheel::push_forward`]),
-    /// `[0, ..]` for a wake-up.
-    forward: Vec<[Cycle; HOPS]>,
+    /// Per thread: its link and forward hops (12 bytes, one host cache line access for
+    /// both).
+    links: Vec<Link>,
     now: Cycle,
     in_wheel: usize,
     overflow: BinaryHeap<Reverse<(Cycle, u32)>>,
+}
+
+/// A thread's place in the wheel.
+#[derive(Clone, Copy, Debug)]
+struct Link {
+    /// The thread after it in its bucket, `NONE` at the end.
+    next: u32,
+    /// Where its entry forwards it, as delays hop after hop (see [`Wheel::push_forward`]),
+    /// `[0, ..]` for a wake-up.
+    hops: [u32; HOPS],
 }
 
 const WHEEL: u64 = 4096;
@@ -523,8 +537,13 @@ impl Wheel {
     fn new(threads: usize) -> Self {
         Self {
             ends: vec![(NONE, NONE); WHEEL as usize],
-            next: vec![NONE; threads],
-            forward: vec![[0; HOPS]; threads],
+            links: vec![
+                Link {
+                    next: NONE,
+                    hops: [0; HOPS]
+                };
+                threads
+            ],
             now: 0,
             in_wheel: 0,
             overflow: BinaryHeap::new(),
@@ -540,45 +559,43 @@ impl Wheel {
         }
     }
 
-    /// A forward entry: thread `id` has nothing to do at `t` but move on to `hops[0]`, then
-    /// (if not 0) from there to `hops[1]`, and so on (increasing cycles after `t`). When a
+    /// A forward entry: thread `id` has nothing to do at `t` but move on `hops[0]` cycles
+    /// later, then (if not 0) `hops[1]` cycles later, and so on. When a
     /// bucket holding a forward entry is handed out, its holder calls
     /// [`Wheel::take_forward`] and pushes the thread to the next hop at its place in the
     /// bucket, exactly where the thread would have pushed itself had it been woken and run;
     /// it is neither touched nor run. Plain [`Wheel::push`] when `hops[0]` is 0.
-    fn push_forward(&mut self, t: Cycle, hops: [Cycle; HOPS], id: u32) {
-        debug_assert!(hops[0] == 0 || hops[0] > t);
-        debug_assert!(hops.windows(2).all(|h| h[1] == 0 || h[1] > h[0]));
-        self.forward[id as usize] = hops;
+    fn push_forward(&mut self, t: Cycle, hops: [u32; HOPS], id: u32) {
+        self.links[id as usize].hops = hops;
         self.push(t, id);
     }
 
     /// True when thread `id`'s entry just handed out is a forward.
     #[inline]
     fn is_forward(&self, id: u32) -> bool {
-        self.forward[id as usize][0] != 0
+        self.links[id as usize].hops[0] != 0
     }
 
     /// The next hop of thread `id`'s forward entry just handed out (the entry is then one
     /// hop shorter), or `None` when the entry is a wake-up.
     #[inline]
     fn take_forward(&mut self, id: u32) -> Option<Cycle> {
-        let h = &mut self.forward[id as usize];
-        let to = h[0];
+        let h = &mut self.links[id as usize].hops;
+        let d = h[0];
         h.copy_within(1.., 0);
         h[HOPS - 1] = 0;
-        (to != 0).then_some(to)
+        (d != 0).then(|| self.now + d as Cycle)
     }
 
     /// Appends thread `id` to bucket `b`'s list.
     #[inline]
     fn append(&mut self, b: usize, id: u32) {
-        self.next[id as usize] = NONE;
+        self.links[id as usize].next = NONE;
         let (first, last) = &mut self.ends[b];
         if *first == NONE {
             *first = id;
         } else {
-            self.next[*last as usize] = id;
+            self.links[*last as usize].next = id;
         }
         *last = id;
         self.in_wheel += 1;
@@ -618,7 +635,7 @@ impl Wheel {
     /// list: it is for a later cycle, and a thread is in the wheel at most once.
     #[inline]
     fn after(&self, id: u32) -> u32 {
-        self.next[id as usize]
+        self.links[id as usize].next
     }
 
     /// One thread of the detached list has been handed out.
@@ -884,8 +901,8 @@ mod tests {
                         let mut hops = [0; HOPS];
                         let mut at = t;
                         for h in hops.iter_mut().take(rng.below(HOPS as u32 + 1) as usize) {
-                            at += delay(&mut rng);
-                            *h = at;
+                            *h = delay(&mut rng) as u32;
+                            at += *h as Cycle;
                             p.push(at);
                         }
                         w.push_forward(t, hops, id);
