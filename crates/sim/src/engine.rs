@@ -205,7 +205,7 @@ impl Chip {
 #[derive(Clone, Debug)]
 #[repr(align(64))]
 pub struct Thread {
-    tm: usize,
+    tm: u32,
     /// The cycle of its next issue slot.
     pub t: Cycle,
     ready: Cycle,
@@ -213,18 +213,24 @@ pub struct Thread {
     /// The macro-ops of its current work item.
     pub ops: Vec<Op>,
     pc: usize,
+    /// A copy of `ops[pc]` noted when the thread went to sleep (`None`: not noted), so
+    /// that the touch pass finds a load's tags from the record alone, in parallel with the
+    /// op buffer's line instead of after it. Only a hint: a stale copy would cost host
+    /// misses, never change a result.
+    next: Option<Op>,
 }
 
 impl Thread {
     /// An idle thread on TM `tm`.
     pub fn new(tm: usize) -> Self {
         Self {
-            tm,
+            tm: tm as u32,
             t: 0,
             ready: 0,
             cause: Cause::Memory,
             ops: Vec::new(),
             pc: 0,
+            next: None,
         }
     }
 
@@ -244,13 +250,14 @@ impl Thread {
     /// of coming one after another. Returns a value to keep the reads.
     #[inline]
     fn touch(&self, chip: &Chip) -> u64 {
-        match self.ops.get(self.pc) {
-            Some(&Op::Load { word, .. }) => {
+        let op = self.ops.get(self.pc).copied();
+        let read = matches!(op, Some(Op::Load { .. })) as u64;
+        match self.next.or(op) {
+            Some(Op::Load { word, .. }) => {
                 let line = word as u64 >> chip.line_word_shift;
-                chip.tms[self.tm].l1.peek(line) ^ chip.l2.peek(line)
+                chip.tms[self.tm as usize].l1.peek(line) ^ chip.l2.peek(line) ^ read
             }
-            Some(_) => 1,
-            None => 0,
+            _ => read,
         }
     }
 
@@ -292,11 +299,13 @@ impl Thread {
                 Some(_) => break,
             }
         }
+        self.next = self.ops.get(self.pc).copied();
         hops
     }
 
     /// Replaces the program (the previous one must be done).
     pub fn load_program(&mut self, ops: Vec<Op>) {
+        self.next = ops.first().copied();
         self.ops = ops;
         self.pc = 0;
     }
@@ -356,7 +365,7 @@ impl Thread {
     }
 
     fn execute(&mut self, op: Op, chip: &mut Chip, now: Cycle) {
-        let tm = self.tm;
+        let tm = self.tm as usize;
         match op {
             Op::Issue { n, fpinv } => {
                 let mut c = self.t;
@@ -677,6 +686,7 @@ fn run_chip_with(
             let hops = th.skip_ahead(stalls);
             wheel.push_forward(t, hops, id);
         } else {
+            th.next = None;
             wheel.push(t, id);
         }
     };
