@@ -34,7 +34,6 @@ use crate::Cycle;
 use crate::config::DramConfig;
 use crate::slots::SparseSlots;
 use serde::{Deserialize, Serialize};
-use std::collections::VecDeque;
 
 /// How a read found its bank.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,31 +67,80 @@ pub struct DramStats {
     pub last_done: Cycle,
 }
 
-/// A row's time open in a bank's schedule.
+/// A row's time open in a bank's schedule. Its `close` (the last tick a column command
+/// may read it) is the next epoch's activate − t_RP − t_RTP, open-ended for the last
+/// epoch: it is derived from the next entry rather than stored, so an epoch is 16 bytes
+/// and opening one writes nothing else.
 #[derive(Clone, Copy, Debug)]
 struct Epoch {
     row: u64,
     /// Tick of its activate.
     act: u64,
-    /// Last tick a column command may read it (`u64::MAX` while no later epoch exists).
-    close: u64,
 }
 
 /// Ticks an epoch is kept after its `close` (reads arrive slightly out of order: fluffy
 /// time).
 const EPOCH_KEEP: u64 = 256;
 
-#[derive(Clone, Debug, Default)]
+/// `Bank::open_row` when no row is open (rows are line numbers / 128 or less: < 2^58).
+const NO_ROW: u64 = u64::MAX;
+
+/// One bank: 64 bytes, one host cache line.
+#[derive(Clone, Debug)]
+#[repr(align(64))]
 struct Bank {
-    /// Earlier epochs still usable by row hits, oldest first (the last one is `open_row`'s).
-    epochs: VecDeque<Epoch>,
-    open_row: Option<u64>,
+    /// The open row, or [`NO_ROW`].
+    open_row: u64,
     /// Tick of the last activate.
     act: u64,
     /// Earliest tick of the next column command.
     col_ready: u64,
     /// Tick of the last column command (for t_RTP).
     last_col: u64,
+    /// `epochs[head..]`: epochs still usable by row hits, oldest first (the last one is
+    /// `open_row`'s). Expired epochs stay before `head` until a push would grow the vector,
+    /// which then drops them instead (no ring arithmetic on the hot path). Epoch `i`
+    /// closes at `epochs[i + 1].act − gap` (`gap` = t_RP + t_RTP).
+    head: usize,
+    epochs: Vec<Epoch>,
+}
+
+impl Default for Bank {
+    fn default() -> Self {
+        Self {
+            open_row: NO_ROW,
+            act: 0,
+            col_ready: 0,
+            last_col: 0,
+            head: 0,
+            epochs: Vec::new(),
+        }
+    }
+}
+
+impl Bank {
+    /// Drops the epochs closed more than [`EPOCH_KEEP`] ticks before tick `a` (the last
+    /// epoch never closes).
+    #[inline]
+    fn expire(&mut self, a: u64, gap: u64) {
+        let mut h = self.head;
+        while h + 1 < self.epochs.len()
+            && (self.epochs[h + 1].act - gap).saturating_add(EPOCH_KEEP) < a
+        {
+            h += 1;
+        }
+        self.head = h;
+    }
+
+    /// Opens `row` at tick `act` (the previous epoch closes `gap` ticks before it).
+    #[inline]
+    fn push(&mut self, row: u64, act: u64) {
+        if self.head > 0 && self.epochs.len() == self.epochs.capacity() {
+            self.epochs.drain(..self.head);
+            self.head = 0;
+        }
+        self.epochs.push(Epoch { row, act });
+    }
 }
 
 #[derive(Clone, Debug, Default)]
@@ -212,24 +260,25 @@ impl Dram {
             a = d;
         }
         let bank = &mut self.banks[chi * c.banks_per_channel as usize + bi];
-        while bank
-            .epochs
-            .front()
-            .is_some_and(|e| e.close.saturating_add(EPOCH_KEEP) < a)
-        {
-            bank.epochs.pop_front();
-        }
-        // Row-hit-first: an earlier epoch of this row still ahead of the read serves it.
-        if bank.open_row != Some(row) {
+        let gap = c.t_rp + c.t_rtp;
+        bank.expire(a, gap);
+        // Row-hit-first: an earlier epoch of this row still ahead of the read serves it
+        // (the last epoch is the open row's).
+        if bank.open_row != row {
             let mut hit = None;
-            for e in bank.epochs.iter().filter(|e| e.row == row) {
+            let live = &bank.epochs[bank.head..];
+            for (e, next) in live.iter().zip(live.iter().skip(1)) {
+                if e.row != row {
+                    continue;
+                }
+                let close = next.act - gap;
                 let col = a.max(e.act + c.t_rcd);
-                if col > e.close {
+                if col > close {
                     continue;
                 }
                 // The column command waits for its data-bus slot (t_CAS before it).
                 let slot = ch.bus.peek(self.burst.div_ceil(col + c.t_cas));
-                if slot * c.t_burst - c.t_cas <= e.close {
+                if slot * c.t_burst - c.t_cas <= close {
                     hit = Some(slot);
                     break;
                 }
@@ -241,30 +290,23 @@ impl Dram {
             }
         }
         let (col, kind) = match bank.open_row {
-            Some(r) if r == row => (a.max(bank.col_ready), DramAccess::RowHit),
+            r if r == row => (a.max(bank.col_ready), DramAccess::RowHit),
             open => {
                 let mut act = a;
-                let kind = if open.is_some() {
+                let kind = if open != NO_ROW {
                     let pre = a.max(bank.act + c.t_ras).max(bank.last_col + c.t_rtp);
                     act = pre + c.t_rp;
                     DramAccess::Conflict
                 } else {
                     DramAccess::Closed
                 };
-                if open.is_some() || bank.act > 0 {
+                if open != NO_ROW || bank.act > 0 {
                     act = act.max(bank.act + c.t_rc);
                 }
                 act = ch.acts.reserve_span(act, c.t_rrd.max(1));
-                if let Some(last) = bank.epochs.back_mut() {
-                    last.close = act - c.t_rp - c.t_rtp;
-                }
-                bank.epochs.push_back(Epoch {
-                    row,
-                    act,
-                    close: u64::MAX,
-                });
+                bank.push(row, act);
                 bank.act = act;
-                bank.open_row = Some(row);
+                bank.open_row = row;
                 self.stats.activations += 1;
                 ((act + c.t_rcd).max(bank.col_ready), kind)
             }
