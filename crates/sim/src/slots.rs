@@ -311,6 +311,13 @@ pub struct SparseSlots<const P: usize = 1> {
     pending: u32,
     /// The earliest pending cycle, while `pending > 0`.
     first_pending: Cycle,
+    /// No span of `known_len` cycles starting in `[known_from, known_to)` fits (each
+    /// overlaps a reservation): what the last searches found, so the next request in that
+    /// range starts searching at `known_to`. Reservations are never removed at or after
+    /// the floor, so a start that does not fit never fits later.
+    known_from: Cycle,
+    known_to: Cycle,
+    known_len: u64,
 }
 
 impl<const P: usize> Default for SparseSlots<P> {
@@ -321,6 +328,9 @@ impl<const P: usize> Default for SparseSlots<P> {
             floor: 0,
             pending: 0,
             first_pending: 0,
+            known_from: 0,
+            known_to: 0,
+            known_len: 0,
         }
     }
 }
@@ -474,9 +484,17 @@ impl<const P: usize> SparseSlots<P> {
 
     #[inline(never)]
     fn reserve_slow(&mut self, c: Cycle, len: u64) -> Cycle {
-        let s = self.find(c.max(self.lo), len);
+        let c = c.max(self.lo);
+        let known = len == self.known_len && self.known_from <= c && c <= self.known_to;
+        let s = self.find(if known { self.known_to } else { c }, len);
         self.cover(s + len - 1);
         self.mark(s, len);
+        // No start in [c, s) fits (the search), nor in [s, s + len) now; joined to the
+        // known range when they touch.
+        if !known {
+            (self.known_from, self.known_len) = (c, len);
+        }
+        self.known_to = s + len;
         s
     }
 }
@@ -820,20 +838,24 @@ mod bank_tests {
 
     /// `SparseSlots` against a plain set of taken cycles: spans of 1..=20 cycles requested
     /// in a jittered order ahead of a rising floor, some far ahead (the ring grows), with
-    /// `peek` checked before each reservation.
+    /// `peek` checked before each reservation; spans of two lengths alternating, or of one
+    /// length in a dense backlog.
     #[test]
     fn sparse_slots_match_a_set_of_taken_cycles() {
-        for seed in 0..8 {
+        for seed in 0..16 {
             let mut rng = Pcg32::new(seed, 9);
             let mut set = BTreeSet::new();
             let mut slots = SparseSlots::<1>::default();
             let mut floor = 0;
             let len = 1 + rng.below(20) as u64;
+            // Seeds 8.. keep one span length and request densely (a saturated backlog:
+            // the known range of non-fitting starts is used and extended).
+            let (mixed, spread) = if seed < 8 { (true, 300) } else { (false, 60) };
             for i in 0..2000 {
                 floor += rng.below(14) as u64;
                 slots.forget_before(floor);
                 let far = if rng.below(50) == 0 { 5000 } else { 0 };
-                let c = floor + far + rng.below(300) as u64;
+                let c = floor + far + rng.below(spread) as u64;
                 let free =
                     |set: &BTreeSet<Cycle>, s: Cycle, l: u64| (s..s + l).all(|x| !set.contains(&x));
                 let mut p = c;
@@ -841,7 +863,7 @@ mod bank_tests {
                     p += 1;
                 }
                 assert_eq!(slots.peek(c), p, "seed {seed}, request {i}: peek");
-                let l = if i % 2 == 0 { len } else { 1 };
+                let l = if mixed && i % 2 == 1 { 1 } else { len };
                 let mut s = c;
                 while !free(&set, s, l) {
                     s += 1;
