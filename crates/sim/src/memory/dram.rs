@@ -85,11 +85,13 @@ const EPOCH_KEEP: u64 = 256;
 /// `Bank::open_row` when no row is open (rows are line numbers / 128 or less: < 2^58).
 const NO_ROW: u64 = u64::MAX;
 
-/// One bank: 64 bytes, one host cache line.
+/// One bank: 64 bytes, one host cache line. Its row epochs are a ring in [`Epochs`]; the
+/// record keeps what most reads need so that they do not touch the ring: when the
+/// earliest epoch expires, and which rows the earlier epochs hold.
 #[derive(Clone, Debug)]
 #[repr(align(64))]
 struct Bank {
-    /// The open row, or [`NO_ROW`].
+    /// The open row (the last epoch's), or [`NO_ROW`].
     open_row: u64,
     /// Tick of the last activate.
     act: u64,
@@ -97,12 +99,18 @@ struct Bank {
     col_ready: u64,
     /// Tick of the last column command (for t_RTP).
     last_col: u64,
-    /// `epochs[head..]`: epochs still usable by row hits, oldest first (the last one is
-    /// `open_row`'s). Expired epochs stay before `head` until a push would grow the vector,
-    /// which then drops them instead (no ring arithmetic on the hot path). Epoch `i`
-    /// closes at `epochs[i + 1].act − gap` (`gap` = t_RP + t_RTP).
-    head: usize,
-    epochs: Vec<Epoch>,
+    /// The earliest epoch expires once a read's tick exceeds this: its close (the next
+    /// epoch's activate − t_RP − t_RTP) + [`EPOCH_KEEP`]; `u64::MAX` while only one epoch
+    /// is live.
+    expiry: u64,
+    /// Bit `row mod 64` set for each live epoch but the last (and possibly for expired
+    /// ones: refreshed whenever a read scans them all), so a read whose bit is clear has no
+    /// earlier epoch of its row to try.
+    rows: u64,
+    /// Ring position of the earliest live epoch.
+    head: u32,
+    /// Live epochs (`0` before the first activate).
+    len: u32,
 }
 
 impl Default for Bank {
@@ -112,34 +120,96 @@ impl Default for Bank {
             act: 0,
             col_ready: 0,
             last_col: 0,
+            expiry: u64::MAX,
+            rows: 0,
             head: 0,
-            epochs: Vec::new(),
+            len: 0,
         }
     }
 }
 
-impl Bank {
-    /// Drops the epochs closed more than [`EPOCH_KEEP`] ticks before tick `a` (the last
-    /// epoch never closes).
-    #[inline]
-    fn expire(&mut self, a: u64, gap: u64) {
-        let mut h = self.head;
-        while h + 1 < self.epochs.len()
-            && (self.epochs[h + 1].act - gap).saturating_add(EPOCH_KEEP) < a
-        {
-            h += 1;
+/// Every bank's live row epochs, oldest first: bank `b`'s ring is
+/// `slab[b · cap .. (b + 1) · cap]` (`cap` a power of two, doubled for all banks the first
+/// time one needs more), so opening an epoch writes 16 bytes and no allocation is touched.
+#[derive(Clone, Debug)]
+struct Epochs {
+    slab: Vec<Epoch>,
+    /// log2(`cap`).
+    shift: u32,
+}
+
+impl Epochs {
+    fn new(banks: usize) -> Self {
+        let shift = 3;
+        Self {
+            slab: vec![Epoch { row: 0, act: 0 }; banks << shift],
+            shift,
         }
-        self.head = h;
     }
 
-    /// Opens `row` at tick `act` (the previous epoch closes `gap` ticks before it).
+    /// Slab index of bank `b`'s `i`-th live epoch.
     #[inline]
-    fn push(&mut self, row: u64, act: u64) {
-        if self.head > 0 && self.epochs.len() == self.epochs.capacity() {
-            self.epochs.drain(..self.head);
-            self.head = 0;
+    fn at(&self, b: usize, bank: &Bank, i: u32) -> usize {
+        let mask = (1u32 << self.shift) - 1;
+        (b << self.shift) + (bank.head.wrapping_add(i) & mask) as usize
+    }
+
+    /// `expiry` for bank `b` whose epochs are as they are now (`gap` = t_RP + t_RTP).
+    #[inline]
+    fn expiry(&self, b: usize, bank: &Bank, gap: u64) -> u64 {
+        if bank.len < 2 {
+            u64::MAX
+        } else {
+            (self.slab[self.at(b, bank, 1)].act - gap).saturating_add(EPOCH_KEEP)
         }
-        self.epochs.push(Epoch { row, act });
+    }
+
+    /// Drops bank `b`'s epochs closed more than [`EPOCH_KEEP`] ticks before tick `a` (the
+    /// last epoch never closes).
+    #[inline]
+    fn expire(&self, b: usize, bank: &mut Bank, a: u64, gap: u64) {
+        if bank.expiry < a {
+            self.expire_slow(b, bank, a, gap);
+        }
+    }
+
+    #[inline(never)]
+    fn expire_slow(&self, b: usize, bank: &mut Bank, a: u64, gap: u64) {
+        while bank.expiry < a {
+            bank.head = bank.head.wrapping_add(1);
+            bank.len -= 1;
+            bank.expiry = self.expiry(b, bank, gap);
+        }
+    }
+
+    /// Opens `row` at tick `act` in bank `b` (the bank's open row and activate are still
+    /// the previous epoch's; its ring has room: [`Dram::read_at`] grows it first).
+    #[inline]
+    fn push(&mut self, b: usize, bank: &mut Bank, row: u64, act: u64, gap: u64) {
+        debug_assert!(bank.len < 1 << self.shift);
+        let i = self.at(b, bank, bank.len);
+        self.slab[i] = Epoch { row, act };
+        if bank.len > 0 {
+            bank.rows |= 1 << (bank.open_row & 63);
+        }
+        bank.len += 1;
+        if bank.len == 2 {
+            bank.expiry = (act - gap).saturating_add(EPOCH_KEEP);
+        }
+    }
+
+    /// Doubles every bank's ring; each ring starts at position 0 afterwards.
+    #[cold]
+    fn grow(&mut self, banks: &mut [Bank]) {
+        let shift = self.shift + 1;
+        let mut slab = vec![Epoch { row: 0, act: 0 }; banks.len() << shift];
+        for (b, bank) in banks.iter_mut().enumerate() {
+            for i in 0..bank.len {
+                slab[(b << shift) + i as usize] = self.slab[self.at(b, bank, i)];
+            }
+            bank.head = 0;
+        }
+        (self.slab, self.shift) = (slab, shift);
     }
 }
 
@@ -159,6 +229,7 @@ struct Channel {
 pub struct Dram {
     cfg: DramConfig,
     banks: Vec<Bank>,
+    epochs: Epochs,
     channels: Vec<Channel>,
     col_bits: u32,
     ch_bits: u32,
@@ -211,6 +282,7 @@ impl Dram {
         Self {
             cfg: cfg.clone(),
             banks: vec![Bank::default(); (cfg.channels * cfg.banks_per_channel) as usize],
+            epochs: Epochs::new((cfg.channels * cfg.banks_per_channel) as usize),
             channels: vec![Channel::default(); cfg.channels as usize],
             col_bits: (cfg.row_bytes / 64).trailing_zeros(),
             ch_bits: cfg.channels.trailing_zeros(),
@@ -244,6 +316,11 @@ impl Dram {
         let c = &self.cfg;
         let tpc = c.ticks_per_cycle;
         let (chi, bi, row) = self.map(line);
+        let b = chi * c.banks_per_channel as usize + bi;
+        // Room for one more epoch in the bank's ring (this read opens at most one).
+        if self.banks[b].len == 1 << self.epochs.shift {
+            self.epochs.grow(&mut self.banks);
+        }
         let ch = &mut self.channels[chi];
         ch.bus.forget_before(self.burst.div(now * tpc));
         ch.acts.forget_before(now * tpc);
@@ -259,19 +336,22 @@ impl Dram {
             self.stats.queue_wait_cycles += self.tpc.div_ceil(d - a);
             a = d;
         }
-        let bank = &mut self.banks[chi * c.banks_per_channel as usize + bi];
+        let bank = &mut self.banks[b];
         let gap = c.t_rp + c.t_rtp;
-        bank.expire(a, gap);
+        let epochs = &mut self.epochs;
+        epochs.expire(b, bank, a, gap);
         // Row-hit-first: an earlier epoch of this row still ahead of the read serves it
         // (the last epoch is the open row's).
-        if bank.open_row != row {
+        if bank.open_row != row && bank.rows & 1 << (row & 63) != 0 {
             let mut hit = None;
-            let live = &bank.epochs[bank.head..];
-            for (e, next) in live.iter().zip(live.iter().skip(1)) {
+            let mut rows = 0;
+            for i in 0..bank.len - 1 {
+                let e = epochs.slab[epochs.at(b, bank, i)];
+                rows |= 1 << (e.row & 63);
                 if e.row != row {
                     continue;
                 }
-                let close = next.act - gap;
+                let close = epochs.slab[epochs.at(b, bank, i + 1)].act - gap;
                 let col = a.max(e.act + c.t_rcd);
                 if col > close {
                     continue;
@@ -282,6 +362,9 @@ impl Dram {
                     hit = Some(slot);
                     break;
                 }
+            }
+            if hit.is_none() {
+                bank.rows = rows;
             }
             if let Some(slot) = hit {
                 ch.bus.reserve_pending(slot);
@@ -304,7 +387,7 @@ impl Dram {
                     act = act.max(bank.act + c.t_rc);
                 }
                 act = ch.acts.reserve_span(act, c.t_rrd.max(1));
-                bank.push(row, act);
+                epochs.push(b, bank, row, act, gap);
                 bank.act = act;
                 bank.open_row = row;
                 self.stats.activations += 1;
