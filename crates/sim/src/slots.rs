@@ -474,10 +474,16 @@ impl<const P: usize> SparseSlots<P> {
     #[inline]
     pub fn reserve_span(&mut self, c: Cycle, len: u64) -> Cycle {
         debug_assert!(c >= self.floor && (1..=64).contains(&len));
-        // Fast path: the span at `c` itself is inside the ring and free.
-        if c >= self.lo && c + len <= self.end() && self.window(c, len) == 0 {
-            self.mark(c, len);
-            return c;
+        // Fast path: the first start not known not to fit (`c`, or the end of the known
+        // range when `c` lies in it) is inside the ring and free.
+        let known = len == self.known_len && self.known_from <= c && c <= self.known_to;
+        let s = if known { self.known_to } else { c };
+        if s >= self.lo && s + len <= self.end() && self.window(s, len) == 0 {
+            self.mark(s, len);
+            if known {
+                self.known_to = s + len;
+            }
+            return s;
         }
         self.reserve_slow(c, len)
     }
