@@ -173,7 +173,7 @@ impl Epochs {
         }
     }
 
-    #[inline(never)]
+    #[inline]
     fn expire_slow(&self, b: usize, bank: &mut Bank, a: u64, gap: u64) {
         while bank.expiry < a {
             bank.head = bank.head.wrapping_add(1);
@@ -234,6 +234,10 @@ pub struct Dram {
     col_bits: u32,
     ch_bits: u32,
     bank_bits: u32,
+    /// `channels − 1`.
+    ch_mask: u64,
+    /// `channels · banks_per_channel − 1`.
+    bank_mask: u64,
     /// Divisions by t_burst and by ticks_per_cycle.
     burst: Divisor,
     tpc: Divisor,
@@ -287,6 +291,8 @@ impl Dram {
             col_bits: (cfg.row_bytes / 64).trailing_zeros(),
             ch_bits: cfg.channels.trailing_zeros(),
             bank_bits: cfg.banks_per_channel.trailing_zeros(),
+            ch_mask: cfg.channels as u64 - 1,
+            bank_mask: (cfg.channels * cfg.banks_per_channel) as u64 - 1,
             burst: Divisor::new(cfg.t_burst),
             tpc: Divisor::new(cfg.ticks_per_cycle),
             stats: DramStats::default(),
@@ -315,8 +321,13 @@ impl Dram {
         debug_assert!(now <= arrive);
         let c = &self.cfg;
         let tpc = c.ticks_per_cycle;
-        let (chi, bi, row) = self.map(line);
-        let b = chi * c.banks_per_channel as usize + bi;
+        // The mapping of `map`; banks are numbered bank · channels + channel.
+        let x = line >> self.col_bits;
+        let (chi, b, row) = (
+            (x & self.ch_mask) as usize,
+            (x & self.bank_mask) as usize,
+            x >> (self.ch_bits + self.bank_bits),
+        );
         // Room for one more epoch in the bank's ring (this read opens at most one).
         if self.banks[b].len == 1 << self.epochs.shift {
             self.epochs.grow(&mut self.banks);
@@ -390,7 +401,6 @@ impl Dram {
                 epochs.push(b, bank, row, act, gap);
                 bank.act = act;
                 bank.open_row = row;
-                self.stats.activations += 1;
                 ((act + c.t_rcd).max(bank.col_ready), kind)
             }
         };
@@ -408,7 +418,6 @@ impl Dram {
     fn finish(&mut self, arrive: Cycle, done: u64, kind: DramAccess) -> (Cycle, DramAccess) {
         let done_cycle = self.tpc.div_ceil(done);
         let s = &mut self.stats;
-        s.reads += 1;
         match kind {
             DramAccess::RowHit => s.row_hits += 1,
             DramAccess::Closed => s.row_closed += 1,
@@ -421,7 +430,14 @@ impl Dram {
 
     /// Counters so far.
     pub fn stats(&self) -> DramStats {
-        self.stats
+        // Every read is a row hit, a closed bank or a conflict, and activates a row unless
+        // it is a row hit: the two sums are not counted on the way.
+        let s = self.stats;
+        DramStats {
+            reads: s.row_hits + s.row_closed + s.row_conflicts,
+            activations: s.row_closed + s.row_conflicts,
+            ..s
+        }
     }
 }
 
