@@ -234,10 +234,6 @@ pub struct Dram {
     col_bits: u32,
     ch_bits: u32,
     bank_bits: u32,
-    /// `channels − 1`.
-    ch_mask: u64,
-    /// `channels · banks_per_channel − 1`.
-    bank_mask: u64,
     /// Divisions by t_burst and by ticks_per_cycle.
     burst: Divisor,
     tpc: Divisor,
@@ -291,8 +287,6 @@ impl Dram {
             col_bits: (cfg.row_bytes / 64).trailing_zeros(),
             ch_bits: cfg.channels.trailing_zeros(),
             bank_bits: cfg.banks_per_channel.trailing_zeros(),
-            ch_mask: cfg.channels as u64 - 1,
-            bank_mask: (cfg.channels * cfg.banks_per_channel) as u64 - 1,
             burst: Divisor::new(cfg.t_burst),
             tpc: Divisor::new(cfg.ticks_per_cycle),
             stats: DramStats::default(),
@@ -323,9 +317,10 @@ impl Dram {
         let tpc = c.ticks_per_cycle;
         // The mapping of `map`; banks are numbered bank · channels + channel.
         let x = line >> self.col_bits;
+        // (Masks by the power-of-two lengths, so the indexing below needs no bounds test.)
         let (chi, b, row) = (
-            (x & self.ch_mask) as usize,
-            (x & self.bank_mask) as usize,
+            x as usize & (self.channels.len() - 1),
+            x as usize & (self.banks.len() - 1),
             x >> (self.ch_bits + self.bank_bits),
         );
         // Room for one more epoch in the bank's ring (this read opens at most one).
