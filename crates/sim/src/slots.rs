@@ -289,7 +289,7 @@ impl BankSlots {
 /// more ([`SparseSlots::forget_before`], from the current event time), and the ring
 /// recycles them, so it only spans the backlog ahead of the present. A search skips taken
 /// words 64 cycles per step (a saturated bus is a run of full words) and otherwise walks the
-/// gaps ([`SparseSlots::find`]); a request whose own cycles are free (most of them) is
+/// gaps (`SparseSlots::find`); a request whose own cycles are free (most of them) is
 /// settled by one word test inline.
 ///
 /// The ring holds `P` bit planes per cycle. Plane 0 is the reservations; with `P = 2`,
