@@ -574,10 +574,16 @@ impl SparseSlots<2> {
         }
         let s = self.first_pending;
         let i = self.index(s);
-        self.words[i][1] &= !(1 << (s & 63));
+        // No pending bit below `s`'s: the rest of its word first.
+        let rest = self.words[i][1] & !(1 << (s & 63));
+        self.words[i][1] = rest;
         self.pending -= 1;
         if self.pending > 0 {
-            self.first_pending = self.next_pending(s + 1);
+            self.first_pending = if rest != 0 {
+                (s & !63) + rest.trailing_zeros() as u64
+            } else {
+                self.next_pending((s | 63) + 1)
+            };
         }
         Some(s)
     }
