@@ -7,6 +7,9 @@
 //! instructions; every 8th visit a 9-word triangle load and a triangle op. The counter is
 //! node visits. `frame_soup`: a whole 128×128 path-traced frame (functional traversal +
 //! timing) on a seeded 20 000-triangle soup, counted in simulated node visits.
+//! `frame_atrium`: a whole 64×64 path-traced frame of the builtin architectural scene
+//! (`builtin:atrium`) in each of the eight configurations, counted the same way (a BVH8
+//! visit loads a 200-byte node and tests 8 boxes, a DST visit one 8–20-byte node).
 
 use divan::counter::ItemsCount;
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
@@ -87,6 +90,23 @@ fn engine_node_visits(b: divan::Bencher) {
         });
 }
 
+/// Simulates `settings`' frame once to count its node visits, then times it.
+fn bench_frame(
+    b: divan::Bencher,
+    scene: &dualsplit_scene::Scene,
+    accel: SimAccel,
+    settings: &dualsplit_render::RenderSettings,
+) {
+    let s = dualsplit_accel::Structures::build(&scene.triangles, &Default::default());
+    let cfg = SimConfig::lin2020();
+    let nodes = simulate(scene, &s, accel, settings, &cfg, &|_, _| {})
+        .unwrap()
+        .instructions
+        .node_steps;
+    b.counter(ItemsCount::new(nodes))
+        .bench(|| simulate(scene, &s, accel, settings, &cfg, &|_, _| {}).unwrap());
+}
+
 #[divan::bench(args = [SimAccel::Bvh2, SimAccel::Dst], sample_count = 3)]
 fn frame_soup(b: divan::Bencher, accel: SimAccel) {
     let mut rng = Pcg32::new(7, 1);
@@ -107,14 +127,14 @@ fn frame_soup(b: divan::Bencher, accel: SimAccel) {
     let scene =
         dualsplit_scene::Scene::from_triangles("soup", "bench:soup", tris, Default::default())
             .unwrap();
-    let s = dualsplit_accel::Structures::build(&scene.triangles, &Default::default());
     let settings =
         dualsplit_render::RenderSettings::new(128, 128, dualsplit_render::Workload::Path);
-    let cfg = SimConfig::lin2020();
-    let nodes = simulate(&scene, &s, accel, &settings, &cfg, &|_, _| {})
-        .unwrap()
-        .instructions
-        .node_steps;
-    b.counter(ItemsCount::new(nodes))
-        .bench(|| simulate(&scene, &s, accel, &settings, &cfg, &|_, _| {}).unwrap());
+    bench_frame(b, &scene, accel, &settings);
+}
+
+#[divan::bench(args = SimAccel::ALL, sample_count = 3)]
+fn frame_atrium(b: divan::Bencher, accel: SimAccel) {
+    let scene = dualsplit_scene::builtin::generate("atrium").unwrap();
+    let settings = dualsplit_render::RenderSettings::new(64, 64, dualsplit_render::Workload::Path);
+    bench_frame(b, &scene, accel, &settings);
 }

@@ -289,29 +289,53 @@ impl BankSlots {
 /// more ([`SparseSlots::forget_before`], from the current event time), and the ring
 /// recycles them, so it only spans the backlog ahead of the present. A search skips taken
 /// words 64 cycles per step (a saturated bus is a run of full words) and otherwise walks the
-/// gaps ([`SparseSlots::find`]).
+/// gaps (`SparseSlots::find`); a request whose own cycles are free (most of them) is
+/// settled by one word test inline.
+///
+/// The ring holds `P` bit planes per cycle. Plane 0 is the reservations; with `P = 2`,
+/// plane 1 marks reservations still *pending* ([`SparseSlots::reserve_pending`]): a DRAM
+/// channel's in-flight reads, each identified by its data-bus slot, so the read queue's
+/// bookkeeping lives in the host cache line of the bus reservation it belongs to instead
+/// of a separate heap (Lin et al. 2020, §5's GDDR5 model; notes §3.3).
 #[derive(Clone, Debug)]
-pub struct SparseSlots {
+pub struct SparseSlots<const P: usize = 1> {
     /// First cycle covered (a multiple of 64); the ring covers `[lo, lo + 64 · words.len())`
     /// and every reservation ever made at or after `lo` lies in it.
     lo: Cycle,
-    /// `words[(x / 64) mod len]` bit `x mod 64`: cycle `x` is taken (power-of-two length).
-    words: Vec<u64>,
+    /// `words[(x / 64) mod len][p]` bit `x mod 64`: cycle `x` is taken (`p = 0`) or pending
+    /// (`p = 1`); power-of-two length.
+    words: Box<[[u64; P]]>,
     /// No request starts before this cycle (`forget_before`).
     floor: Cycle,
+    /// Pending cycles (plane 1).
+    pending: u32,
+    /// The earliest pending cycle, while `pending > 0`.
+    first_pending: Cycle,
+    /// No span of `known_len` cycles starting in `[known_from, known_to)` fits (each
+    /// overlaps a reservation): what the last searches found, so the next request in that
+    /// range starts searching at `known_to`. Reservations are never removed at or after
+    /// the floor, so a start that does not fit never fits later.
+    known_from: Cycle,
+    known_to: Cycle,
+    known_len: u64,
 }
 
-impl Default for SparseSlots {
+impl<const P: usize> Default for SparseSlots<P> {
     fn default() -> Self {
         Self {
             lo: 0,
-            words: vec![0; 16],
+            words: vec![[0; P]; 16].into_boxed_slice(),
             floor: 0,
+            pending: 0,
+            first_pending: 0,
+            known_from: 0,
+            known_to: 0,
+            known_len: 0,
         }
     }
 }
 
-impl SparseSlots {
+impl<const P: usize> SparseSlots<P> {
     /// Forgets reservations before `floor`: no later request starts before `floor`, so they
     /// can no longer collide with one (results are unchanged).
     #[inline]
@@ -324,27 +348,41 @@ impl SparseSlots {
         self.lo + ((self.words.len() as u64) << 6)
     }
 
+    /// Ring index of cycle `x`'s word.
+    #[inline]
+    fn index(&self, x: Cycle) -> usize {
+        (x >> 6) as usize & (self.words.len() - 1)
+    }
+
     #[inline]
     fn word(&self, x: Cycle) -> u64 {
-        self.words[(x >> 6) as usize & (self.words.len() - 1)]
+        self.words[self.index(x)][0]
     }
 
     /// Makes the ring cover cycle `hi` (recycling cycles before the floor, growing if that
     /// is not enough).
+    #[inline]
     fn cover(&mut self, hi: Cycle) {
-        if hi < self.end() {
-            return;
+        if hi >= self.end() {
+            self.cover_slow(hi);
         }
+    }
+
+    #[inline(never)]
+    fn cover_slow(&mut self, hi: Cycle) {
         let n = self.words.len();
         let new_lo = (self.floor & !63).max(self.lo);
         let (old_w, new_w) = (self.lo >> 6, new_lo >> 6);
         for j in old_w..old_w + (new_w - old_w).min(n as u64) {
-            self.words[j as usize & (n - 1)] = 0;
+            let w = &mut self.words[j as usize & (n - 1)];
+            // Pending cycles are retired before the floor passes them (the owner's contract).
+            debug_assert!(w[1..].iter().all(|&p| p == 0), "pending cycle recycled");
+            *w = [0; P];
         }
         self.lo = new_lo;
         while hi >= self.end() {
             let n = self.words.len();
-            let mut words = vec![0; n * 2];
+            let mut words = vec![[0; P]; n * 2].into_boxed_slice();
             for j in self.lo >> 6..(self.lo >> 6) + n as u64 {
                 words[j as usize & (2 * n - 1)] = self.words[j as usize & (n - 1)];
             }
@@ -362,6 +400,19 @@ impl SparseSlots {
             m |= self.word(s + 64) << (64 - sh);
         }
         m & (u64::MAX >> (64 - len))
+    }
+
+    /// Marks cycles `[s, s + len)` taken (`1 ≤ len ≤ 64`, inside the ring).
+    #[inline]
+    fn mark(&mut self, s: Cycle, len: u64) {
+        let sh = s & 63;
+        let m = u64::MAX >> (64 - len);
+        let i = self.index(s);
+        self.words[i][0] |= m << sh;
+        if sh + len > 64 {
+            let j = self.index(s + 64);
+            self.words[j][0] |= m >> (64 - sh);
+        }
     }
 
     /// First start `s ≥ c` where `[s, s + len)` overlaps no reservation (`c ≥` the floor).
@@ -402,25 +453,153 @@ impl SparseSlots {
     }
 
     /// Reserves the first free cycle at or after `c` and returns it.
+    #[inline]
     pub fn reserve(&mut self, c: Cycle) -> Cycle {
-        self.reserve_span(c, 1)
+        debug_assert!(c >= self.floor);
+        // Fast path (most requests): `c` inside the ring and free.
+        if c >= self.lo && c < self.end() {
+            let i = self.index(c);
+            let bit = 1u64 << (c & 63);
+            if self.words[i][0] & bit == 0 {
+                self.words[i][0] |= bit;
+                return c;
+            }
+        }
+        self.reserve_slow(c, 1)
     }
 
     /// Reserves a span of `len` cycles (`1 ≤ len ≤ 64`) at the first start at or after `c`
     /// where it overlaps no other span (spans are all `len` long, so starts end up at least
     /// `len` apart: a minimum spacing such as t_RRD between activations).
+    #[inline]
     pub fn reserve_span(&mut self, c: Cycle, len: u64) -> Cycle {
-        debug_assert!(c >= self.floor);
-        let s = self.find(c.max(self.lo), len);
-        self.cover(s + len - 1);
-        let sh = s & 63;
-        let m = u64::MAX >> (64 - len);
-        let n = self.words.len();
-        self.words[(s >> 6) as usize & (n - 1)] |= m << sh;
-        if sh + len > 64 {
-            self.words[((s >> 6) + 1) as usize & (n - 1)] |= m >> (64 - sh);
+        debug_assert!(c >= self.floor && (1..=64).contains(&len));
+        // Fast path: the first start not known not to fit (`c`, or the end of the known
+        // range when `c` lies in it) is inside the ring and free.
+        let known = len == self.known_len && self.known_from <= c && c <= self.known_to;
+        let s = if known { self.known_to } else { c };
+        if s >= self.lo && s + len <= self.end() && self.window(s, len) == 0 {
+            self.mark(s, len);
+            if known {
+                self.known_to = s + len;
+            }
+            return s;
         }
+        self.reserve_slow(c, len)
+    }
+
+    #[inline(never)]
+    fn reserve_slow(&mut self, c: Cycle, len: u64) -> Cycle {
+        let c = c.max(self.lo);
+        let known = len == self.known_len && self.known_from <= c && c <= self.known_to;
+        let s = self.find(if known { self.known_to } else { c }, len);
+        self.cover(s + len - 1);
+        self.mark(s, len);
+        // No start in [c, s) fits (the search), nor in [s, s + len) now; joined to the
+        // known range when they touch.
+        if !known {
+            (self.known_from, self.known_len) = (c, len);
+        }
+        self.known_to = s + len;
         s
+    }
+}
+
+impl SparseSlots<2> {
+    /// Reserves the first free cycle at or after `c` (as [`SparseSlots::reserve`]) and
+    /// marks it pending until it is retired ([`SparseSlots::retire_before`],
+    /// [`SparseSlots::retire_first`]). The owner retires every pending cycle before it
+    /// raises the floor past it.
+    #[inline]
+    pub fn reserve_pending(&mut self, c: Cycle) -> Cycle {
+        let s = self.reserve(c);
+        let i = self.index(s);
+        self.words[i][1] |= 1 << (s & 63);
+        if self.pending == 0 || s < self.first_pending {
+            self.first_pending = s;
+        }
+        self.pending += 1;
+        s
+    }
+
+    /// Pending cycles.
+    #[inline]
+    pub fn pending(&self) -> u32 {
+        self.pending
+    }
+
+    /// Retires every pending cycle before `limit`.
+    #[inline]
+    pub fn retire_before(&mut self, limit: Cycle) {
+        if self.pending > 0 && self.first_pending < limit {
+            self.retire_before_slow(limit);
+        }
+    }
+
+    #[inline(never)]
+    fn retire_before_slow(&mut self, limit: Cycle) {
+        let mut x = self.first_pending;
+        loop {
+            // `x < limit` is the earliest pending cycle: clear its word's bits below `limit`.
+            let w0 = x & !63;
+            let keep = if limit - w0 >= 64 {
+                0
+            } else {
+                u64::MAX << (limit - w0)
+            };
+            let i = self.index(x);
+            let bits = self.words[i][1];
+            self.words[i][1] = bits & keep;
+            self.pending -= (bits & !keep).count_ones();
+            if self.pending == 0 {
+                return;
+            }
+            x = if bits & keep != 0 {
+                w0 + (bits & keep).trailing_zeros() as u64
+            } else {
+                self.next_pending(w0 + 64)
+            };
+            if x >= limit {
+                self.first_pending = x;
+                return;
+            }
+        }
+    }
+
+    /// Retires the earliest pending cycle and returns it (`None` when none is pending).
+    #[inline]
+    pub fn retire_first(&mut self) -> Option<Cycle> {
+        if self.pending == 0 {
+            return None;
+        }
+        let s = self.first_pending;
+        let i = self.index(s);
+        // No pending bit below `s`'s: the rest of its word first.
+        let rest = self.words[i][1] & !(1 << (s & 63));
+        self.words[i][1] = rest;
+        self.pending -= 1;
+        if self.pending > 0 {
+            self.first_pending = if rest != 0 {
+                (s & !63) + rest.trailing_zeros() as u64
+            } else {
+                self.next_pending((s | 63) + 1)
+            };
+        }
+        Some(s)
+    }
+
+    /// The first pending cycle at or after `from` (one exists: `pending > 0` and none
+    /// before `from`).
+    fn next_pending(&self, from: Cycle) -> Cycle {
+        let mut x = from;
+        loop {
+            debug_assert!(x < self.end(), "no pending cycle from {from}");
+            let bits = self.words[self.index(x)][1] >> (x & 63);
+            if bits != 0 {
+                return x + bits.trailing_zeros() as u64;
+            }
+            x = (x | 63) + 1;
+        }
     }
 }
 
@@ -430,7 +609,7 @@ mod tests {
 
     #[test]
     fn sparse_far_future_reservations_keep_earlier_cycles_free() {
-        let mut s = SparseSlots::default();
+        let mut s = SparseSlots::<1>::default();
         assert_eq!(s.reserve(100_000), 100_000);
         // A plain window would have slid past cycle 1000.
         assert_eq!(s.reserve(1000), 1000);
@@ -438,7 +617,7 @@ mod tests {
         assert_eq!(s.peek(1000), 1002);
         assert_eq!(s.reserve(99_999), 99_999);
         assert_eq!(s.reserve(99_999), 100_001);
-        let mut a = SparseSlots::default();
+        let mut a = SparseSlots::<1>::default();
         assert_eq!(a.reserve_span(100_000, 13), 100_000);
         assert_eq!(a.reserve_span(100, 13), 100);
         assert_eq!(a.reserve_span(100, 13), 113);
@@ -453,7 +632,7 @@ mod tests {
     /// at once, and a gap of exactly the span's length fits.
     #[test]
     fn sparse_span_search_skips_short_gaps_and_full_words() {
-        let mut s = SparseSlots::default();
+        let mut s = SparseSlots::<1>::default();
         // One taken cycle every 10 up to 1000: no gap of 13 before 991.
         for x in (0..1000).step_by(10) {
             assert_eq!(s.reserve(x), x);
@@ -483,7 +662,7 @@ mod tests {
     #[test]
     fn spans_keep_their_spacing_and_fill_gaps() {
         // Spans (t_RRD between activations) live in the DRAM's `SparseSlots`.
-        let mut s = SparseSlots::default();
+        let mut s = SparseSlots::<1>::default();
         assert_eq!(s.reserve_span(100, 13), 100);
         assert_eq!(s.reserve_span(100, 13), 113);
         // A gap of 13 before 100 is usable; one of 12 is not.
@@ -630,22 +809,65 @@ mod bank_tests {
         }
     }
 
+    /// The pending plane against a min-heap of the pending cycles (the DRAM read queue's
+    /// previous form): cycles reserved in a jittered order ahead of a rising floor, some far
+    /// ahead, retired in bulk below a limit that moves back and forth (never below the
+    /// floor) and one at a time from the earliest, as a full read queue does.
+    #[test]
+    fn pending_plane_matches_a_heap() {
+        use std::cmp::Reverse;
+        use std::collections::BinaryHeap;
+        for seed in 0..20 {
+            let mut rng = Pcg32::new(seed, 11);
+            let mut heap = BinaryHeap::new();
+            let mut slots = SparseSlots::<2>::default();
+            let mut floor = 0;
+            let cap = [1, 4, 64][seed as usize % 3];
+            for i in 0..3000 {
+                floor += rng.below(6) as u64 * (rng.below(4) == 0) as u64;
+                let limit = floor + rng.below(40) as u64;
+                while heap.peek().is_some_and(|&Reverse(d)| d < limit) {
+                    heap.pop();
+                }
+                slots.retire_before(limit);
+                slots.forget_before(floor);
+                let what = format!("seed {seed}, request {i}");
+                assert_eq!(slots.pending() as usize, heap.len(), "{what}");
+                if heap.len() >= cap {
+                    let first = heap.pop().map(|Reverse(d)| d);
+                    assert_eq!(slots.retire_first(), first, "{what}");
+                }
+                let far = if rng.below(100) == 0 { 3000 } else { 0 };
+                let s = slots.reserve_pending(floor + far + rng.below(200) as u64);
+                heap.push(Reverse(s));
+            }
+            while let Some(Reverse(d)) = heap.pop() {
+                assert_eq!(slots.retire_first(), Some(d), "seed {seed}: draining");
+            }
+            assert_eq!(slots.retire_first(), None);
+        }
+    }
+
     /// `SparseSlots` against a plain set of taken cycles: spans of 1..=20 cycles requested
     /// in a jittered order ahead of a rising floor, some far ahead (the ring grows), with
-    /// `peek` checked before each reservation.
+    /// `peek` checked before each reservation; spans of two lengths alternating, or of one
+    /// length in a dense backlog.
     #[test]
     fn sparse_slots_match_a_set_of_taken_cycles() {
-        for seed in 0..8 {
+        for seed in 0..16 {
             let mut rng = Pcg32::new(seed, 9);
             let mut set = BTreeSet::new();
-            let mut slots = SparseSlots::default();
+            let mut slots = SparseSlots::<1>::default();
             let mut floor = 0;
             let len = 1 + rng.below(20) as u64;
+            // Seeds 8.. keep one span length and request densely (a saturated backlog:
+            // the known range of non-fitting starts is used and extended).
+            let (mixed, spread) = if seed < 8 { (true, 300) } else { (false, 60) };
             for i in 0..2000 {
                 floor += rng.below(14) as u64;
                 slots.forget_before(floor);
                 let far = if rng.below(50) == 0 { 5000 } else { 0 };
-                let c = floor + far + rng.below(300) as u64;
+                let c = floor + far + rng.below(spread) as u64;
                 let free =
                     |set: &BTreeSet<Cycle>, s: Cycle, l: u64| (s..s + l).all(|x| !set.contains(&x));
                 let mut p = c;
@@ -653,7 +875,7 @@ mod bank_tests {
                     p += 1;
                 }
                 assert_eq!(slots.peek(c), p, "seed {seed}, request {i}: peek");
-                let l = if i % 2 == 0 { len } else { 1 };
+                let l = if mixed && i % 2 == 1 { 1 } else { len };
                 let mut s = c;
                 while !free(&set, s, l) {
                     s += 1;
