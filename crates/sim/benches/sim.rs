@@ -10,6 +10,12 @@
 //! `frame_atrium`: a whole 64×64 path-traced frame of the builtin architectural scene
 //! (`builtin:atrium`) in each of the eight configurations, counted the same way (a BVH8
 //! visit loads a 200-byte node and tests 8 boxes, a DST visit one 8–20-byte node).
+//! `frame_dragon`: a 128×128 path-traced frame of `../shared/scenes/dragon_box.ply.gz` (the
+//! issue's scene; skipped with a note when the file is absent), every configuration.
+//!
+//! The synthetic stream is a stress case, not a typical frame: 1.54 DRAM reads per visit
+//! and 100-visit programs, where the dragon_box 512² BVH2 path frame makes 0.20 DRAM reads
+//! per visit and 11.7 visits per ray (`docs/performance.md`, "Simulator speed").
 
 use divan::counter::ItemsCount;
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
@@ -136,5 +142,23 @@ fn frame_soup(b: divan::Bencher, accel: SimAccel) {
 fn frame_atrium(b: divan::Bencher, accel: SimAccel) {
     let scene = dualsplit_scene::builtin::generate("atrium").unwrap();
     let settings = dualsplit_render::RenderSettings::new(64, 64, dualsplit_render::Workload::Path);
+    bench_frame(b, &scene, accel, &settings);
+}
+
+#[divan::bench(args = SimAccel::ALL, sample_count = 3)]
+fn frame_dragon(b: divan::Bencher, accel: SimAccel) {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/scenes/dragon_box.ply.gz"
+    );
+    let scene = match dualsplit_scene::load(path) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("frame_dragon skipped: {e}");
+            return;
+        }
+    };
+    let settings =
+        dualsplit_render::RenderSettings::new(128, 128, dualsplit_render::Workload::Path);
     bench_frame(b, &scene, accel, &settings);
 }
