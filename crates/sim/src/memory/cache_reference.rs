@@ -1,0 +1,367 @@
+//! The tag arrays as they were before the hot/cold split (one 16-byte record per way),
+//! kept as the reference that `cache.rs`'s randomized tests compare the cache with.
+#![allow(dead_code)]
+
+use crate::Cycle;
+use rustc_hash::FxHashMap;
+
+/// The result of a tag lookup.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lookup {
+    /// The line is present or in flight; its data is (or will be) there at `fill`.
+    Present {
+        /// Cycle the line's fill arrives (≤ now for a plain hit).
+        fill: Cycle,
+    },
+    /// The line is absent and not in flight.
+    Absent,
+}
+
+/// One way's tag: the line it holds once its fill arrives, and the line it replaced, still
+/// readable until then. Stored as 32-bit words (16 bytes a way) while every line number and
+/// fill cycle fits, as 64-bit words (32 bytes) from the first one that does not ([`Ways`]).
+#[derive(Clone, Copy, Debug)]
+struct Way<W> {
+    /// The line this way holds once `fill` has arrived.
+    line: W,
+    fill: W,
+    /// The line replaced by `line`, still readable before `fill` (its own fill cycle).
+    prev: W,
+    prev_fill: W,
+}
+
+/// A tag word: a line number or a cycle.
+trait Word: Copy + Eq {
+    /// No line.
+    const INVALID: Self;
+    const ZERO: Self;
+    /// `x` as a word, if it fits and is not `INVALID`.
+    fn fit(x: u64) -> Option<Self>;
+    fn get(self) -> u64;
+}
+
+impl Word for u32 {
+    const INVALID: u32 = u32::MAX;
+    const ZERO: u32 = 0;
+    #[inline]
+    fn fit(x: u64) -> Option<u32> {
+        u32::try_from(x).ok().filter(|&v| v != u32::MAX)
+    }
+    #[inline]
+    fn get(self) -> u64 {
+        u64::from(self)
+    }
+}
+
+impl Word for u64 {
+    const INVALID: u64 = u64::MAX;
+    const ZERO: u64 = 0;
+    #[inline]
+    fn fit(x: u64) -> Option<u64> {
+        Some(x)
+    }
+    #[inline]
+    fn get(self) -> u64 {
+        self
+    }
+}
+
+impl<W: Word> Way<W> {
+    const EMPTY: Self = Way {
+        line: W::INVALID,
+        fill: W::ZERO,
+        prev: W::INVALID,
+        prev_fill: W::ZERO,
+    };
+}
+
+/// The tag array: 16-byte ways halve the host memory a lookup streams through (64 L1 tag
+/// arrays and the L2's, several MB, far beyond the host's L2 cache), and every frame so
+/// far fits them (line numbers and cycles below 2^32 − 1); the first install that does not
+/// fit converts the array to 64-bit words, so results never depend on the width.
+#[derive(Clone, Debug)]
+enum Ways {
+    Narrow(Vec<Way<u32>>),
+    Wide(Vec<Way<u64>>),
+}
+
+/// Finds `line` in set `s` (see [`Cache::lookup`]): the fill cycle of a present line or of
+/// a replaced line still readable at `now`.
+#[inline]
+fn find<W: Word>(
+    ways: &[Way<W>],
+    used: &mut [u64],
+    stamp: u64,
+    s: usize,
+    assoc: usize,
+    line: u64,
+    now: Cycle,
+) -> Option<Cycle> {
+    // A line that does not fit was never installed in a narrow array.
+    let line = W::fit(line)?;
+    if assoc == 1 {
+        let w = ways[s];
+        if w.line == line {
+            return Some(w.fill.get());
+        }
+        if w.prev == line && now < w.fill.get() {
+            return Some(w.prev_fill.get());
+        }
+        return None;
+    }
+    for i in s..s + assoc {
+        if ways[i].line == line {
+            used[i] = stamp;
+            return Some(ways[i].fill.get());
+        }
+    }
+    ways[s..s + assoc]
+        .iter()
+        .find(|w| w.prev == line && now < w.fill.get())
+        .map(|w| w.prev_fill.get())
+}
+
+/// Puts `line` (filled at `fill`, missed at `now`) into the least recently used way of set
+/// `s` (see [`Cache::install`]); returns the replaced line and its fill if it was still in
+/// flight.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn replace<W: Word>(
+    ways: &mut [Way<W>],
+    used: &mut [u64],
+    stamp: u64,
+    s: usize,
+    assoc: usize,
+    line: W,
+    fill: W,
+    now: Cycle,
+) -> Option<(u64, Cycle)> {
+    let victim = if assoc == 1 {
+        s
+    } else {
+        let v = (s..s + assoc)
+            .min_by_key(|&i| {
+                if ways[i].line == W::INVALID {
+                    0
+                } else {
+                    used[i] + 1
+                }
+            })
+            .expect("at least one way");
+        used[v] = stamp;
+        v
+    };
+    let w = &mut ways[victim];
+    let mut moved = None;
+    if w.line != W::INVALID {
+        if w.fill.get() <= now {
+            w.prev = w.line;
+            w.prev_fill = w.fill;
+        } else {
+            // Still in flight: the older resident (`prev`) stays readable, the in-flight
+            // line keeps its MSHR entry.
+            moved = Some((w.line.get(), w.fill.get()));
+        }
+    }
+    w.line = line;
+    w.fill = fill;
+    moved
+}
+
+/// In-flight entries are pruned once the table has grown past this many (amortised).
+const INFLIGHT_PRUNE: usize = 64;
+
+/// Tags of a set-associative cache, with the in-flight (MSHR) list.
+#[derive(Clone, Debug)]
+pub struct Cache {
+    ways: Ways,
+    /// LRU stamps, parallel to `ways` (empty when direct-mapped: nothing to choose).
+    used: Vec<u64>,
+    assoc: usize,
+    set_mask: u64,
+    stamp: u64,
+    /// Lines in flight whose way has since been taken by a later miss: line → fill cycle.
+    /// (Fx hashing: the list is probed on every miss that the set does not answer, and
+    /// SipHash's resistance to chosen keys buys nothing for line numbers.)
+    inflight: FxHashMap<u64, Cycle>,
+    prune_at: usize,
+    /// What may be on `inflight` (host speed only; the answer is the list's).
+    filter: InflightFilter,
+}
+
+/// A one-hash Bloom filter over the in-flight list's lines (bit set ⇒ the line may be on
+/// it; clear ⇒ it is not), rebuilt when the list is pruned, and the latest fill on the
+/// list: most misses are answered by one bit test instead of a hash-table probe.
+#[derive(Clone, Debug)]
+struct InflightFilter {
+    bits: Vec<u64>,
+    /// log2 of the bit count (the hash keeps this many top bits).
+    log2: u32,
+    /// The latest fill of a listed line: nothing is in flight from then on.
+    until: Cycle,
+}
+
+impl InflightFilter {
+    /// One bit per set, 4096 to 65 536 bits.
+    fn new(sets: u64) -> Self {
+        let log2 = sets.next_power_of_two().trailing_zeros().clamp(12, 16);
+        InflightFilter {
+            bits: vec![0; 1 << (log2 - 6)],
+            log2,
+            until: 0,
+        }
+    }
+
+    /// Word and bit of `line` (Fibonacci hashing: lines of one set share their low bits,
+    /// so those cannot be used directly).
+    #[inline]
+    fn bit(&self, line: u64) -> (usize, u64) {
+        let h = line.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.log2);
+        ((h >> 6) as usize, 1 << (h & 63))
+    }
+
+    /// Records `line`, in flight until `fill`.
+    #[inline]
+    fn note(&mut self, line: u64, fill: Cycle) {
+        let (i, bit) = self.bit(line);
+        self.bits[i] |= bit;
+        self.until = self.until.max(fill);
+    }
+
+    /// Whether `line` may be on the list at `now`.
+    #[inline]
+    fn may_hold(&self, line: u64, now: Cycle) -> bool {
+        now < self.until && {
+            let (i, bit) = self.bit(line);
+            self.bits[i] & bit != 0
+        }
+    }
+
+    /// Forgets everything and records `list` again.
+    fn rebuild(&mut self, list: &FxHashMap<u64, Cycle>) {
+        self.bits.fill(0);
+        self.until = 0;
+        for (&l, &f) in list {
+            self.note(l, f);
+        }
+    }
+}
+
+impl Cache {
+    /// A cache of `size_bytes` with 64-byte lines and `associativity` ways (power-of-two sets).
+    pub fn new(size_bytes: u64, line_bytes: u64, associativity: u32) -> Self {
+        let assoc = associativity.max(1) as usize;
+        let sets = (size_bytes / line_bytes / assoc as u64).max(1);
+        let n = sets as usize * assoc;
+        Self {
+            ways: Ways::Narrow(vec![Way::EMPTY; n]),
+            used: if assoc > 1 { vec![0; n] } else { Vec::new() },
+            assoc,
+            set_mask: sets - 1,
+            stamp: 0,
+            inflight: FxHashMap::default(),
+            prune_at: INFLIGHT_PRUNE,
+            filter: InflightFilter::new(sets),
+        }
+    }
+
+    #[inline]
+    fn set(&self, line: u64) -> usize {
+        (line & self.set_mask) as usize * self.assoc
+    }
+
+    /// Looks up `line` (a line number: byte address / 64) at cycle `now`, updating LRU state
+    /// on a hit. A line replaced by a miss still in flight is a hit until that fill arrives;
+    /// a line in flight is `Present` with its future fill cycle (the caller merges).
+    #[inline]
+    pub fn lookup(&mut self, line: u64, now: Cycle) -> Lookup {
+        let s = self.set(line);
+        if self.assoc > 1 {
+            self.stamp += 1;
+        }
+        let (assoc, stamp) = (self.assoc, self.stamp);
+        let found = match &self.ways {
+            Ways::Narrow(w) => find(w, &mut self.used, stamp, s, assoc, line, now),
+            Ways::Wide(w) => find(w, &mut self.used, stamp, s, assoc, line, now),
+        };
+        if let Some(fill) = found {
+            return Lookup::Present { fill };
+        }
+        if self.filter.may_hold(line, now)
+            && let Some(&fill) = self.inflight.get(&line)
+            && fill > now
+        {
+            return Lookup::Present { fill };
+        }
+        Lookup::Absent
+    }
+
+    /// The tag word of `line`'s first way, read without effect (see `Thread::touch`).
+    #[inline]
+    pub fn peek(&self, line: u64) -> u64 {
+        let s = self.set(line);
+        match &self.ways {
+            Ways::Narrow(w) => w[s].line.get(),
+            Ways::Wide(w) => w[s].line,
+        }
+    }
+
+    /// Takes the tag array out as 64-bit words (exact: every narrow word widens to itself,
+    /// `INVALID` to `INVALID`); the caller puts it back.
+    fn take_wide(&mut self) -> Vec<Way<u64>> {
+        match std::mem::replace(&mut self.ways, Ways::Wide(Vec::new())) {
+            Ways::Wide(w) => w,
+            Ways::Narrow(w) => {
+                let wide = |x: u32| {
+                    if x == u32::INVALID {
+                        u64::INVALID
+                    } else {
+                        u64::from(x)
+                    }
+                };
+                w.iter()
+                    .map(|w| Way {
+                        line: wide(w.line),
+                        fill: u64::from(w.fill),
+                        prev: wide(w.prev),
+                        prev_fill: u64::from(w.prev_fill),
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// Reserves the least recently used way of `line`'s set for a miss made at cycle `now`
+    /// whose fill arrives at `fill`. The line it replaces stays readable until then; if that
+    /// line is itself still in flight, it moves to the in-flight list.
+    #[inline]
+    pub fn install(&mut self, line: u64, fill: Cycle, now: Cycle) {
+        let s = self.set(line);
+        if self.assoc > 1 {
+            self.stamp += 1;
+        }
+        let (assoc, stamp) = (self.assoc, self.stamp);
+        let moved = match (&mut self.ways, u32::fit(line), u32::fit(fill)) {
+            (Ways::Narrow(w), Some(l), Some(f)) => {
+                replace(w, &mut self.used, stamp, s, assoc, l, f, now)
+            }
+            (Ways::Wide(w), ..) => replace(w, &mut self.used, stamp, s, assoc, line, fill, now),
+            (Ways::Narrow(_), ..) => {
+                // The first line or cycle beyond 32 bits.
+                let mut w = self.take_wide();
+                let moved = replace(&mut w, &mut self.used, stamp, s, assoc, line, fill, now);
+                self.ways = Ways::Wide(w);
+                moved
+            }
+        };
+        if let Some((l, f)) = moved {
+            self.inflight.insert(l, f);
+            self.filter.note(l, f);
+            if self.inflight.len() >= self.prune_at {
+                self.inflight.retain(|_, f| *f > now);
+                self.prune_at = (2 * self.inflight.len()).max(INFLIGHT_PRUNE);
+                self.filter.rebuild(&self.inflight);
+            }
+        }
+    }
+}
