@@ -35,17 +35,17 @@ pub enum Lookup {
     Absent,
 }
 
-/// One way's tag word pair: a line and its fill cycle. The tag array keeps the pairs of a
-/// way in two parallel arrays ([`Arrays`]): the line the way holds once its fill arrives
-/// (*hot*: every lookup and every touch-pass peek reads it) and the line it replaced, still
-/// readable until then (*cold*: read only by a lookup that misses a way whose fill is still
-/// ahead, written by a miss). Stored as 32-bit words (8 bytes a pair) while every line
-/// number and fill cycle fits, as 64-bit words (16 bytes) from the first one that does not
-/// ([`Ways`]).
+/// One way's tag: the line it holds once its fill arrives, and the line it replaced, still
+/// readable until then. Stored as 32-bit words (16 bytes a way) while every line number and
+/// fill cycle fits, as 64-bit words (32 bytes) from the first one that does not ([`Ways`]).
 #[derive(Clone, Copy, Debug)]
-struct Tag<W> {
+struct Way<W> {
+    /// The line this way holds once `fill` has arrived.
     line: W,
     fill: W,
+    /// The line replaced by `line`, still readable before `fill` (its own fill cycle).
+    prev: W,
+    prev_fill: W,
 }
 
 /// A tag word: a line number or a cycle.
@@ -84,50 +84,30 @@ impl Word for u64 {
     }
 }
 
-impl<W: Word> Tag<W> {
-    const EMPTY: Self = Tag {
+impl<W: Word> Way<W> {
+    const EMPTY: Self = Way {
         line: W::INVALID,
         fill: W::ZERO,
+        prev: W::INVALID,
+        prev_fill: W::ZERO,
     };
 }
 
-/// The ways of every set, hot and cold apart (way `i` is `tags[i]` and `prev[i]`): a hit
-/// (most L1 lookups of a real frame) and the touch pass's peeks read only `tags`, half the
-/// host memory of one 16-byte record per way, so the 64 L1 tag arrays (8 KB each) and the
-/// L2's (512 KB) stay in the host's caches more often.
-#[derive(Clone, Debug)]
-struct Arrays<W> {
-    /// The line each way holds once `fill` has arrived.
-    tags: Vec<Tag<W>>,
-    /// The line replaced by `tags[i].line`, readable before `tags[i].fill` (its own fill).
-    prev: Vec<Tag<W>>,
-}
-
-impl<W: Word> Arrays<W> {
-    fn new(n: usize) -> Self {
-        Arrays {
-            tags: vec![Tag::EMPTY; n],
-            prev: vec![Tag::EMPTY; n],
-        }
-    }
-}
-
-/// The tag arrays: 32-bit words halve the host memory a lookup streams through (64 L1 tag
-/// arrays and the L2's, far beyond the host's L2 cache), and every frame so far fits them
-/// (line numbers and cycles below 2^32 − 1); the first install that does not fit converts
-/// the arrays to 64-bit words, so results never depend on the width.
+/// The tag array: 16-byte ways halve the host memory a lookup streams through (64 L1 tag
+/// arrays and the L2's, several MB, far beyond the host's L2 cache), and every frame so
+/// far fits them (line numbers and cycles below 2^32 − 1); the first install that does not
+/// fit converts the array to 64-bit words, so results never depend on the width.
 #[derive(Clone, Debug)]
 enum Ways {
-    Narrow(Arrays<u32>),
-    Wide(Arrays<u64>),
+    Narrow(Vec<Way<u32>>),
+    Wide(Vec<Way<u64>>),
 }
 
 /// Finds `line` in set `s` (see [`Cache::lookup`]): the fill cycle of a present line or of
-/// a replaced line still readable at `now`. The cold half is read only for a way whose
-/// fill is still ahead of `now` (before it, its replaced line is not readable).
+/// a replaced line still readable at `now`.
 #[inline]
 fn find<W: Word>(
-    ways: &Arrays<W>,
+    ways: &[Way<W>],
     used: &mut [u64],
     stamp: u64,
     s: usize,
@@ -138,26 +118,25 @@ fn find<W: Word>(
     // A line that does not fit was never installed in a narrow array.
     let line = W::fit(line)?;
     if assoc == 1 {
-        let t = ways.tags[s];
-        if t.line == line {
-            return Some(t.fill.get());
+        let w = ways[s];
+        if w.line == line {
+            return Some(w.fill.get());
         }
-        if now < t.fill.get() {
-            let p = ways.prev[s];
-            if p.line == line {
-                return Some(p.fill.get());
-            }
+        if w.prev == line && now < w.fill.get() {
+            return Some(w.prev_fill.get());
         }
         return None;
     }
-    let tags = &ways.tags[s..s + assoc];
-    if let Some(i) = tags.iter().position(|t| t.line == line) {
-        used[s + i] = stamp;
-        return Some(tags[i].fill.get());
+    for i in s..s + assoc {
+        if ways[i].line == line {
+            used[i] = stamp;
+            return Some(ways[i].fill.get());
+        }
     }
-    (s..s + assoc)
-        .find(|&i| now < ways.tags[i].fill.get() && ways.prev[i].line == line)
-        .map(|i| ways.prev[i].fill.get())
+    ways[s..s + assoc]
+        .iter()
+        .find(|w| w.prev == line && now < w.fill.get())
+        .map(|w| w.prev_fill.get())
 }
 
 /// Puts `line` (filled at `fill`, missed at `now`) into the least recently used way of set
@@ -166,7 +145,7 @@ fn find<W: Word>(
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn replace<W: Word>(
-    ways: &mut Arrays<W>,
+    ways: &mut [Way<W>],
     used: &mut [u64],
     stamp: u64,
     s: usize,
@@ -180,7 +159,7 @@ fn replace<W: Word>(
     } else {
         let v = (s..s + assoc)
             .min_by_key(|&i| {
-                if ways.tags[i].line == W::INVALID {
+                if ways[i].line == W::INVALID {
                     0
                 } else {
                     used[i] + 1
@@ -190,18 +169,20 @@ fn replace<W: Word>(
         used[v] = stamp;
         v
     };
-    let old = ways.tags[victim];
+    let w = &mut ways[victim];
     let mut moved = None;
-    if old.line != W::INVALID {
-        if old.fill.get() <= now {
-            ways.prev[victim] = old;
+    if w.line != W::INVALID {
+        if w.fill.get() <= now {
+            w.prev = w.line;
+            w.prev_fill = w.fill;
         } else {
             // Still in flight: the older resident (`prev`) stays readable, the in-flight
             // line keeps its MSHR entry.
-            moved = Some((old.line.get(), old.fill.get()));
+            moved = Some((w.line.get(), w.fill.get()));
         }
     }
-    ways.tags[victim] = Tag { line, fill };
+    w.line = line;
+    w.fill = fill;
     moved
 }
 
@@ -291,7 +272,7 @@ impl Cache {
         let sets = (size_bytes / line_bytes / assoc as u64).max(1);
         let n = sets as usize * assoc;
         Self {
-            ways: Ways::Narrow(Arrays::new(n)),
+            ways: Ways::Narrow(vec![Way::EMPTY; n]),
             used: if assoc > 1 { vec![0; n] } else { Vec::new() },
             assoc,
             set_mask: sets - 1,
@@ -338,29 +319,32 @@ impl Cache {
     pub fn peek(&self, line: u64) -> u64 {
         let s = self.set(line);
         match &self.ways {
-            Ways::Narrow(w) => w.tags[s].line.get(),
-            Ways::Wide(w) => w.tags[s].line,
+            Ways::Narrow(w) => w[s].line.get(),
+            Ways::Wide(w) => w[s].line,
         }
     }
 
     /// Takes the tag array out as 64-bit words (exact: every narrow word widens to itself,
     /// `INVALID` to `INVALID`); the caller puts it back.
-    fn take_wide(&mut self) -> Arrays<u64> {
-        match std::mem::replace(&mut self.ways, Ways::Wide(Arrays::new(0))) {
+    fn take_wide(&mut self) -> Vec<Way<u64>> {
+        match std::mem::replace(&mut self.ways, Ways::Wide(Vec::new())) {
             Ways::Wide(w) => w,
             Ways::Narrow(w) => {
-                let wide = |t: &Tag<u32>| Tag {
-                    line: if t.line == u32::INVALID {
+                let wide = |x: u32| {
+                    if x == u32::INVALID {
                         u64::INVALID
                     } else {
-                        u64::from(t.line)
-                    },
-                    fill: u64::from(t.fill),
+                        u64::from(x)
+                    }
                 };
-                Arrays {
-                    tags: w.tags.iter().map(wide).collect(),
-                    prev: w.prev.iter().map(wide).collect(),
-                }
+                w.iter()
+                    .map(|w| Way {
+                        line: wide(w.line),
+                        fill: u64::from(w.fill),
+                        prev: wide(w.prev),
+                        prev_fill: u64::from(w.prev_fill),
+                    })
+                    .collect()
             }
         }
     }
@@ -401,57 +385,8 @@ impl Cache {
 }
 
 #[cfg(test)]
-#[path = "cache_reference.rs"]
-mod reference;
-
-#[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The hot/cold tag arrays answer every lookup as the former 16-byte records
-    /// (`reference`): random lines over a few times the cache's sets, fills near and far
-    /// (lines in flight, replaced lines still readable, the in-flight list), for direct
-    /// mapped and set-associative caches, narrow and (from a late install) wide words.
-    #[test]
-    fn hot_and_cold_ways_answer_as_the_single_records() {
-        for (assoc, seed) in [(1, 1), (1, 2), (2, 3), (4, 4), (8, 5)] {
-            let mut rng = dualsplit_geometry::Pcg32::new(seed, 17);
-            let mut c = Cache::new(64 * 64, 64, assoc);
-            let mut r = reference::Cache::new(64 * 64, 64, assoc);
-            let mut now = 0;
-            let mut kinds = [0u64; 3];
-            for i in 0..60_000 {
-                now += rng.below(4) as u64;
-                let line = match (i, rng.below(16)) {
-                    (50_000.., 0) => (1u64 << 33) + rng.below(64) as u64,
-                    _ => rng.below(256) as u64,
-                };
-                let at = now + rng.below(40) as u64;
-                let got = c.lookup(line, at);
-                let want = match r.lookup(line, at) {
-                    reference::Lookup::Present { fill } => Lookup::Present { fill },
-                    reference::Lookup::Absent => Lookup::Absent,
-                };
-                assert_eq!(got, want, "assoc {assoc}, step {i}, line {line}, at {at}");
-                assert_eq!(c.peek(line), r.peek(line), "assoc {assoc}, step {i}");
-                match got {
-                    Lookup::Present { fill } if fill <= at => kinds[0] += 1,
-                    Lookup::Present { .. } => kinds[1] += 1,
-                    Lookup::Absent => {
-                        kinds[2] += 1;
-                        let fill = at + 1 + rng.below(if i % 7 == 0 { 2000 } else { 200 }) as u64;
-                        c.install(line, fill, at);
-                        r.install(line, fill, at);
-                    }
-                }
-            }
-            assert!(
-                kinds.iter().all(|&k| k > 1000),
-                "assoc {assoc}: hits, merges, misses {kinds:?}"
-            );
-            assert!(matches!(c.ways, Ways::Wide(_)), "assoc {assoc}");
-        }
-    }
 
     #[test]
     fn direct_mapped_conflict_evicts_when_the_new_line_arrives() {
@@ -500,10 +435,9 @@ mod tests {
                 let Ways::Narrow(ways) = &c.ways else {
                     panic!("the test's lines and cycles fit 32 bits")
                 };
-                let in_set = (set..set + c.assoc).any(|i| {
-                    let (t, p) = (ways.tags[i], ways.prev[i]);
-                    t.line.get() == line || (p.line.get() == line && now < t.fill.get())
-                });
+                let in_set = ways[set..set + c.assoc]
+                    .iter()
+                    .any(|w| w.line.get() == line || (w.prev.get() == line && now < w.fill.get()));
                 let listed = c.inflight.get(&line).copied().filter(|&f| f > now);
                 let got = c.lookup(line, now);
                 if !in_set {
