@@ -32,9 +32,13 @@ impl Slots {
         self.reserve_slow(c)
     }
 
+    /// A request outside the window or on a taken cycle: slides the window when `c` lies
+    /// past it, then takes the first free cycle from `c` (from the window base if `c` lies
+    /// before it), sliding by half while the window is full from there. The offset stays
+    /// below `WINDOW` throughout, so the search is one shift and one bit scan per step.
     #[inline(never)]
     fn reserve_slow(&mut self, c: Cycle) -> Cycle {
-        if c >= self.base + WINDOW {
+        let mut off = if c >= self.base + WINDOW {
             // Keep the last 64 cycles of history before `c`.
             let nb = c - WINDOW / 2;
             let shift = nb - self.base;
@@ -44,23 +48,21 @@ impl Slots {
                 self.mask >> shift
             };
             self.base = nb;
-        }
-        let c = c.max(self.base);
+            WINDOW / 2
+        } else {
+            c.saturating_sub(self.base)
+        };
         loop {
-            let off = c.saturating_sub(self.base);
-            if off < WINDOW {
-                let free = !self.mask >> off;
-                if free != 0 {
-                    let s = off + free.trailing_zeros() as u64;
-                    if s < WINDOW {
-                        self.mask |= 1u128 << s;
-                        return self.base + s;
-                    }
-                }
+            let free = !self.mask >> off;
+            if free != 0 {
+                let s = off + free.trailing_zeros() as u64;
+                self.mask |= 1u128 << s;
+                return self.base + s;
             }
             // Nothing free in the window from `c`: slide it by half.
             self.mask >>= WINDOW / 2;
             self.base += WINDOW / 2;
+            off = off.saturating_sub(WINDOW / 2);
         }
     }
 
@@ -94,6 +96,9 @@ pub struct BankSlots {
     words: usize,
     /// log2(banks).
     bank_shift: u32,
+    /// `lo + 64 · words`: the first cycle past the ring (kept so the fast path's bound is
+    /// one compare).
+    end: Cycle,
     /// `bits[(x / 64 mod words) · banks + d]` bit `x mod 64`: bank `(d + x) mod banks` is
     /// taken at cycle `x`.
     bits: Vec<u64>,
@@ -122,6 +127,7 @@ impl BankSlots {
             bank_shift: banks.trailing_zeros(),
             lo: 0,
             words,
+            end: 64 * words as u64,
             bits: vec![0; banks as usize * words],
         }
     }
@@ -134,7 +140,7 @@ impl BankSlots {
     /// that is not enough.
     #[inline]
     fn cover(&mut self, hi: Cycle, now: Cycle) {
-        if hi < self.lo + self.span() {
+        if hi < self.end {
             return;
         }
         self.cover_slow(hi, now);
@@ -164,6 +170,7 @@ impl BankSlots {
             self.bits = bits;
             self.words = w2;
         }
+        self.end = self.lo + self.span();
     }
 
     /// Index in `bits` of diagonal `d`'s word `i`.
@@ -208,7 +215,7 @@ impl BankSlots {
     pub fn reserve_run(&mut self, bank: u64, c: Cycle, n: u64, now: Cycle, from: Cycle) -> Placed {
         debug_assert!(n >= 1 && c >= now && c >= self.lo);
         // Fast path (most runs): every word's bank is free in its cycle, one word test.
-        if n <= 64 && c + n <= self.lo + ((self.words as u64) << 6) {
+        if n <= 64 && c + n <= self.end {
             let d = (bank.wrapping_sub(c) & self.bank_mask) as usize;
             if self.taken(d, c, n) == 0 {
                 self.take(d, c, n);
@@ -646,6 +653,82 @@ mod tests {
         assert_eq!(s.reserve_span(1995, 13), 2200);
         assert_eq!(s.reserve_span(1995, 1), 1995);
         assert_eq!(s.reserve_span(1990, 13), 2300);
+    }
+
+    /// `Slots::reserve_slow` before its search was simplified (the test's reference).
+    #[derive(Clone, Copy, Default)]
+    struct OldSlots {
+        base: Cycle,
+        mask: u128,
+    }
+    impl OldSlots {
+        fn reserve(&mut self, c: Cycle) -> Cycle {
+            let off = c.wrapping_sub(self.base);
+            if off < WINDOW && self.mask & (1u128 << off) == 0 {
+                self.mask |= 1u128 << off;
+                return c;
+            }
+            if c >= self.base + WINDOW {
+                let nb = c - WINDOW / 2;
+                let shift = nb - self.base;
+                self.mask = if shift >= WINDOW {
+                    0
+                } else {
+                    self.mask >> shift
+                };
+                self.base = nb;
+            }
+            let c = c.max(self.base);
+            loop {
+                let off = c.saturating_sub(self.base);
+                if off < WINDOW {
+                    let free = !self.mask >> off;
+                    if free != 0 {
+                        let s = off + free.trailing_zeros() as u64;
+                        if s < WINDOW {
+                            self.mask |= 1u128 << s;
+                            return self.base + s;
+                        }
+                    }
+                }
+                self.mask >>= WINDOW / 2;
+                self.base += WINDOW / 2;
+            }
+        }
+    }
+
+    /// The simplified search reserves the cycles the former one did: contended requests
+    /// (many per cycle, jittered behind and ahead of the window, occasional far jumps), and
+    /// the window state matches after every request.
+    #[test]
+    fn slots_search_matches_the_former_search() {
+        for seed in 0..50 {
+            let mut rng = dualsplit_geometry::Pcg32::new(seed, 21);
+            let (mut new, mut old) = (Slots::default(), OldSlots::default());
+            let mut now = 0u64;
+            let mut slid = 0;
+            for i in 0..5000 {
+                now += rng.below(3) as u64 * (rng.below(2) == 0) as u64;
+                if rng.below(500) == 0 {
+                    now += 100 + rng.below(300) as u64;
+                }
+                let c = (now + rng.below(40) as u64).saturating_sub(rng.below(200) as u64);
+                let base = new.base;
+                assert_eq!(
+                    new.peek(c),
+                    old.clone().reserve(c),
+                    "seed {seed}, {i}: peek"
+                );
+                assert_eq!(new.reserve(c), old.reserve(c), "seed {seed}, {i}");
+                assert_eq!(
+                    (new.base, new.mask),
+                    (old.base, old.mask),
+                    "seed {seed}, {i}"
+                );
+                slid += u64::from(new.base != base);
+            }
+            assert!(slid > 20, "seed {seed}: the window slid {slid} times");
+        }
     }
 
     #[test]
