@@ -787,6 +787,15 @@ mod tests {
     }
 
     impl VecWheel {
+        fn new() -> Self {
+            Self {
+                buckets: vec![Vec::new(); WHEEL as usize],
+                now: 0,
+                in_wheel: 0,
+                overflow: BinaryHeap::new(),
+            }
+        }
+
         fn push(&mut self, t: Cycle, id: u32) {
             if t - self.now < WHEEL {
                 self.buckets[(t % WHEEL) as usize].push(id);
@@ -831,12 +840,7 @@ mod tests {
             let mut rng = dualsplit_geometry::Pcg32::new(seed, 7);
             let n = 300;
             let mut w = Wheel::new(n);
-            let mut v = VecWheel {
-                buckets: vec![Vec::new(); WHEEL as usize],
-                now: 0,
-                in_wheel: 0,
-                overflow: BinaryHeap::new(),
-            };
+            let mut v = VecWheel::new();
             for id in 0..n as u32 {
                 w.push(0, id);
                 v.push(0, id);
@@ -875,12 +879,7 @@ mod tests {
             let mut rng = dualsplit_geometry::Pcg32::new(seed, 11);
             let n = 300;
             let mut w = Wheel::new(n);
-            let mut v = VecWheel {
-                buckets: vec![Vec::new(); WHEEL as usize],
-                now: 0,
-                in_wheel: 0,
-                overflow: BinaryHeap::new(),
-            };
+            let mut v = VecWheel::new();
             // The reference's pending hops per thread (it wakes the thread at each).
             let mut plan: Vec<Vec<Cycle>> = vec![Vec::new(); n];
             for id in 0..n as u32 {
