@@ -305,11 +305,21 @@ impl Dram {
 
     /// (channel, bank, row) of a line number (byte address / 64).
     pub fn map(&self, line: u64) -> (usize, usize, u64) {
+        let (ch, b, row) = self.locate(line);
+        (ch, b >> self.ch_bits, row)
+    }
+
+    /// The mapping of [`Dram::map`] as indices: (channel, bank record, row), bank records
+    /// numbered bank · channels + channel, so both indices are masks of the same bits by
+    /// power-of-two table lengths (and the indexing needs no bounds test).
+    #[inline]
+    fn locate(&self, line: u64) -> (usize, usize, u64) {
         let x = line >> self.col_bits;
-        let ch = (x & ((1 << self.ch_bits) - 1)) as usize;
-        let x = x >> self.ch_bits;
-        let bank = (x & ((1 << self.bank_bits) - 1)) as usize;
-        (ch, bank, x >> self.bank_bits)
+        (
+            x as usize & (self.channels.len() - 1),
+            x as usize & (self.banks.len() - 1),
+            x >> (self.ch_bits + self.bank_bits),
+        )
     }
 
     /// Reads `line` arriving at core cycle `arrive`; returns the core cycle its data has
@@ -325,14 +335,7 @@ impl Dram {
         debug_assert!(now <= arrive);
         let c = &self.cfg;
         let tpc = c.ticks_per_cycle;
-        // The mapping of `map`; banks are numbered bank · channels + channel.
-        let x = line >> self.col_bits;
-        // (Masks by the power-of-two lengths, so the indexing below needs no bounds test.)
-        let (chi, b, row) = (
-            x as usize & (self.channels.len() - 1),
-            x as usize & (self.banks.len() - 1),
-            x >> (self.ch_bits + self.bank_bits),
-        );
+        let (chi, b, row) = self.locate(line);
         // Room for one more epoch in the bank's ring (this read opens at most one).
         if self.banks[b].len == 1 << self.epochs.shift {
             self.epochs.grow(&mut self.banks);
