@@ -22,6 +22,7 @@ use dualsplit_geometry::{Pcg32, Triangle, Vec3};
 use dualsplit_sim::engine::{Chip, Thread, WorkSource, run_chip};
 use dualsplit_sim::kernel::{Op, Pipe};
 use dualsplit_sim::{SimAccel, SimConfig, simulate};
+use std::sync::OnceLock;
 
 fn main() {
     divan::main();
@@ -96,69 +97,92 @@ fn engine_node_visits(b: divan::Bencher) {
         });
 }
 
-/// Simulates `settings`' frame once to count its node visits, then times it.
-fn bench_frame(
-    b: divan::Bencher,
-    scene: &dualsplit_scene::Scene,
-    accel: SimAccel,
-    settings: &dualsplit_render::RenderSettings,
-) {
-    let s = dualsplit_accel::Structures::build(&scene.triangles, &Default::default());
+/// A frame bench's scene with its structures, built once per bench function: divan calls
+/// the function once per configuration, and every configuration reads the same structures
+/// (dragon_box takes ≈ 2 s to load and build).
+type Built = (dualsplit_scene::Scene, dualsplit_accel::Structures);
+
+/// `None` when the scene could not be had.
+type Prepared = Option<Built>;
+
+/// Builds `cell`'s scene on first use (`None`: the scene could not be had; said once).
+fn prepared(
+    cell: &'static OnceLock<Prepared>,
+    scene: impl FnOnce() -> Result<dualsplit_scene::Scene, String>,
+) -> Option<&'static Built> {
+    cell.get_or_init(|| match scene() {
+        Ok(scene) => {
+            let s = dualsplit_accel::Structures::build(&scene.triangles, &Default::default());
+            Some((scene, s))
+        }
+        Err(e) => {
+            eprintln!("frame bench skipped: {e}");
+            None
+        }
+    })
+    .as_ref()
+}
+
+/// Simulates a `res`² path-traced frame of the prepared scene once to count its node
+/// visits, then times it.
+fn bench_frame(b: divan::Bencher, prepared: Option<&'static Built>, accel: SimAccel, res: u32) {
+    let Some((scene, s)) = prepared else {
+        return;
+    };
+    let settings =
+        dualsplit_render::RenderSettings::new(res, res, dualsplit_render::Workload::Path);
     let cfg = SimConfig::lin2020();
-    let nodes = simulate(scene, &s, accel, settings, &cfg, &|_, _| {})
+    let nodes = simulate(scene, s, accel, &settings, &cfg, &|_, _| {})
         .unwrap()
         .instructions
         .node_steps;
     b.counter(ItemsCount::new(nodes))
-        .bench(|| simulate(scene, &s, accel, settings, &cfg, &|_, _| {}).unwrap());
+        .bench(|| simulate(scene, s, accel, &settings, &cfg, &|_, _| {}).unwrap());
 }
 
 #[divan::bench(args = [SimAccel::Bvh2, SimAccel::Dst], sample_count = 3)]
 fn frame_soup(b: divan::Bencher, accel: SimAccel) {
-    let mut rng = Pcg32::new(7, 1);
-    let tris: Vec<Triangle> = (0..20_000)
-        .map(|_| {
-            let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
-            let mut v = || {
-                c + Vec3::new(
-                    rng.range_f32(-0.02, 0.02),
-                    rng.range_f32(-0.02, 0.02),
-                    rng.range_f32(-0.02, 0.02),
-                )
-            };
-            let (a, b, d) = (v(), v(), v());
-            Triangle::new(a, b, d)
-        })
-        .collect();
-    let scene =
+    static SOUP: OnceLock<Prepared> = OnceLock::new();
+    let soup = prepared(&SOUP, || {
+        let mut rng = Pcg32::new(7, 1);
+        let tris: Vec<Triangle> = (0..20_000)
+            .map(|_| {
+                let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+                let mut v = || {
+                    c + Vec3::new(
+                        rng.range_f32(-0.02, 0.02),
+                        rng.range_f32(-0.02, 0.02),
+                        rng.range_f32(-0.02, 0.02),
+                    )
+                };
+                let (a, b, d) = (v(), v(), v());
+                Triangle::new(a, b, d)
+            })
+            .collect();
         dualsplit_scene::Scene::from_triangles("soup", "bench:soup", tris, Default::default())
-            .unwrap();
-    let settings =
-        dualsplit_render::RenderSettings::new(128, 128, dualsplit_render::Workload::Path);
-    bench_frame(b, &scene, accel, &settings);
+            .map_err(|e| e.to_string())
+    });
+    bench_frame(b, soup, accel, 128);
 }
 
 #[divan::bench(args = SimAccel::ALL, sample_count = 3)]
 fn frame_atrium(b: divan::Bencher, accel: SimAccel) {
-    let scene = dualsplit_scene::builtin::generate("atrium").unwrap();
-    let settings = dualsplit_render::RenderSettings::new(64, 64, dualsplit_render::Workload::Path);
-    bench_frame(b, &scene, accel, &settings);
+    static ATRIUM: OnceLock<Prepared> = OnceLock::new();
+    let atrium = prepared(&ATRIUM, || {
+        dualsplit_scene::builtin::generate("atrium").map_err(|e| e.to_string())
+    });
+    bench_frame(b, atrium, accel, 64);
 }
 
 #[divan::bench(args = SimAccel::ALL, sample_count = 3)]
 fn frame_dragon(b: divan::Bencher, accel: SimAccel) {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/scenes/dragon_box.ply.gz"
-    );
-    let scene = match dualsplit_scene::load(path) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("frame_dragon skipped: {e}");
-            return;
-        }
-    };
-    let settings =
-        dualsplit_render::RenderSettings::new(128, 128, dualsplit_render::Workload::Path);
-    bench_frame(b, &scene, accel, &settings);
+    static DRAGON: OnceLock<Prepared> = OnceLock::new();
+    let dragon = prepared(&DRAGON, || {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/scenes/dragon_box.ply.gz"
+        );
+        dualsplit_scene::load(path).map_err(|e| e.to_string())
+    });
+    bench_frame(b, dragon, accel, 128);
 }
