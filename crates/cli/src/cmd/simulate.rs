@@ -4,6 +4,7 @@ use anyhow::{Context, bail};
 use dualsplit_render::{RenderSettings, Workload};
 use dualsplit_sim::{SimAccel, SimConfig, SimResult, simulate};
 use std::process::ExitCode;
+use std::time::{Duration, Instant};
 
 /// Arguments of `dualsplit simulate`.
 #[derive(clap::Args)]
@@ -67,20 +68,24 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let (scene, structures) = super::load_and_build(&args.scene, ctx)?;
     let settings = RenderSettings::new(args.res, args.res, workload);
 
-    let sim_one = |accel: SimAccel| -> anyhow::Result<SimResult> {
+    // Each run's host time, for the table's `host` line only: a host measurement is never
+    // part of a result (the JSON is the same on every machine).
+    let sim_one = |accel: SimAccel| -> anyhow::Result<(SimResult, Duration)> {
         let total = settings.width as u64 * settings.height as u64;
         let bar = ctx.bar(total, format!("{} {}", accel.label(), workload.name()));
+        let t0 = Instant::now();
         let r = simulate(&scene, &structures, accel, &settings, &cfg, &|done, _| {
             bar.set_position(done)
         })
         .with_context(|| format!("simulating {}", accel.label()))?;
+        let host = t0.elapsed();
         bar.finish_and_clear();
-        Ok(r)
+        Ok((r, host))
     };
     // Two configurations at a time: each run is single-threaded and deterministic.
     let mut results = Vec::with_capacity(accels.len());
     for pair in accels.chunks(2) {
-        let out: Vec<anyhow::Result<SimResult>> = std::thread::scope(|s| {
+        let out: Vec<anyhow::Result<(SimResult, Duration)>> = std::thread::scope(|s| {
             let handles: Vec<_> = pair
                 .iter()
                 .map(|&a| {
@@ -99,6 +104,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
 
     if args.json {
+        let results: Vec<&SimResult> = results.iter().map(|(r, _)| r).collect();
         println!("{}", serde_json::to_string_pretty(&results)?);
     } else {
         println!(
@@ -111,14 +117,16 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             cfg.tms,
             cfg.tps_per_tm
         );
-        for r in &results {
-            print_result(r);
+        for (r, host) in &results {
+            print_result(r, *host);
         }
     }
     Ok(ExitCode::SUCCESS)
 }
 
-fn print_result(r: &SimResult) {
+/// Prints one configuration's result; `host` is the wall time its simulation took on this
+/// machine (one core), shown with the simulator's speed in node visits per second.
+fn print_result(r: &SimResult, host: Duration) {
     let label = r.accel.map_or("?", |a| a.label());
     let e = &r.energy;
     let i = &r.instructions;
@@ -182,5 +190,11 @@ fn print_result(r: &SimResult) {
         pct(s.l1_bank),
         pct(s.atomic),
         pct(s.idle)
+    );
+    let secs = host.as_secs_f64();
+    println!(
+        "  host           {:.2} s on one core, {:.2} M simulated node visits/s",
+        secs,
+        r.instructions.node_steps as f64 / secs.max(1e-9) / 1e6
     );
 }
