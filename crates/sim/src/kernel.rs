@@ -45,6 +45,30 @@ impl Mix {
     pub const fn total(&self) -> u64 {
         self.int + self.fpadd + self.fpmul + self.fpcmp + self.fpinv + self.local
     }
+    /// `self` taken `k` times (exact: the fields are integers).
+    #[inline(always)]
+    const fn times(self, k: u64) -> Mix {
+        Mix::new(
+            self.int * k,
+            self.fpadd * k,
+            self.fpmul * k,
+            self.fpcmp * k,
+            self.fpinv * k,
+            self.local * k,
+        )
+    }
+    #[inline(always)]
+    const fn plus(self, o: Mix) -> Mix {
+        Mix::new(
+            self.int + o.int,
+            self.fpadd + o.fpadd,
+            self.fpmul + o.fpmul,
+            self.fpcmp + o.fpcmp,
+            self.fpinv + o.fpinv,
+            self.local + o.local,
+        )
+    }
+    #[inline(always)]
     fn add(&mut self, o: Mix) {
         self.int += o.int;
         self.fpadd += o.fpadd;
@@ -304,8 +328,14 @@ impl InstrCounts {
 
 /// The observer the simulator passes to the traversal: appends macro-ops to a thread's
 /// program and counts instructions.
+///
+/// Consecutive instruction runs merge into one [`Op::Issue`]. The run being merged is kept
+/// in the recorder (`run`), not in the op buffer, and written out when a load or pipeline
+/// op follows or the recording ends ([`Recorder::finish`], [`Recorder::finish_open`]): each
+/// event then costs a few adds on the recorder instead of a read-modify-write of the
+/// buffer's last op (`docs/performance.md`, "Fifth round"). The op sequence is exactly the
+/// one of merging into the buffer's last op; a test compares both on random event streams.
 pub struct Recorder<'a> {
-    accel: SimAccel,
     ops: &'a mut Vec<Op>,
     /// Counts so far.
     pub counts: InstrCounts,
@@ -313,37 +343,107 @@ pub struct Recorder<'a> {
     pub base: u64,
     /// The first step that did not fit an [`Op`] (the program is then incomplete).
     pub error: Option<OpRangeError>,
+    /// The open instruction run (`None`: the last op recorded is not an `Issue`).
+    run: Option<Run>,
+    /// DST configurations: the stack entries carry `[t_min, t_max]`.
+    dst: bool,
+    /// DST on the dual-split pipeline (not decoded in software).
+    dst_hw: bool,
+    /// The "+" configurations: all child boxes in one issue slot.
+    parallel_boxes: bool,
+}
+
+/// An instruction run being merged: the fields of its future [`Op::Issue`], already checked
+/// against their widths.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Run {
+    /// Instructions.
+    pub n: u32,
+    /// Of which reciprocal / inverse-square-root ops.
+    pub fpinv: u16,
+}
+
+impl Run {
+    /// The run as an op.
+    pub fn op(self) -> Op {
+        Op::Issue {
+            n: self.n,
+            fpinv: self.fpinv,
+        }
+    }
 }
 
 impl<'a> Recorder<'a> {
-    /// Records into `ops` for configuration `accel`.
+    /// Records into `ops` for configuration `accel`; a trailing `Issue` of `ops` is continued
+    /// (the next instructions merge into it).
     pub fn new(accel: SimAccel, ops: &'a mut Vec<Op>) -> Self {
+        let run = match ops.last() {
+            Some(&Op::Issue { n, fpinv }) => {
+                ops.pop();
+                Some(Run { n, fpinv })
+            }
+            _ => None,
+        };
+        Self::resume(accel, ops, run)
+    }
+
+    /// Records into `ops` for configuration `accel`, continuing the open run `run` (the
+    /// trailing `Issue` of the previous recording, see [`Recorder::finish_open`]) as if it
+    /// were the last op of `ops`.
+    #[inline]
+    pub fn resume(accel: SimAccel, ops: &'a mut Vec<Op>, run: Option<Run>) -> Self {
         Self {
-            accel,
             ops,
             counts: InstrCounts::default(),
             base: 0,
             error: None,
+            run,
+            dst: matches!(accel, SimAccel::Dst | SimAccel::DstSw),
+            dst_hw: accel == SimAccel::Dst,
+            parallel_boxes: matches!(
+                accel,
+                SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
+            ),
         }
     }
 
+    /// Ends the recording with the open run written to the ops; returns the counts and the
+    /// first range error.
+    pub fn finish(mut self) -> (InstrCounts, Option<OpRangeError>) {
+        self.close_run();
+        (self.counts, self.error)
+    }
+
+    /// Ends the recording leaving the open run out of the ops: it is returned, to be
+    /// continued by the next recording ([`Recorder::resume`]) or written as the program's
+    /// last op.
+    #[inline]
+    pub fn finish_open(self) -> (InstrCounts, Option<OpRangeError>, Option<Run>) {
+        (self.counts, self.error, self.run)
+    }
+
     /// Appends instructions of mix `m` (merged into a preceding `Issue`).
+    #[inline(always)]
     pub fn issue(&mut self, m: Mix) {
         self.counts.mix.add(m);
-        // Merged into a preceding `Issue`: the sums are checked against the op's widths.
-        let (pn, pf) = match self.ops.last() {
-            Some(&Op::Issue { n, fpinv }) => (n as u64, fpinv as u64),
-            _ => (0, 0),
+        // Merged into the open run: the sums are checked against the op's widths.
+        let (pn, pf) = match self.run {
+            Some(r) => (r.n as u64, r.fpinv as u64),
+            None => (0, 0),
         };
         let (n, fpinv) = (pn + m.total(), pf + m.fpinv);
-        let op = match (u32::try_from(n), u16::try_from(fpinv)) {
-            (Ok(n), Ok(fpinv)) => Op::Issue { n, fpinv },
-            (Err(_), _) => return self.fail(OpRangeError::Issue { n }),
-            (_, Err(_)) => return self.fail(OpRangeError::Fpinv { fpinv }),
-        };
-        match self.ops.last_mut() {
-            Some(last @ Op::Issue { .. }) => *last = op,
-            _ => self.ops.push(op),
+        match (u32::try_from(n), u16::try_from(fpinv)) {
+            (Ok(n), Ok(fpinv)) => self.run = Some(Run { n, fpinv }),
+            (Err(_), _) => self.fail(OpRangeError::Issue { n }),
+            (_, Err(_)) => self.fail(OpRangeError::Fpinv { fpinv }),
+        }
+    }
+
+    /// Writes the open run (if any) as an `Issue` op: a load or pipeline op follows.
+    #[inline(always)]
+    fn close_run(&mut self) {
+        if let Some(r) = self.run.take() {
+            self.ops.push(r.op());
         }
     }
 
@@ -353,6 +453,7 @@ impl<'a> Recorder<'a> {
         self.error.get_or_insert(e);
     }
 
+    #[inline(always)]
     fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool) {
         if n == 0 {
             return;
@@ -365,6 +466,7 @@ impl<'a> Recorder<'a> {
             Pipe::Triangle => self.counts.tri_ops += n as u64,
             Pipe::DualSplit => self.counts.dst_ops += n as u64,
         }
+        self.close_run();
         self.ops.push(Op::Pipe { pipe, n, parallel });
     }
 
@@ -372,21 +474,21 @@ impl<'a> Recorder<'a> {
     pub fn atomic(&mut self) {
         self.counts.atomics += 1;
     }
+}
 
-    fn is_dst(&self) -> bool {
-        matches!(self.accel, SimAccel::Dst | SimAccel::DstSw)
-    }
-
-    fn parallel_boxes(&self) -> bool {
-        matches!(
-            self.accel,
-            SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
-        )
-    }
+/// The instructions around a BVH node's box tests: node overhead, per valid child, per hit
+/// child and per compare-exchange of the entry-distance sort (`hits·(hits − 1)/2` pairs).
+#[inline(always)]
+pub fn bvh_step(valid: u8, hits: u8) -> Mix {
+    let pairs = (hits as u32 * hits.saturating_sub(1) as u32) / 2;
+    BVH_NODE
+        .plus(BVH_PER_CHILD.times(valid as u64))
+        .plus(BVH_PER_HIT.times(hits as u64))
+        .plus(BVH_SORT_PAIR.times(pairs as u64))
 }
 
 impl Observer for Recorder<'_> {
-    #[inline]
+    #[inline(always)]
     fn fetch(&mut self, addr: u64, bytes: u32) {
         let a = self.base + addr;
         let first = a & !3;
@@ -396,36 +498,27 @@ impl Observer for Recorder<'_> {
         }
         self.counts.loads += words;
         match Op::load(first, words) {
-            Ok(op) => self.ops.push(op),
+            Ok(op) => {
+                self.close_run();
+                self.ops.push(op);
+            }
             Err(e) => self.fail(e),
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn step(&mut self, step: NodeStep) {
         match step {
             NodeStep::Bvh { valid, hits, .. } => {
                 self.counts.node_steps += 1;
-                let parallel = self.parallel_boxes();
-                self.pipe(Pipe::Box, valid, parallel);
-                let mut m = BVH_NODE;
-                for _ in 0..valid {
-                    m.add(BVH_PER_CHILD);
-                }
-                for _ in 0..hits {
-                    m.add(BVH_PER_HIT);
-                }
-                let pairs = (hits as u32 * hits.saturating_sub(1) as u32) / 2;
-                for _ in 0..pairs {
-                    m.add(BVH_SORT_PAIR);
-                }
-                self.issue(m);
+                self.pipe(Pipe::Box, valid, self.parallel_boxes);
+                self.issue(bvh_step(valid, hits));
             }
             NodeStep::Dst { kind, code, .. } => {
                 if kind != DstNodeKind::Leaf {
                     self.counts.node_steps += 1;
                 }
-                if self.accel == SimAccel::Dst {
+                if self.dst_hw {
                     self.pipe(Pipe::DualSplit, 1, false);
                     self.issue(dst_hw_step(code));
                 } else {
@@ -436,7 +529,7 @@ impl Observer for Recorder<'_> {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn triangle_test(&mut self, _prim: u32, hit: bool) {
         self.pipe(Pipe::Triangle, 1, false);
         self.issue(TRI_TEST);
@@ -445,20 +538,228 @@ impl Observer for Recorder<'_> {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn push(&mut self) {
-        self.issue(if self.is_dst() { DST_PUSH } else { PUSH });
+        self.issue(if self.dst { DST_PUSH } else { PUSH });
     }
 
-    #[inline]
+    #[inline(always)]
     fn pop(&mut self) {
-        self.issue(if self.is_dst() { DST_POP } else { POP });
+        self.issue(if self.dst { DST_POP } else { POP });
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use dualsplit_geometry::Pcg32;
+
+    /// The recorder before the fifth round (`docs/performance.md`): every instruction run is
+    /// merged into the op buffer's last op. Kept as the reference of
+    /// `recorder_matches_merging_into_the_last_op`.
+    struct Reference<'a> {
+        accel: SimAccel,
+        ops: &'a mut Vec<Op>,
+        counts: InstrCounts,
+        error: Option<OpRangeError>,
+    }
+
+    impl Reference<'_> {
+        fn issue(&mut self, m: Mix) {
+            self.counts.mix.add(m);
+            let (pn, pf) = match self.ops.last() {
+                Some(&Op::Issue { n, fpinv }) => (n as u64, fpinv as u64),
+                _ => (0, 0),
+            };
+            let (n, fpinv) = (pn + m.total(), pf + m.fpinv);
+            let op = match (u32::try_from(n), u16::try_from(fpinv)) {
+                (Ok(n), Ok(fpinv)) => Op::Issue { n, fpinv },
+                (Err(_), _) => return self.fail(OpRangeError::Issue { n }),
+                (_, Err(_)) => return self.fail(OpRangeError::Fpinv { fpinv }),
+            };
+            match self.ops.last_mut() {
+                Some(last @ Op::Issue { .. }) => *last = op,
+                _ => self.ops.push(op),
+            }
+        }
+        fn fail(&mut self, e: OpRangeError) {
+            self.error.get_or_insert(e);
+        }
+        fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool) {
+            if n == 0 {
+                return;
+            }
+            match pipe {
+                Pipe::Box => {
+                    self.counts.box_ops += n as u64;
+                    self.counts.box_issues += if parallel { 1 } else { n as u64 };
+                }
+                Pipe::Triangle => self.counts.tri_ops += n as u64,
+                Pipe::DualSplit => self.counts.dst_ops += n as u64,
+            }
+            self.ops.push(Op::Pipe { pipe, n, parallel });
+        }
+        fn is_dst(&self) -> bool {
+            matches!(self.accel, SimAccel::Dst | SimAccel::DstSw)
+        }
+    }
+
+    impl Observer for Reference<'_> {
+        fn fetch(&mut self, addr: u64, bytes: u32) {
+            let first = addr & !3;
+            let words = ((addr + bytes as u64).div_ceil(4) * 4 - first) / 4;
+            if words == 0 {
+                return;
+            }
+            self.counts.loads += words;
+            match Op::load(first, words) {
+                Ok(op) => self.ops.push(op),
+                Err(e) => self.fail(e),
+            }
+        }
+        fn step(&mut self, step: NodeStep) {
+            match step {
+                NodeStep::Bvh { valid, hits, .. } => {
+                    self.counts.node_steps += 1;
+                    let parallel = matches!(
+                        self.accel,
+                        SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
+                    );
+                    self.pipe(Pipe::Box, valid, parallel);
+                    let mut m = BVH_NODE;
+                    for _ in 0..valid {
+                        m.add(BVH_PER_CHILD);
+                    }
+                    for _ in 0..hits {
+                        m.add(BVH_PER_HIT);
+                    }
+                    let pairs = (hits as u32 * hits.saturating_sub(1) as u32) / 2;
+                    for _ in 0..pairs {
+                        m.add(BVH_SORT_PAIR);
+                    }
+                    self.issue(m);
+                }
+                NodeStep::Dst { kind, code, .. } => {
+                    if kind != DstNodeKind::Leaf {
+                        self.counts.node_steps += 1;
+                    }
+                    if self.accel == SimAccel::Dst {
+                        self.pipe(Pipe::DualSplit, 1, false);
+                        self.issue(dst_hw_step(code));
+                    } else {
+                        self.issue(dst_sw_step(kind, code));
+                    }
+                }
+                NodeStep::Leaf { .. } => self.issue(LEAF),
+            }
+        }
+        fn triangle_test(&mut self, _prim: u32, hit: bool) {
+            self.pipe(Pipe::Triangle, 1, false);
+            self.issue(TRI_TEST);
+            if hit {
+                self.issue(TRI_ACCEPT);
+            }
+        }
+        fn push(&mut self) {
+            self.issue(if self.is_dst() { DST_PUSH } else { PUSH });
+        }
+        fn pop(&mut self) {
+            self.issue(if self.is_dst() { DST_POP } else { POP });
+        }
+    }
+
+    /// One random traversal event (or an instruction run of the ray's set-up and finish).
+    fn random_event<O: Observer>(
+        rng: &mut Pcg32,
+        obs: &mut O,
+        issue: &mut impl FnMut(&mut O, Mix),
+    ) {
+        let kinds = [
+            DstNodeKind::Split,
+            DstNodeKind::SingleCarve,
+            DstNodeKind::DualCarve,
+            DstNodeKind::Leaf,
+        ];
+        match rng.below(9) {
+            0 => obs.fetch(rng.below(1 << 20) as u64, rng.below(220)),
+            1 => {
+                let arity = [2u8, 4, 8][rng.below(3) as usize];
+                let valid = rng.below(arity as u32 + 1) as u8;
+                let hits = rng.below(valid as u32 + 1) as u8;
+                obs.step(NodeStep::Bvh { arity, valid, hits });
+            }
+            2 => obs.step(NodeStep::Dst {
+                kind: kinds[rng.below(4) as usize],
+                code: rng.below(4) as u8,
+                carving_leaf: rng.below(2) == 1,
+            }),
+            3 => obs.step(NodeStep::Leaf {
+                count: rng.below(8),
+            }),
+            4 => obs.triangle_test(rng.below(1000), rng.below(2) == 1),
+            5 => obs.push(),
+            6 => obs.pop(),
+            7 => issue(obs, RAY_SETUP),
+            _ => issue(obs, [RAY_FINISH, LEAF, PUSH][rng.below(3) as usize]),
+        }
+    }
+
+    #[test]
+    fn recorder_matches_merging_into_the_last_op() {
+        for seed in 0..40u64 {
+            for accel in SimAccel::ALL {
+                let events = 1 + Pcg32::new(seed, 7).below(300);
+                // The reference: one recording merging into the buffer's last op.
+                let mut want = Vec::new();
+                let mut reference = Reference {
+                    accel,
+                    ops: &mut want,
+                    counts: InstrCounts::default(),
+                    error: None,
+                };
+                let mut rng = Pcg32::new(seed, 1);
+                for _ in 0..events {
+                    random_event(&mut rng, &mut reference, &mut |o: &mut Reference, m| {
+                        o.issue(m)
+                    });
+                }
+                let (want_counts, want_error) = (reference.counts, reference.error);
+                // The recorder, the stream cut into recordings at random points (as a
+                // pixel's rays are), each continuing the previous one's open run.
+                let mut got = Vec::new();
+                let mut counts = InstrCounts::default();
+                let mut run = None;
+                let mut rng = Pcg32::new(seed, 1);
+                let mut cuts = Pcg32::new(seed, 2);
+                let mut left = events;
+                while left > 0 {
+                    let n = (1 + cuts.below(40)).min(left);
+                    left -= n;
+                    let mut r = Recorder::resume(accel, &mut got, run);
+                    for _ in 0..n {
+                        random_event(&mut rng, &mut r, &mut |o: &mut Recorder, m| o.issue(m));
+                    }
+                    let (c, e, open) = r.finish_open();
+                    assert_eq!(e, None);
+                    counts.add(&c);
+                    run = open;
+                }
+                got.extend(run.map(Run::op));
+                assert_eq!(want_error, None);
+                assert_eq!(got, want, "seed {seed}, {accel:?}");
+                assert_eq!(counts, want_counts, "seed {seed}, {accel:?}");
+                // `new` continues a trailing Issue; `finish` writes the open run.
+                let mut again = Vec::new();
+                let mut rng = Pcg32::new(seed, 1);
+                for _ in 0..events {
+                    let mut r = Recorder::new(accel, &mut again);
+                    random_event(&mut rng, &mut r, &mut |o: &mut Recorder, m| o.issue(m));
+                    assert_eq!(r.finish().1, None);
+                }
+                assert_eq!(again, want, "seed {seed}, {accel:?}");
+            }
+        }
+    }
 
     #[test]
     fn fetch_covers_every_touched_word() {
@@ -521,6 +822,8 @@ mod tests {
         r.issue(big);
         r.issue(big);
         assert_eq!(r.error, Some(OpRangeError::Issue { n: 6_000_000_000 }));
+        let (_, error) = r.finish();
+        assert_eq!(error, Some(OpRangeError::Issue { n: 6_000_000_000 }));
         assert_eq!(
             ops,
             vec![Op::Issue {
