@@ -127,7 +127,7 @@ pub const BVH_SORT_PAIR: Mix = Mix::new(2, 0, 0, 1, 0, 0);
 ///         mov   tmax, tmax_out
 ///         j     LOOP             ; code 2: 8
 /// ```
-pub fn dst_hw_step(code: u8) -> Mix {
+pub const fn dst_hw_step(code: u8) -> Mix {
     match code {
         0 => Mix::new(1, 0, 0, 0, 0, 0),
         1 => Mix::new(7, 0, 0, 0, 0, 0),
@@ -152,7 +152,7 @@ pub const DST_POP: Mix = Mix::new(3, 0, 0, 2, 0, 3);
 /// min/max and the interval tests are FP compares, and a child is addressed from the 26-bit
 /// offset (and B, the left size, for the right child). Every instruction is written out in
 /// `docs/simulator.md` ("DST* decoder sequences").
-pub fn dst_sw_step(kind: DstNodeKind, code: u8) -> Mix {
+pub const fn dst_sw_step(kind: DstNodeKind, code: u8) -> Mix {
     let hit = code != 0;
     match kind {
         // dispatch 3, axis 1, index 2 + 2 local loads, 2 × (sub, mul), sign select (bltz,
@@ -326,25 +326,160 @@ impl InstrCounts {
     }
 }
 
+/// Kernel steps counted by kind: their instruction mixes are constants (or, for a BVH node,
+/// linear in its child counts), so a step adds 1 to a counter and the mixes are multiplied
+/// out once, when the counts are read ([`Tally::counts`]). Integer arithmetic: the totals
+/// are exactly those of adding each step's mix as it happens.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Steps {
+    push: u64,
+    pop: u64,
+    leaf: u64,
+    tri_test: u64,
+    tri_accept: u64,
+    bvh_nodes: u64,
+    bvh_valid: u64,
+    bvh_hits: u64,
+    bvh_pairs: u64,
+    /// DST steps by node kind (the enum's order) and return code.
+    dst: [[u64; 4]; 4],
+}
+
+/// Instructions of each DST step on the pipeline, by return code ([`dst_hw_step`]).
+const DST_HW_TOTAL: [u64; 4] = {
+    let mut t = [0; 4];
+    let mut c = 0;
+    while c < 4 {
+        t[c] = dst_hw_step(c as u8).total();
+        c += 1;
+    }
+    t
+};
+
+/// Instructions of each DST* step, by node kind and return code ([`dst_sw_step`]).
+const DST_SW_TOTAL: [[u64; 4]; 4] = {
+    let kinds = [
+        DstNodeKind::Split,
+        DstNodeKind::SingleCarve,
+        DstNodeKind::DualCarve,
+        DstNodeKind::Leaf,
+    ];
+    let mut t = [[0; 4]; 4];
+    let mut k = 0;
+    while k < 4 {
+        let mut c = 0;
+        while c < 4 {
+            t[k][c] = dst_sw_step(kinds[k], c as u8).total();
+            c += 1;
+        }
+        k += 1;
+    }
+    t
+};
+
+/// Instructions of a BVH node step ([`bvh_step`]'s total), from the constants.
+#[inline(always)]
+const fn bvh_total(valid: u64, hits: u64, pairs: u64) -> u64 {
+    BVH_NODE.total()
+        + BVH_PER_CHILD.total() * valid
+        + BVH_PER_HIT.total() * hits
+        + BVH_SORT_PAIR.total() * pairs
+}
+
+/// What the recorders of one frame count, summed over every ray: instruction and event
+/// counts, kernel steps by kind, and the first step that did not fit an [`Op`].
+#[derive(Clone, Debug)]
+pub struct Tally {
+    accel: SimAccel,
+    /// Counts besides the kernel steps' instruction mixes.
+    counts: InstrCounts,
+    steps: Steps,
+    error: Option<OpRangeError>,
+}
+
+impl Tally {
+    /// Nothing counted yet, for configuration `accel`.
+    pub fn new(accel: SimAccel) -> Self {
+        Self {
+            accel,
+            counts: InstrCounts::default(),
+            steps: Steps::default(),
+            error: None,
+        }
+    }
+
+    /// The counts so far, every kernel step's instruction mix included.
+    pub fn counts(&self) -> InstrCounts {
+        let s = &self.steps;
+        let dst = matches!(self.accel, SimAccel::Dst | SimAccel::DstSw);
+        let kinds = [
+            DstNodeKind::Split,
+            DstNodeKind::SingleCarve,
+            DstNodeKind::DualCarve,
+            DstNodeKind::Leaf,
+        ];
+        let mut c = self.counts;
+        let m = &mut c.mix;
+        m.add(if dst { DST_PUSH } else { PUSH }.times(s.push));
+        m.add(if dst { DST_POP } else { POP }.times(s.pop));
+        m.add(LEAF.times(s.leaf));
+        m.add(TRI_TEST.times(s.tri_test));
+        m.add(TRI_ACCEPT.times(s.tri_accept));
+        m.add(BVH_NODE.times(s.bvh_nodes));
+        m.add(BVH_PER_CHILD.times(s.bvh_valid));
+        m.add(BVH_PER_HIT.times(s.bvh_hits));
+        m.add(BVH_SORT_PAIR.times(s.bvh_pairs));
+        for (kind, row) in kinds.into_iter().zip(&s.dst) {
+            for (code, &n) in row.iter().enumerate() {
+                let step = if self.accel == SimAccel::Dst {
+                    dst_hw_step(code as u8)
+                } else {
+                    dst_sw_step(kind, code as u8)
+                };
+                m.add(step.times(n));
+            }
+        }
+        c
+    }
+
+    /// The first step that did not fit an [`Op`] (a program is then incomplete).
+    pub fn error(&self) -> Option<OpRangeError> {
+        self.error
+    }
+
+    /// Counts the global atomic increment that hands a pixel to a thread.
+    pub fn atomic(&mut self) {
+        self.counts.atomics += 1;
+    }
+
+    /// Keeps the first range error.
+    #[cold]
+    fn fail(&mut self, e: OpRangeError) {
+        self.error.get_or_insert(e);
+    }
+}
+
 /// The observer the simulator passes to the traversal: appends macro-ops to a thread's
-/// program and counts instructions.
+/// program and counts instructions into a [`Tally`].
 ///
 /// Consecutive instruction runs merge into one [`Op::Issue`]. The run being merged is kept
-/// in the recorder (`run`), not in the op buffer, and written out when a load or pipeline
-/// op follows or the recording ends ([`Recorder::finish`], [`Recorder::finish_open`]): each
-/// event then costs a few adds on the recorder instead of a read-modify-write of the
-/// buffer's last op (`docs/performance.md`, "Fifth round"). The op sequence is exactly the
-/// one of merging into the buffer's last op; a test compares both on random event streams.
+/// in the recorder, not in the op buffer, and written out when a load or pipeline op follows
+/// or the recording ends ([`Recorder::finish`], [`Recorder::finish_open`]); a kernel step
+/// adds its instruction count to the run and 1 to its kind's counter in the tally
+/// (`docs/performance.md`, "Fifth round"). The ops and counts are exactly those of merging
+/// into the buffer's last op and adding each step's mix; a test compares both on random
+/// event streams.
 pub struct Recorder<'a> {
     ops: &'a mut Vec<Op>,
-    /// Counts so far.
-    pub counts: InstrCounts,
+    tally: &'a mut Tally,
     /// Byte address added to every fetch (where the image lives in simulated memory).
     pub base: u64,
-    /// The first step that did not fit an [`Op`] (the program is then incomplete).
-    pub error: Option<OpRangeError>,
-    /// The open instruction run (`None`: the last op recorded is not an `Issue`).
-    run: Option<Run>,
+    /// The open run's instructions and reciprocal ops (0 when closed), each within its
+    /// op field's width.
+    run_n: u64,
+    run_fpinv: u64,
+    /// True when the last op recorded is the (unwritten) open run.
+    open: bool,
     /// DST configurations: the stack entries carry `[t_min, t_max]`.
     dst: bool,
     /// DST on the dual-split pipeline (not decoded in software).
@@ -374,9 +509,9 @@ impl Run {
 }
 
 impl<'a> Recorder<'a> {
-    /// Records into `ops` for configuration `accel`; a trailing `Issue` of `ops` is continued
+    /// Records into `ops`, counting into `tally`; a trailing `Issue` of `ops` is continued
     /// (the next instructions merge into it).
-    pub fn new(accel: SimAccel, ops: &'a mut Vec<Op>) -> Self {
+    pub fn new(tally: &'a mut Tally, ops: &'a mut Vec<Op>) -> Self {
         let run = match ops.last() {
             Some(&Op::Issue { n, fpinv }) => {
                 ops.pop();
@@ -384,20 +519,22 @@ impl<'a> Recorder<'a> {
             }
             _ => None,
         };
-        Self::resume(accel, ops, run)
+        Self::resume(tally, ops, run)
     }
 
-    /// Records into `ops` for configuration `accel`, continuing the open run `run` (the
-    /// trailing `Issue` of the previous recording, see [`Recorder::finish_open`]) as if it
-    /// were the last op of `ops`.
+    /// Records into `ops`, counting into `tally`, continuing the open run `run` (the trailing
+    /// `Issue` of the previous recording, see [`Recorder::finish_open`]) as if it were the
+    /// last op of `ops`.
     #[inline]
-    pub fn resume(accel: SimAccel, ops: &'a mut Vec<Op>, run: Option<Run>) -> Self {
+    pub fn resume(tally: &'a mut Tally, ops: &'a mut Vec<Op>, run: Option<Run>) -> Self {
+        let accel = tally.accel;
         Self {
             ops,
-            counts: InstrCounts::default(),
+            tally,
             base: 0,
-            error: None,
-            run,
+            run_n: run.map_or(0, |r| r.n as u64),
+            run_fpinv: run.map_or(0, |r| r.fpinv as u64),
+            open: run.is_some(),
             dst: matches!(accel, SimAccel::Dst | SimAccel::DstSw),
             dst_hw: accel == SimAccel::Dst,
             parallel_boxes: matches!(
@@ -407,50 +544,58 @@ impl<'a> Recorder<'a> {
         }
     }
 
-    /// Ends the recording with the open run written to the ops; returns the counts and the
-    /// first range error.
-    pub fn finish(mut self) -> (InstrCounts, Option<OpRangeError>) {
+    /// The tally counted into (the open run's instructions are in its counts already).
+    pub fn tally(&self) -> &Tally {
+        self.tally
+    }
+
+    /// Ends the recording with the open run written to the ops.
+    pub fn finish(mut self) {
         self.close_run();
-        (self.counts, self.error)
     }
 
     /// Ends the recording leaving the open run out of the ops: it is returned, to be
     /// continued by the next recording ([`Recorder::resume`]) or written as the program's
     /// last op.
     #[inline]
-    pub fn finish_open(self) -> (InstrCounts, Option<OpRangeError>, Option<Run>) {
-        (self.counts, self.error, self.run)
+    pub fn finish_open(self) -> Option<Run> {
+        self.open.then_some(Run {
+            n: self.run_n as u32,
+            fpinv: self.run_fpinv as u16,
+        })
     }
 
     /// Appends instructions of mix `m` (merged into a preceding `Issue`).
     #[inline(always)]
     pub fn issue(&mut self, m: Mix) {
-        self.counts.mix.add(m);
-        // Merged into the open run: the sums are checked against the op's widths.
-        let (pn, pf) = match self.run {
-            Some(r) => (r.n as u64, r.fpinv as u64),
-            None => (0, 0),
-        };
-        let (n, fpinv) = (pn + m.total(), pf + m.fpinv);
-        match (u32::try_from(n), u16::try_from(fpinv)) {
-            (Ok(n), Ok(fpinv)) => self.run = Some(Run { n, fpinv }),
-            (Err(_), _) => self.fail(OpRangeError::Issue { n }),
-            (_, Err(_)) => self.fail(OpRangeError::Fpinv { fpinv }),
+        self.tally.counts.mix.add(m);
+        self.extend_run(m.total(), m.fpinv);
+    }
+
+    /// Merges `n` instructions, `fpinv` of them reciprocals, into the open run (opening one
+    /// if needed); the sums are checked against the op's widths.
+    #[inline(always)]
+    fn extend_run(&mut self, n: u64, fpinv: u64) {
+        let (n, fpinv) = (self.run_n + n, self.run_fpinv + fpinv);
+        if n > u32::MAX as u64 {
+            self.tally.fail(OpRangeError::Issue { n });
+        } else if fpinv > u16::MAX as u64 {
+            self.tally.fail(OpRangeError::Fpinv { fpinv });
+        } else {
+            (self.run_n, self.run_fpinv, self.open) = (n, fpinv, true);
         }
     }
 
     /// Writes the open run (if any) as an `Issue` op: a load or pipeline op follows.
     #[inline(always)]
     fn close_run(&mut self) {
-        if let Some(r) = self.run.take() {
-            self.ops.push(r.op());
+        if self.open {
+            self.ops.push(Op::Issue {
+                n: self.run_n as u32,
+                fpinv: self.run_fpinv as u16,
+            });
+            (self.run_n, self.run_fpinv, self.open) = (0, 0, false);
         }
-    }
-
-    /// Keeps the first range error.
-    #[cold]
-    fn fail(&mut self, e: OpRangeError) {
-        self.error.get_or_insert(e);
     }
 
     #[inline(always)]
@@ -458,27 +603,22 @@ impl<'a> Recorder<'a> {
         if n == 0 {
             return;
         }
+        let c = &mut self.tally.counts;
         match pipe {
             Pipe::Box => {
-                self.counts.box_ops += n as u64;
-                self.counts.box_issues += if parallel { 1 } else { n as u64 };
+                c.box_ops += n as u64;
+                c.box_issues += if parallel { 1 } else { n as u64 };
             }
-            Pipe::Triangle => self.counts.tri_ops += n as u64,
-            Pipe::DualSplit => self.counts.dst_ops += n as u64,
+            Pipe::Triangle => c.tri_ops += n as u64,
+            Pipe::DualSplit => c.dst_ops += n as u64,
         }
         self.close_run();
         self.ops.push(Op::Pipe { pipe, n, parallel });
-    }
-
-    /// Records the global atomic increment that hands a pixel to the thread.
-    pub fn atomic(&mut self) {
-        self.counts.atomics += 1;
     }
 }
 
 /// The instructions around a BVH node's box tests: node overhead, per valid child, per hit
 /// child and per compare-exchange of the entry-distance sort (`hits·(hits − 1)/2` pairs).
-#[inline(always)]
 pub fn bvh_step(valid: u8, hits: u8) -> Mix {
     let pairs = (hits as u32 * hits.saturating_sub(1) as u32) / 2;
     BVH_NODE
@@ -491,18 +631,18 @@ impl Observer for Recorder<'_> {
     #[inline(always)]
     fn fetch(&mut self, addr: u64, bytes: u32) {
         let a = self.base + addr;
-        let first = a & !3;
-        let words = ((a + bytes as u64).div_ceil(4) * 4 - first) / 4;
+        // Words from the one holding byte `a` to the one holding byte `a + bytes − 1`.
+        let words = (a + bytes as u64).div_ceil(4) - a / 4;
         if words == 0 {
             return;
         }
-        self.counts.loads += words;
-        match Op::load(first, words) {
+        self.tally.counts.loads += words;
+        match Op::load(a & !3, words) {
             Ok(op) => {
                 self.close_run();
                 self.ops.push(op);
             }
-            Err(e) => self.fail(e),
+            Err(e) => self.tally.fail(e),
         }
     }
 
@@ -510,42 +650,58 @@ impl Observer for Recorder<'_> {
     fn step(&mut self, step: NodeStep) {
         match step {
             NodeStep::Bvh { valid, hits, .. } => {
-                self.counts.node_steps += 1;
+                self.tally.counts.node_steps += 1;
                 self.pipe(Pipe::Box, valid, self.parallel_boxes);
-                self.issue(bvh_step(valid, hits));
+                let pairs = (hits as u64 * hits.saturating_sub(1) as u64) / 2;
+                let s = &mut self.tally.steps;
+                s.bvh_nodes += 1;
+                s.bvh_valid += valid as u64;
+                s.bvh_hits += hits as u64;
+                s.bvh_pairs += pairs;
+                self.extend_run(bvh_total(valid as u64, hits as u64, pairs), 0);
             }
             NodeStep::Dst { kind, code, .. } => {
                 if kind != DstNodeKind::Leaf {
-                    self.counts.node_steps += 1;
+                    self.tally.counts.node_steps += 1;
                 }
+                // Codes above 3 take code 3's mix in both step functions.
+                let (k, c) = (kind as usize & 3, code.min(3) as usize);
+                self.tally.steps.dst[k][c] += 1;
                 if self.dst_hw {
                     self.pipe(Pipe::DualSplit, 1, false);
-                    self.issue(dst_hw_step(code));
+                    self.extend_run(DST_HW_TOTAL[c], 0);
                 } else {
-                    self.issue(dst_sw_step(kind, code));
+                    self.extend_run(DST_SW_TOTAL[k][c], 0);
                 }
             }
-            NodeStep::Leaf { .. } => self.issue(LEAF),
+            NodeStep::Leaf { .. } => {
+                self.tally.steps.leaf += 1;
+                self.extend_run(LEAF.total(), 0);
+            }
         }
     }
 
     #[inline(always)]
     fn triangle_test(&mut self, _prim: u32, hit: bool) {
         self.pipe(Pipe::Triangle, 1, false);
-        self.issue(TRI_TEST);
+        self.tally.steps.tri_test += 1;
+        self.extend_run(TRI_TEST.total(), 0);
         if hit {
-            self.issue(TRI_ACCEPT);
+            self.tally.steps.tri_accept += 1;
+            self.extend_run(TRI_ACCEPT.total(), 0);
         }
     }
 
     #[inline(always)]
     fn push(&mut self) {
-        self.issue(if self.dst { DST_PUSH } else { PUSH });
+        self.tally.steps.push += 1;
+        self.extend_run(if self.dst { DST_PUSH } else { PUSH }.total(), 0);
     }
 
     #[inline(always)]
     fn pop(&mut self) {
-        self.issue(if self.dst { DST_POP } else { POP });
+        self.tally.steps.pop += 1;
+        self.extend_run(if self.dst { DST_POP } else { POP }.total(), 0);
     }
 }
 
@@ -727,7 +883,7 @@ mod tests {
                 // The recorder, the stream cut into recordings at random points (as a
                 // pixel's rays are), each continuing the previous one's open run.
                 let mut got = Vec::new();
-                let mut counts = InstrCounts::default();
+                let mut tally = Tally::new(accel);
                 let mut run = None;
                 let mut rng = Pcg32::new(seed, 1);
                 let mut cuts = Pcg32::new(seed, 2);
@@ -735,28 +891,28 @@ mod tests {
                 while left > 0 {
                     let n = (1 + cuts.below(40)).min(left);
                     left -= n;
-                    let mut r = Recorder::resume(accel, &mut got, run);
+                    let mut r = Recorder::resume(&mut tally, &mut got, run);
                     for _ in 0..n {
                         random_event(&mut rng, &mut r, &mut |o: &mut Recorder, m| o.issue(m));
                     }
-                    let (c, e, open) = r.finish_open();
-                    assert_eq!(e, None);
-                    counts.add(&c);
-                    run = open;
+                    run = r.finish_open();
                 }
                 got.extend(run.map(Run::op));
                 assert_eq!(want_error, None);
+                assert_eq!(tally.error(), None);
                 assert_eq!(got, want, "seed {seed}, {accel:?}");
-                assert_eq!(counts, want_counts, "seed {seed}, {accel:?}");
+                assert_eq!(tally.counts(), want_counts, "seed {seed}, {accel:?}");
                 // `new` continues a trailing Issue; `finish` writes the open run.
                 let mut again = Vec::new();
+                let mut tally = Tally::new(accel);
                 let mut rng = Pcg32::new(seed, 1);
                 for _ in 0..events {
-                    let mut r = Recorder::new(accel, &mut again);
+                    let mut r = Recorder::new(&mut tally, &mut again);
                     random_event(&mut rng, &mut r, &mut |o: &mut Recorder, m| o.issue(m));
-                    assert_eq!(r.finish().1, None);
+                    r.finish();
                 }
                 assert_eq!(again, want, "seed {seed}, {accel:?}");
+                assert_eq!(tally.counts(), want_counts, "seed {seed}, {accel:?}");
             }
         }
     }
@@ -764,10 +920,11 @@ mod tests {
     #[test]
     fn fetch_covers_every_touched_word() {
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::Bvh2, &mut ops);
+        let mut tally = Tally::new(SimAccel::Bvh2);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         r.fetch(52, 52);
         r.fetch(6, 4); // straddles two words
-        assert_eq!(r.counts.loads, 15);
+        assert_eq!(r.tally().counts().loads, 15);
         assert_eq!(
             ops,
             vec![
@@ -801,29 +958,40 @@ mod tests {
         );
         // The recorder keeps the first error instead of wrapping.
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::Bvh2, &mut ops);
+        let mut tally = Tally::new(SimAccel::Bvh2);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         r.fetch(8, 4);
-        assert_eq!(r.error, None);
+        assert_eq!(r.tally().error(), None);
         r.fetch(top + 8, 4);
         r.fetch(0, 4 * 70_000);
-        assert_eq!(r.error, Some(OpRangeError::Address { addr: top + 8 }));
+        assert_eq!(
+            r.tally().error(),
+            Some(OpRangeError::Address { addr: top + 8 })
+        );
         // Merged issue runs: reciprocal ops beyond u16, instructions beyond u32.
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::Bvh2, &mut ops);
+        let mut tally = Tally::new(SimAccel::Bvh2);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         let inv = Mix::new(0, 0, 0, 0, 30_000, 0);
         r.issue(inv);
         r.issue(inv);
-        assert_eq!(r.error, None);
+        assert_eq!(r.tally().error(), None);
         r.issue(inv);
-        assert_eq!(r.error, Some(OpRangeError::Fpinv { fpinv: 90_000 }));
+        assert_eq!(
+            r.tally().error(),
+            Some(OpRangeError::Fpinv { fpinv: 90_000 })
+        );
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::Bvh2, &mut ops);
+        let mut tally = Tally::new(SimAccel::Bvh2);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         let big = Mix::new(3_000_000_000, 0, 0, 0, 0, 0);
         r.issue(big);
         r.issue(big);
-        assert_eq!(r.error, Some(OpRangeError::Issue { n: 6_000_000_000 }));
-        let (_, error) = r.finish();
-        assert_eq!(error, Some(OpRangeError::Issue { n: 6_000_000_000 }));
+        assert_eq!(
+            r.tally().error(),
+            Some(OpRangeError::Issue { n: 6_000_000_000 })
+        );
+        r.finish();
         assert_eq!(
             ops,
             vec![Op::Issue {
@@ -837,16 +1005,17 @@ mod tests {
     fn serial_and_parallel_box_issue() {
         for (accel, issues) in [(SimAccel::Bvh4, 3), (SimAccel::Bvh4Plus, 1)] {
             let mut ops = Vec::new();
-            let mut r = Recorder::new(accel, &mut ops);
+            let mut tally = Tally::new(accel);
+            let mut r = Recorder::new(&mut tally, &mut ops);
             r.step(NodeStep::Bvh {
                 arity: 4,
                 valid: 3,
                 hits: 2,
             });
-            assert_eq!(r.counts.box_ops, 3);
-            assert_eq!(r.counts.box_issues, issues);
+            assert_eq!(r.tally().counts().box_ops, 3);
+            assert_eq!(r.tally().counts().box_issues, issues);
             // node 4 + 3 children × 2 + 2 hits × 2 + 1 sort pair × 3
-            assert_eq!(r.counts.mix.total(), 4 + 6 + 4 + 3);
+            assert_eq!(r.tally().counts().mix.total(), 4 + 6 + 4 + 3);
         }
     }
 
@@ -873,21 +1042,23 @@ mod tests {
             carving_leaf: false,
         };
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::Dst, &mut ops);
+        let mut tally = Tally::new(SimAccel::Dst);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         r.step(step);
-        assert_eq!(r.counts.dst_ops, 1);
+        assert_eq!(r.tally().counts().dst_ops, 1);
         // Code 2: the branch chain to the "both children" case, next node, t_max, jump.
-        assert_eq!(r.counts.mix.total(), 8);
+        assert_eq!(r.tally().counts().mix.total(), 8);
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::DstSw, &mut ops);
+        let mut tally = Tally::new(SimAccel::DstSw);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         r.step(step);
-        assert_eq!(r.counts.dst_ops, 0);
+        assert_eq!(r.tally().counts().dst_ops, 0);
         // 23 int, 2 local loads, 2 sub, 3 mul, 4 min/max/compare.
-        assert_eq!(r.counts.mix.total(), 34);
-        assert_eq!(r.counts.mix.local, 2);
+        assert_eq!(r.tally().counts().mix.total(), 34);
+        assert_eq!(r.tally().counts().mix.local, 2);
         // The stack entries of both DSTs carry [t_min, t_max]: 3 local-store accesses.
         r.push();
         r.pop();
-        assert_eq!(r.counts.mix.local, 2 + 3 + 3);
+        assert_eq!(r.tally().counts().mix.local, 2 + 3 + 3);
     }
 }

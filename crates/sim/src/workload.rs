@@ -3,7 +3,7 @@
 //! 2020, §4.3–4.4; notes §5.2).
 
 use crate::engine::{Chip, Thread, WorkSource, run_chip};
-use crate::kernel::{Mix, Op, OpRangeError, Recorder, Run};
+use crate::kernel::{Mix, Op, Recorder, Run, Tally};
 use crate::{SimAccel, SimConfig, SimError, SimResult, energy};
 use dualsplit_accel::Structures;
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult};
@@ -30,15 +30,14 @@ struct Active<'a> {
     carry: Option<Run>,
 }
 
-/// What tracing a ray needs and gathers: the structures and configuration, the counters and
-/// the first range error.
+/// What tracing a ray needs and gathers: the structures and configuration, the rays and
+/// the recorders' tally (counts and the first range error: no work is handed out after
+/// one).
 struct Tracer<'a> {
     structures: &'a Structures,
     accel: SimAccel,
     rays: u64,
-    counts: crate::InstrCounts,
-    /// The first traversal step that did not fit an op: no work is handed out after it.
-    error: Option<OpRangeError>,
+    tally: Tally,
 }
 
 struct Pixels<'a> {
@@ -63,7 +62,7 @@ impl<'a> Tracer<'a> {
             return false;
         };
         let kind = self.accel.kind();
-        let mut rec = Recorder::resume(self.accel, ops, a.carry.take());
+        let mut rec = Recorder::resume(&mut self.tally, ops, a.carry.take());
         self.rays += 1;
         rec.issue(crate::kernel::RAY_SETUP);
         let result = match q.kind {
@@ -79,12 +78,7 @@ impl<'a> Tracer<'a> {
             }
         };
         // The ray's last instructions stay open for the next ray of the pixel.
-        let (counts, error, carry) = rec.finish_open();
-        self.counts.add(&counts);
-        if let Some(e) = error {
-            self.error.get_or_insert(e);
-        }
-        a.carry = carry;
+        a.carry = rec.finish_open();
         a.job.submit(result);
         true
     }
@@ -96,7 +90,7 @@ impl WorkSource for Pixels<'_> {
     /// whole pixel recorded at once, but a thread's program stays small, so the replay's
     /// host memory traffic stays in cache.
     fn next(&mut self, id: usize, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>> {
-        if self.tracer.error.is_some() {
+        if self.tracer.tally.error().is_some() {
             return None;
         }
         // The thread's finished program's buffer is reused for its next one.
@@ -107,7 +101,7 @@ impl WorkSource for Pixels<'_> {
         ops.clear();
         if let Some(a) = &mut self.active[id] {
             if self.tracer.trace_ray(a, &mut ops) {
-                return self.tracer.error.is_none().then_some(ops);
+                return self.tracer.tally.error().is_none().then_some(ops);
             }
             self.radiance[a.px as usize] = a.job.radiance();
             let carry = a.carry;
@@ -123,7 +117,7 @@ impl WorkSource for Pixels<'_> {
             return None;
         }
         thread.atomic(chip);
-        self.tracer.counts.atomics += 1;
+        self.tracer.tally.atomic();
         let px = self.next;
         self.next += 1;
         let w = self.settings.width as u64;
@@ -140,7 +134,7 @@ impl WorkSource for Pixels<'_> {
         if self.next.is_multiple_of(1024) || self.next == self.total {
             (self.progress)(self.next, self.total);
         }
-        self.tracer.error.is_none().then_some(ops)
+        self.tracer.tally.error().is_none().then_some(ops)
     }
 }
 
@@ -170,19 +164,18 @@ pub(crate) fn run(
             structures,
             accel,
             rays: 0,
-            counts: Default::default(),
-            error: None,
+            tally: Tally::new(accel),
         },
     };
     let cycles = run_chip(&mut chip, &mut threads, &mut work);
-    if let Some(e) = work.tracer.error {
+    if let Some(e) = work.tracer.tally.error() {
         return Err(e.into());
     }
     let dram = chip.dram.stats();
     let c = &chip.caches;
     let ratio = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
     let frame_ms = cycles as f64 / (cfg.clock_ghz * 1e6);
-    let counts = work.tracer.counts;
+    let counts = work.tracer.tally.counts();
     let cyc_units = cycles.max(1) as f64 * cfg.tms as f64;
     let utilisation = crate::Utilisation {
         box_pipe: chip.units.box_ops as f64 / (cyc_units * accel.box_pipes(cfg) as f64),
