@@ -338,6 +338,8 @@ struct Steps {
     tri_test: u64,
     tri_accept: u64,
     bvh_nodes: u64,
+    /// BVH nodes with at least one valid child (one ray-box pipeline op each).
+    bvh_boxed: u64,
     bvh_valid: u64,
     bvh_hits: u64,
     bvh_pairs: u64,
@@ -412,6 +414,10 @@ impl Tally {
     pub fn counts(&self) -> InstrCounts {
         let s = &self.steps;
         let dst = matches!(self.accel, SimAccel::Dst | SimAccel::DstSw);
+        let parallel = matches!(
+            self.accel,
+            SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
+        );
         let kinds = [
             DstNodeKind::Split,
             DstNodeKind::SingleCarve,
@@ -419,6 +425,18 @@ impl Tally {
             DstNodeKind::Leaf,
         ];
         let mut c = self.counts;
+        // Pipeline ops and node steps: one box op per valid child (one issue slot per node
+        // on parallel pipes), one triangle op per test, one dual-split op per DST step on
+        // the pipeline; node steps are BVH nodes and DST steps other than leaf words.
+        c.box_ops += s.bvh_valid;
+        c.box_issues += if parallel { s.bvh_boxed } else { s.bvh_valid };
+        c.tri_ops += s.tri_test;
+        let dst_steps: u64 = s.dst.iter().flatten().sum();
+        if self.accel == SimAccel::Dst {
+            c.dst_ops += dst_steps;
+        }
+        c.node_steps +=
+            s.bvh_nodes + dst_steps - s.dst[DstNodeKind::Leaf as usize].iter().sum::<u64>();
         let m = &mut c.mix;
         m.add(if dst { DST_PUSH } else { PUSH }.times(s.push));
         m.add(if dst { DST_POP } else { POP }.times(s.pop));
@@ -474,12 +492,11 @@ pub struct Recorder<'a> {
     tally: &'a mut Tally,
     /// Byte address added to every fetch (where the image lives in simulated memory).
     pub base: u64,
-    /// The open run's instructions and reciprocal ops (0 when closed), each within its
-    /// op field's width.
-    run_n: u64,
+    /// The open run: [`OPEN`] plus its instructions (below 2^32) while the last op recorded
+    /// is the (unwritten) run, 0 when there is none.
+    run: u64,
+    /// The open run's reciprocal ops (below 2^16; 0 when there is no open run).
     run_fpinv: u64,
-    /// True when the last op recorded is the (unwritten) open run.
-    open: bool,
     /// DST configurations: the stack entries carry `[t_min, t_max]`.
     dst: bool,
     /// DST on the dual-split pipeline (not decoded in software).
@@ -487,6 +504,9 @@ pub struct Recorder<'a> {
     /// The "+" configurations: all child boxes in one issue slot.
     parallel_boxes: bool,
 }
+
+/// The flag of [`Recorder`]'s open run (above any instruction count an op holds).
+const OPEN: u64 = 1 << 63;
 
 /// An instruction run being merged: the fields of its future [`Op::Issue`], already checked
 /// against their widths.
@@ -532,9 +552,8 @@ impl<'a> Recorder<'a> {
             ops,
             tally,
             base: 0,
-            run_n: run.map_or(0, |r| r.n as u64),
+            run: run.map_or(0, |r| OPEN | r.n as u64),
             run_fpinv: run.map_or(0, |r| r.fpinv as u64),
-            open: run.is_some(),
             dst: matches!(accel, SimAccel::Dst | SimAccel::DstSw),
             dst_hw: accel == SimAccel::Dst,
             parallel_boxes: matches!(
@@ -559,8 +578,8 @@ impl<'a> Recorder<'a> {
     /// last op.
     #[inline]
     pub fn finish_open(self) -> Option<Run> {
-        self.open.then_some(Run {
-            n: self.run_n as u32,
+        (self.run != 0).then_some(Run {
+            n: self.run as u32,
             fpinv: self.run_fpinv as u16,
         })
     }
@@ -569,49 +588,47 @@ impl<'a> Recorder<'a> {
     #[inline(always)]
     pub fn issue(&mut self, m: Mix) {
         self.tally.counts.mix.add(m);
-        self.extend_run(m.total(), m.fpinv);
-    }
-
-    /// Merges `n` instructions, `fpinv` of them reciprocals, into the open run (opening one
-    /// if needed); the sums are checked against the op's widths.
-    #[inline(always)]
-    fn extend_run(&mut self, n: u64, fpinv: u64) {
-        let (n, fpinv) = (self.run_n + n, self.run_fpinv + fpinv);
+        if m.fpinv == 0 && m.total() <= u32::MAX as u64 {
+            return self.extend_run(m.total());
+        }
+        // Merged into the open run: the sums are checked against the op's widths.
+        let (n, fpinv) = ((self.run & !OPEN) + m.total(), self.run_fpinv + m.fpinv);
         if n > u32::MAX as u64 {
             self.tally.fail(OpRangeError::Issue { n });
         } else if fpinv > u16::MAX as u64 {
             self.tally.fail(OpRangeError::Fpinv { fpinv });
         } else {
-            (self.run_n, self.run_fpinv, self.open) = (n, fpinv, true);
+            (self.run, self.run_fpinv) = (OPEN | n, fpinv);
+        }
+    }
+
+    /// Merges `n` instructions without reciprocals into the open run (opening one if
+    /// needed), checked against the op's width.
+    #[inline(always)]
+    fn extend_run(&mut self, n: u64) {
+        let run = (self.run | OPEN) + n;
+        if run & !OPEN > u32::MAX as u64 {
+            self.tally.fail(OpRangeError::Issue { n: run & !OPEN });
+        } else {
+            self.run = run;
         }
     }
 
     /// Writes the open run (if any) as an `Issue` op: a load or pipeline op follows.
     #[inline(always)]
     fn close_run(&mut self) {
-        if self.open {
+        if self.run != 0 {
             self.ops.push(Op::Issue {
-                n: self.run_n as u32,
+                n: self.run as u32,
                 fpinv: self.run_fpinv as u16,
             });
-            (self.run_n, self.run_fpinv, self.open) = (0, 0, false);
+            (self.run, self.run_fpinv) = (0, 0);
         }
     }
 
+    /// Appends a pipeline op (counted from the steps, in [`Tally::counts`]).
     #[inline(always)]
     fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool) {
-        if n == 0 {
-            return;
-        }
-        let c = &mut self.tally.counts;
-        match pipe {
-            Pipe::Box => {
-                c.box_ops += n as u64;
-                c.box_issues += if parallel { 1 } else { n as u64 };
-            }
-            Pipe::Triangle => c.tri_ops += n as u64,
-            Pipe::DualSplit => c.dst_ops += n as u64,
-        }
         self.close_run();
         self.ops.push(Op::Pipe { pipe, n, parallel });
     }
@@ -632,7 +649,7 @@ impl Observer for Recorder<'_> {
     fn fetch(&mut self, addr: u64, bytes: u32) {
         let a = self.base + addr;
         // Words from the one holding byte `a` to the one holding byte `a + bytes − 1`.
-        let words = (a + bytes as u64).div_ceil(4) - a / 4;
+        let words = ((a & 3) + bytes as u64).div_ceil(4);
         if words == 0 {
             return;
         }
@@ -650,33 +667,32 @@ impl Observer for Recorder<'_> {
     fn step(&mut self, step: NodeStep) {
         match step {
             NodeStep::Bvh { valid, hits, .. } => {
-                self.tally.counts.node_steps += 1;
-                self.pipe(Pipe::Box, valid, self.parallel_boxes);
+                if valid != 0 {
+                    self.pipe(Pipe::Box, valid, self.parallel_boxes);
+                }
                 let pairs = (hits as u64 * hits.saturating_sub(1) as u64) / 2;
                 let s = &mut self.tally.steps;
                 s.bvh_nodes += 1;
+                s.bvh_boxed += (valid != 0) as u64;
                 s.bvh_valid += valid as u64;
                 s.bvh_hits += hits as u64;
                 s.bvh_pairs += pairs;
-                self.extend_run(bvh_total(valid as u64, hits as u64, pairs), 0);
+                self.extend_run(bvh_total(valid as u64, hits as u64, pairs));
             }
             NodeStep::Dst { kind, code, .. } => {
-                if kind != DstNodeKind::Leaf {
-                    self.tally.counts.node_steps += 1;
-                }
                 // Codes above 3 take code 3's mix in both step functions.
                 let (k, c) = (kind as usize & 3, code.min(3) as usize);
                 self.tally.steps.dst[k][c] += 1;
                 if self.dst_hw {
                     self.pipe(Pipe::DualSplit, 1, false);
-                    self.extend_run(DST_HW_TOTAL[c], 0);
+                    self.extend_run(DST_HW_TOTAL[c]);
                 } else {
-                    self.extend_run(DST_SW_TOTAL[k][c], 0);
+                    self.extend_run(DST_SW_TOTAL[k][c]);
                 }
             }
             NodeStep::Leaf { .. } => {
                 self.tally.steps.leaf += 1;
-                self.extend_run(LEAF.total(), 0);
+                self.extend_run(LEAF.total());
             }
         }
     }
@@ -685,23 +701,23 @@ impl Observer for Recorder<'_> {
     fn triangle_test(&mut self, _prim: u32, hit: bool) {
         self.pipe(Pipe::Triangle, 1, false);
         self.tally.steps.tri_test += 1;
-        self.extend_run(TRI_TEST.total(), 0);
+        self.extend_run(TRI_TEST.total());
         if hit {
             self.tally.steps.tri_accept += 1;
-            self.extend_run(TRI_ACCEPT.total(), 0);
+            self.extend_run(TRI_ACCEPT.total());
         }
     }
 
     #[inline(always)]
     fn push(&mut self) {
         self.tally.steps.push += 1;
-        self.extend_run(if self.dst { DST_PUSH } else { PUSH }.total(), 0);
+        self.extend_run(if self.dst { DST_PUSH } else { PUSH }.total());
     }
 
     #[inline(always)]
     fn pop(&mut self) {
         self.tally.steps.pop += 1;
-        self.extend_run(if self.dst { DST_POP } else { POP }.total(), 0);
+        self.extend_run(if self.dst { DST_POP } else { POP }.total());
     }
 }
 
