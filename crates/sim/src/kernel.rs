@@ -347,6 +347,25 @@ struct Steps {
     dst: [[u64; 4]; 4],
 }
 
+/// The DST node kinds in the enum's order: `kind as usize` indexes [`Steps::dst`] and the
+/// step tables.
+const DST_KINDS: [DstNodeKind; 4] = [
+    DstNodeKind::Split,
+    DstNodeKind::SingleCarve,
+    DstNodeKind::DualCarve,
+    DstNodeKind::Leaf,
+];
+const _: () = {
+    let mut k = 0;
+    while k < 4 {
+        assert!(
+            DST_KINDS[k] as usize == k,
+            "DST_KINDS must follow DstNodeKind's order"
+        );
+        k += 1;
+    }
+};
+
 /// Instructions of each DST step on the pipeline, by return code ([`dst_hw_step`]).
 const DST_HW_TOTAL: [u64; 4] = {
     let mut t = [0; 4];
@@ -360,18 +379,12 @@ const DST_HW_TOTAL: [u64; 4] = {
 
 /// Instructions of each DST* step, by node kind and return code ([`dst_sw_step`]).
 const DST_SW_TOTAL: [[u64; 4]; 4] = {
-    let kinds = [
-        DstNodeKind::Split,
-        DstNodeKind::SingleCarve,
-        DstNodeKind::DualCarve,
-        DstNodeKind::Leaf,
-    ];
     let mut t = [[0; 4]; 4];
     let mut k = 0;
     while k < 4 {
         let mut c = 0;
         while c < 4 {
-            t[k][c] = dst_sw_step(kinds[k], c as u8).total();
+            t[k][c] = dst_sw_step(DST_KINDS[k], c as u8).total();
             c += 1;
         }
         k += 1;
@@ -418,12 +431,6 @@ impl Tally {
             self.accel,
             SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
         );
-        let kinds = [
-            DstNodeKind::Split,
-            DstNodeKind::SingleCarve,
-            DstNodeKind::DualCarve,
-            DstNodeKind::Leaf,
-        ];
         let mut c = self.counts;
         // Pipeline ops and node steps: one box op per valid child (one issue slot per node
         // on parallel pipes), one triangle op per test, one dual-split op per DST step on
@@ -447,7 +454,7 @@ impl Tally {
         m.add(BVH_PER_CHILD.times(s.bvh_valid));
         m.add(BVH_PER_HIT.times(s.bvh_hits));
         m.add(BVH_SORT_PAIR.times(s.bvh_pairs));
-        for (kind, row) in kinds.into_iter().zip(&s.dst) {
+        for (kind, row) in DST_KINDS.into_iter().zip(&s.dst) {
             for (code, &n) in row.iter().enumerate() {
                 let step = if self.accel == SimAccel::Dst {
                     dst_hw_step(code as u8)
@@ -846,12 +853,6 @@ mod tests {
         obs: &mut O,
         issue: &mut impl FnMut(&mut O, Mix),
     ) {
-        let kinds = [
-            DstNodeKind::Split,
-            DstNodeKind::SingleCarve,
-            DstNodeKind::DualCarve,
-            DstNodeKind::Leaf,
-        ];
         match rng.below(9) {
             0 => obs.fetch(rng.below(1 << 20) as u64, rng.below(220)),
             1 => {
@@ -861,7 +862,7 @@ mod tests {
                 obs.step(NodeStep::Bvh { arity, valid, hits });
             }
             2 => obs.step(NodeStep::Dst {
-                kind: kinds[rng.below(4) as usize],
+                kind: DST_KINDS[rng.below(4) as usize],
                 code: rng.below(4) as u8,
                 carving_leaf: rng.below(2) == 1,
             }),
