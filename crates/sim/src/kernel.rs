@@ -45,6 +45,30 @@ impl Mix {
     pub const fn total(&self) -> u64 {
         self.int + self.fpadd + self.fpmul + self.fpcmp + self.fpinv + self.local
     }
+    /// `self` taken `k` times (exact: the fields are integers).
+    #[inline(always)]
+    const fn times(self, k: u64) -> Mix {
+        Mix::new(
+            self.int * k,
+            self.fpadd * k,
+            self.fpmul * k,
+            self.fpcmp * k,
+            self.fpinv * k,
+            self.local * k,
+        )
+    }
+    #[inline(always)]
+    const fn plus(self, o: Mix) -> Mix {
+        Mix::new(
+            self.int + o.int,
+            self.fpadd + o.fpadd,
+            self.fpmul + o.fpmul,
+            self.fpcmp + o.fpcmp,
+            self.fpinv + o.fpinv,
+            self.local + o.local,
+        )
+    }
+    #[inline(always)]
     fn add(&mut self, o: Mix) {
         self.int += o.int;
         self.fpadd += o.fpadd;
@@ -103,7 +127,7 @@ pub const BVH_SORT_PAIR: Mix = Mix::new(2, 0, 0, 1, 0, 0);
 ///         mov   tmax, tmax_out
 ///         j     LOOP             ; code 2: 8
 /// ```
-pub fn dst_hw_step(code: u8) -> Mix {
+pub const fn dst_hw_step(code: u8) -> Mix {
     match code {
         0 => Mix::new(1, 0, 0, 0, 0, 0),
         1 => Mix::new(7, 0, 0, 0, 0, 0),
@@ -128,7 +152,7 @@ pub const DST_POP: Mix = Mix::new(3, 0, 0, 2, 0, 3);
 /// min/max and the interval tests are FP compares, and a child is addressed from the 26-bit
 /// offset (and B, the left size, for the right child). Every instruction is written out in
 /// `docs/simulator.md` ("DST* decoder sequences").
-pub fn dst_sw_step(kind: DstNodeKind, code: u8) -> Mix {
+pub const fn dst_sw_step(kind: DstNodeKind, code: u8) -> Mix {
     let hit = code != 0;
     match kind {
         // dispatch 3, axis 1, index 2 + 2 local loads, 2 × (sub, mul), sign select (bltz,
@@ -302,49 +326,155 @@ impl InstrCounts {
     }
 }
 
-/// The observer the simulator passes to the traversal: appends macro-ops to a thread's
-/// program and counts instructions.
-pub struct Recorder<'a> {
-    accel: SimAccel,
-    ops: &'a mut Vec<Op>,
-    /// Counts so far.
-    pub counts: InstrCounts,
-    /// Byte address added to every fetch (where the image lives in simulated memory).
-    pub base: u64,
-    /// The first step that did not fit an [`Op`] (the program is then incomplete).
-    pub error: Option<OpRangeError>,
+/// Kernel steps counted by kind: their instruction mixes are constants (or, for a BVH node,
+/// linear in its child counts), so a step adds 1 to a counter and the mixes are multiplied
+/// out once, when the counts are read ([`Tally::counts`]). Integer arithmetic: the totals
+/// are exactly those of adding each step's mix as it happens.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Steps {
+    push: u64,
+    pop: u64,
+    leaf: u64,
+    tri_test: u64,
+    tri_accept: u64,
+    bvh_nodes: u64,
+    /// BVH nodes with at least one valid child (one ray-box pipeline op each).
+    bvh_boxed: u64,
+    bvh_valid: u64,
+    bvh_hits: u64,
+    bvh_pairs: u64,
+    /// DST steps by node kind (the enum's order) and return code.
+    dst: [[u64; 4]; 4],
 }
 
-impl<'a> Recorder<'a> {
-    /// Records into `ops` for configuration `accel`.
-    pub fn new(accel: SimAccel, ops: &'a mut Vec<Op>) -> Self {
+/// The DST node kinds in the enum's order: `kind as usize` indexes [`Steps::dst`] and the
+/// step tables.
+const DST_KINDS: [DstNodeKind; 4] = [
+    DstNodeKind::Split,
+    DstNodeKind::SingleCarve,
+    DstNodeKind::DualCarve,
+    DstNodeKind::Leaf,
+];
+const _: () = {
+    let mut k = 0;
+    while k < 4 {
+        assert!(
+            DST_KINDS[k] as usize == k,
+            "DST_KINDS must follow DstNodeKind's order"
+        );
+        k += 1;
+    }
+};
+
+/// Instructions of each DST step on the pipeline, by return code ([`dst_hw_step`]).
+const DST_HW_TOTAL: [u64; 4] = {
+    let mut t = [0; 4];
+    let mut c = 0;
+    while c < 4 {
+        t[c] = dst_hw_step(c as u8).total();
+        c += 1;
+    }
+    t
+};
+
+/// Instructions of each DST* step, by node kind and return code ([`dst_sw_step`]).
+const DST_SW_TOTAL: [[u64; 4]; 4] = {
+    let mut t = [[0; 4]; 4];
+    let mut k = 0;
+    while k < 4 {
+        let mut c = 0;
+        while c < 4 {
+            t[k][c] = dst_sw_step(DST_KINDS[k], c as u8).total();
+            c += 1;
+        }
+        k += 1;
+    }
+    t
+};
+
+/// Instructions of a BVH node step ([`bvh_step`]'s total), from the constants.
+#[inline(always)]
+const fn bvh_total(valid: u64, hits: u64, pairs: u64) -> u64 {
+    BVH_NODE.total()
+        + BVH_PER_CHILD.total() * valid
+        + BVH_PER_HIT.total() * hits
+        + BVH_SORT_PAIR.total() * pairs
+}
+
+/// What the recorders of one frame count, summed over every ray: instruction and event
+/// counts, kernel steps by kind, and the first step that did not fit an [`Op`].
+#[derive(Clone, Debug)]
+pub struct Tally {
+    accel: SimAccel,
+    /// Counts besides the kernel steps' instruction mixes.
+    counts: InstrCounts,
+    steps: Steps,
+    error: Option<OpRangeError>,
+}
+
+impl Tally {
+    /// Nothing counted yet, for configuration `accel`.
+    pub fn new(accel: SimAccel) -> Self {
         Self {
             accel,
-            ops,
             counts: InstrCounts::default(),
-            base: 0,
+            steps: Steps::default(),
             error: None,
         }
     }
 
-    /// Appends instructions of mix `m` (merged into a preceding `Issue`).
-    pub fn issue(&mut self, m: Mix) {
-        self.counts.mix.add(m);
-        // Merged into a preceding `Issue`: the sums are checked against the op's widths.
-        let (pn, pf) = match self.ops.last() {
-            Some(&Op::Issue { n, fpinv }) => (n as u64, fpinv as u64),
-            _ => (0, 0),
-        };
-        let (n, fpinv) = (pn + m.total(), pf + m.fpinv);
-        let op = match (u32::try_from(n), u16::try_from(fpinv)) {
-            (Ok(n), Ok(fpinv)) => Op::Issue { n, fpinv },
-            (Err(_), _) => return self.fail(OpRangeError::Issue { n }),
-            (_, Err(_)) => return self.fail(OpRangeError::Fpinv { fpinv }),
-        };
-        match self.ops.last_mut() {
-            Some(last @ Op::Issue { .. }) => *last = op,
-            _ => self.ops.push(op),
+    /// The counts so far, every kernel step's instruction mix included.
+    pub fn counts(&self) -> InstrCounts {
+        let s = &self.steps;
+        let dst = matches!(self.accel, SimAccel::Dst | SimAccel::DstSw);
+        let parallel = matches!(
+            self.accel,
+            SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
+        );
+        let mut c = self.counts;
+        // Pipeline ops and node steps: one box op per valid child (one issue slot per node
+        // on parallel pipes), one triangle op per test, one dual-split op per DST step on
+        // the pipeline; node steps are BVH nodes and DST steps other than leaf words.
+        c.box_ops += s.bvh_valid;
+        c.box_issues += if parallel { s.bvh_boxed } else { s.bvh_valid };
+        c.tri_ops += s.tri_test;
+        let dst_steps: u64 = s.dst.iter().flatten().sum();
+        if self.accel == SimAccel::Dst {
+            c.dst_ops += dst_steps;
         }
+        c.node_steps +=
+            s.bvh_nodes + dst_steps - s.dst[DstNodeKind::Leaf as usize].iter().sum::<u64>();
+        let m = &mut c.mix;
+        m.add(if dst { DST_PUSH } else { PUSH }.times(s.push));
+        m.add(if dst { DST_POP } else { POP }.times(s.pop));
+        m.add(LEAF.times(s.leaf));
+        m.add(TRI_TEST.times(s.tri_test));
+        m.add(TRI_ACCEPT.times(s.tri_accept));
+        m.add(BVH_NODE.times(s.bvh_nodes));
+        m.add(BVH_PER_CHILD.times(s.bvh_valid));
+        m.add(BVH_PER_HIT.times(s.bvh_hits));
+        m.add(BVH_SORT_PAIR.times(s.bvh_pairs));
+        for (kind, row) in DST_KINDS.into_iter().zip(&s.dst) {
+            for (code, &n) in row.iter().enumerate() {
+                let step = if self.accel == SimAccel::Dst {
+                    dst_hw_step(code as u8)
+                } else {
+                    dst_sw_step(kind, code as u8)
+                };
+                m.add(step.times(n));
+            }
+        }
+        c
+    }
+
+    /// The first step that did not fit an [`Op`] (a program is then incomplete).
+    pub fn error(&self) -> Option<OpRangeError> {
+        self.error
+    }
+
+    /// Counts the global atomic increment that hands a pixel to a thread.
+    pub fn atomic(&mut self) {
+        self.counts.atomics += 1;
     }
 
     /// Keeps the first range error.
@@ -352,121 +482,466 @@ impl<'a> Recorder<'a> {
     fn fail(&mut self, e: OpRangeError) {
         self.error.get_or_insert(e);
     }
+}
 
-    fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool) {
-        if n == 0 {
-            return;
+/// The observer the simulator passes to the traversal: appends macro-ops to a thread's
+/// program and counts instructions into a [`Tally`].
+///
+/// Consecutive instruction runs merge into one [`Op::Issue`]. The run being merged is kept
+/// in the recorder, not in the op buffer, and written out when a load or pipeline op follows
+/// or the recording ends ([`Recorder::finish`], [`Recorder::finish_open`]); a kernel step
+/// adds its instruction count to the run and 1 to its kind's counter in the tally
+/// (`docs/performance.md`, "Fifth round"). The ops and counts are exactly those of merging
+/// into the buffer's last op and adding each step's mix; a test compares both on random
+/// event streams.
+pub struct Recorder<'a> {
+    ops: &'a mut Vec<Op>,
+    tally: &'a mut Tally,
+    /// Byte address added to every fetch (where the image lives in simulated memory).
+    pub base: u64,
+    /// The open run: [`OPEN`] plus its instructions (below 2^32) while the last op recorded
+    /// is the (unwritten) run, 0 when there is none.
+    run: u64,
+    /// The open run's reciprocal ops (below 2^16; 0 when there is no open run).
+    run_fpinv: u64,
+    /// DST configurations: the stack entries carry `[t_min, t_max]`.
+    dst: bool,
+    /// DST on the dual-split pipeline (not decoded in software).
+    dst_hw: bool,
+    /// The "+" configurations: all child boxes in one issue slot.
+    parallel_boxes: bool,
+}
+
+/// The flag of [`Recorder`]'s open run (above any instruction count an op holds).
+const OPEN: u64 = 1 << 63;
+
+/// An instruction run being merged: the fields of its future [`Op::Issue`], already checked
+/// against their widths.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Run {
+    /// Instructions.
+    pub n: u32,
+    /// Of which reciprocal / inverse-square-root ops.
+    pub fpinv: u16,
+}
+
+impl Run {
+    /// The run as an op.
+    pub fn op(self) -> Op {
+        Op::Issue {
+            n: self.n,
+            fpinv: self.fpinv,
         }
-        match pipe {
-            Pipe::Box => {
-                self.counts.box_ops += n as u64;
-                self.counts.box_issues += if parallel { 1 } else { n as u64 };
-            }
-            Pipe::Triangle => self.counts.tri_ops += n as u64,
-            Pipe::DualSplit => self.counts.dst_ops += n as u64,
-        }
-        self.ops.push(Op::Pipe { pipe, n, parallel });
-    }
-
-    /// Records the global atomic increment that hands a pixel to the thread.
-    pub fn atomic(&mut self) {
-        self.counts.atomics += 1;
-    }
-
-    fn is_dst(&self) -> bool {
-        matches!(self.accel, SimAccel::Dst | SimAccel::DstSw)
-    }
-
-    fn parallel_boxes(&self) -> bool {
-        matches!(
-            self.accel,
-            SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
-        )
     }
 }
 
-impl Observer for Recorder<'_> {
+impl<'a> Recorder<'a> {
+    /// Records into `ops`, counting into `tally`; a trailing `Issue` of `ops` is continued
+    /// (the next instructions merge into it).
+    pub fn new(tally: &'a mut Tally, ops: &'a mut Vec<Op>) -> Self {
+        let run = match ops.last() {
+            Some(&Op::Issue { n, fpinv }) => {
+                ops.pop();
+                Some(Run { n, fpinv })
+            }
+            _ => None,
+        };
+        Self::resume(tally, ops, run)
+    }
+
+    /// Records into `ops`, counting into `tally`, continuing the open run `run` (the trailing
+    /// `Issue` of the previous recording, see [`Recorder::finish_open`]) as if it were the
+    /// last op of `ops`.
     #[inline]
+    pub fn resume(tally: &'a mut Tally, ops: &'a mut Vec<Op>, run: Option<Run>) -> Self {
+        let accel = tally.accel;
+        Self {
+            ops,
+            tally,
+            base: 0,
+            run: run.map_or(0, |r| OPEN | r.n as u64),
+            run_fpinv: run.map_or(0, |r| r.fpinv as u64),
+            dst: matches!(accel, SimAccel::Dst | SimAccel::DstSw),
+            dst_hw: accel == SimAccel::Dst,
+            parallel_boxes: matches!(
+                accel,
+                SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
+            ),
+        }
+    }
+
+    /// The tally counted into (the open run's instructions are in its counts already).
+    pub fn tally(&self) -> &Tally {
+        self.tally
+    }
+
+    /// Ends the recording with the open run written to the ops.
+    pub fn finish(mut self) {
+        self.close_run();
+    }
+
+    /// Ends the recording leaving the open run out of the ops: it is returned, to be
+    /// continued by the next recording ([`Recorder::resume`]) or written as the program's
+    /// last op.
+    #[inline]
+    pub fn finish_open(self) -> Option<Run> {
+        (self.run != 0).then_some(Run {
+            n: self.run as u32,
+            fpinv: self.run_fpinv as u16,
+        })
+    }
+
+    /// Appends instructions of mix `m` (merged into a preceding `Issue`).
+    #[inline(always)]
+    pub fn issue(&mut self, m: Mix) {
+        self.tally.counts.mix.add(m);
+        if m.fpinv == 0 && m.total() <= u32::MAX as u64 {
+            return self.extend_run(m.total());
+        }
+        // Merged into the open run: the sums are checked against the op's widths.
+        let (n, fpinv) = ((self.run & !OPEN) + m.total(), self.run_fpinv + m.fpinv);
+        if n > u32::MAX as u64 {
+            self.tally.fail(OpRangeError::Issue { n });
+        } else if fpinv > u16::MAX as u64 {
+            self.tally.fail(OpRangeError::Fpinv { fpinv });
+        } else {
+            (self.run, self.run_fpinv) = (OPEN | n, fpinv);
+        }
+    }
+
+    /// Merges `n` instructions without reciprocals into the open run (opening one if
+    /// needed), checked against the op's width.
+    #[inline(always)]
+    fn extend_run(&mut self, n: u64) {
+        let run = (self.run | OPEN) + n;
+        if run & !OPEN > u32::MAX as u64 {
+            self.tally.fail(OpRangeError::Issue { n: run & !OPEN });
+        } else {
+            self.run = run;
+        }
+    }
+
+    /// Writes the open run (if any) as an `Issue` op: a load or pipeline op follows.
+    #[inline(always)]
+    fn close_run(&mut self) {
+        if self.run != 0 {
+            self.ops.push(Op::Issue {
+                n: self.run as u32,
+                fpinv: self.run_fpinv as u16,
+            });
+            (self.run, self.run_fpinv) = (0, 0);
+        }
+    }
+
+    /// Appends a pipeline op (counted from the steps, in [`Tally::counts`]).
+    #[inline(always)]
+    fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool) {
+        self.close_run();
+        self.ops.push(Op::Pipe { pipe, n, parallel });
+    }
+}
+
+/// The instructions around a BVH node's box tests: node overhead, per valid child, per hit
+/// child and per compare-exchange of the entry-distance sort (`hits·(hits − 1)/2` pairs).
+pub fn bvh_step(valid: u8, hits: u8) -> Mix {
+    let pairs = (hits as u32 * hits.saturating_sub(1) as u32) / 2;
+    BVH_NODE
+        .plus(BVH_PER_CHILD.times(valid as u64))
+        .plus(BVH_PER_HIT.times(hits as u64))
+        .plus(BVH_SORT_PAIR.times(pairs as u64))
+}
+
+impl Observer for Recorder<'_> {
+    #[inline(always)]
     fn fetch(&mut self, addr: u64, bytes: u32) {
         let a = self.base + addr;
-        let first = a & !3;
-        let words = ((a + bytes as u64).div_ceil(4) * 4 - first) / 4;
+        // Words from the one holding byte `a` to the one holding byte `a + bytes − 1`.
+        let words = ((a & 3) + bytes as u64).div_ceil(4);
         if words == 0 {
             return;
         }
-        self.counts.loads += words;
-        match Op::load(first, words) {
-            Ok(op) => self.ops.push(op),
-            Err(e) => self.fail(e),
+        self.tally.counts.loads += words;
+        match Op::load(a & !3, words) {
+            Ok(op) => {
+                self.close_run();
+                self.ops.push(op);
+            }
+            Err(e) => self.tally.fail(e),
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn step(&mut self, step: NodeStep) {
         match step {
             NodeStep::Bvh { valid, hits, .. } => {
-                self.counts.node_steps += 1;
-                let parallel = self.parallel_boxes();
-                self.pipe(Pipe::Box, valid, parallel);
-                let mut m = BVH_NODE;
-                for _ in 0..valid {
-                    m.add(BVH_PER_CHILD);
+                if valid != 0 {
+                    self.pipe(Pipe::Box, valid, self.parallel_boxes);
                 }
-                for _ in 0..hits {
-                    m.add(BVH_PER_HIT);
-                }
-                let pairs = (hits as u32 * hits.saturating_sub(1) as u32) / 2;
-                for _ in 0..pairs {
-                    m.add(BVH_SORT_PAIR);
-                }
-                self.issue(m);
+                let pairs = (hits as u64 * hits.saturating_sub(1) as u64) / 2;
+                let s = &mut self.tally.steps;
+                s.bvh_nodes += 1;
+                s.bvh_boxed += (valid != 0) as u64;
+                s.bvh_valid += valid as u64;
+                s.bvh_hits += hits as u64;
+                s.bvh_pairs += pairs;
+                self.extend_run(bvh_total(valid as u64, hits as u64, pairs));
             }
             NodeStep::Dst { kind, code, .. } => {
-                if kind != DstNodeKind::Leaf {
-                    self.counts.node_steps += 1;
-                }
-                if self.accel == SimAccel::Dst {
+                // Codes above 3 take code 3's mix in both step functions.
+                let (k, c) = (kind as usize & 3, code.min(3) as usize);
+                self.tally.steps.dst[k][c] += 1;
+                if self.dst_hw {
                     self.pipe(Pipe::DualSplit, 1, false);
-                    self.issue(dst_hw_step(code));
+                    self.extend_run(DST_HW_TOTAL[c]);
                 } else {
-                    self.issue(dst_sw_step(kind, code));
+                    self.extend_run(DST_SW_TOTAL[k][c]);
                 }
             }
-            NodeStep::Leaf { .. } => self.issue(LEAF),
+            NodeStep::Leaf { .. } => {
+                self.tally.steps.leaf += 1;
+                self.extend_run(LEAF.total());
+            }
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn triangle_test(&mut self, _prim: u32, hit: bool) {
         self.pipe(Pipe::Triangle, 1, false);
-        self.issue(TRI_TEST);
+        self.tally.steps.tri_test += 1;
+        self.extend_run(TRI_TEST.total());
         if hit {
-            self.issue(TRI_ACCEPT);
+            self.tally.steps.tri_accept += 1;
+            self.extend_run(TRI_ACCEPT.total());
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn push(&mut self) {
-        self.issue(if self.is_dst() { DST_PUSH } else { PUSH });
+        self.tally.steps.push += 1;
+        self.extend_run(if self.dst { DST_PUSH } else { PUSH }.total());
     }
 
-    #[inline]
+    #[inline(always)]
     fn pop(&mut self) {
-        self.issue(if self.is_dst() { DST_POP } else { POP });
+        self.tally.steps.pop += 1;
+        self.extend_run(if self.dst { DST_POP } else { POP }.total());
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use dualsplit_geometry::Pcg32;
+
+    /// The recorder before the fifth round (`docs/performance.md`): every instruction run is
+    /// merged into the op buffer's last op. Kept as the reference of
+    /// `recorder_matches_merging_into_the_last_op`.
+    struct Reference<'a> {
+        accel: SimAccel,
+        ops: &'a mut Vec<Op>,
+        counts: InstrCounts,
+        error: Option<OpRangeError>,
+    }
+
+    impl Reference<'_> {
+        fn issue(&mut self, m: Mix) {
+            self.counts.mix.add(m);
+            let (pn, pf) = match self.ops.last() {
+                Some(&Op::Issue { n, fpinv }) => (n as u64, fpinv as u64),
+                _ => (0, 0),
+            };
+            let (n, fpinv) = (pn + m.total(), pf + m.fpinv);
+            let op = match (u32::try_from(n), u16::try_from(fpinv)) {
+                (Ok(n), Ok(fpinv)) => Op::Issue { n, fpinv },
+                (Err(_), _) => return self.fail(OpRangeError::Issue { n }),
+                (_, Err(_)) => return self.fail(OpRangeError::Fpinv { fpinv }),
+            };
+            match self.ops.last_mut() {
+                Some(last @ Op::Issue { .. }) => *last = op,
+                _ => self.ops.push(op),
+            }
+        }
+        fn fail(&mut self, e: OpRangeError) {
+            self.error.get_or_insert(e);
+        }
+        fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool) {
+            if n == 0 {
+                return;
+            }
+            match pipe {
+                Pipe::Box => {
+                    self.counts.box_ops += n as u64;
+                    self.counts.box_issues += if parallel { 1 } else { n as u64 };
+                }
+                Pipe::Triangle => self.counts.tri_ops += n as u64,
+                Pipe::DualSplit => self.counts.dst_ops += n as u64,
+            }
+            self.ops.push(Op::Pipe { pipe, n, parallel });
+        }
+        fn is_dst(&self) -> bool {
+            matches!(self.accel, SimAccel::Dst | SimAccel::DstSw)
+        }
+    }
+
+    impl Observer for Reference<'_> {
+        fn fetch(&mut self, addr: u64, bytes: u32) {
+            let first = addr & !3;
+            let words = ((addr + bytes as u64).div_ceil(4) * 4 - first) / 4;
+            if words == 0 {
+                return;
+            }
+            self.counts.loads += words;
+            match Op::load(first, words) {
+                Ok(op) => self.ops.push(op),
+                Err(e) => self.fail(e),
+            }
+        }
+        fn step(&mut self, step: NodeStep) {
+            match step {
+                NodeStep::Bvh { valid, hits, .. } => {
+                    self.counts.node_steps += 1;
+                    let parallel = matches!(
+                        self.accel,
+                        SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
+                    );
+                    self.pipe(Pipe::Box, valid, parallel);
+                    let mut m = BVH_NODE;
+                    for _ in 0..valid {
+                        m.add(BVH_PER_CHILD);
+                    }
+                    for _ in 0..hits {
+                        m.add(BVH_PER_HIT);
+                    }
+                    let pairs = (hits as u32 * hits.saturating_sub(1) as u32) / 2;
+                    for _ in 0..pairs {
+                        m.add(BVH_SORT_PAIR);
+                    }
+                    self.issue(m);
+                }
+                NodeStep::Dst { kind, code, .. } => {
+                    if kind != DstNodeKind::Leaf {
+                        self.counts.node_steps += 1;
+                    }
+                    if self.accel == SimAccel::Dst {
+                        self.pipe(Pipe::DualSplit, 1, false);
+                        self.issue(dst_hw_step(code));
+                    } else {
+                        self.issue(dst_sw_step(kind, code));
+                    }
+                }
+                NodeStep::Leaf { .. } => self.issue(LEAF),
+            }
+        }
+        fn triangle_test(&mut self, _prim: u32, hit: bool) {
+            self.pipe(Pipe::Triangle, 1, false);
+            self.issue(TRI_TEST);
+            if hit {
+                self.issue(TRI_ACCEPT);
+            }
+        }
+        fn push(&mut self) {
+            self.issue(if self.is_dst() { DST_PUSH } else { PUSH });
+        }
+        fn pop(&mut self) {
+            self.issue(if self.is_dst() { DST_POP } else { POP });
+        }
+    }
+
+    /// One random traversal event (or an instruction run of the ray's set-up and finish).
+    fn random_event<O: Observer>(
+        rng: &mut Pcg32,
+        obs: &mut O,
+        issue: &mut impl FnMut(&mut O, Mix),
+    ) {
+        match rng.below(9) {
+            0 => obs.fetch(rng.below(1 << 20) as u64, rng.below(220)),
+            1 => {
+                let arity = [2u8, 4, 8][rng.below(3) as usize];
+                let valid = rng.below(arity as u32 + 1) as u8;
+                let hits = rng.below(valid as u32 + 1) as u8;
+                obs.step(NodeStep::Bvh { arity, valid, hits });
+            }
+            2 => obs.step(NodeStep::Dst {
+                kind: DST_KINDS[rng.below(4) as usize],
+                code: rng.below(4) as u8,
+                carving_leaf: rng.below(2) == 1,
+            }),
+            3 => obs.step(NodeStep::Leaf {
+                count: rng.below(8),
+            }),
+            4 => obs.triangle_test(rng.below(1000), rng.below(2) == 1),
+            5 => obs.push(),
+            6 => obs.pop(),
+            7 => issue(obs, RAY_SETUP),
+            _ => issue(obs, [RAY_FINISH, LEAF, PUSH][rng.below(3) as usize]),
+        }
+    }
+
+    #[test]
+    fn recorder_matches_merging_into_the_last_op() {
+        for seed in 0..40u64 {
+            for accel in SimAccel::ALL {
+                let events = 1 + Pcg32::new(seed, 7).below(300);
+                // The reference: one recording merging into the buffer's last op.
+                let mut want = Vec::new();
+                let mut reference = Reference {
+                    accel,
+                    ops: &mut want,
+                    counts: InstrCounts::default(),
+                    error: None,
+                };
+                let mut rng = Pcg32::new(seed, 1);
+                for _ in 0..events {
+                    random_event(&mut rng, &mut reference, &mut |o: &mut Reference, m| {
+                        o.issue(m)
+                    });
+                }
+                let (want_counts, want_error) = (reference.counts, reference.error);
+                // The recorder, the stream cut into recordings at random points (as a
+                // pixel's rays are), each continuing the previous one's open run.
+                let mut got = Vec::new();
+                let mut tally = Tally::new(accel);
+                let mut run = None;
+                let mut rng = Pcg32::new(seed, 1);
+                let mut cuts = Pcg32::new(seed, 2);
+                let mut left = events;
+                while left > 0 {
+                    let n = (1 + cuts.below(40)).min(left);
+                    left -= n;
+                    let mut r = Recorder::resume(&mut tally, &mut got, run);
+                    for _ in 0..n {
+                        random_event(&mut rng, &mut r, &mut |o: &mut Recorder, m| o.issue(m));
+                    }
+                    run = r.finish_open();
+                }
+                got.extend(run.map(Run::op));
+                assert_eq!(want_error, None);
+                assert_eq!(tally.error(), None);
+                assert_eq!(got, want, "seed {seed}, {accel:?}");
+                assert_eq!(tally.counts(), want_counts, "seed {seed}, {accel:?}");
+                // `new` continues a trailing Issue; `finish` writes the open run.
+                let mut again = Vec::new();
+                let mut tally = Tally::new(accel);
+                let mut rng = Pcg32::new(seed, 1);
+                for _ in 0..events {
+                    let mut r = Recorder::new(&mut tally, &mut again);
+                    random_event(&mut rng, &mut r, &mut |o: &mut Recorder, m| o.issue(m));
+                    r.finish();
+                }
+                assert_eq!(again, want, "seed {seed}, {accel:?}");
+                assert_eq!(tally.counts(), want_counts, "seed {seed}, {accel:?}");
+            }
+        }
+    }
 
     #[test]
     fn fetch_covers_every_touched_word() {
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::Bvh2, &mut ops);
+        let mut tally = Tally::new(SimAccel::Bvh2);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         r.fetch(52, 52);
         r.fetch(6, 4); // straddles two words
-        assert_eq!(r.counts.loads, 15);
+        assert_eq!(r.tally().counts().loads, 15);
         assert_eq!(
             ops,
             vec![
@@ -500,27 +975,40 @@ mod tests {
         );
         // The recorder keeps the first error instead of wrapping.
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::Bvh2, &mut ops);
+        let mut tally = Tally::new(SimAccel::Bvh2);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         r.fetch(8, 4);
-        assert_eq!(r.error, None);
+        assert_eq!(r.tally().error(), None);
         r.fetch(top + 8, 4);
         r.fetch(0, 4 * 70_000);
-        assert_eq!(r.error, Some(OpRangeError::Address { addr: top + 8 }));
+        assert_eq!(
+            r.tally().error(),
+            Some(OpRangeError::Address { addr: top + 8 })
+        );
         // Merged issue runs: reciprocal ops beyond u16, instructions beyond u32.
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::Bvh2, &mut ops);
+        let mut tally = Tally::new(SimAccel::Bvh2);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         let inv = Mix::new(0, 0, 0, 0, 30_000, 0);
         r.issue(inv);
         r.issue(inv);
-        assert_eq!(r.error, None);
+        assert_eq!(r.tally().error(), None);
         r.issue(inv);
-        assert_eq!(r.error, Some(OpRangeError::Fpinv { fpinv: 90_000 }));
+        assert_eq!(
+            r.tally().error(),
+            Some(OpRangeError::Fpinv { fpinv: 90_000 })
+        );
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::Bvh2, &mut ops);
+        let mut tally = Tally::new(SimAccel::Bvh2);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         let big = Mix::new(3_000_000_000, 0, 0, 0, 0, 0);
         r.issue(big);
         r.issue(big);
-        assert_eq!(r.error, Some(OpRangeError::Issue { n: 6_000_000_000 }));
+        assert_eq!(
+            r.tally().error(),
+            Some(OpRangeError::Issue { n: 6_000_000_000 })
+        );
+        r.finish();
         assert_eq!(
             ops,
             vec![Op::Issue {
@@ -534,16 +1022,17 @@ mod tests {
     fn serial_and_parallel_box_issue() {
         for (accel, issues) in [(SimAccel::Bvh4, 3), (SimAccel::Bvh4Plus, 1)] {
             let mut ops = Vec::new();
-            let mut r = Recorder::new(accel, &mut ops);
+            let mut tally = Tally::new(accel);
+            let mut r = Recorder::new(&mut tally, &mut ops);
             r.step(NodeStep::Bvh {
                 arity: 4,
                 valid: 3,
                 hits: 2,
             });
-            assert_eq!(r.counts.box_ops, 3);
-            assert_eq!(r.counts.box_issues, issues);
+            assert_eq!(r.tally().counts().box_ops, 3);
+            assert_eq!(r.tally().counts().box_issues, issues);
             // node 4 + 3 children × 2 + 2 hits × 2 + 1 sort pair × 3
-            assert_eq!(r.counts.mix.total(), 4 + 6 + 4 + 3);
+            assert_eq!(r.tally().counts().mix.total(), 4 + 6 + 4 + 3);
         }
     }
 
@@ -570,21 +1059,23 @@ mod tests {
             carving_leaf: false,
         };
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::Dst, &mut ops);
+        let mut tally = Tally::new(SimAccel::Dst);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         r.step(step);
-        assert_eq!(r.counts.dst_ops, 1);
+        assert_eq!(r.tally().counts().dst_ops, 1);
         // Code 2: the branch chain to the "both children" case, next node, t_max, jump.
-        assert_eq!(r.counts.mix.total(), 8);
+        assert_eq!(r.tally().counts().mix.total(), 8);
         let mut ops = Vec::new();
-        let mut r = Recorder::new(SimAccel::DstSw, &mut ops);
+        let mut tally = Tally::new(SimAccel::DstSw);
+        let mut r = Recorder::new(&mut tally, &mut ops);
         r.step(step);
-        assert_eq!(r.counts.dst_ops, 0);
+        assert_eq!(r.tally().counts().dst_ops, 0);
         // 23 int, 2 local loads, 2 sub, 3 mul, 4 min/max/compare.
-        assert_eq!(r.counts.mix.total(), 34);
-        assert_eq!(r.counts.mix.local, 2);
+        assert_eq!(r.tally().counts().mix.total(), 34);
+        assert_eq!(r.tally().counts().mix.local, 2);
         // The stack entries of both DSTs carry [t_min, t_max]: 3 local-store accesses.
         r.push();
         r.pop();
-        assert_eq!(r.counts.mix.local, 2 + 3 + 3);
+        assert_eq!(r.tally().counts().mix.local, 2 + 3 + 3);
     }
 }

@@ -3,7 +3,7 @@
 //! 2020, §4.3–4.4; notes §5.2).
 
 use crate::engine::{Chip, Thread, WorkSource, run_chip};
-use crate::kernel::{Mix, Op, OpRangeError, Recorder};
+use crate::kernel::{Mix, Op, Recorder, Run, Tally};
 use crate::{SimAccel, SimConfig, SimError, SimResult, energy};
 use dualsplit_accel::Structures;
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult};
@@ -24,39 +24,45 @@ const SHADOW_FINISH: Mix = Mix {
 struct Active<'a> {
     px: u64,
     job: PixelJob<'a>,
-    /// The trailing `Issue` of the previous ray's ops: the recorder merges the next ray's
-    /// set-up into it, exactly as when the whole pixel is recorded into one program.
-    carry: Option<Op>,
+    /// The trailing instruction run of the previous ray's ops, not yet written: the
+    /// recorder merges the next ray's set-up into it, exactly as when the whole pixel is
+    /// recorded into one program.
+    carry: Option<Run>,
+}
+
+/// What tracing a ray needs and gathers: the structures and configuration, the rays and
+/// the recorders' tally (counts and the first range error: no work is handed out after
+/// one).
+struct Tracer<'a> {
+    structures: &'a Structures,
+    accel: SimAccel,
+    rays: u64,
+    tally: Tally,
 }
 
 struct Pixels<'a> {
     scene: &'a Scene,
-    structures: &'a Structures,
-    accel: SimAccel,
     settings: &'a RenderSettings,
     next: u64,
     total: u64,
-    rays: u64,
-    counts: crate::InstrCounts,
     radiance: Vec<f32>,
     progress: &'a (dyn Fn(u64, u64) + Sync),
     spare: Vec<Vec<Op>>,
-    /// Per thread: the pixel it is working on.
+    /// Per thread: the pixel it is working on (updated in place, not moved per ray).
     active: Vec<Option<Active<'a>>>,
-    /// The first traversal step that did not fit an op: no work is handed out after it.
-    error: Option<OpRangeError>,
+    tracer: Tracer<'a>,
 }
 
-impl<'a> Pixels<'a> {
-    /// Records the next ray of `a`'s pixel into `ops` (which starts with the carried Issue);
-    /// false when the pixel has no ray left.
+impl<'a> Tracer<'a> {
+    /// Records the next ray of `a`'s pixel into `ops`, continuing the instruction run carried
+    /// from its previous ray; false when the pixel has no ray left.
+    #[inline]
     fn trace_ray(&mut self, a: &mut Active<'a>, ops: &mut Vec<Op>) -> bool {
         let Some(q) = a.job.next_ray() else {
             return false;
         };
         let kind = self.accel.kind();
-        ops.extend(a.carry.take());
-        let mut rec = Recorder::new(self.accel, ops);
+        let mut rec = Recorder::resume(&mut self.tally, ops, a.carry.take());
         self.rays += 1;
         rec.issue(crate::kernel::RAY_SETUP);
         let result = match q.kind {
@@ -71,14 +77,9 @@ impl<'a> Pixels<'a> {
                 TraceResult::Closest(hit)
             }
         };
-        self.counts.add(&rec.counts);
-        if let Some(e) = rec.error {
-            self.error.get_or_insert(e);
-        }
+        // The ray's last instructions stay open for the next ray of the pixel.
+        a.carry = rec.finish_open();
         a.job.submit(result);
-        if matches!(ops.last(), Some(Op::Issue { .. })) {
-            a.carry = ops.pop();
-        }
         true
     }
 }
@@ -89,50 +90,51 @@ impl WorkSource for Pixels<'_> {
     /// whole pixel recorded at once, but a thread's program stays small, so the replay's
     /// host memory traffic stays in cache.
     fn next(&mut self, id: usize, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>> {
-        if self.error.is_some() {
+        if self.tracer.tally.error().is_some() {
             return None;
         }
-        let old = std::mem::take(&mut thread.ops);
-        if old.capacity() > 0 {
-            self.spare.push(old);
+        // The thread's finished program's buffer is reused for its next one.
+        let mut ops = std::mem::take(&mut thread.ops);
+        if ops.capacity() == 0 {
+            ops = self.spare.pop().unwrap_or_default();
         }
-        let mut ops = self.spare.pop().unwrap_or_default();
         ops.clear();
-        if let Some(mut a) = self.active[id].take() {
-            if self.trace_ray(&mut a, &mut ops) {
-                self.active[id] = Some(a);
-                return self.error.is_none().then_some(ops);
+        if let Some(a) = &mut self.active[id] {
+            if self.tracer.trace_ray(a, &mut ops) {
+                return self.tracer.tally.error().is_none().then_some(ops);
             }
             self.radiance[a.px as usize] = a.job.radiance();
-            if let Some(op) = a.carry {
+            let carry = a.carry;
+            self.active[id] = None;
+            if let Some(run) = carry {
                 // The pixel's last instructions.
-                ops.push(op);
+                ops.push(run.op());
                 return Some(ops);
             }
         }
         if self.next >= self.total {
+            self.spare.push(ops);
             return None;
         }
         thread.atomic(chip);
-        self.counts.atomics += 1;
+        self.tracer.tally.atomic();
         let px = self.next;
         self.next += 1;
         let w = self.settings.width as u64;
         let (x, y) = ((px % w) as u32, (px / w) as u32);
-        let mut a = Active {
+        let a = self.active[id].insert(Active {
             px,
             job: PixelJob::new(self.scene, self.settings, x, y),
             carry: None,
-        };
-        if self.trace_ray(&mut a, &mut ops) {
-            self.active[id] = Some(a);
-        } else {
+        });
+        if !self.tracer.trace_ray(a, &mut ops) {
             self.radiance[px as usize] = a.job.radiance();
+            self.active[id] = None;
         }
         if self.next.is_multiple_of(1024) || self.next == self.total {
             (self.progress)(self.next, self.total);
         }
-        self.error.is_none().then_some(ops)
+        self.tracer.tally.error().is_none().then_some(ops)
     }
 }
 
@@ -151,28 +153,29 @@ pub(crate) fn run(
         .collect();
     let mut work = Pixels {
         scene,
-        structures,
-        accel,
         settings,
         next: 0,
         total,
-        rays: 0,
-        counts: Default::default(),
         radiance: vec![0.0; total as usize],
         progress,
         spare: Vec::new(),
         active: (0..threads.len()).map(|_| None).collect(),
-        error: None,
+        tracer: Tracer {
+            structures,
+            accel,
+            rays: 0,
+            tally: Tally::new(accel),
+        },
     };
     let cycles = run_chip(&mut chip, &mut threads, &mut work);
-    if let Some(e) = work.error {
+    if let Some(e) = work.tracer.tally.error() {
         return Err(e.into());
     }
     let dram = chip.dram.stats();
     let c = &chip.caches;
     let ratio = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
     let frame_ms = cycles as f64 / (cfg.clock_ghz * 1e6);
-    let counts = work.counts;
+    let counts = work.tracer.tally.counts();
     let cyc_units = cycles.max(1) as f64 * cfg.tms as f64;
     let utilisation = crate::Utilisation {
         box_pipe: chip.units.box_ops as f64 / (cyc_units * accel.box_pipes(cfg) as f64),
@@ -192,7 +195,7 @@ pub(crate) fn run(
         row_hit_rate: ratio(dram.row_hits, dram.reads),
         l1_hit_rate: ratio(c.l1_hits, c.l1_accesses),
         l2_hit_rate: ratio(c.l2_hits, c.l2_accesses),
-        rays: work.rays,
+        rays: work.tracer.rays,
         pixels: total,
         instructions: counts,
         caches: chip.caches,

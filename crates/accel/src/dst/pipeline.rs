@@ -96,10 +96,12 @@ pub struct PipelineOutput {
     pub t_max_out: f32,
 }
 
-/// A 2:1 multiplexer: `a` when `s`, else `b`.
+/// A 2:1 multiplexer: `a` when `s`, else `b`. Written as a conditional expression, which
+/// the compiler lowers to a select (`cmov`, a blend) rather than the stack round trip of
+/// indexing a two-element array (callgrind: `docs/performance.md`, "Fifth round").
 #[inline(always)]
 pub fn mux<T: Copy>(s: bool, a: T, b: T) -> T {
-    [b, a][s as usize]
+    if s { a } else { b }
 }
 
 /// The comparator `a ≤ b` with NaN counted as true: a NaN plane distance (the ray lies in

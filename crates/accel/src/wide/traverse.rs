@@ -17,12 +17,22 @@ use super::encode::LAST_IN_RUN;
 use crate::image::{ChildKind, MemoryImage, NodeLayout};
 use crate::observer::{NodeStep, Observer};
 use dualsplit_geometry::{Hit, Ray, cull_limit};
+use std::cell::Cell;
 
 #[derive(Clone, Copy)]
 struct Entry {
     t: f32,
     word: u32,
     leaf: bool,
+}
+
+thread_local! {
+    /// The traversal stack's buffer, one per thread, reused from ray to ray: a ray costs no
+    /// allocation (the simulator traces millions of rays one at a time; an allocation and
+    /// a free per ray were ≈ 3 % of its functional side, `docs/performance.md`, "Fifth
+    /// round"). A traversal that finds it taken (an observer tracing a ray inside a
+    /// traversal) allocates its own.
+    static STACK: Cell<Vec<Entry>> = const { Cell::new(Vec::new()) };
 }
 
 /// Traverses the image with node layout `L`. `ANY`: stop at the first hit (shadow rays).
@@ -33,11 +43,25 @@ pub fn traverse<L: NodeLayout, O: Observer, const ANY: bool>(
     ray: &Ray,
     obs: &mut O,
 ) -> Option<Hit> {
+    let mut stack = STACK.take();
+    stack.clear();
+    let hit = traverse_with::<L, O, ANY>(img, ray, obs, &mut stack);
+    STACK.set(stack);
+    hit
+}
+
+/// [`traverse`] with the stack's buffer given.
+#[inline(always)]
+fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
+    img: &MemoryImage,
+    ray: &Ray,
+    obs: &mut O,
+    stack: &mut Vec<Entry>,
+) -> Option<Hit> {
     let r = ray.precompute();
     let words = &img.words[..];
     let mut best: Option<Hit> = None;
     let mut best_t = ray.t_max;
-    let mut stack: Vec<Entry> = Vec::with_capacity(64);
     let mut cur = Some(Entry {
         t: ray.t_min,
         word: 0,
