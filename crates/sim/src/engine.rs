@@ -286,7 +286,14 @@ impl Thread {
         match self.next.or(op) {
             Some(Op::Load { word, .. }) => {
                 let line = word as u64 >> chip.line_word_shift;
-                chip.tms[self.tm as usize].l1.peek(line) ^ chip.l2.peek(line) ^ read
+                let l1 = chip.tms[self.tm as usize].l1.peek(line);
+                // The L2's tag only when the L1's first way holds another line: most loads
+                // hit the L1 and never read the L2's tags (1 MB at random).
+                if l1 == line {
+                    l1 ^ read
+                } else {
+                    l1 ^ chip.l2.peek(line) ^ read
+                }
             }
             _ => read,
         }
