@@ -370,8 +370,33 @@ impl Cache {
     /// Reserves the least recently used way of `line`'s set for a miss made at cycle `now`
     /// whose fill arrives at `fill`. The line it replaces stays readable until then; if that
     /// line is itself still in flight, it moves to the in-flight list.
+    ///
+    /// A direct-mapped cache with 32-bit tags whose way holds no line still in flight (most
+    /// installs) is served inline; the rest goes through `Cache::install_general`.
     #[inline]
     pub fn install(&mut self, line: u64, fill: Cycle, now: Cycle) {
+        let s = self.set(line);
+        if self.assoc == 1
+            && let Ways::Narrow(ways) = &mut self.ways
+            && let (Some(l), Some(f)) = (u32::fit(line), u32::fit(fill))
+        {
+            let w = &mut ways[s];
+            if w.line == u32::INVALID {
+                (w.line, w.fill) = (l, f);
+                return;
+            }
+            if u64::from(w.fill) <= now {
+                (w.prev, w.prev_fill, w.line, w.fill) = (w.line, w.fill, l, f);
+                return;
+            }
+        }
+        self.install_general(line, fill, now);
+    }
+
+    /// [`Cache::install`] in general: any associativity or tag width, and a replaced line
+    /// still in flight, which moves to the in-flight list.
+    #[inline(never)]
+    fn install_general(&mut self, line: u64, fill: Cycle, now: Cycle) {
         let s = self.set(line);
         if self.assoc > 1 {
             self.stamp += 1;
