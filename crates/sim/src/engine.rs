@@ -188,7 +188,8 @@ impl Chip {
         now: Cycle,
     ) -> (Cycle, Cycle) {
         let l1_lat = self.cfg.l1.hit_latency;
-        match self.tms[tm].l1.lookup(line, slot) {
+        // `find_direct` has not answered: the general lookup.
+        match self.tms[tm].l1.lookup_general(line, slot) {
             Lookup::Present { fill } if fill <= slot => {
                 self.caches.l1_hits += 1;
                 (slot + l1_lat, fill)

@@ -291,8 +291,21 @@ impl Cache {
     /// Looks up `line` (a line number: byte address / 64) at cycle `now`, updating LRU state
     /// on a hit. A line replaced by a miss still in flight is a hit until that fill arrives;
     /// a line in flight is `Present` with its future fill cycle (the caller merges).
+    ///
+    /// A line a direct-mapped cache holds in its way is answered inline
+    /// ([`Cache::find_direct`]); the rest goes through `Cache::lookup_general`.
     #[inline]
     pub fn lookup(&mut self, line: u64, now: Cycle) -> Lookup {
+        if let Some(fill) = self.find_direct(line) {
+            return Lookup::Present { fill };
+        }
+        self.lookup_general(line, now)
+    }
+
+    /// [`Cache::lookup`] in general: any associativity or tag width, the replaced line
+    /// still readable, and the in-flight list.
+    #[inline(never)]
+    pub(crate) fn lookup_general(&mut self, line: u64, now: Cycle) -> Lookup {
         let s = self.set(line);
         if self.assoc > 1 {
             self.stamp += 1;
@@ -569,7 +582,7 @@ mod tests {
                     _ => rng.below(80) as u64,
                 };
                 let direct = c.find_direct(line);
-                let got = c.lookup(line, now);
+                let got = c.lookup_general(line, now);
                 if let Some(fill) = direct {
                     assert_eq!(got, Lookup::Present { fill }, "assoc {assoc}, step {i}");
                     answered += 1;
