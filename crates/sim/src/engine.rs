@@ -18,7 +18,11 @@
 //! memory the replay streams through stays small. Wake-ups that would only wait for
 //! operands or run plain instructions are played ahead when a thread goes to sleep, and the
 //! wheel forwards the thread through those cycles in its place without running it
-//! ([`run_chip`]; about half of all wake-ups). None of this changes a simulated result.
+//! ([`run_chip`]; about half of all wake-ups). A line segment whose banks are free is
+//! placed with one bitmap test and, when its line sits in the direct-mapped L1, answered
+//! without a call ([`memory::Cache::find_direct`](crate::memory::Cache::find_direct)); the
+//! touch pass reads the L2's tag only for a load whose L1 way holds another line. None of
+//! this changes a simulated result.
 
 use crate::Cycle;
 use crate::config::SimConfig;
