@@ -18,7 +18,11 @@
 //! memory the replay streams through stays small. Wake-ups that would only wait for
 //! operands or run plain instructions are played ahead when a thread goes to sleep, and the
 //! wheel forwards the thread through those cycles in its place without running it
-//! ([`run_chip`]; about half of all wake-ups). None of this changes a simulated result.
+//! ([`run_chip`]; about half of all wake-ups). A line segment whose banks are free is
+//! placed with one bitmap test and, when its line sits in the direct-mapped L1, answered
+//! without a call ([`memory::Cache::find_direct`](crate::memory::Cache::find_direct)); the
+//! touch pass reads the L2's tag only for a load whose L1 way holds another line. None of
+//! this changes a simulated result.
 
 use crate::Cycle;
 use crate::config::SimConfig;
@@ -156,11 +160,40 @@ impl Chip {
 
     /// As [`Chip::load_word`], also returning the fill cycle now in the line's L1 tag;
     /// `now` (≤ `slot`) is the current event time: no later access starts before it.
+    ///
+    /// A line a direct-mapped L1 holds in its way is answered inline
+    /// ([`Cache::find_direct`]: the same answer as the lookup, which has no other effect
+    /// there); everything else goes through [`Chip::load_word_lookup`].
+    #[inline(always)]
     fn load_word_fill(&mut self, tm: usize, word: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
         let line = word >> self.line_word_shift;
-        let l1_lat = self.cfg.l1.hit_latency;
         self.caches.l1_accesses += 1;
-        match self.tms[tm].l1.lookup(line, slot) {
+        if let Some(fill) = self.tms[tm].l1.find_direct(line) {
+            return if fill <= slot {
+                self.caches.l1_hits += 1;
+                (slot + self.cfg.l1.hit_latency, fill)
+            } else {
+                self.caches.l1_merged += 1;
+                (fill.max(slot + self.cfg.l1.hit_latency), fill)
+            };
+        }
+        self.load_word_lookup(tm, line, word, slot, now)
+    }
+
+    /// [`Chip::load_word_fill`] after the inline test: the L1 lookup, and the L2 and DRAM
+    /// on a miss.
+    #[inline(never)]
+    fn load_word_lookup(
+        &mut self,
+        tm: usize,
+        line: u64,
+        word: u64,
+        slot: Cycle,
+        now: Cycle,
+    ) -> (Cycle, Cycle) {
+        let l1_lat = self.cfg.l1.hit_latency;
+        // `find_direct` has not answered: the general lookup.
+        match self.tms[tm].l1.lookup_general(line, slot) {
             Lookup::Present { fill } if fill <= slot => {
                 self.caches.l1_hits += 1;
                 (slot + l1_lat, fill)
@@ -258,7 +291,14 @@ impl Thread {
         match self.next.or(op) {
             Some(Op::Load { word, .. }) => {
                 let line = word as u64 >> chip.line_word_shift;
-                chip.tms[self.tm as usize].l1.peek(line) ^ chip.l2.peek(line) ^ read
+                let l1 = chip.tms[self.tm as usize].l1.peek(line);
+                // The L2's tag only when the L1's first way holds another line: most loads
+                // hit the L1 and never read the L2's tags (1 MB at random).
+                if l1 == line {
+                    l1 ^ read
+                } else {
+                    l1 ^ chip.l2.peek(line) ^ read
+                }
             }
             _ => read,
         }
@@ -397,6 +437,27 @@ impl Thread {
                 // line segment are placed in one run (`BankSlots::reserve_run`).
                 while w < end {
                     let seg_end = (((w >> shift) + 1) << shift).min(end);
+                    let k = seg_end - w;
+                    // Fast path (most segments): every word's bank is free in its cycle, so
+                    // the words take cycles `c .. c + k` and only the first looks the line
+                    // up; the later ones hit once the fill has arrived, merge before.
+                    // Exactly the placement of the general path below, which reserves the
+                    // first word, then the rest (the lookup touches no bank table).
+                    if chip.tms[tm].l1_banks.try_run(w & bank_mask, c, k) {
+                        let (mut r, fill) = chip.load_word_fill(tm, w, c, now);
+                        if k > 1 {
+                            let rest = k - 1;
+                            let hits = (c + k).saturating_sub((c + 1).max(fill)).min(rest);
+                            chip.caches.l1_accesses += rest;
+                            chip.caches.l1_hits += hits;
+                            chip.caches.l1_merged += rest - hits;
+                            r = r.max(fill.max(c + k - 1 + l1_lat));
+                        }
+                        c += k;
+                        self.result(r, Cause::Memory);
+                        w = seg_end;
+                        continue;
+                    }
                     let first = chip.tms[tm]
                         .l1_banks
                         .reserve_run(w & bank_mask, c, 1, now, 0);

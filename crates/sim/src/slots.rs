@@ -16,18 +16,35 @@ const WINDOW: u64 = 128;
 #[repr(align(32))]
 pub struct Slots {
     base: Cycle,
-    mask: u128,
+    /// The 128-cycle window as two 64-bit words (bit `i` of word `h`: cycle
+    /// `base + 64 h + i` is taken), so the fast path tests and sets one word instead of
+    /// shifting a 128-bit value (a dozen instructions on x86-64).
+    words: [u64; 2],
 }
 
 impl Slots {
+    /// The window as one 128-bit mask (bit i: cycle `base + i`).
+    #[inline]
+    fn mask(&self) -> u128 {
+        u128::from(self.words[0]) | u128::from(self.words[1]) << 64
+    }
+
+    #[inline]
+    fn set_mask(&mut self, mask: u128) {
+        self.words = [mask as u64, (mask >> 64) as u64];
+    }
+
     /// Reserves the first free cycle at or after `c` and returns it.
     #[inline]
     pub fn reserve(&mut self, c: Cycle) -> Cycle {
         // Fast path (most requests): `c` inside the window and free.
         let off = c.wrapping_sub(self.base);
-        if off < WINDOW && self.mask & (1u128 << off) == 0 {
-            self.mask |= 1u128 << off;
-            return c;
+        if off < WINDOW {
+            let (h, bit) = ((off >> 6) as usize & 1, 1u64 << (off & 63));
+            if self.words[h] & bit == 0 {
+                self.words[h] |= bit;
+                return c;
+            }
         }
         self.reserve_slow(c)
     }
@@ -38,29 +55,26 @@ impl Slots {
     /// below `WINDOW` throughout, so the search is one shift and one bit scan per step.
     #[inline(never)]
     fn reserve_slow(&mut self, c: Cycle) -> Cycle {
+        let mut mask = self.mask();
         let mut off = if c >= self.base + WINDOW {
             // Keep the last 64 cycles of history before `c`.
             let nb = c - WINDOW / 2;
             let shift = nb - self.base;
-            self.mask = if shift >= WINDOW {
-                0
-            } else {
-                self.mask >> shift
-            };
+            mask = if shift >= WINDOW { 0 } else { mask >> shift };
             self.base = nb;
             WINDOW / 2
         } else {
             c.saturating_sub(self.base)
         };
         loop {
-            let free = !self.mask >> off;
+            let free = !mask >> off;
             if free != 0 {
                 let s = off + free.trailing_zeros() as u64;
-                self.mask |= 1u128 << s;
+                self.set_mask(mask | 1u128 << s);
                 return self.base + s;
             }
             // Nothing free in the window from `c`: slide it by half.
-            self.mask >>= WINDOW / 2;
+            mask >>= WINDOW / 2;
             self.base += WINDOW / 2;
             off = off.saturating_sub(WINDOW / 2);
         }
@@ -215,19 +229,32 @@ impl BankSlots {
     pub fn reserve_run(&mut self, bank: u64, c: Cycle, n: u64, now: Cycle, from: Cycle) -> Placed {
         debug_assert!(n >= 1 && c >= now && c >= self.lo);
         // Fast path (most runs): every word's bank is free in its cycle, one word test.
+        if self.try_run(bank, c, n) {
+            return Placed {
+                first: c,
+                last: c + n - 1,
+                stall: 0,
+                at_or_after: (c + n).saturating_sub(c.max(from)).min(n),
+            };
+        }
+        self.reserve_run_slow(bank, c, n, now, from)
+    }
+
+    /// Takes cycles `c .. c + n` for `n` consecutive words, the first on `bank`, if every
+    /// word's bank is free in its cycle (and the ring covers them); returns whether it did.
+    /// When it does, [`BankSlots::reserve_run`] would have placed the words exactly there
+    /// (no stall); when it does not, nothing is taken.
+    #[inline]
+    pub fn try_run(&mut self, bank: u64, c: Cycle, n: u64) -> bool {
+        debug_assert!(n >= 1 && c >= self.lo);
         if n <= 64 && c + n <= self.end {
             let d = (bank.wrapping_sub(c) & self.bank_mask) as usize;
             if self.taken(d, c, n) == 0 {
                 self.take(d, c, n);
-                return Placed {
-                    first: c,
-                    last: c + n - 1,
-                    stall: 0,
-                    at_or_after: (c + n).saturating_sub(c.max(from)).min(n),
-                };
+                return true;
             }
         }
-        self.reserve_run_slow(bank, c, n, now, from)
+        false
     }
 
     #[inline(never)]
@@ -721,7 +748,7 @@ mod tests {
                 );
                 assert_eq!(new.reserve(c), old.reserve(c), "seed {seed}, {i}");
                 assert_eq!(
-                    (new.base, new.mask),
+                    (new.base, new.mask()),
                     (old.base, old.mask),
                     "seed {seed}, {i}"
                 );
@@ -842,6 +869,33 @@ mod bank_tests {
                     &format!("seed {seed}, {banks} banks"),
                 );
             }
+        }
+    }
+
+    /// `try_run` takes a run exactly when `reserve_run` would place it without a stall
+    /// (the same cycles), and leaves the table untouched otherwise: two tables fed the same
+    /// random requests, one through `try_run` first, place every run alike.
+    #[test]
+    fn try_run_is_the_stall_free_reserve_run() {
+        for seed in 0..50 {
+            let mut rng = Pcg32::new(seed, 9);
+            let (mut plain, mut tried) = (BankSlots::new(16), BankSlots::new(16));
+            let (mut now, mut taken) = (0, 0);
+            for i in 0..3000 {
+                now += (rng.below(4) == 0) as u64 * rng.below(40) as u64;
+                let c = now + rng.below(8) as u64;
+                let bank = rng.below(16) as u64;
+                let n = 1 + rng.below(20) as u64;
+                let p = plain.reserve_run(bank, c, n, now, 0);
+                let what = format!("seed {seed}, step {i}");
+                if tried.try_run(bank, c, n) {
+                    taken += 1;
+                    assert_eq!((p.first, p.last, p.stall), (c, c + n - 1, 0), "{what}");
+                } else {
+                    assert_eq!(tried.reserve_run(bank, c, n, now, 0), p, "{what}");
+                }
+            }
+            assert!(taken > 300, "seed {seed}: {taken}");
         }
     }
 

@@ -291,8 +291,21 @@ impl Cache {
     /// Looks up `line` (a line number: byte address / 64) at cycle `now`, updating LRU state
     /// on a hit. A line replaced by a miss still in flight is a hit until that fill arrives;
     /// a line in flight is `Present` with its future fill cycle (the caller merges).
+    ///
+    /// A line a direct-mapped cache holds in its way is answered inline
+    /// ([`Cache::find_direct`]); the rest goes through `Cache::lookup_general`.
     #[inline]
     pub fn lookup(&mut self, line: u64, now: Cycle) -> Lookup {
+        if let Some(fill) = self.find_direct(line) {
+            return Lookup::Present { fill };
+        }
+        self.lookup_general(line, now)
+    }
+
+    /// [`Cache::lookup`] in general: any associativity or tag width, the replaced line
+    /// still readable, and the in-flight list.
+    #[inline(never)]
+    pub(crate) fn lookup_general(&mut self, line: u64, now: Cycle) -> Lookup {
         let s = self.set(line);
         if self.assoc > 1 {
             self.stamp += 1;
@@ -312,6 +325,24 @@ impl Cache {
             return Lookup::Present { fill };
         }
         Lookup::Absent
+    }
+
+    /// The fill cycle of `line` when a direct-mapped cache holds it in its way (the first
+    /// test of [`Cache::lookup`], which has no other effect there); `None` when the way
+    /// holds another line, or the cache is set-associative or has 64-bit tags: then
+    /// [`Cache::lookup`] answers. Small enough to inline into the load path, so an L1 hit
+    /// costs no call.
+    #[inline]
+    pub fn find_direct(&self, line: u64) -> Option<Cycle> {
+        match &self.ways {
+            Ways::Narrow(w) if self.assoc == 1 => {
+                let way = w[self.set(line)];
+                // An empty way (`INVALID`) never matches, even line 2^32 − 1.
+                (way.line != u32::INVALID && u64::from(way.line) == line)
+                    .then_some(u64::from(way.fill))
+            }
+            _ => None,
+        }
     }
 
     /// The tag word of `line`'s first way, read without effect (see `Thread::touch`).
@@ -352,8 +383,33 @@ impl Cache {
     /// Reserves the least recently used way of `line`'s set for a miss made at cycle `now`
     /// whose fill arrives at `fill`. The line it replaces stays readable until then; if that
     /// line is itself still in flight, it moves to the in-flight list.
+    ///
+    /// A direct-mapped cache with 32-bit tags whose way holds no line still in flight (most
+    /// installs) is served inline; the rest goes through `Cache::install_general`.
     #[inline]
     pub fn install(&mut self, line: u64, fill: Cycle, now: Cycle) {
+        let s = self.set(line);
+        if self.assoc == 1
+            && let Ways::Narrow(ways) = &mut self.ways
+            && let (Some(l), Some(f)) = (u32::fit(line), u32::fit(fill))
+        {
+            let w = &mut ways[s];
+            if w.line == u32::INVALID {
+                (w.line, w.fill) = (l, f);
+                return;
+            }
+            if u64::from(w.fill) <= now {
+                (w.prev, w.prev_fill, w.line, w.fill) = (w.line, w.fill, l, f);
+                return;
+            }
+        }
+        self.install_general(line, fill, now);
+    }
+
+    /// [`Cache::install`] in general: any associativity or tag width, and a replaced line
+    /// still in flight, which moves to the in-flight list.
+    #[inline(never)]
+    fn install_general(&mut self, line: u64, fill: Cycle, now: Cycle) {
         let s = self.set(line);
         if self.assoc > 1 {
             self.stamp += 1;
@@ -387,6 +443,13 @@ impl Cache {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    impl Cache {
+        /// A lookup at cycle 0 on a copy (no effect on `self`).
+        fn lookup_copy(&self, line: u64) -> Lookup {
+            self.clone().lookup(line, 0)
+        }
+    }
 
     #[test]
     fn direct_mapped_conflict_evicts_when_the_new_line_arrives() {
@@ -490,6 +553,49 @@ mod tests {
                 assert!(!is_wide || i >= from, "widened at step {i}");
             }
             assert!(matches!(narrow.ways, Ways::Wide(_)), "assoc {assoc}");
+        }
+    }
+
+    /// The inline test `find_direct` answers as `lookup` whenever it answers (random
+    /// conflicting lines, fills ahead, lines up to 2^32 − 1 so an empty way's `INVALID` is
+    /// asked for), answers most hits of a direct-mapped narrow cache, and never a
+    /// set-associative or wide one (nor this one once line 2^32 − 1 has widened it).
+    #[test]
+    fn find_direct_answers_as_lookup() {
+        // An empty way is not line 2^32 − 1.
+        let cold = Cache::new(64 * 64, 64, 1);
+        assert_eq!(cold.find_direct(u64::from(u32::MAX)), None);
+        assert_eq!(cold.lookup_copy(u64::from(u32::MAX)), Lookup::Absent);
+        for (assoc, wide) in [(1, false), (2, false), (1, true)] {
+            let mut rng = dualsplit_geometry::Pcg32::new(assoc as u64, 17);
+            let mut c = Cache::new(64 * 64, 64, assoc);
+            if wide {
+                c.ways = Ways::Wide(c.take_wide());
+            }
+            let (mut now, mut answered) = (0, 0);
+            for i in 0..20_000 {
+                now += rng.below(3) as u64;
+                // Line 2^32 − 1 widens the array when installed: asked for late.
+                let line = match (i, rng.below(50)) {
+                    (15_000.., 0) => u64::from(u32::MAX),
+                    (_, 1) => u64::from(u32::MAX) - 64,
+                    _ => rng.below(80) as u64,
+                };
+                let direct = c.find_direct(line);
+                let got = c.lookup_general(line, now);
+                if let Some(fill) = direct {
+                    assert_eq!(got, Lookup::Present { fill }, "assoc {assoc}, step {i}");
+                    answered += 1;
+                }
+                if got == Lookup::Absent {
+                    c.install(line, now + 1 + rng.below(300) as u64, now);
+                }
+            }
+            if assoc == 1 && !wide {
+                assert!(answered > 1000, "only {answered} answered");
+            } else {
+                assert_eq!(answered, 0, "assoc {assoc}, wide {wide}");
+            }
         }
     }
 
