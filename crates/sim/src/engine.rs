@@ -28,7 +28,7 @@ use crate::Cycle;
 use crate::config::SimConfig;
 use crate::kernel::{Op, Pipe};
 use crate::memory::{Cache, Dram, Lookup};
-use crate::slots::{BankSlots, Slots};
+use crate::slots::{BankSlots, Placed, Slots};
 use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -438,42 +438,34 @@ impl Thread {
                 while w < end {
                     let seg_end = (((w >> shift) + 1) << shift).min(end);
                     let k = seg_end - w;
-                    // Fast path (most segments): every word's bank is free in its cycle, so
-                    // the words take cycles `c .. c + k` and only the first looks the line
-                    // up; the later ones hit once the fill has arrived, merge before.
-                    // Exactly the placement of the general path below, which reserves the
-                    // first word, then the rest (the lookup touches no bank table).
-                    if chip.tms[tm].l1_banks.try_run(w & bank_mask, c, k) {
-                        let (mut r, fill) = chip.load_word_fill(tm, w, c, now);
-                        if k > 1 {
-                            let rest = k - 1;
-                            let hits = (c + k).saturating_sub((c + 1).max(fill)).min(rest);
-                            chip.caches.l1_accesses += rest;
-                            chip.caches.l1_hits += hits;
-                            chip.caches.l1_merged += rest - hits;
-                            r = r.max(fill.max(c + k - 1 + l1_lat));
-                        }
-                        c += k;
-                        self.result(r, Cause::Memory);
-                        w = seg_end;
-                        continue;
-                    }
-                    let first = chip.tms[tm]
-                        .l1_banks
-                        .reserve_run(w & bank_mask, c, 1, now, 0);
-                    let slot = first.first;
-                    bank_stall += first.stall;
+                    // Most segments find every word's bank free in its cycle: one table test
+                    // (`try_run`) places them all at `c .. c + k`, exactly where the general
+                    // path (the first word, then the rest after its lookup) puts them.
+                    let free = chip.tms[tm].l1_banks.try_run(w & bank_mask, c, k);
+                    let slot = if free {
+                        c
+                    } else {
+                        let first = chip.tms[tm]
+                            .l1_banks
+                            .reserve_run(w & bank_mask, c, 1, now, 0);
+                        bank_stall += first.stall;
+                        first.first
+                    };
                     let (mut r, fill) = chip.load_word_fill(tm, w, slot, now);
                     c = slot + 1;
-                    if seg_end > w + 1 {
-                        let rest = seg_end - w - 1;
-                        let run = chip.tms[tm].l1_banks.reserve_run(
-                            (w + 1) & bank_mask,
-                            c,
-                            rest,
-                            now,
-                            fill,
-                        );
+                    if k > 1 {
+                        let rest = k - 1;
+                        let run = if free {
+                            Placed::stall_free(c, rest, fill)
+                        } else {
+                            chip.tms[tm].l1_banks.reserve_run(
+                                (w + 1) & bank_mask,
+                                c,
+                                rest,
+                                now,
+                                fill,
+                            )
+                        };
                         bank_stall += run.stall;
                         let hits = run.at_or_after;
                         c = run.last + 1;

@@ -131,6 +131,20 @@ pub struct Placed {
     pub at_or_after: u64,
 }
 
+impl Placed {
+    /// `n` words placed without a stall at cycles `c .. c + n` (what [`BankSlots::try_run`]
+    /// takes), counting those at or after `from`.
+    #[inline]
+    pub fn stall_free(c: Cycle, n: u64, from: Cycle) -> Placed {
+        Placed {
+            first: c,
+            last: c + n - 1,
+            stall: 0,
+            at_or_after: (c + n).saturating_sub(c.max(from)).min(n),
+        }
+    }
+}
+
 impl BankSlots {
     /// `banks` free banks (a power of two).
     pub fn new(banks: u32) -> Self {
@@ -230,12 +244,7 @@ impl BankSlots {
         debug_assert!(n >= 1 && c >= now && c >= self.lo);
         // Fast path (most runs): every word's bank is free in its cycle, one word test.
         if self.try_run(bank, c, n) {
-            return Placed {
-                first: c,
-                last: c + n - 1,
-                stall: 0,
-                at_or_after: (c + n).saturating_sub(c.max(from)).min(n),
-            };
+            return Placed::stall_free(c, n, from);
         }
         self.reserve_run_slow(bank, c, n, now, from)
     }
