@@ -58,17 +58,6 @@ impl Mix {
         )
     }
     #[inline(always)]
-    const fn plus(self, o: Mix) -> Mix {
-        Mix::new(
-            self.int + o.int,
-            self.fpadd + o.fpadd,
-            self.fpmul + o.fpmul,
-            self.fpcmp + o.fpcmp,
-            self.fpinv + o.fpinv,
-            self.local + o.local,
-        )
-    }
-    #[inline(always)]
     fn add(&mut self, o: Mix) {
         self.int += o.int;
         self.fpadd += o.fpadd;
@@ -392,7 +381,8 @@ const DST_SW_TOTAL: [[u64; 4]; 4] = {
     t
 };
 
-/// Instructions of a BVH node step ([`bvh_step`]'s total), from the constants.
+/// Instructions of a BVH node step: node overhead, per valid child, per hit child and per
+/// compare-exchange of the entry-distance sort (`hits·(hits − 1)/2` pairs).
 #[inline(always)]
 const fn bvh_total(valid: u64, hits: u64, pairs: u64) -> u64 {
     BVH_NODE.total()
@@ -639,16 +629,6 @@ impl<'a> Recorder<'a> {
         self.close_run();
         self.ops.push(Op::Pipe { pipe, n, parallel });
     }
-}
-
-/// The instructions around a BVH node's box tests: node overhead, per valid child, per hit
-/// child and per compare-exchange of the entry-distance sort (`hits·(hits − 1)/2` pairs).
-pub fn bvh_step(valid: u8, hits: u8) -> Mix {
-    let pairs = (hits as u32 * hits.saturating_sub(1) as u32) / 2;
-    BVH_NODE
-        .plus(BVH_PER_CHILD.times(valid as u64))
-        .plus(BVH_PER_HIT.times(hits as u64))
-        .plus(BVH_SORT_PAIR.times(pairs as u64))
 }
 
 impl Observer for Recorder<'_> {

@@ -47,7 +47,6 @@ struct Pixels<'a> {
     total: u64,
     radiance: Vec<f32>,
     progress: &'a (dyn Fn(u64, u64) + Sync),
-    spare: Vec<Vec<Op>>,
     /// Per thread: the pixel it is working on (updated in place, not moved per ray).
     active: Vec<Option<Active<'a>>>,
     tracer: Tracer<'a>,
@@ -95,9 +94,6 @@ impl WorkSource for Pixels<'_> {
         }
         // The thread's finished program's buffer is reused for its next one.
         let mut ops = std::mem::take(&mut thread.ops);
-        if ops.capacity() == 0 {
-            ops = self.spare.pop().unwrap_or_default();
-        }
         ops.clear();
         if let Some(a) = &mut self.active[id] {
             if self.tracer.trace_ray(a, &mut ops) {
@@ -113,7 +109,6 @@ impl WorkSource for Pixels<'_> {
             }
         }
         if self.next >= self.total {
-            self.spare.push(ops);
             return None;
         }
         thread.atomic(chip);
@@ -158,7 +153,6 @@ pub(crate) fn run(
         total,
         radiance: vec![0.0; total as usize],
         progress,
-        spare: Vec::new(),
         active: (0..threads.len()).map(|_| None).collect(),
         tracer: Tracer {
             structures,
