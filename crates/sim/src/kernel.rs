@@ -416,11 +416,8 @@ impl Tally {
     /// The counts so far, every kernel step's instruction mix included.
     pub fn counts(&self) -> InstrCounts {
         let s = &self.steps;
-        let dst = matches!(self.accel, SimAccel::Dst | SimAccel::DstSw);
-        let parallel = matches!(
-            self.accel,
-            SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
-        );
+        let dst = self.accel.is_dst();
+        let parallel = self.accel.parallel_boxes();
         let mut c = self.counts;
         // Pipeline ops and node steps: one box op per valid child (one issue slot per node
         // on parallel pipes), one triangle op per test, one dual-split op per DST step on
@@ -551,12 +548,9 @@ impl<'a> Recorder<'a> {
             base: 0,
             run: run.map_or(0, |r| OPEN | r.n as u64),
             run_fpinv: run.map_or(0, |r| r.fpinv as u64),
-            dst: matches!(accel, SimAccel::Dst | SimAccel::DstSw),
+            dst: accel.is_dst(),
             dst_hw: accel == SimAccel::Dst,
-            parallel_boxes: matches!(
-                accel,
-                SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
-            ),
+            parallel_boxes: accel.parallel_boxes(),
         }
     }
 

@@ -133,6 +133,19 @@ impl SimAccel {
             SimAccel::Dst => AccelKind::Dst,
         }
     }
+    /// The "+" configurations: all child boxes of a node tested in one issue slot, on as
+    /// many ray-box pipelines (§4).
+    pub fn parallel_boxes(self) -> bool {
+        matches!(
+            self,
+            SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
+        )
+    }
+    /// DST and DST\*: the traversal of the dual-split tree (stack entries carry
+    /// `[t_min, t_max]`).
+    pub fn is_dst(self) -> bool {
+        matches!(self, SimAccel::Dst | SimAccel::DstSw)
+    }
     /// Ray-box pipelines per TM: the node arity for the "+" configurations (§4).
     pub fn box_pipes(self, cfg: &SimConfig) -> u32 {
         match self {
