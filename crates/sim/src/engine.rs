@@ -28,7 +28,7 @@ use crate::Cycle;
 use crate::config::SimConfig;
 use crate::kernel::{Op, Pipe};
 use crate::memory::{Cache, Dram, Lookup};
-use crate::slots::{BankSlots, Placed, Slots};
+use crate::slots::{BankSlots, Slots};
 use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -385,152 +385,234 @@ impl Thread {
 
     /// Runs ops while they can start at or before `now`; returns false when the program is
     /// finished. The thread's next event is then at `self.t`.
+    ///
+    /// The common ops are executed inline: a plain instruction run, a load whose line
+    /// segments find their L1 banks free, a pipeline op on the TM's only pipe of its kind.
+    /// The rest (reciprocals, bank conflicts, several pipes) is out of line, so the
+    /// function stays small and saves few registers per wake-up (docs/performance.md,
+    /// "Sixth round: engine").
     pub fn run(&mut self, chip: &mut Chip, now: Cycle) -> bool {
-        while self.pc < self.ops.len() {
+        while let Some(&op) = self.ops.get(self.pc) {
             if self.t > now {
                 return true;
             }
-            let op = self.ops[self.pc];
             if !matches!(op, Op::Load { .. }) && self.ready > self.t {
-                if self.ready > now {
-                    // Sleep until the operands are there.
-                    let r = self.ready;
-                    self.wait(r, &mut chip.stalls);
-                    return true;
-                }
                 let r = self.ready;
                 self.wait(r, &mut chip.stalls);
+                if r > now {
+                    // Sleep until the operands are there.
+                    return true;
+                }
             }
             self.pc += 1;
-            self.execute(op, chip, now);
+            match op {
+                Op::Issue { n, fpinv: 0 } => self.t += n as Cycle,
+                Op::Issue { n, fpinv } => self.issue_fpinv(n, fpinv, chip),
+                Op::Load { word, words } => self.load(word, words, chip, now),
+                Op::Pipe { pipe, n, parallel } => self.pipe(pipe, n, parallel, chip),
+            }
         }
         false
     }
 
-    fn execute(&mut self, op: Op, chip: &mut Chip, now: Cycle) {
+    /// An instruction run of which `fpinv` go to the TM's shared reciprocal units.
+    #[inline(never)]
+    fn issue_fpinv(&mut self, n: u32, fpinv: u16, chip: &mut Chip) {
         let tm = self.tm as usize;
-        match op {
-            Op::Issue { n, fpinv } => {
-                let mut c = self.t;
-                for _ in 0..fpinv {
-                    let s = earliest(&mut chip.tms[tm].fpinv, c);
-                    chip.stalls.fpinv += s - c;
-                    chip.units.fpinv_ops += 1;
-                    let lat = chip.cfg.units.fpinv_latency;
-                    self.result(s + lat, Cause::Fpinv);
-                    c = s + 1;
-                }
-                self.t = c + (n - fpinv as u32) as Cycle;
+        let mut c = self.t;
+        for _ in 0..fpinv {
+            let s = earliest(&mut chip.tms[tm].fpinv, c);
+            chip.stalls.fpinv += s - c;
+            chip.units.fpinv_ops += 1;
+            let lat = chip.cfg.units.fpinv_latency;
+            self.result(s + lat, Cause::Fpinv);
+            c = s + 1;
+        }
+        self.t = c + (n - fpinv as u32) as Cycle;
+    }
+
+    /// `words` word loads from `word`, line segment by line segment: the first word looks
+    /// the line up (L1 tags, then L2/DRAM on a miss); later words of the same line see
+    /// exactly what a second tag lookup would (hit once the fill has arrived, merged
+    /// before). Every word takes its own L1 bank slot, one issue slot after the previous
+    /// word's.
+    ///
+    /// Most segments find every word's bank free in its cycle: one table test
+    /// ([`BankSlots::try_run`]) places them all at `c .. c + k`, exactly where the general
+    /// path ([`Thread::load_segment_conflict`]) puts them, and a line the direct-mapped L1
+    /// holds is answered inline, all `k` words at once: a word at cycle `x` is a hit when
+    /// the fill has arrived (`fill ≤ x`), merged before, and the data is in the register
+    /// at `max(fill, x + L1 latency)`.
+    #[inline(always)]
+    fn load(&mut self, word: u32, words: u16, chip: &mut Chip, now: Cycle) {
+        let tm = self.tm as usize;
+        let shift = chip.line_word_shift;
+        let l1_lat = chip.cfg.l1.hit_latency;
+        let mut c = self.t;
+        let mut w = word as u64;
+        let end = w + words as u64;
+        while w < end {
+            let seg_end = (((w >> shift) + 1) << shift).min(end);
+            let k = seg_end - w;
+            let tmr = &mut chip.tms[tm];
+            if !tmr.l1_banks.try_run(w & chip.l1_bank_mask, c, k) {
+                c = self.load_segment_conflict(chip, w, k, c, now);
+                w = seg_end;
+                continue;
             }
-            Op::Load { word, words } => {
-                let mut c = self.t;
-                let bank_mask = chip.l1_bank_mask;
-                let shift = chip.line_word_shift;
-                let l1_lat = chip.cfg.l1.hit_latency;
-                let mut w = word as u64;
-                let end = w + words as u64;
-                let mut bank_stall = 0;
-                // Line by line: the first word looks the line up (L1 tags, then L2/DRAM on a
-                // miss); later words of the same line see exactly what a second tag lookup
-                // would (hit once the fill has arrived, merged before). Every word takes its
-                // own L1 bank slot, one issue slot after the previous word's; the banks of a
-                // line segment are placed in one run (`BankSlots::reserve_run`).
-                while w < end {
-                    let seg_end = (((w >> shift) + 1) << shift).min(end);
-                    let k = seg_end - w;
-                    // Most segments find every word's bank free in its cycle: one table test
-                    // (`try_run`) places them all at `c .. c + k`, exactly where the general
-                    // path (the first word, then the rest after its lookup) puts them.
-                    let free = chip.tms[tm].l1_banks.try_run(w & bank_mask, c, k);
-                    let slot = if free {
-                        c
-                    } else {
-                        let first = chip.tms[tm]
-                            .l1_banks
-                            .reserve_run(w & bank_mask, c, 1, now, 0);
-                        bank_stall += first.stall;
-                        first.first
-                    };
-                    let (mut r, fill) = chip.load_word_fill(tm, w, slot, now);
-                    c = slot + 1;
-                    if k > 1 {
-                        let rest = k - 1;
-                        let run = if free {
-                            Placed::stall_free(c, rest, fill)
-                        } else {
-                            chip.tms[tm].l1_banks.reserve_run(
-                                (w + 1) & bank_mask,
-                                c,
-                                rest,
-                                now,
-                                fill,
-                            )
-                        };
-                        bank_stall += run.stall;
-                        let hits = run.at_or_after;
-                        c = run.last + 1;
-                        chip.caches.l1_accesses += rest;
-                        chip.caches.l1_hits += hits;
-                        chip.caches.l1_merged += rest - hits;
-                        r = r.max(fill.max(c - 1 + l1_lat));
-                    }
-                    self.result(r, Cause::Memory);
-                    w = seg_end;
+            let line = w >> shift;
+            let last = c + k - 1;
+            let (fill, from) = match tmr.l1.find_direct(line) {
+                Some(fill) => (fill, c),
+                None => {
+                    // The first word's lookup (its hit, merge or miss counted there),
+                    // then the rest.
+                    chip.caches.l1_accesses += 1;
+                    let (_, fill) = chip.load_word_lookup(tm, line, w, c, now);
+                    (fill, c + 1)
                 }
-                chip.stalls.l1_bank += bank_stall;
-                self.t = c;
+            };
+            // Words at `from ..= last` not counted yet: hits from the fill on.
+            let n = last + 1 - from;
+            let hits = (last + 1).saturating_sub(from.max(fill)).min(n);
+            chip.caches.l1_accesses += n;
+            chip.caches.l1_hits += hits;
+            chip.caches.l1_merged += n - hits;
+            self.result(fill.max(last + l1_lat), Cause::Memory);
+            c = last + 1;
+            w = seg_end;
+        }
+        self.t = c;
+    }
+
+    /// A line segment of `k` words from `w` (issue from cycle `c`) some of whose banks are
+    /// busy: the first word takes its bank's first free cycle and looks the line up, the
+    /// rest are placed after it by [`BankSlots::reserve_run`]. Returns the cycle after the
+    /// last word.
+    #[inline(never)]
+    fn load_segment_conflict(
+        &mut self,
+        chip: &mut Chip,
+        w: u64,
+        k: u64,
+        c: Cycle,
+        now: Cycle,
+    ) -> Cycle {
+        let tm = self.tm as usize;
+        let bank_mask = chip.l1_bank_mask;
+        let l1_lat = chip.cfg.l1.hit_latency;
+        let first = chip.tms[tm]
+            .l1_banks
+            .reserve_run(w & bank_mask, c, 1, now, 0);
+        let mut bank_stall = first.stall;
+        let slot = first.first;
+        let (mut r, fill) = chip.load_word_fill(tm, w, slot, now);
+        let mut c = slot + 1;
+        if k > 1 {
+            let rest = k - 1;
+            let run = chip.tms[tm]
+                .l1_banks
+                .reserve_run((w + 1) & bank_mask, c, rest, now, fill);
+            bank_stall += run.stall;
+            let hits = run.at_or_after;
+            c = run.last + 1;
+            chip.caches.l1_accesses += rest;
+            chip.caches.l1_hits += hits;
+            chip.caches.l1_merged += rest - hits;
+            r = r.max(fill.max(c - 1 + l1_lat));
+        }
+        self.result(r, Cause::Memory);
+        chip.stalls.l1_bank += bank_stall;
+        c
+    }
+
+    /// `n` ray-box, ray-triangle or dual-split ops. On the TM's only pipe of the kind
+    /// (BVH2, BVH4, BVH8, DST: one of each) they issue one after another, each at the
+    /// pipe's first free cycle; the rest is [`Thread::pipe_general`].
+    #[inline(always)]
+    fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool, chip: &mut Chip) {
+        let tm = &mut chip.tms[self.tm as usize];
+        let (pipes, lat, ops) = match pipe {
+            Pipe::Box => (
+                &mut tm.box_pipes,
+                chip.cfg.units.box_latency,
+                &mut chip.units.box_ops,
+            ),
+            Pipe::Triangle => (
+                &mut tm.tri_pipes,
+                chip.cfg.units.tri_latency,
+                &mut chip.units.tri_ops,
+            ),
+            Pipe::DualSplit => (
+                &mut tm.dst_pipes,
+                chip.cfg.units.dst_latency,
+                &mut chip.units.dst_ops,
+            ),
+        };
+        *ops += n as u64;
+        let mut c = self.t;
+        let mut last = c;
+        if let [only] = &mut pipes[..] {
+            // One pipe: a parallel op of n > 1 serialises, n = 1 is the same either way.
+            let mut busy = 0;
+            for _ in 0..n {
+                let s = only.reserve(c);
+                busy += s - c;
+                last = s;
+                c = s + 1;
             }
-            Op::Pipe { pipe, n, parallel } => {
-                let (pipes, lat) = match pipe {
-                    Pipe::Box => {
-                        chip.units.box_ops += n as u64;
-                        (&mut chip.tms[tm].box_pipes, chip.cfg.units.box_latency)
-                    }
-                    Pipe::Triangle => {
-                        chip.units.tri_ops += n as u64;
-                        (&mut chip.tms[tm].tri_pipes, chip.cfg.units.tri_latency)
-                    }
-                    Pipe::DualSplit => {
-                        chip.units.dst_ops += n as u64;
-                        (&mut chip.tms[tm].dst_pipes, chip.cfg.units.dst_latency)
-                    }
-                };
-                let mut c = self.t;
-                let mut last = c;
-                if parallel && pipes.len() >= n as usize {
-                    // All n ops start together on n pipes, in one issue slot: the first
-                    // cycle from `c` at which n pipes are free.
-                    let mut s = c;
-                    loop {
-                        let free = pipes.iter().filter(|p| p.peek(s) == s).count();
-                        if free >= n as usize {
-                            break;
-                        }
-                        s += 1;
-                    }
-                    chip.stalls.pipeline_busy += s - c;
-                    let mut taken = 0;
-                    for p in pipes.iter_mut() {
-                        if taken < n && p.peek(s) == s {
-                            p.reserve(s);
-                            taken += 1;
-                        }
-                    }
-                    last = s;
-                    c = s + 1;
-                } else {
-                    for _ in 0..n {
-                        let s = earliest(pipes, c);
-                        chip.stalls.pipeline_busy += s - c;
-                        last = s;
-                        c = s + 1;
-                    }
-                }
-                self.t = c;
-                self.result(last + lat, Cause::Pipeline);
+            chip.stalls.pipeline_busy += busy;
+        } else {
+            (last, c) = pipe_general(pipes, n, parallel, c, &mut chip.stalls);
+        }
+        self.t = c;
+        self.result(last + lat, Cause::Pipeline);
+    }
+}
+
+/// A pipeline op of `n` ops from cycle `c` on several pipes of its kind (the "+"
+/// configurations' box pipes): in parallel when asked and there are pipes enough (all n
+/// start together in one issue slot, at the first cycle from `c` at which n pipes are
+/// free), else one after another, each on the pipe free first. Returns the last op's issue
+/// cycle and the cycle after it.
+#[inline(never)]
+fn pipe_general(
+    pipes: &mut [Slots],
+    n: u8,
+    parallel: bool,
+    c: Cycle,
+    stalls: &mut Stalls,
+) -> (Cycle, Cycle) {
+    let mut c = c;
+    let mut last = c;
+    if parallel && pipes.len() >= n as usize {
+        let mut s = c;
+        loop {
+            let free = pipes.iter().filter(|p| p.peek(s) == s).count();
+            if free >= n as usize {
+                break;
+            }
+            s += 1;
+        }
+        stalls.pipeline_busy += s - c;
+        let mut taken = 0;
+        for p in pipes.iter_mut() {
+            if taken < n && p.peek(s) == s {
+                p.reserve(s);
+                taken += 1;
             }
         }
+        last = s;
+        c = s + 1;
+    } else {
+        for _ in 0..n {
+            let s = earliest(pipes, c);
+            stalls.pipeline_busy += s - c;
+            last = s;
+            c = s + 1;
+        }
     }
+    (last, c)
 }
 
 /// Reserves the earliest free cycle at or after `c` on any of `units`.
