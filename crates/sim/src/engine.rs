@@ -486,8 +486,9 @@ impl Thread {
     }
 
     /// A line segment of `k` words from `w` (issue from cycle `c`) some of whose banks are
-    /// busy: the first word takes its bank's first free cycle and looks the line up, the
-    /// rest are placed after it by [`BankSlots::reserve_run`]. Returns the cycle after the
+    /// busy: the first word takes its bank's first free cycle
+    /// ([`BankSlots::reserve_word`]) and looks the line up, the rest are placed after it
+    /// by [`BankSlots::reserve_run`]. Returns the cycle after the
     /// last word.
     #[inline(never)]
     fn load_segment_conflict(
@@ -501,11 +502,8 @@ impl Thread {
         let tm = self.tm as usize;
         let bank_mask = chip.l1_bank_mask;
         let l1_lat = chip.cfg.l1.hit_latency;
-        let first = chip.tms[tm]
-            .l1_banks
-            .reserve_run(w & bank_mask, c, 1, now, 0);
-        let mut bank_stall = first.stall;
-        let slot = first.first;
+        let slot = chip.tms[tm].l1_banks.reserve_word(w & bank_mask, c, now);
+        let mut bank_stall = slot - c;
         let (mut r, fill) = chip.load_word_fill(tm, w, slot, now);
         let mut c = slot + 1;
         if k > 1 {
