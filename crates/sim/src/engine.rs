@@ -87,9 +87,9 @@ pub struct UnitStats {
 struct Tm {
     l1: Cache,
     l1_banks: BankSlots,
-    box_pipes: Vec<Slots>,
-    tri_pipes: Vec<Slots>,
-    dst_pipes: Vec<Slots>,
+    /// Ray-box, ray-triangle and dual-split pipelines, indexed by [`Pipe`] (`pipe as
+    /// usize`), so a pipeline op selects its table and latency by one index.
+    pipes: [Vec<Slots>; 3],
     fpinv: Vec<Slots>,
 }
 
@@ -100,6 +100,8 @@ pub struct Chip {
     l1_bank_mask: u64,
     l2_bank_mask: u64,
     line_word_shift: u32,
+    /// Latency of each pipeline kind, indexed by [`Pipe`].
+    pipe_latency: [u64; 3],
     tms: Vec<Tm>,
     l2: Cache,
     l2_banks: Vec<Slots>,
@@ -130,9 +132,11 @@ impl Chip {
         let tm = || Tm {
             l1: Cache::new(cfg.l1.size_bytes, cfg.l1.line_bytes, cfg.l1.associativity),
             l1_banks: BankSlots::new(cfg.l1.banks),
-            box_pipes: vec![Slots::default(); box_pipes.max(1) as usize],
-            tri_pipes: vec![Slots::default(); cfg.units.tri_pipes as usize],
-            dst_pipes: vec![Slots::default(); cfg.units.dst_pipes as usize],
+            pipes: [
+                vec![Slots::default(); box_pipes.max(1) as usize],
+                vec![Slots::default(); cfg.units.tri_pipes as usize],
+                vec![Slots::default(); cfg.units.dst_pipes as usize],
+            ],
             fpinv: vec![Slots::default(); cfg.units.fpinv_units as usize],
         };
         Self {
@@ -140,6 +144,11 @@ impl Chip {
             l1_bank_mask: cfg.l1.banks as u64 - 1,
             l2_bank_mask: cfg.l2.banks as u64 - 1,
             line_word_shift: (cfg.l1.line_bytes / 4).trailing_zeros(),
+            pipe_latency: [
+                cfg.units.box_latency,
+                cfg.units.tri_latency,
+                cfg.units.dst_latency,
+            ],
             tms: (0..cfg.tms).map(|_| tm()).collect(),
             l2: Cache::new(cfg.l2.size_bytes, cfg.l2.line_bytes, cfg.l2.associativity),
             l2_banks: vec![Slots::default(); cfg.l2.banks as usize],
@@ -529,25 +538,13 @@ impl Thread {
     /// pipe's first free cycle; the rest is [`Thread::pipe_general`].
     #[inline(always)]
     fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool, chip: &mut Chip) {
-        let tm = &mut chip.tms[self.tm as usize];
-        let (pipes, lat, ops) = match pipe {
-            Pipe::Box => (
-                &mut tm.box_pipes,
-                chip.cfg.units.box_latency,
-                &mut chip.units.box_ops,
-            ),
-            Pipe::Triangle => (
-                &mut tm.tri_pipes,
-                chip.cfg.units.tri_latency,
-                &mut chip.units.tri_ops,
-            ),
-            Pipe::DualSplit => (
-                &mut tm.dst_pipes,
-                chip.cfg.units.dst_latency,
-                &mut chip.units.dst_ops,
-            ),
-        };
-        *ops += n as u64;
+        match pipe {
+            Pipe::Box => chip.units.box_ops += n as u64,
+            Pipe::Triangle => chip.units.tri_ops += n as u64,
+            Pipe::DualSplit => chip.units.dst_ops += n as u64,
+        }
+        let lat = chip.pipe_latency[pipe as usize];
+        let pipes = &mut chip.tms[self.tm as usize].pipes[pipe as usize];
         let mut c = self.t;
         let mut last = c;
         if let [only] = &mut pipes[..] {
@@ -727,9 +724,13 @@ impl Wheel {
     fn take_forward(&mut self, id: u32) -> Option<Cycle> {
         let h = &mut self.links[id as usize].hops;
         let d = h[0];
+        if d == 0 {
+            // A wake-up: no hops (they are filled from the first), nothing to write.
+            return None;
+        }
         h.copy_within(1.., 0);
         h[HOPS - 1] = 0;
-        (d != 0).then(|| self.now + d as Cycle)
+        Some(self.now + d as Cycle)
     }
 
     /// Appends thread `id` to bucket `b`'s list.
