@@ -692,13 +692,20 @@ impl Wheel {
         }
     }
 
+    #[inline(always)]
     fn push(&mut self, t: Cycle, id: u32) {
         debug_assert!(t >= self.now);
         if t - self.now < WHEEL {
             self.append((t % WHEEL) as usize, id);
         } else {
-            self.overflow.push(Reverse((t, id)));
+            self.push_overflow(t, id);
         }
+    }
+
+    /// A wake-up beyond the wheel, into the overflow heap (rare).
+    #[inline(never)]
+    fn push_overflow(&mut self, t: Cycle, id: u32) {
+        self.overflow.push(Reverse((t, id)));
     }
 
     /// A forward entry: thread `id` has nothing to do at `t` but move on `hops[0]` cycles
@@ -791,6 +798,21 @@ impl Wheel {
     }
 }
 
+/// Puts thread `id` back into the wheel at its next issue slot, as a forward entry when
+/// `forwards` ([`Thread::skip_ahead`]); inlined at both call sites in [`run_chip_with`]
+/// (as a closure it was a call per wake-up).
+#[inline(always)]
+fn sleep(th: &mut Thread, wheel: &mut Wheel, stalls: &mut Stalls, id: u32, forwards: bool) {
+    let t = th.t;
+    if forwards {
+        let hops = th.skip_ahead(stalls);
+        wheel.push_forward(t, hops, id);
+    } else {
+        th.next = None;
+        wheel.push(t, id);
+    }
+}
+
 /// Runs every thread to completion; returns the cycle the last result arrived.
 pub fn run_chip(chip: &mut Chip, threads: &mut [Thread], work: &mut dyn WorkSource) -> Cycle {
     run_chip_with(chip, threads, work, true)
@@ -817,16 +839,6 @@ fn run_chip_with(
         wheel.push(0, i);
     }
     let mut finish = vec![0; threads.len()];
-    let sleep = |th: &mut Thread, wheel: &mut Wheel, stalls: &mut Stalls, id: u32| {
-        let t = th.t;
-        if forwards {
-            let hops = th.skip_ahead(stalls);
-            wheel.push_forward(t, hops, id);
-        } else {
-            th.next = None;
-            wheel.push(t, id);
-        }
-    };
     while let Some((now, first)) = wheel.next_bucket() {
         let mut touched = 0;
         let mut id = first;
@@ -849,7 +861,7 @@ fn run_chip_with(
             let th = &mut threads[id as usize];
             loop {
                 if th.run(chip, now) {
-                    sleep(th, &mut wheel, &mut chip.stalls, id);
+                    sleep(th, &mut wheel, &mut chip.stalls, id, forwards);
                     break;
                 }
                 // Program finished: the thread takes more work or retires once results are in.
@@ -857,7 +869,7 @@ fn run_chip_with(
                     Some(ops) => {
                         th.load_program(ops);
                         if th.t > now {
-                            sleep(th, &mut wheel, &mut chip.stalls, id);
+                            sleep(th, &mut wheel, &mut chip.stalls, id, forwards);
                             break;
                         }
                     }
