@@ -37,13 +37,19 @@ impl Slots {
     /// Reserves the first free cycle at or after `c` and returns it.
     #[inline]
     pub fn reserve(&mut self, c: Cycle) -> Cycle {
-        // Fast path (most requests): `c` inside the window and free.
+        // Fast path (most requests): `c` inside the window and a free cycle from `c` on in
+        // the same 64-cycle word (bit j of `free`: cycle `c + j` is free; the zeros
+        // shifted in at the top are not free). That is the first free cycle from `c`:
+        // the window's later word holds only later cycles.
         let off = c.wrapping_sub(self.base);
         if off < WINDOW {
-            let (h, bit) = ((off >> 6) as usize & 1, 1u64 << (off & 63));
-            if self.words[h] & bit == 0 {
-                self.words[h] |= bit;
-                return c;
+            let (h, i) = ((off >> 6) as usize & 1, off & 63);
+            let w = self.words[h];
+            let free = !w >> i;
+            if free != 0 {
+                let j = free.trailing_zeros() as u64;
+                self.words[h] = w | 1 << (i + j);
+                return c + j;
             }
         }
         self.reserve_slow(c)
