@@ -133,46 +133,77 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
         let mut near: Option<Entry> = None;
         let (mut valid, mut nhit) = (0u8, 0u8);
         let mut addr = node.offset();
-        for k in 0..L::ARITY {
-            let kind = node.kind(k);
-            if kind == ChildKind::Empty {
-                continue;
-            }
-            valid += 1;
-            let (entry, exit) = if fast {
-                slab.test(node.box_words(k), ray.t_min, limit)
-            } else {
-                let b = node.child_bounds(k);
-                r.slab(b.min, b.max, ray.t_min, limit)
-            };
-            if entry <= exit {
-                nhit += 1;
-                let e = Entry {
-                    t: entry,
-                    word: addr,
-                    leaf: kind == ChildKind::Leaf,
-                };
-                match near {
-                    None => near = Some(e),
-                    // A later slot is nearer only when strictly nearer.
-                    Some(n) if entry < n.t => {
-                        // `n` precedes every stacked entry: it goes on top.
-                        stack.push(n);
-                        near = Some(e);
-                    }
-                    Some(_) => {
-                        // Below the stacked entries that are nearer or equally near.
-                        stack.push(e);
-                        let mut j = stack.len() - 1;
-                        while j > base && stack[j - 1].t <= entry {
-                            stack[j] = stack[j - 1];
-                            j -= 1;
+        // One slot's test and sort step (a macro, so that BVH2's two slots are unrolled
+        // with constant slot numbers: the decode folds).
+        macro_rules! child {
+            ($k:expr) => {{
+                let k: usize = $k;
+                let kind = node.kind(k);
+                if kind != ChildKind::Empty {
+                    valid += 1;
+                    let (entry, exit) = if fast {
+                        slab.test(node.box_words(k), ray.t_min, limit)
+                    } else {
+                        let b = node.child_bounds(k);
+                        r.slab(b.min, b.max, ray.t_min, limit)
+                    };
+                    if entry <= exit {
+                        nhit += 1;
+                        let e = Entry {
+                            t: entry,
+                            word: addr,
+                            leaf: kind == ChildKind::Leaf,
+                        };
+                        match near {
+                            None => near = Some(e),
+                            // A later slot is nearer only when strictly nearer.
+                            Some(n) if entry < n.t => {
+                                // `n` precedes every stacked entry: it goes on top.
+                                stack.push(n);
+                                near = Some(e);
+                            }
+                            Some(_) => {
+                                // Below the stacked entries that are nearer or equally near.
+                                stack.push(e);
+                                let mut j = stack.len() - 1;
+                                while j > base && stack[j - 1].t <= entry {
+                                    stack[j] = stack[j - 1];
+                                    j -= 1;
+                                }
+                                stack[j] = e;
+                            }
                         }
-                        stack[j] = e;
                     }
                 }
+                addr += L::child_words(kind);
+            }};
+        }
+        match L::ARITY {
+            2 => {
+                child!(0);
+                child!(1);
             }
-            addr += L::child_words(kind);
+            4 => {
+                child!(0);
+                child!(1);
+                child!(2);
+                child!(3);
+            }
+            8 => {
+                child!(0);
+                child!(1);
+                child!(2);
+                child!(3);
+                child!(4);
+                child!(5);
+                child!(6);
+                child!(7);
+            }
+            _ => {
+                for k in 0..L::ARITY {
+                    child!(k);
+                }
+            }
         }
         obs.step(NodeStep::Bvh {
             arity: L::ARITY as u8,
