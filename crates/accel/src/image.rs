@@ -197,8 +197,15 @@ pub trait NodeLayout: bytemuck::Pod {
     fn offset(&self) -> u32;
     /// Kind of slot `k`.
     fn kind(&self, k: usize) -> ChildKind;
+    /// The six words of slot `k`'s box as stored: min.xyz, max.xyz (the degenerate box
+    /// for an empty slot). Traversal slab-tests these words in place ([`NodeLayout::child_bounds`]
+    /// builds an [`Aabb`] from them).
+    fn box_words(&self, k: usize) -> &[f32; 6];
     /// Box of slot `k` (degenerate for an empty slot).
-    fn child_bounds(&self, k: usize) -> Aabb;
+    #[inline(always)]
+    fn child_bounds(&self, k: usize) -> Aabb {
+        words_box(self.box_words(k))
+    }
 
     /// Size in words of a child of kind `kind` inside a child block.
     #[inline(always)]

@@ -326,12 +326,13 @@ struct Steps {
     leaf: u64,
     tri_test: u64,
     tri_accept: u64,
-    bvh_nodes: u64,
-    /// BVH nodes with at least one valid child (one ray-box pipeline op each).
-    bvh_boxed: u64,
-    bvh_valid: u64,
-    bvh_hits: u64,
-    bvh_pairs: u64,
+    /// BVH node steps by (valid children, hit children), both at most 8: one counter to
+    /// add per node.
+    bvh: [[u64; 9]; 9],
+    /// BVH node steps with more than 8 valid or hit children (no layout has them; counted
+    /// apart so that the table above stays small): nodes, nodes with a valid child, and
+    /// Σvalid, Σhits, Σpairs.
+    bvh_wide: [u64; 5],
     /// DST steps by node kind (the enum's order) and return code.
     dst: [[u64; 4]; 4],
 }
@@ -381,6 +382,27 @@ const DST_SW_TOTAL: [[u64; 4]; 4] = {
     t
 };
 
+/// Instructions of a BVH node step with `valid` valid and `hits` hit children (both at
+/// most 8), by [`bvh_total`].
+const BVH_STEP_TOTAL: [[u64; 9]; 9] = {
+    let mut t = [[0; 9]; 9];
+    let mut v = 0;
+    while v < 9 {
+        let mut h = 0;
+        while h < 9 {
+            t[v][h] = bvh_total(v as u64, h as u64, bvh_pairs(h as u64));
+            h += 1;
+        }
+        v += 1;
+    }
+    t
+};
+
+/// Compare-exchanges of the entry-distance sort of `hits` children: `hits·(hits − 1)/2`.
+const fn bvh_pairs(hits: u64) -> u64 {
+    hits * hits.saturating_sub(1) / 2
+}
+
 /// Instructions of a BVH node step: node overhead, per valid child, per hit child and per
 /// compare-exchange of the entry-distance sort (`hits·(hits − 1)/2` pairs).
 #[inline(always)]
@@ -419,28 +441,46 @@ impl Tally {
         let dst = self.accel.is_dst();
         let parallel = self.accel.parallel_boxes();
         let mut c = self.counts;
+        // The BVH node steps' sums, from the (valid, hits) table.
+        let [
+            mut bvh_nodes,
+            mut bvh_boxed,
+            mut bvh_valid,
+            mut bvh_hits,
+            mut bvh_pairs_sum,
+        ] = s.bvh_wide;
+        for (v, row) in s.bvh.iter().enumerate() {
+            for (h, &n) in row.iter().enumerate() {
+                let (v, h) = (v as u64, h as u64);
+                bvh_nodes += n;
+                bvh_boxed += if v != 0 { n } else { 0 };
+                bvh_valid += v * n;
+                bvh_hits += h * n;
+                bvh_pairs_sum += bvh_pairs(h) * n;
+            }
+        }
         // Pipeline ops and node steps: one box op per valid child (one issue slot per node
         // on parallel pipes), one triangle op per test, one dual-split op per DST step on
         // the pipeline; node steps are BVH nodes and DST steps other than leaf words.
-        c.box_ops += s.bvh_valid;
-        c.box_issues += if parallel { s.bvh_boxed } else { s.bvh_valid };
+        c.box_ops += bvh_valid;
+        c.box_issues += if parallel { bvh_boxed } else { bvh_valid };
         c.tri_ops += s.tri_test;
         let dst_steps: u64 = s.dst.iter().flatten().sum();
         if self.accel == SimAccel::Dst {
             c.dst_ops += dst_steps;
         }
         c.node_steps +=
-            s.bvh_nodes + dst_steps - s.dst[DstNodeKind::Leaf as usize].iter().sum::<u64>();
+            bvh_nodes + dst_steps - s.dst[DstNodeKind::Leaf as usize].iter().sum::<u64>();
         let m = &mut c.mix;
         m.add(if dst { DST_PUSH } else { PUSH }.times(s.push));
         m.add(if dst { DST_POP } else { POP }.times(s.pop));
         m.add(LEAF.times(s.leaf));
         m.add(TRI_TEST.times(s.tri_test));
         m.add(TRI_ACCEPT.times(s.tri_accept));
-        m.add(BVH_NODE.times(s.bvh_nodes));
-        m.add(BVH_PER_CHILD.times(s.bvh_valid));
-        m.add(BVH_PER_HIT.times(s.bvh_hits));
-        m.add(BVH_SORT_PAIR.times(s.bvh_pairs));
+        m.add(BVH_NODE.times(bvh_nodes));
+        m.add(BVH_PER_CHILD.times(bvh_valid));
+        m.add(BVH_PER_HIT.times(bvh_hits));
+        m.add(BVH_SORT_PAIR.times(bvh_pairs_sum));
         for (kind, row) in DST_KINDS.into_iter().zip(&s.dst) {
             for (code, &n) in row.iter().enumerate() {
                 let step = if self.accel == SimAccel::Dst {
@@ -568,21 +608,16 @@ impl<'a> Recorder<'a> {
     /// continued by the next recording ([`Recorder::resume`]) or written as the program's
     /// last op.
     #[inline]
-    pub fn finish_open(self) -> Option<Run> {
-        (self.run != 0).then_some(Run {
-            n: self.run as u32,
-            fpinv: self.run_fpinv as u16,
-        })
+    pub fn finish_open(mut self) -> Option<Run> {
+        (self.run != 0).then(|| self.checked_run())
     }
 
     /// Appends instructions of mix `m` (merged into a preceding `Issue`).
     #[inline(always)]
     pub fn issue(&mut self, m: Mix) {
         self.tally.counts.mix.add(m);
-        if m.fpinv == 0 && m.total() <= u32::MAX as u64 {
-            return self.extend_run(m.total());
-        }
-        // Merged into the open run: the sums are checked against the op's widths.
+        // Merged into the open run: the sums are checked against the op's widths (here,
+        // not only when the run is written: a run that does not fit keeps its last count).
         let (n, fpinv) = ((self.run & !OPEN) + m.total(), self.run_fpinv + m.fpinv);
         if n > u32::MAX as u64 {
             self.tally.fail(OpRangeError::Issue { n });
@@ -593,26 +628,63 @@ impl<'a> Recorder<'a> {
         }
     }
 
+    /// A BVH node step with more than 8 valid or hit children (no layout has them).
+    #[cold]
+    #[inline(never)]
+    fn wide_bvh_step(&mut self, valid: u64, hits: u64) {
+        let pairs = bvh_pairs(hits);
+        let w = &mut self.tally.steps.bvh_wide;
+        for (k, x) in [1, (valid != 0) as u64, valid, hits, pairs]
+            .into_iter()
+            .enumerate()
+        {
+            w[k] += x;
+        }
+        self.extend_run(bvh_total(valid, hits, pairs));
+    }
+
     /// Merges `n` instructions without reciprocals into the open run (opening one if
-    /// needed), checked against the op's width.
+    /// needed). The run's width is checked when it is written or handed on
+    /// ([`Recorder::run_op`]): a kernel step adds a few instructions, so the 64-bit sum
+    /// cannot wrap before that.
     #[inline(always)]
     fn extend_run(&mut self, n: u64) {
-        let run = (self.run | OPEN) + n;
-        if run & !OPEN > u32::MAX as u64 {
-            self.tally.fail(OpRangeError::Issue { n: run & !OPEN });
-        } else {
-            self.run = run;
+        self.run = (self.run | OPEN) + n;
+    }
+
+    /// The open run, its instruction count checked against the op's width (an
+    /// [`OpRangeError::Issue`] is kept in the tally, and the run then carries the largest
+    /// count an op holds).
+    #[inline(always)]
+    fn checked_run(&mut self) -> Run {
+        let n = self.run & !OPEN;
+        if n > u32::MAX as u64 {
+            self.tally.fail(OpRangeError::Issue { n });
+        }
+        Run {
+            n: n.min(u32::MAX as u64) as u32,
+            fpinv: self.run_fpinv as u16,
         }
     }
 
-    /// Writes the open run (if any) as an `Issue` op: a load or pipeline op follows.
+    /// Writes the open run (if any) as an `Issue` op, then `op` (a load or pipeline op).
+    #[inline(always)]
+    fn close_run_then(&mut self, op: Op) {
+        if self.run != 0 {
+            let run = self.checked_run().op();
+            self.ops.extend_from_slice(&[run, op]);
+            (self.run, self.run_fpinv) = (0, 0);
+        } else {
+            self.ops.push(op);
+        }
+    }
+
+    /// Writes the open run (if any) as an `Issue` op.
     #[inline(always)]
     fn close_run(&mut self) {
         if self.run != 0 {
-            self.ops.push(Op::Issue {
-                n: self.run as u32,
-                fpinv: self.run_fpinv as u16,
-            });
+            let run = self.checked_run().op();
+            self.ops.push(run);
             (self.run, self.run_fpinv) = (0, 0);
         }
     }
@@ -620,8 +692,7 @@ impl<'a> Recorder<'a> {
     /// Appends a pipeline op (counted from the steps, in [`Tally::counts`]).
     #[inline(always)]
     fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool) {
-        self.close_run();
-        self.ops.push(Op::Pipe { pipe, n, parallel });
+        self.close_run_then(Op::Pipe { pipe, n, parallel });
     }
 }
 
@@ -636,10 +707,7 @@ impl Observer for Recorder<'_> {
         }
         self.tally.counts.loads += words;
         match Op::load(a & !3, words) {
-            Ok(op) => {
-                self.close_run();
-                self.ops.push(op);
-            }
+            Ok(op) => self.close_run_then(op),
             Err(e) => self.tally.fail(e),
         }
     }
@@ -651,14 +719,12 @@ impl Observer for Recorder<'_> {
                 if valid != 0 {
                     self.pipe(Pipe::Box, valid, self.parallel_boxes);
                 }
-                let pairs = (hits as u64 * hits.saturating_sub(1) as u64) / 2;
-                let s = &mut self.tally.steps;
-                s.bvh_nodes += 1;
-                s.bvh_boxed += (valid != 0) as u64;
-                s.bvh_valid += valid as u64;
-                s.bvh_hits += hits as u64;
-                s.bvh_pairs += pairs;
-                self.extend_run(bvh_total(valid as u64, hits as u64, pairs));
+                if valid <= 8 && hits <= 8 {
+                    self.tally.steps.bvh[valid as usize][hits as usize] += 1;
+                    self.extend_run(BVH_STEP_TOTAL[valid as usize][hits as usize]);
+                } else {
+                    self.wide_bvh_step(valid as u64, hits as u64);
+                }
             }
             NodeStep::Dst { kind, code, .. } => {
                 // Codes above 3 take code 3's mix in both step functions.
@@ -987,6 +1053,53 @@ mod tests {
             ops,
             vec![Op::Issue {
                 n: 3_000_000_000,
+                fpinv: 0
+            }]
+        );
+    }
+
+    #[test]
+    fn a_run_beyond_the_op_width_is_an_error_when_written_or_handed_on() {
+        // Kernel steps extend the open run unchecked; the width is checked when the run
+        // becomes an op (a load follows, or the recording ends) or is handed to the next ray.
+        let near = Run {
+            n: u32::MAX - 3,
+            fpinv: 0,
+        };
+        for hand_on in [false, true] {
+            let mut ops = Vec::new();
+            let mut tally = Tally::new(SimAccel::Bvh2);
+            let mut r = Recorder::resume(&mut tally, &mut ops, Some(near));
+            r.push(); // + 3: exactly u32::MAX
+            assert_eq!(r.tally().error(), None);
+            r.pop(); // + 6
+            if hand_on {
+                let run = r.finish_open();
+                assert_eq!(run.map(|r| r.n), Some(u32::MAX));
+            } else {
+                r.fetch(0, 4);
+                assert_eq!(
+                    ops[0],
+                    Op::Issue {
+                        n: u32::MAX,
+                        fpinv: 0
+                    }
+                );
+            }
+            let n = u32::MAX as u64 + 6;
+            assert_eq!(tally.error(), Some(OpRangeError::Issue { n }));
+        }
+        // Just fitting is no error.
+        let mut ops = Vec::new();
+        let mut tally = Tally::new(SimAccel::Bvh2);
+        let mut r = Recorder::resume(&mut tally, &mut ops, Some(near));
+        r.push();
+        r.finish();
+        assert_eq!(tally.error(), None);
+        assert_eq!(
+            ops,
+            vec![Op::Issue {
+                n: u32::MAX,
                 fpinv: 0
             }]
         );

@@ -1,6 +1,6 @@
 //! The 100-byte BVH4 internal node (Lin et al. 2020, §4.2).
 
-use crate::image::{ChildKind, ImageError, NodeLayout, encode_packed, packed_kind, words_box};
+use crate::image::{ChildKind, ImageError, NodeLayout, encode_packed, packed_kind};
 use dualsplit_geometry::Aabb;
 
 /// BVH4 internal node: four child boxes and one packed offset/type word, 100 bytes.
@@ -57,8 +57,8 @@ impl NodeLayout for Node4 {
     }
 
     #[inline(always)]
-    fn child_bounds(&self, k: usize) -> Aabb {
-        words_box(&self.boxes[k])
+    fn box_words(&self, k: usize) -> &[f32; 6] {
+        &self.boxes[k]
     }
 }
 

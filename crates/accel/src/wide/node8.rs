@@ -1,6 +1,6 @@
 //! The 200-byte BVH8 internal node (Lin et al. 2020, §4.2).
 
-use crate::image::{ChildKind, ImageError, NodeLayout, box_words, words_box};
+use crate::image::{ChildKind, ImageError, NodeLayout, box_words};
 use dualsplit_geometry::Aabb;
 
 /// BVH8 internal node: eight child boxes, an offset word and a child-types word, 200 bytes.
@@ -75,8 +75,8 @@ impl NodeLayout for Node8 {
     }
 
     #[inline(always)]
-    fn child_bounds(&self, k: usize) -> Aabb {
-        words_box(&self.boxes[k])
+    fn box_words(&self, k: usize) -> &[f32; 6] {
+        &self.boxes[k]
     }
 }
 

@@ -3,9 +3,11 @@
 //! the [`Observer`] every fetch and step (contract 2 of `docs/architecture.md`).
 //!
 //! Per internal node: fetch the node, slab-test every non-empty child box against
-//! `[ray.t_min, cull_limit(best_t)]` ([`dualsplit_geometry::RayPre::slab`], whose far-plane
-//! exits are widened by `1 + 2γ₃` (Ize 2013) so a ray aimed at a vertex on a box corner is
-//! never rounded away), report `NodeStep::Bvh`, sort the hit children by entry
+//! `[ray.t_min, cull_limit(best_t)]` (the arithmetic of [`dualsplit_geometry::RayPre::slab`],
+//! whose far-plane exits are widened by `1 + 2γ₃` (Ize 2013) so a ray aimed at a vertex on a
+//! box corner is never rounded away, evaluated on the node's stored box words by `BoxSlab`:
+//! planes picked by index, bounds clipped by compare-and-select; `docs/performance.md`,
+//! "Sixth round"), report `NodeStep::Bvh`, sort the hit children by entry
 //! distance (near first, ties in slot order), continue with the nearest and push the others
 //! far-first with their entry distance. A popped entry whose entry distance is beyond
 //! `cull_limit(best_t)` is discarded. Per leaf: fetch the leaf word, then the index run (its
@@ -16,7 +18,7 @@
 use super::encode::LAST_IN_RUN;
 use crate::image::{ChildKind, MemoryImage, NodeLayout};
 use crate::observer::{NodeStep, Observer};
-use dualsplit_geometry::{Hit, Ray, cull_limit};
+use dualsplit_geometry::{Hit, Ray, RayPre, cull_limit, widen_exit};
 use std::cell::Cell;
 
 #[derive(Clone, Copy)]
@@ -59,6 +61,7 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
     stack: &mut Vec<Entry>,
 ) -> Option<Hit> {
     let r = ray.precompute();
+    let slab = BoxSlab::new(&r);
     let words = &img.words[..];
     let mut best: Option<Hit> = None;
     let mut best_t = ray.t_max;
@@ -121,49 +124,190 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
         obs.fetch(MemoryImage::addr(w), (L::WORDS * 4) as u32);
         let node = L::read(words, w);
         let limit = cull_limit(best_t);
-        let mut hits = [Entry {
-            t: 0.0,
-            word: 0,
-            leaf: false,
-        }; 8];
-        let (mut valid, mut nhit) = (0u8, 0usize);
+        // The compare-and-select slab needs non-NaN interval ends (see `BoxSlab`); a NaN
+        // `t_min` or cull limit (a ray with `t_max = -∞`) takes `RayPre::slab` itself.
+        let fast = !(ray.t_min - limit).is_nan();
+        // The hit children: the nearest in `near`, the others on the stack above `base`,
+        // nearest on top; order by entry distance, ties in slot order.
+        let base = stack.len();
+        let mut near: Option<Entry> = None;
+        let (mut valid, mut nhit) = (0u8, 0u8);
         let mut addr = node.offset();
-        for k in 0..L::ARITY {
-            let kind = node.kind(k);
-            if kind == ChildKind::Empty {
-                continue;
-            }
-            valid += 1;
-            let b = node.child_bounds(k);
-            let (entry, exit) = r.slab(b.min, b.max, ray.t_min, limit);
-            if entry <= exit {
-                // Insertion sort by entry distance; equal distances keep slot order.
-                let mut j = nhit;
-                while j > 0 && hits[j - 1].t > entry {
-                    hits[j] = hits[j - 1];
-                    j -= 1;
+        // One slot's test and sort step (a macro, so that BVH2's two slots are unrolled
+        // with constant slot numbers: the decode folds).
+        macro_rules! child {
+            ($k:expr) => {{
+                let k: usize = $k;
+                let kind = node.kind(k);
+                if kind != ChildKind::Empty {
+                    valid += 1;
+                    let (entry, exit) = if fast {
+                        slab.test(node.box_words(k), ray.t_min, limit)
+                    } else {
+                        let b = node.child_bounds(k);
+                        r.slab(b.min, b.max, ray.t_min, limit)
+                    };
+                    if entry <= exit {
+                        nhit += 1;
+                        let e = Entry {
+                            t: entry,
+                            word: addr,
+                            leaf: kind == ChildKind::Leaf,
+                        };
+                        match near {
+                            None => near = Some(e),
+                            // A later slot is nearer only when strictly nearer.
+                            Some(n) if entry < n.t => {
+                                // `n` precedes every stacked entry: it goes on top.
+                                stack.push(n);
+                                near = Some(e);
+                            }
+                            Some(_) => {
+                                // Below the stacked entries that are nearer or equally near.
+                                stack.push(e);
+                                let mut j = stack.len() - 1;
+                                while j > base && stack[j - 1].t <= entry {
+                                    stack[j] = stack[j - 1];
+                                    j -= 1;
+                                }
+                                stack[j] = e;
+                            }
+                        }
+                    }
                 }
-                hits[j] = Entry {
-                    t: entry,
-                    word: addr,
-                    leaf: kind == ChildKind::Leaf,
-                };
-                nhit += 1;
+                addr += L::child_words(kind);
+            }};
+        }
+        match L::ARITY {
+            2 => {
+                child!(0);
+                child!(1);
             }
-            addr += L::child_words(kind);
+            4 => {
+                child!(0);
+                child!(1);
+                child!(2);
+                child!(3);
+            }
+            8 => {
+                child!(0);
+                child!(1);
+                child!(2);
+                child!(3);
+                child!(4);
+                child!(5);
+                child!(6);
+                child!(7);
+            }
+            _ => {
+                for k in 0..L::ARITY {
+                    child!(k);
+                }
+            }
         }
         obs.step(NodeStep::Bvh {
             arity: L::ARITY as u8,
             valid,
-            hits: nhit as u8,
+            hits: nhit,
         });
-        if nhit == 0 {
-            continue;
-        }
-        for h in hits[1..nhit].iter().rev() {
-            stack.push(*h);
+        for _ in 1..nhit {
             obs.push();
         }
-        cur = Some(hits[0]);
+        cur = near;
+    }
+}
+
+/// The slab test of [`RayPre::slab`] on a box's six stored words, with the near and far
+/// planes picked by index from the ray's direction signs and the interval clipped by
+/// compare-and-select instead of the NaN-permissive `f32::min`/`f32::max`.
+///
+/// The plane distances are the same IEEE operations (`(p - o[a]) * inv[a]`, far planes
+/// widened by [`dualsplit_geometry::widen_exit`]), so the result equals `RayPre::slab`'s
+/// whenever the interval ends `t_lo` and `t_hi` are not NaN: a NaN plane distance (a ray
+/// lying in a slab's plane) loses every comparison, so the running bound is kept, exactly
+/// as `f32::max`/`f32::min` ignore a NaN operand. Only the sign of a zero bound may
+/// differ, which no comparison sees. Callers with a NaN interval end use `RayPre::slab`.
+#[derive(Clone, Copy, Debug)]
+struct BoxSlab {
+    origin: [f32; 3],
+    inv: [f32; 3],
+    neg: [bool; 3],
+}
+
+impl BoxSlab {
+    fn new(r: &RayPre) -> Self {
+        Self {
+            origin: r.ray.origin.to_array(),
+            inv: r.inv_dir.to_array(),
+            neg: r.neg,
+        }
+    }
+
+    /// `(entry, exit)` of box words `w` (min.xyz, max.xyz) clipped to `[t_lo, t_hi]`.
+    #[inline(always)]
+    fn test(&self, w: &[f32; 6], t_lo: f32, t_hi: f32) -> (f32, f32) {
+        let mut entry = t_lo;
+        let mut exit = t_hi;
+        for a in 0..3 {
+            // Near plane: min on a positive axis, max on a negative one (bool → 0 or 3).
+            let s = 3 * self.neg[a] as usize;
+            let tn = (w[a + s] - self.origin[a]) * self.inv[a];
+            let tf = widen_exit((w[a + 3 - s] - self.origin[a]) * self.inv[a]);
+            if tn > entry {
+                entry = tn;
+            }
+            if tf < exit {
+                exit = tf;
+            }
+        }
+        (entry, exit)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dualsplit_geometry::{Aabb, Pcg32, Vec3};
+
+    /// A coordinate from a small set (so that box planes often pass exactly through the
+    /// ray's origin and zero direction components make NaN plane distances) or random.
+    fn coord(rng: &mut Pcg32) -> f32 {
+        match rng.below(6) {
+            0 => 0.0,
+            1 => -0.0,
+            2 => 1.0,
+            3 => -1.0,
+            _ => rng.range_f32(-4.0, 4.0),
+        }
+    }
+
+    /// `BoxSlab::test` answers as `RayPre::slab` (the same values, up to the sign of a zero,
+    /// and the same hit or miss) for every non-NaN interval, on boxes whose planes pass
+    /// through the origin, degenerate boxes, axis-parallel rays and ±0 directions.
+    #[test]
+    fn box_slab_matches_ray_slab() {
+        let mut rng = Pcg32::new(7, 3);
+        for i in 0..200_000 {
+            let origin = Vec3::new(coord(&mut rng), coord(&mut rng), coord(&mut rng));
+            let dir = Vec3::new(coord(&mut rng), coord(&mut rng), coord(&mut rng));
+            let r = Ray::new(origin, dir).precompute();
+            let b = if rng.below(10) == 0 {
+                Aabb::DEGENERATE
+            } else {
+                let (p, q) = (
+                    Vec3::new(coord(&mut rng), coord(&mut rng), coord(&mut rng)),
+                    Vec3::new(coord(&mut rng), coord(&mut rng), coord(&mut rng)),
+                );
+                Aabb::new(p.min(q), p.max(q))
+            };
+            let ends = [0.0, -0.0, 0.5, 1e-3, f32::INFINITY, f32::NEG_INFINITY, 3.0];
+            let t_lo = ends[rng.below(ends.len() as u32) as usize];
+            let t_hi = ends[rng.below(ends.len() as u32) as usize];
+            let w = [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z];
+            let (e, x) = BoxSlab::new(&r).test(&w, t_lo, t_hi);
+            let (we, wx) = r.slab(b.min, b.max, t_lo, t_hi);
+            assert_eq!((e, x, e <= x), (we, wx, we <= wx), "case {i}: {r:?} {b:?}");
+            assert!(!e.is_nan() && !x.is_nan());
+        }
     }
 }
