@@ -21,8 +21,13 @@
 //! ([`run_chip`]; about half of all wake-ups). A line segment whose banks are free is
 //! placed with one bitmap test and, when its line sits in the direct-mapped L1, answered
 //! without a call ([`memory::Cache::find_direct`](crate::memory::Cache::find_direct)); the
-//! touch pass reads the L2's tag only for a load whose L1 way holds another line. None of
-//! this changes a simulated result.
+//! touch pass reads the L2's tag only for a load whose L1 way holds another line. A wake-up
+//! usually runs one op, so [`Thread::run`] keeps only the common ops inline (a plain
+//! instruction run, a load whose segments find their banks free, all of a segment's words
+//! counted at once, a pipeline op on the TM's only pipe, its table and latency chosen by
+//! one index) and calls out of line for the rest (reciprocals, bank conflicts, several
+//! pipes), so each call saves few registers; going back to sleep is inlined into
+//! `run_chip`. None of this changes a simulated result.
 
 use crate::Cycle;
 use crate::config::SimConfig;
