@@ -220,7 +220,8 @@ pub trait NodeLayout: bytemuck::Pod {
     /// Reads the node at word `at` of `words`.
     #[inline(always)]
     fn read(words: &[u32], at: usize) -> &Self {
-        bytemuck::from_bytes(bytemuck::cast_slice(&words[at..at + Self::WORDS]))
+        // Word-aligned layouts: the cast checks nothing at run time.
+        &bytemuck::cast_slice(&words[at..at + Self::WORDS])[0]
     }
 
     /// Checks that `offset` fits the offset field.

@@ -524,8 +524,6 @@ impl Tally {
 pub struct Recorder<'a> {
     ops: &'a mut Vec<Op>,
     tally: &'a mut Tally,
-    /// Byte address added to every fetch (where the image lives in simulated memory).
-    pub base: u64,
     /// The open run: [`OPEN`] plus its instructions (below 2^32) while the last op recorded
     /// is the (unwritten) run, 0 when there is none.
     run: u64,
@@ -585,7 +583,6 @@ impl<'a> Recorder<'a> {
         Self {
             ops,
             tally,
-            base: 0,
             run: run.map_or(0, |r| OPEN | r.n as u64),
             run_fpinv: run.map_or(0, |r| r.fpinv as u64),
             dst: accel.is_dst(),
@@ -699,7 +696,7 @@ impl<'a> Recorder<'a> {
 impl Observer for Recorder<'_> {
     #[inline(always)]
     fn fetch(&mut self, addr: u64, bytes: u32) {
-        let a = self.base + addr;
+        let a = addr;
         // Words from the one holding byte `a` to the one holding byte `a + bytes − 1`.
         let words = ((a & 3) + bytes as u64).div_ceil(4);
         if words == 0 {

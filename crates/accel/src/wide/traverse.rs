@@ -65,6 +65,11 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
     let words = &img.words[..];
     let mut best: Option<Hit> = None;
     let mut best_t = ray.t_max;
+    // `cull_limit(best_t)`, updated with `best_t`.
+    let mut limit = cull_limit(best_t);
+    // The compare-and-select slab needs non-NaN interval ends (see `BoxSlab`); a NaN
+    // `t_min` or cull limit (a ray with `t_max = -∞`) takes `RayPre::slab` itself.
+    let mut fast = !(ray.t_min - limit).is_nan();
     let mut cur = Some(Entry {
         t: ray.t_min,
         word: 0,
@@ -78,7 +83,7 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
                     return best;
                 };
                 obs.pop();
-                if e.t <= cull_limit(best_t) {
+                if e.t <= limit {
                     break e;
                 }
             },
@@ -116,6 +121,8 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
                         return best;
                     }
                     best_t = h.t;
+                    limit = cull_limit(best_t);
+                    fast = !(ray.t_min - limit).is_nan();
                 }
             }
             continue;
@@ -123,10 +130,6 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
         let w = e.word as usize;
         obs.fetch(MemoryImage::addr(w), (L::WORDS * 4) as u32);
         let node = L::read(words, w);
-        let limit = cull_limit(best_t);
-        // The compare-and-select slab needs non-NaN interval ends (see `BoxSlab`); a NaN
-        // `t_min` or cull limit (a ray with `t_max = -∞`) takes `RayPre::slab` itself.
-        let fast = !(ray.t_min - limit).is_nan();
         // The hit children: the nearest in `near`, the others on the stack above `base`,
         // nearest on top; order by entry distance, ties in slot order.
         let base = stack.len();
