@@ -33,7 +33,7 @@ use crate::Cycle;
 use crate::config::SimConfig;
 use crate::kernel::{Op, Pipe};
 use crate::memory::{Cache, Dram, Lookup};
-use crate::slots::{BankSlots, Slots};
+use crate::slots::{self, BankSlots, Slots};
 use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -173,40 +173,14 @@ impl Chip {
     }
 
     /// As [`Chip::load_word`], also returning the fill cycle now in the line's L1 tag;
-    /// `now` (≤ `slot`) is the current event time: no later access starts before it.
-    ///
-    /// A line a direct-mapped L1 holds in its way is answered inline
-    /// ([`Cache::find_direct`]: the same answer as the lookup, which has no other effect
-    /// there); everything else goes through [`Chip::load_word_lookup`].
-    #[inline(always)]
-    fn load_word_fill(&mut self, tm: usize, word: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
-        let line = word >> self.line_word_shift;
-        self.caches.l1_accesses += 1;
-        if let Some(fill) = self.tms[tm].l1.find_direct(line) {
-            return if fill <= slot {
-                self.caches.l1_hits += 1;
-                (slot + self.cfg.l1.hit_latency, fill)
-            } else {
-                self.caches.l1_merged += 1;
-                (fill.max(slot + self.cfg.l1.hit_latency), fill)
-            };
-        }
-        self.load_word_lookup(tm, line, word, slot, now)
-    }
-
-    /// [`Chip::load_word_fill`] after the inline test: the L1 lookup, and the L2 and DRAM
-    /// on a miss.
+    /// `now` (≤ `slot`) is the current event time: no later access starts before it. (The
+    /// common case, a line the direct-mapped L1 holds, is answered by [`Thread::run`]'s
+    /// load path without a call; this is the call.)
     #[inline(never)]
-    fn load_word_lookup(
-        &mut self,
-        tm: usize,
-        line: u64,
-        word: u64,
-        slot: Cycle,
-        now: Cycle,
-    ) -> (Cycle, Cycle) {
+    fn load_word_fill(&mut self, tm: usize, word: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
+        self.caches.l1_accesses += 1;
+        let line = word >> self.line_word_shift;
         let l1_lat = self.cfg.l1.hit_latency;
-        // `find_direct` has not answered: the general lookup.
         match self.tms[tm].l1.lookup_general(line, slot) {
             Lookup::Present { fill } if fill <= slot => {
                 self.caches.l1_hits += 1;
@@ -481,14 +455,13 @@ impl Thread {
                 None => {
                     // The first word's lookup (its hit, merge or miss counted there),
                     // then the rest.
-                    chip.caches.l1_accesses += 1;
-                    let (_, fill) = chip.load_word_lookup(tm, line, w, c, now);
+                    let (_, fill) = chip.load_word_fill(tm, w, c, now);
                     (fill, c + 1)
                 }
             };
             // Words at `from ..= last` not counted yet: hits from the fill on.
             let n = last + 1 - from;
-            let hits = (last + 1).saturating_sub(from.max(fill)).min(n);
+            let hits = slots::at_or_after(from, n, fill);
             chip.caches.l1_accesses += n;
             chip.caches.l1_hits += hits;
             chip.caches.l1_merged += n - hits;

@@ -664,25 +664,31 @@ impl<'a> Recorder<'a> {
         }
     }
 
+    /// The open run as an `Issue` op (width-checked), now closed; `None` when there is none.
+    #[inline(always)]
+    fn take_run(&mut self) -> Option<Op> {
+        if self.run == 0 {
+            return None;
+        }
+        let run = self.checked_run().op();
+        (self.run, self.run_fpinv) = (0, 0);
+        Some(run)
+    }
+
     /// Writes the open run (if any) as an `Issue` op, then `op` (a load or pipeline op).
     #[inline(always)]
     fn close_run_then(&mut self, op: Op) {
-        if self.run != 0 {
-            let run = self.checked_run().op();
-            self.ops.extend_from_slice(&[run, op]);
-            (self.run, self.run_fpinv) = (0, 0);
-        } else {
-            self.ops.push(op);
+        match self.take_run() {
+            Some(run) => self.ops.extend_from_slice(&[run, op]),
+            None => self.ops.push(op),
         }
     }
 
     /// Writes the open run (if any) as an `Issue` op.
     #[inline(always)]
     fn close_run(&mut self) {
-        if self.run != 0 {
-            let run = self.checked_run().op();
+        if let Some(run) = self.take_run() {
             self.ops.push(run);
-            (self.run, self.run_fpinv) = (0, 0);
         }
     }
 
@@ -696,14 +702,13 @@ impl<'a> Recorder<'a> {
 impl Observer for Recorder<'_> {
     #[inline(always)]
     fn fetch(&mut self, addr: u64, bytes: u32) {
-        let a = addr;
-        // Words from the one holding byte `a` to the one holding byte `a + bytes − 1`.
-        let words = ((a & 3) + bytes as u64).div_ceil(4);
+        // Words from the one holding byte `addr` to the one holding byte `addr + bytes − 1`.
+        let words = ((addr & 3) + bytes as u64).div_ceil(4);
         if words == 0 {
             return;
         }
         self.tally.counts.loads += words;
-        match Op::load(a & !3, words) {
+        match Op::load(addr & !3, words) {
             Ok(op) => self.close_run_then(op),
             Err(e) => self.tally.fail(e),
         }

@@ -137,18 +137,11 @@ pub struct Placed {
     pub at_or_after: u64,
 }
 
-impl Placed {
-    /// `n` words placed without a stall at cycles `c .. c + n` (what [`BankSlots::try_run`]
-    /// takes), counting those at or after `from`.
-    #[inline]
-    pub fn stall_free(c: Cycle, n: u64, from: Cycle) -> Placed {
-        Placed {
-            first: c,
-            last: c + n - 1,
-            stall: 0,
-            at_or_after: (c + n).saturating_sub(c.max(from)).min(n),
-        }
-    }
+/// How many of `n` words at consecutive cycles `c .. c + n` are at or after cycle `from`
+/// (the words of a line segment that find its fill arrived: L1 hits).
+#[inline]
+pub fn at_or_after(c: Cycle, n: u64, from: Cycle) -> u64 {
+    (c + n).saturating_sub(c.max(from)).min(n)
 }
 
 impl BankSlots {
@@ -250,7 +243,12 @@ impl BankSlots {
         debug_assert!(n >= 1 && c >= now && c >= self.lo);
         // Fast path (most runs): every word's bank is free in its cycle, one word test.
         if self.try_run(bank, c, n) {
-            return Placed::stall_free(c, n, from);
+            return Placed {
+                first: c,
+                last: c + n - 1,
+                stall: 0,
+                at_or_after: at_or_after(c, n, from),
+            };
         }
         self.reserve_run_slow(bank, c, n, now, from)
     }
@@ -293,7 +291,7 @@ impl BankSlots {
             if free > 0 {
                 self.take(d, c, free);
                 first.get_or_insert(c);
-                at_or_after += (c + free).saturating_sub(c.max(from)).min(free);
+                at_or_after += self::at_or_after(c, free, from);
                 bank += free;
                 c += free;
                 left -= free;
