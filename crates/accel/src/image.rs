@@ -1,5 +1,6 @@
-//! Contract 1 of `docs/architecture.md`: every structure is encoded once into a byte-exact
-//! memory image, which CPU traversal reads and the simulator reads at the same addresses.
+//! The memory-image contract (README, "What is where"): every structure is encoded once
+//! into a byte-exact memory image, which CPU traversal reads and the simulator reads at the
+//! same addresses.
 //!
 //! Layout of every image, in 32-bit words from byte address 0:
 //!

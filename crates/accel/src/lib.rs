@@ -6,7 +6,8 @@
 //!   each encoded into a byte-exact MemoryImage (image.rs) that its traversal reads
 //! ```
 //!
-//! Every traversal is generic over an [`Observer`] (contract 2 of `docs/architecture.md`).
+//! Every traversal is generic over an [`Observer`] (the one-traversal contract: README,
+//! "What is where").
 //! [`Structures`] builds all of them from one scene and dispatches by [`AccelKind`].
 
 pub mod build;

@@ -1,6 +1,6 @@
-//! Contract 2 of `docs/architecture.md`: every traversal reports what it does to an
-//! [`Observer`]. The CPU path passes [`NoObserver`], which compiles away; statistics use
-//! [`CountingObserver`]; the simulator records macro-operations.
+//! The one-traversal contract (README, "What is where"): every traversal reports what it
+//! does to an [`Observer`]. The CPU path passes [`NoObserver`], which compiles away;
+//! statistics use [`CountingObserver`]; the simulator records macro-operations.
 
 /// The kind of a dual-split tree node (the pipeline's derived 2-bit "node type").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]

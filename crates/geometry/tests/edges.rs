@@ -100,7 +100,8 @@ fn interval_is_inclusive() {
 mod grazing;
 use grazing::{GRAZING_CASES, grazing_case};
 
-/// The slab test without widening (the old rule), for the regression's premise.
+/// The slab test without widening, for the test's premise: the plain rule rounds these
+/// boxes away.
 fn slab_unwidened(r: &RayPre, min: Vec3, max: Vec3) -> (f32, f32) {
     let (mut entry, mut exit) = (0.0f32, f32::INFINITY);
     for a in 0..3 {

@@ -108,7 +108,7 @@ fn synthetic_report() -> ReportData {
             full: false,
         },
         scenes: vec![
-            synthetic_scene("dragon_box", "../shared/scenes/dragon_box.ply.gz", 0, &[64]),
+            synthetic_scene("dragon_box", "scenes/dragon_box.ply.gz", 0, &[64]),
             synthetic_scene("hairball", "builtin:hairball", 1, &tms),
             synthetic_scene("atrium", "builtin:atrium", 2, &tms),
         ],

@@ -2,9 +2,10 @@
 //! files (keyed by file stem), and command-line overrides.
 //!
 //! The paper renders each test scene from one fixed view (Lin et al. 2020, §4, Fig. 6); the
-//! presets play that role for the files in `shared/scenes/`, each showing its subject (the
-//! dragon inside its box, the Sponza courtyard from inside, the dragons in a row). Presets
-//! are expressed relative to the scene bounds, so a rescaled file still gets a sensible view.
+//! presets play that role for the shipped mesh files (`docs/scenes.md`), each showing its
+//! subject (the dragon inside its box, the Sponza courtyard from inside, the dragons in a
+//! row). Presets are expressed relative to the scene bounds, so a rescaled file still gets a
+//! sensible view.
 
 use dualsplit_geometry::{Aabb, Vec3};
 use serde::{Deserialize, Serialize};
@@ -138,7 +139,7 @@ impl View {
     }
 }
 
-/// The shipped files' views, by stem (y is up in all of them, see `shared/scenes/README.md`).
+/// The shipped files' views, by stem (y is up in all of them, see `docs/scenes.md`).
 fn preset_view(stem: &str) -> Option<View> {
     Some(match stem {
         // The dragon alone: three-quarter view of its left side, slightly from above.

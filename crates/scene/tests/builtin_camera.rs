@@ -5,7 +5,7 @@ use dualsplit_scene::{Camera, CameraError, Light, file_stem, parse_vec3};
 use std::path::Path;
 
 fn dragon_box_bounds() -> Aabb {
-    // The bounds of shared/scenes/dragon_box.ply.gz.
+    // The bounds of the shipped mesh dragon_box.ply.gz.
     Aabb::new(
         Vec3::new(-0.1595, 0.0527, -0.1583),
         Vec3::new(0.1478, 0.3601, 0.1491),
@@ -26,7 +26,7 @@ fn inside(b: &Aabb, p: Vec3) -> bool {
 #[test]
 fn file_stems_strip_scene_extensions() {
     assert_eq!(
-        file_stem(Path::new("../shared/scenes/dragon_box.ply.gz")),
+        file_stem(Path::new("scenes/dragon_box.ply.gz")),
         "dragon_box"
     );
     assert_eq!(file_stem(Path::new("a/bunny.obj")), "bunny");

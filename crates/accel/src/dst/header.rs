@@ -1,5 +1,5 @@
 //! The 32-bit header-offset word of a dual-split tree node (Lin et al. 2020, §3, Fig. 4;
-//! dst-spec §2).
+//! the bit layout of `docs/dst-encoding.md`, §1).
 //!
 //! ```text
 //! bit:   31 | 30 29 | 28 27 | 26 | 25 ............................ 0
@@ -59,7 +59,8 @@ impl AxisPair {
         }
     }
 
-    /// `(first, second)` axis: first = A >> 1, second = (A & 1) + 1 (dst-spec §2).
+    /// `(first, second)` axis: first = A >> 1, second = (A & 1) + 1, so A = 00, 01, 11 give
+    /// (x, y), (x, z), (y, z) and A = 10 is free to mean single-axis carving.
     #[inline(always)]
     pub fn axes(self) -> (usize, usize) {
         let a = self as usize;

@@ -162,7 +162,8 @@ pub enum Partitioning {
 }
 
 /// SAH costs of the converter, in units of one ray–triangle test, each multiplied by the
-/// surface area of the region in which the node is tested (dst-spec §5.2).
+/// surface area of the region in which the node is tested (the recursive SAH of Lin et al.
+/// 2019; `docs/dst-encoding.md`, §3).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DstCosts {
     /// A splitting node.
@@ -240,7 +241,7 @@ pub struct Dst {
 }
 
 impl Dst {
-    /// The byte-exact memory image (contract 1 of `docs/architecture.md`).
+    /// The byte-exact memory image, read by the CPU traversal and the simulator alike.
     pub fn image(&self) -> &MemoryImage {
         &self.image
     }

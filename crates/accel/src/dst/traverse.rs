@@ -1,5 +1,5 @@
 //! Software traversal of the encoded DST (the paper's DST*): the readable reference that the
-//! pipeline loop is tested against (Lin et al. 2020, §3, Fig. 3; dst-spec §4).
+//! pipeline loop is tested against (Lin et al. 2020, §3, Fig. 3; `docs/dst-encoding.md`, §4).
 //!
 //! Each stack entry carries its `[t_min, t_max]` (the region clip, kd-tree style). Sibling
 //! regions may overlap, so traversal continues after a hit; a popped entry is discarded

@@ -74,7 +74,8 @@ impl WideBvh {
         collapse::dammertz4(bvh)
     }
 
-    /// BVH8 by the adaptive collapse of Ylitie, Karras and Laine 2017 (dst-spec §8): a
+    /// BVH8 by the adaptive collapse of Ylitie, Karras and Laine 2017 (HPG, "Efficient
+    /// Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs"): a
     /// bottom-up cost over up to 8 roots per BVH2 node, then a top-down pass following it.
     /// Leaves stay the BVH2's leaves.
     pub fn collapse_bvh8(bvh: &Bvh2, cfg: &CollapseConfig) -> Self {

@@ -1,18 +1,19 @@
 //! The one traversal of every BVH image (BVH2, BVH4, BVH8): closest hit and any hit,
 //! reading nodes, leaf words, index runs and triangles from the [`MemoryImage`] and telling
-//! the [`Observer`] every fetch and step (contract 2 of `docs/architecture.md`).
+//! the [`Observer`] every fetch and step (the one-traversal contract: README, "What is where").
 //!
 //! Per internal node: fetch the node, slab-test every non-empty child box against
 //! `[ray.t_min, cull_limit(best_t)]` (the arithmetic of [`dualsplit_geometry::RayPre::slab`],
 //! whose far-plane exits are widened by `1 + 2γ₃` (Ize 2013) so a ray aimed at a vertex on a
 //! box corner is never rounded away, evaluated on the node's stored box words by `BoxSlab`:
-//! planes picked by index, bounds clipped by compare-and-select; `docs/performance.md`,
-//! "Sixth round"), report `NodeStep::Bvh`, sort the hit children by entry
-//! distance (near first, ties in slot order), continue with the nearest and push the others
-//! far-first with their entry distance. A popped entry whose entry distance is beyond
-//! `cull_limit(best_t)` is discarded. Per leaf: fetch the leaf word, then the index run (its
-//! last entry has bit 31 set), report `NodeStep::Leaf`, then fetch and test each triangle on
-//! `[ray.t_min, best_t]`, keeping the closest by [`Hit::closer_than`]'s `(t, prim)` order.
+//! planes picked by index from the ray's signs, bounds clipped by compare-and-select, which
+//! x86-64 does in one instruction where `f32::max`/`min` take six), report `NodeStep::Bvh`,
+//! sort the hit children by entry distance (near first, ties in slot order), continue with
+//! the nearest and push the others far-first with their entry distance. A popped entry
+//! whose entry distance is beyond `cull_limit(best_t)` is discarded. Per leaf: fetch the
+//! leaf word, then the index run (its last entry has bit 31 set), report `NodeStep::Leaf`,
+//! then fetch and test each triangle on `[ray.t_min, best_t]`, keeping the closest by
+//! [`Hit::closer_than`]'s `(t, prim)` order.
 //! Any hit returns at the first accepted triangle and culls against `ray.t_max`.
 
 use super::encode::LAST_IN_RUN;
@@ -30,9 +31,9 @@ struct Entry {
 
 thread_local! {
     /// The traversal stack's buffer, one per thread, reused from ray to ray: a ray costs no
-    /// allocation (the simulator traces millions of rays one at a time; an allocation and
-    /// a free per ray were ≈ 3 % of its functional side, `docs/performance.md`, "Fifth
-    /// round"). A traversal that finds it taken (an observer tracing a ray inside a
+    /// allocation (the simulator traces millions of rays one at a time, and an allocation
+    /// and a free per ray would cost it ≈ 3 % of its functional side). A traversal that
+    /// finds it taken (an observer tracing a ray inside a
     /// traversal) allocates its own.
     static STACK: Cell<Vec<Entry>> = const { Cell::new(Vec::new()) };
 }
