@@ -6,17 +6,15 @@
 //! `[ray.t_min, cull_limit(best_t)]` (the arithmetic of [`dualsplit_geometry::RayPre::slab`],
 //! whose far-plane exits are widened by `1 + 2γ₃` (Ize 2013) so a ray aimed at a vertex on a
 //! box corner is never rounded away, evaluated on the node's stored box words by `BoxSlab`:
-//! planes picked by index, bounds clipped by compare-and-select; `docs/performance.md`,
-//! "Sixth round"), report `NodeStep::Bvh`, sort the hit children by entry
-//! distance (near first, ties in slot order), continue with the nearest and push the others
+//! planes picked by index, bounds clipped by compare-and-select), report `NodeStep::Bvh`,
+//! sort the hit children by entry distance (near first, ties in slot order), continue with the nearest and push the others
 //! far-first with their entry distance. A popped entry whose entry distance is beyond
 //! `cull_limit(best_t)` is discarded. Per leaf: fetch the leaf word, then the index run (its
-//! last entry has bit 31 set), report `NodeStep::Leaf`, then fetch and test each triangle on
+//! last entry carries [`RUN_END`]), report `NodeStep::Leaf`, then fetch and test each triangle on
 //! `[ray.t_min, best_t]`, keeping the closest by [`Hit::closer_than`]'s `(t, prim)` order.
 //! Any hit returns at the first accepted triangle and culls against `ray.t_max`.
 
-use super::encode::LAST_IN_RUN;
-use crate::image::{ChildKind, MemoryImage, NodeLayout};
+use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
 use crate::observer::{NodeStep, Observer};
 use dualsplit_geometry::{Hit, Ray, RayPre, cull_limit, widen_exit};
 use std::cell::Cell;
@@ -30,9 +28,8 @@ struct Entry {
 
 thread_local! {
     /// The traversal stack's buffer, one per thread, reused from ray to ray: a ray costs no
-    /// allocation (the simulator traces millions of rays one at a time; an allocation and
-    /// a free per ray were ≈ 3 % of its functional side, `docs/performance.md`, "Fifth
-    /// round"). A traversal that finds it taken (an observer tracing a ray inside a
+    /// allocation (the simulator traces millions of rays one at a time, and an allocation
+    /// and a free per ray cost about 3 % of its functional side). A traversal that finds it taken (an observer tracing a ray inside a
     /// traversal) allocates its own.
     static STACK: Cell<Vec<Entry>> = const { Cell::new(Vec::new()) };
 }
@@ -93,7 +90,7 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
             obs.fetch(MemoryImage::addr(w), 4);
             let run = words[w] as usize;
             let mut count = 0;
-            while words[run + count] & LAST_IN_RUN == 0 {
+            while words[run + count] & RUN_END == 0 {
                 count += 1;
             }
             count += 1;
@@ -102,7 +99,7 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
                 count: count as u32,
             });
             for &entry in &words[run..run + count] {
-                let p = entry & !LAST_IN_RUN;
+                let p = entry & !RUN_END;
                 let tri = img.fetch_triangle(p, obs);
                 let Some(h) = tri.intersect(&r, ray.t_min, best_t) else {
                     obs.triangle_test(p, false);
