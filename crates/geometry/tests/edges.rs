@@ -96,11 +96,9 @@ fn interval_is_inclusive() {
     assert!(t.intersect(&r, 0.0, 1.999).is_none());
 }
 
-#[path = "common/grazing.rs"]
-mod grazing;
-use grazing::{GRAZING_CASES, grazing_case};
+use dualsplit_testkit::grazing::{GRAZING_CASES, grazing_case};
 
-/// The slab test without widening (the old rule), for the regression's premise.
+/// The slab test without widening, for the regression's premise.
 fn slab_unwidened(r: &RayPre, min: Vec3, max: Vec3) -> (f32, f32) {
     let (mut entry, mut exit) = (0.0f32, f32::INFINITY);
     for a in 0..3 {
