@@ -4,17 +4,15 @@
 //! Run: `cargo bench -p dualsplit-accel --bench build`. Before timing it prints the size
 //! table of the three structures (the paper's Table 3) once.
 
-#[path = "../tests/support/mod.rs"]
-mod support;
-
 use dualsplit_accel::{BuildConfig, Bvh2, CollapseConfig, Structures, WideBvh};
 use dualsplit_geometry::Aabb;
+use dualsplit_testkit::scenes::load_scene;
 use std::sync::OnceLock;
 
 fn boxes() -> &'static Vec<Aabb> {
     static B: OnceLock<Vec<Aabb>> = OnceLock::new();
     B.get_or_init(|| {
-        let scene = support::load_scene("dragon_box.ply.gz");
+        let scene = load_scene("dragon_box.ply.gz");
         scene.triangles.iter().map(|t| t.bounds()).collect()
     })
 }
@@ -64,7 +62,7 @@ fn main() {
         cpu_seconds() - c,
         b.nodes.len()
     );
-    let scene = support::load_scene("dragon_box.ply.gz");
+    let scene = load_scene("dragon_box.ply.gz");
     let s = Structures::build(&scene.triangles, &BuildConfig::default());
     for st in s.stats() {
         eprintln!(

@@ -3,13 +3,11 @@
 //!
 //! `cargo bench -p dualsplit-accel --bench dst_convert`
 
-#[path = "../tests/dst_common/mod.rs"]
-mod dst_common;
-
 use dualsplit_accel::dst::{Dst, DstConfig, Partitioning};
 use dualsplit_accel::image::Words;
 use dualsplit_accel::{BuildConfig, Bvh2, BvhImage, SharedTriangles, WideBvh};
 use dualsplit_geometry::Aabb;
+use dualsplit_testkit::scenes::load_shipped;
 use std::sync::OnceLock;
 
 struct Input {
@@ -21,7 +19,7 @@ struct Input {
 fn input() -> &'static Input {
     static INPUT: OnceLock<Input> = OnceLock::new();
     INPUT.get_or_init(|| {
-        let tris: SharedTriangles = dst_common::load_shipped(&scene_name()).into();
+        let tris: SharedTriangles = load_shipped(&scene_name()).into();
         let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
         let bvh = Bvh2::build(&boxes, &BuildConfig::default());
         Input { tris, boxes, bvh }

@@ -1,13 +1,10 @@
 //! CPU traversal speed: closest-hit (primary, diffuse) and any-hit (shadow) rays on shipped
-//! scenes, for the BVH2 traversal on `main` (the `Structures` reference), the DST software
+//! scenes, for the BVH2 traversal (the `Structures` reference), the DST software
 //! decoder (DST*) and the DST pipeline-function loop. Rays come from the renderer's
 //! path-tracing jobs (128² pixels, ≤ 16K rays per kind). Every ray is checked against the
 //! BVH2 before anything is timed.
 //!
 //! `cargo bench -p dualsplit-accel --bench dst_traversal`
-
-#[path = "../tests/dst_common/mod.rs"]
-mod dst_common;
 
 use divan::Bencher;
 use divan::counter::ItemsCount;
@@ -16,6 +13,8 @@ use dualsplit_accel::{AccelKind, CountingObserver, NoObserver, Structures};
 use dualsplit_geometry::Ray;
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::{LoadStats, Scene};
+use dualsplit_testkit::dst::{build, check_dst_ray};
+use dualsplit_testkit::scenes::load_shipped;
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
 
@@ -45,9 +44,9 @@ struct Prepared {
 }
 
 fn prepare(name: &str) -> Prepared {
-    let tris = dst_common::load_shipped(&format!("{name}.ply.gz"));
+    let tris = load_shipped(&format!("{name}.ply.gz"));
     let scene = Scene::from_triangles(name, name, tris, LoadStats::default()).expect("scene");
-    let b = dst_common::build(&scene.triangles, &DstConfig::hardware());
+    let b = build(&scene.triangles, &DstConfig::hardware());
     let side = side();
     let settings = RenderSettings::new(side, side, Workload::Path);
     let mut rays: [Vec<Ray>; 3] = Default::default();
@@ -59,7 +58,7 @@ fn prepare(name: &str) -> Prepared {
                     .reference
                     .closest_hit(AccelKind::Bvh2, &q.ray, &mut NoObserver);
                 // Correctness before timing.
-                dst_common::check_ray(&b.dst, &q.ray, hit, name);
+                check_dst_ray(&b.dst, &q.ray, hit, name);
                 let list = &mut rays[q.kind as usize];
                 if list.len() < MAX_RAYS {
                     list.push(q.ray);

@@ -6,11 +6,11 @@
 //! Run: `cargo bench -p dualsplit-accel --bench traversal`. Each sample traces a whole ray
 //! set; divan reports the time per set (`RAYS` rays).
 
-#[path = "../tests/support/mod.rs"]
-mod support;
-
 use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
 use dualsplit_geometry::Ray;
+use dualsplit_testkit::oracle::key;
+use dualsplit_testkit::rays::record_rays;
+use dualsplit_testkit::scenes::load_scene;
 use std::sync::OnceLock;
 
 /// Rays of each kind per set.
@@ -28,9 +28,9 @@ fn data(scene: &str) -> &'static Data {
     static SPONZA: OnceLock<Data> = OnceLock::new();
     let cell = if scene == "dragon_box" { &BOX } else { &SPONZA };
     cell.get_or_init(|| {
-        let sc = support::load_scene(&format!("{scene}.ply.gz"));
+        let sc = load_scene(&format!("{scene}.ply.gz"));
         let s = Structures::build(&sc.triangles, &BuildConfig::default());
-        let r = support::record_rays(&sc, &s, 150, RAYS);
+        let r = record_rays(&sc, &s, 150, RAYS);
         let cut = |v: Vec<Ray>| v.into_iter().take(RAYS).collect::<Vec<_>>();
         let d = Data {
             primary: cut(r.primary),
@@ -42,11 +42,8 @@ fn data(scene: &str) -> &'static Data {
         for kind in AccelKind::ALL {
             for set in [&d.primary, &d.diffuse] {
                 for ray in set {
-                    let want = support::key(d.s.closest_hit(AccelKind::Bvh2, ray, &mut NoObserver));
-                    assert_eq!(
-                        support::key(d.s.closest_hit(kind, ray, &mut NoObserver)),
-                        want
-                    );
+                    let want = key(d.s.closest_hit(AccelKind::Bvh2, ray, &mut NoObserver));
+                    assert_eq!(key(d.s.closest_hit(kind, ray, &mut NoObserver)), want);
                 }
             }
             for ray in &d.shadow {

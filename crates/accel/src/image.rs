@@ -26,9 +26,9 @@
 //!
 //! so child `k` lives at `offset + Σ_{j<k} size(kind_j)`, exactly as the DST finds its right
 //! child at "left + size(left)" (Lin et al. 2020, §3). A leaf's index run is a list of triangle
-//! ids whose last entry has bit 31 set (the DST convention), so no count is stored. A root
-//! that is itself a leaf (tiny scenes) is encoded as a root node with that leaf in slot 0 and
-//! empty slots elsewhere; an empty scene is a root node whose slots are all empty.
+//! ids whose last entry has bit 31 set ([`RUN_END`], as in the DST), so no count is stored.
+//! A root that is itself a leaf (tiny scenes) is encoded as a root node with that leaf in
+//! slot 0 and empty slots elsewhere; an empty scene is a root node whose slots are all empty.
 //!
 //! Runs are laid out in the depth-first order of the leaves. All offsets are absolute word
 //! indices; the triangle of id `i` is at word `triangles.start + 9·i`.
@@ -48,6 +48,10 @@ use dualsplit_geometry::{Aabb, Triangle, Vec3};
 use std::ops::Range;
 use std::sync::Arc;
 pub use words::{MAPPED_MIN_BYTES, Words};
+
+/// Bit 31 of an index-run entry: set on the last triangle id of a leaf's run, in every
+/// structure's image (BVH2, BVH4, BVH8 and DST). Triangle ids are therefore below 2^31.
+pub const RUN_END: u32 = 1 << 31;
 
 /// The scene's triangles in id order, shared (not copied) by every image built from them.
 pub type SharedTriangles = Arc<[Triangle]>;
@@ -149,7 +153,7 @@ pub enum ImageError {
     OffsetOverflow {
         /// Which node layout.
         structure: &'static str,
-        /// The offset that was to be stored (word index).
+        /// The offset to be stored (word index).
         given: u64,
         /// Field width in bits.
         bits: u32,

@@ -1,8 +1,7 @@
 //! Structural checks of BVH memory images: `dualsplit check` prints the report, tests assert
 //! it is clean.
 
-use crate::image::{ChildKind, MemoryImage, NodeLayout};
-use crate::wide::encode::LAST_IN_RUN;
+use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
 use dualsplit_geometry::Aabb;
 use serde::Serialize;
 
@@ -56,7 +55,7 @@ impl ValidationReport {
         rep
     }
 
-    /// True when no violation was found.
+    /// True when the report holds no violation.
     pub fn is_ok(&self) -> bool {
         self.error_count == 0
     }
@@ -151,7 +150,7 @@ pub fn validate_image<L: NodeLayout>(img: &MemoryImage) -> ValidationReport {
                             &mut index_cover,
                             j - img.indices.start..j - img.indices.start + 1,
                         );
-                        let p = (words[j] & !LAST_IN_RUN) as usize;
+                        let p = (words[j] & !RUN_END) as usize;
                         if p >= tri_refs.len() {
                             rep.error(format!("index word {j}: triangle {p} out of range"));
                         } else {
@@ -162,7 +161,7 @@ pub fn validate_image<L: NodeLayout>(img: &MemoryImage) -> ValidationReport {
                                 ));
                             }
                         }
-                        if words[j] & LAST_IN_RUN != 0 {
+                        if words[j] & RUN_END != 0 {
                             break;
                         }
                         j += 1;

@@ -5,11 +5,11 @@
 //! Release builds (`cargo test --release`, what CI runs) compare at least 100K rays of each
 //! kind per scene; debug builds compare 3K of each so that `cargo test` stays quick.
 
-mod support;
-
 use dualsplit_accel::{AccelKind, BuildConfig, CollapseConfig, NoObserver, Structures, WideBvh};
+use dualsplit_testkit::oracle::key;
+use dualsplit_testkit::rays::record_rays;
+use dualsplit_testkit::scenes::load_scene;
 use rayon::prelude::*;
-use support::{key, load_scene, record_rays};
 
 const RAYS: usize = if cfg!(debug_assertions) {
     3_000

@@ -2,13 +2,12 @@
 //! paper's rules (Lin et al. 2020, Figs. 2–3, App. A–C), and the per-ray counters of the
 //! software traversal and the pipeline loop.
 
-mod dst_common;
-
-use dst_common::{build, random_rays};
 use dualsplit_accel::dst::pipeline::{PipelineInput, ReturnCode, step};
 use dualsplit_accel::dst::{AxisPair, Corner, DstConfig, HeaderOffset};
 use dualsplit_accel::{CountingObserver, DstNodeKind};
 use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3, widen_exit};
+use dualsplit_testkit::dst::build;
+use dualsplit_testkit::rays::random_rays;
 use proptest::prelude::*;
 use std::cmp::Ordering;
 

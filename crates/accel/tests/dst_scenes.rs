@@ -6,13 +6,12 @@
 //! `cargo test --release` traces at least 100 000 rays of each kind per scene; debug builds
 //! trace a smaller image so the suite stays quick.
 
-mod dst_common;
-
-use dst_common::{build, check_ray, load_shipped};
 use dualsplit_accel::dst::{DstConfig, Partitioning};
 use dualsplit_accel::{AccelKind, NoObserver};
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::{LoadStats, Scene};
+use dualsplit_testkit::dst::{build, check_dst_ray};
+use dualsplit_testkit::scenes::load_shipped;
 
 /// Image side; pixels are visited in a scattered order until every ray kind has
 /// [`MIN_RAYS`] rays (the open meshes send many rays to the sky, so shadow rays are rarest).
@@ -79,9 +78,9 @@ fn rays_case(scene: &Scene, name: &str, cfg: DstConfig, min_rays: u64) {
                     .reference
                     .closest_hit(AccelKind::Bvh2, &q.ray, &mut NoObserver);
                 // Both partitioning modes equal the BVH2 bit for bit: with widened exits
-                // (dualsplit-geometry, Ize 2013) the BVH2 no longer rounds grazing hits
+                // (dualsplit-geometry, Ize 2013) the BVH2 does not round grazing hits
                 // away, so a looser similar-mode leaf region has nothing extra to find.
-                check_ray(&b.dst, &q.ray, bvh, name);
+                check_dst_ray(&b.dst, &q.ray, bvh, name);
                 let result = match q.kind {
                     RayKind::Shadow => TraceResult::Occluded(bvh.is_some()),
                     _ => TraceResult::Closest(bvh),

@@ -96,9 +96,7 @@ fn interval_is_inclusive() {
     assert!(t.intersect(&r, 0.0, 1.999).is_none());
 }
 
-#[path = "common/grazing.rs"]
-mod grazing;
-use grazing::{GRAZING_CASES, grazing_case};
+use dualsplit_testkit::grazing::{GRAZING_CASES, grazing_case};
 
 /// The slab test without widening, for the test's premise: the plain rule rounds these
 /// boxes away.

@@ -5,13 +5,11 @@
 //! Run with `cargo bench -p dualsplit-render`. Figures for real scenes come from
 //! `dualsplit bench` (see docs/performance.md).
 
-#[path = "../tests/common/mod.rs"]
-mod common;
-
 use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
 use dualsplit_render::bench::{RaySet, ray_sets, verify};
 use dualsplit_render::{RayQuery, RenderSettings, Workload, render, trace_query};
 use dualsplit_scene::Scene;
+use dualsplit_testkit::scenes::room;
 use std::sync::OnceLock;
 
 fn main() {
@@ -27,7 +25,7 @@ struct Fixture {
 fn fixture() -> &'static Fixture {
     static F: OnceLock<Fixture> = OnceLock::new();
     F.get_or_init(|| {
-        let scene = common::room(false, 90);
+        let scene = room(false, 90);
         let structures = Structures::build(&scene.triangles, &BuildConfig::default());
         let sets = ray_sets(
             &scene,

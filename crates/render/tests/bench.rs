@@ -1,15 +1,14 @@
 //! Throughput measurement: ray sets are the renderer's rays, and a structure that disagrees
 //! with BVH2 is an error, not a number.
 
-mod common;
-
 use dualsplit_accel::{AccelKind, BuildConfig, Structures};
 use dualsplit_render::bench::{MeasureConfig, measure, ray_sets, verify};
 use dualsplit_render::{RayKind, RenderError, RenderSettings, TraceResult, Workload, render};
+use dualsplit_testkit::scenes::room;
 
 #[test]
 fn ray_sets_hold_exactly_the_frames_rays() {
-    let scene = common::room(false, 8);
+    let scene = room(false, 8);
     let structures = Structures::build(&scene.triangles, &BuildConfig::default());
     for workload in Workload::ALL {
         let settings = RenderSettings::new(20, 16, workload);
@@ -28,7 +27,7 @@ fn ray_sets_hold_exactly_the_frames_rays() {
 
 #[test]
 fn measure_checks_every_structure_then_times() {
-    let scene = common::room(false, 8);
+    let scene = room(false, 8);
     let structures = Structures::build(&scene.triangles, &BuildConfig::default());
     let sets = ray_sets(
         &scene,
@@ -52,7 +51,7 @@ fn measure_checks_every_structure_then_times() {
 
 #[test]
 fn a_wrong_answer_is_reported_with_the_ray() {
-    let scene = common::room(false, 8);
+    let scene = room(false, 8);
     let structures = Structures::build(&scene.triangles, &BuildConfig::default());
     let mut sets = ray_sets(
         &scene,

@@ -1,14 +1,13 @@
 //! Every structure renders a bit-identical image (and identical ray counters) of the same
 //! scene, for both workloads (issue 4, "Done means").
 
-mod common;
-
 use dualsplit_accel::{AccelKind, BuildConfig, Structures};
 use dualsplit_render::{RenderSettings, Workload, render};
+use dualsplit_testkit::scenes::room;
 
 #[test]
 fn every_structure_renders_the_same_bits() {
-    let scene = common::room(false, 12);
+    let scene = room(false, 12);
     let structures = Structures::build(&scene.triangles, &BuildConfig::default());
     for workload in Workload::ALL {
         let mut settings = RenderSettings::new(40, 30, workload);

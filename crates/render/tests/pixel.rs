@@ -1,8 +1,6 @@
 //! Determinism by pixel: a pixel regenerated alone yields exactly the rays and hits it had in
 //! the full render; ray budgets; the shading formula; settings validation.
 
-mod common;
-
 use dualsplit_accel::{AccelKind, BuildConfig, CountingObserver, NoObserver, Structures};
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
 use dualsplit_render::{
@@ -10,10 +8,11 @@ use dualsplit_render::{
     render_records, trace_pixel,
 };
 use dualsplit_scene::{Camera, Light, LoadStats, Scene};
+use dualsplit_testkit::scenes::room;
 
 #[test]
 fn a_pixel_regenerated_alone_matches_the_full_render() {
-    let scene = common::room(false, 10);
+    let scene = room(false, 10);
     let structures = Structures::build(&scene.triangles, &BuildConfig::default());
     for workload in Workload::ALL {
         let mut settings = RenderSettings::new(48, 36, workload);
@@ -47,7 +46,7 @@ fn a_pixel_regenerated_alone_matches_the_full_render() {
 
 #[test]
 fn the_seed_changes_the_path_but_not_the_primary_rays() {
-    let scene = common::room(true, 8);
+    let scene = room(true, 8);
     let structures = Structures::build(&scene.triangles, &BuildConfig::default());
     let a = RenderSettings::new(16, 16, Workload::Path);
     let b = RenderSettings { seed: 1, ..a };
@@ -80,7 +79,7 @@ fn the_seed_changes_the_path_but_not_the_primary_rays() {
 fn path_budget_in_a_closed_room_is_exactly_five_bounces() {
     // No ray can escape a closed room, and there is no Russian roulette, so every sample
     // traces 1 primary + 5 diffuse rays, each followed by at most one shadow ray.
-    let scene = common::room(true, 8);
+    let scene = room(true, 8);
     let structures = Structures::build(&scene.triangles, &BuildConfig::default());
     let mut settings = RenderSettings::new(24, 24, Workload::Path);
     settings.spp = 3;
@@ -103,7 +102,7 @@ fn path_budget_in_a_closed_room_is_exactly_five_bounces() {
 
 #[test]
 fn cast_budget_is_one_primary_and_at_most_one_shadow() {
-    let scene = common::room(false, 8);
+    let scene = room(false, 8);
     let structures = Structures::build(&scene.triangles, &BuildConfig::default());
     let settings = RenderSettings::new(32, 32, Workload::Cast);
     let mut shadows = 0;
@@ -118,7 +117,7 @@ fn cast_budget_is_one_primary_and_at_most_one_shadow() {
 
 #[test]
 fn observer_sees_every_traversal() {
-    let scene = common::room(false, 8);
+    let scene = room(false, 8);
     let structures = Structures::build(&scene.triangles, &BuildConfig::default());
     let settings = RenderSettings::new(16, 16, Workload::Path);
     let mut obs = CountingObserver::default();

@@ -24,11 +24,8 @@ use super::header::{HeaderOffset, OFFSET_LIMIT};
 use super::stats::DstStats;
 use super::{Dst, DstConfig, DstError};
 use crate::build::Bvh2;
-use crate::image::{MemoryImage, SharedTriangles};
+use crate::image::{MemoryImage, RUN_END, SharedTriangles};
 use dualsplit_geometry::Aabb;
-
-/// Bit 31 of an index entry: the last triangle of a leaf's run.
-pub(super) const RUN_END: u32 = 1 << 31;
 
 /// Subtrees below this depth (the root is at depth 0) are planned and emitted as
 /// independent rayon tasks, up to 2^PARALLEL_DEPTH of them.

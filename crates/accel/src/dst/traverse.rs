@@ -1,5 +1,5 @@
 //! Software traversal of the encoded DST (the paper's DST*): the readable reference that the
-//! pipeline loop is tested against (Lin et al. 2020, §3, Fig. 3; `docs/dst-encoding.md`, §4).
+//! pipeline loop is tested against (Lin et al. 2020, §3, Fig. 3).
 //!
 //! Each stack entry carries its `[t_min, t_max]` (the region clip, kd-tree style). Sibling
 //! regions may overlap, so traversal continues after a hit; a popped entry is discarded
@@ -13,10 +13,9 @@
 //! drops a child. Leaf triangles are tested on the ray's own interval `[ray.t_min, best_t]`.
 
 use super::Dst;
-use super::encode::RUN_END;
 use super::header::HeaderOffset;
 use super::pipeline::le_or_nan;
-use crate::image::MemoryImage;
+use crate::image::{MemoryImage, RUN_END};
 use crate::observer::{DstNodeKind, NodeStep, Observer};
 use dualsplit_geometry::{Hit, Ray, RayPre, Triangle, cull_limit, widen_exit};
 

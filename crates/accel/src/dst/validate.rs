@@ -7,10 +7,10 @@
 //! leaf's run holds exactly its BVH leaf's triangles and ends with bit 31; every triangle is
 //! referenced exactly once.
 
-use super::encode::RUN_END;
 use super::header::HeaderOffset;
 use super::{Dst, DstError, Partitioning};
 use crate::build::Bvh2;
+use crate::image::RUN_END;
 use crate::observer::DstNodeKind;
 use dualsplit_geometry::Aabb;
 use serde::Serialize;
@@ -227,7 +227,7 @@ impl Walker<'_> {
 }
 
 impl Dst {
-    /// Walks the tree beside `bvh` (the BVH2 it was converted from) and checks it; see the
+    /// Walks the tree beside `bvh` (the BVH2 it is converted from) and checks it; see the
     /// module docs for what is checked. Lin et al. 2020, §4.2.
     pub fn validate(&self, bvh: &Bvh2) -> Result<DstValidation, DstError> {
         let img = &self.image;

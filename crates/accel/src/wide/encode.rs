@@ -1,10 +1,7 @@
 //! Writes a [`WideBvh`] into a byte-exact [`MemoryImage`] (layout in [`crate::image`]).
 
 use super::{WideBvh, WideChild};
-use crate::image::{ChildKind, ImageError, MemoryImage, NodeLayout, SharedTriangles};
-
-/// Bit 31 of an index-list entry: the last triangle of a leaf's run.
-pub const LAST_IN_RUN: u32 = 1 << 31;
+use crate::image::{ChildKind, ImageError, MemoryImage, NodeLayout, RUN_END, SharedTriangles};
 
 /// Encodes `wide` with node layout `L`: nodes depth-first with all children of a node
 /// stored consecutively (internal children as whole nodes, leaves as one leaf word), then
@@ -82,24 +79,24 @@ impl Encoder<'_> {
                 WideChild::Node(c) => self.emit::<L>(c as usize, addr)?,
                 WideChild::Leaf { first, count } => {
                     let run = self.next_index;
-                    if run as u64 >= LAST_IN_RUN as u64 {
+                    if run as u64 >= RUN_END as u64 {
                         return Err(ImageError::OffsetOverflow {
                             structure: L::NAME,
                             given: run as u64,
                             bits: 31,
-                            limit: LAST_IN_RUN as u64 - 1,
+                            limit: RUN_END as u64 - 1,
                         });
                     }
                     self.words[addr] = run as u32;
                     let ids = &self.prim_ids[first as usize..(first + count) as usize];
                     for (j, &p) in ids.iter().enumerate() {
-                        if p >= LAST_IN_RUN {
+                        if p >= RUN_END {
                             return Err(ImageError::PrimOverflow {
                                 given: p as u64,
-                                limit: LAST_IN_RUN as u64 - 1,
+                                limit: RUN_END as u64 - 1,
                             });
                         }
-                        let last = if j + 1 == ids.len() { LAST_IN_RUN } else { 0 };
+                        let last = if j + 1 == ids.len() { RUN_END } else { 0 };
                         self.words[run + j] = p | last;
                     }
                     self.next_index += ids.len();

@@ -11,13 +11,12 @@
 //! sort the hit children by entry distance (near first, ties in slot order), continue with
 //! the nearest and push the others far-first with their entry distance. A popped entry
 //! whose entry distance is beyond `cull_limit(best_t)` is discarded. Per leaf: fetch the
-//! leaf word, then the index run (its last entry has bit 31 set), report `NodeStep::Leaf`,
+//! leaf word, then the index run (its last entry carries [`RUN_END`]), report `NodeStep::Leaf`,
 //! then fetch and test each triangle on `[ray.t_min, best_t]`, keeping the closest by
 //! [`Hit::closer_than`]'s `(t, prim)` order.
 //! Any hit returns at the first accepted triangle and culls against `ray.t_max`.
 
-use super::encode::LAST_IN_RUN;
-use crate::image::{ChildKind, MemoryImage, NodeLayout};
+use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
 use crate::observer::{NodeStep, Observer};
 use dualsplit_geometry::{Hit, Ray, RayPre, cull_limit, widen_exit};
 use std::cell::Cell;
@@ -94,7 +93,7 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
             obs.fetch(MemoryImage::addr(w), 4);
             let run = words[w] as usize;
             let mut count = 0;
-            while words[run + count] & LAST_IN_RUN == 0 {
+            while words[run + count] & RUN_END == 0 {
                 count += 1;
             }
             count += 1;
@@ -103,7 +102,7 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
                 count: count as u32,
             });
             for &entry in &words[run..run + count] {
-                let p = entry & !LAST_IN_RUN;
+                let p = entry & !RUN_END;
                 let tri = img.fetch_triangle(p, obs);
                 let Some(h) = tri.intersect(&r, ray.t_min, best_t) else {
                     obs.triangle_test(p, false);

@@ -1,9 +1,31 @@
-//! Test scenes built with `Scene::from_triangles` (no loader needed): a room with two boxes
-//! and a UV sphere, camera inside.
-#![allow(dead_code)]
+//! Scenes for tests and benchmarks: the shipped meshes, and a room built in code (no
+//! loader needed).
 
 use dualsplit_geometry::{Triangle, Vec3};
 use dualsplit_scene::{Camera, Light, LoadStats, Scene};
+
+/// Path of the shipped scene file `name` (in the `shared/scenes` folder beside the
+/// repository).
+pub fn scene_path(name: &str) -> String {
+    format!(
+        "{}/../../../shared/scenes/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
+/// Loads the shipped scene `name` with `dualsplit_scene::load`.
+///
+/// # Panics
+/// When the file is missing or does not parse, naming the path.
+pub fn load_scene(name: &str) -> Scene {
+    let path = scene_path(name);
+    dualsplit_scene::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// The triangles of the shipped scene `name`.
+pub fn load_shipped(name: &str) -> Vec<Triangle> {
+    load_scene(name).triangles
+}
 
 /// Two triangles of the quad `a b c d` (counter-clockwise).
 pub fn quad(out: &mut Vec<Triangle>, a: Vec3, b: Vec3, c: Vec3, d: Vec3) {

@@ -1,5 +1,5 @@
-//! The grazing-ray regression cases, shared by `geometry/tests/edges.rs` and
-//! `accel/tests/dst_random.rs` (included with `#[path]`).
+//! The grazing-ray regression cases of the slab test, shared by the geometry tests (the
+//! premise) and the DST tests (every structure finds the hit).
 
 use dualsplit_geometry::{Ray, Triangle, Vec3};
 

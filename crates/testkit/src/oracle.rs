@@ -1,0 +1,78 @@
+//! The brute-force reference: every triangle tested against the ray, the closest hit chosen
+//! in `(t, triangle id)` order. Every structure must match it bit for bit, ray by ray.
+
+use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_geometry::{Hit, Ray, Triangle};
+
+/// Closest hit over all triangles on `[t_min, t_max]`, ordered by `(t, triangle id)`: equal
+/// `t` goes to the smaller id.
+pub fn oracle_closest(tris: &[Triangle], ray: &Ray) -> Option<Hit> {
+    let r = ray.precompute();
+    let mut best: Option<Hit> = None;
+    for (i, tri) in tris.iter().enumerate() {
+        let Some(h) = tri.intersect(&r, ray.t_min, ray.t_max) else {
+            continue;
+        };
+        let prim = i as u32;
+        if best.is_none_or(|b| !b.closer_than(h.t, prim)) {
+            best = Some(Hit {
+                t: h.t,
+                prim,
+                u: h.u,
+                v: h.v,
+            });
+        }
+    }
+    best
+}
+
+/// Whether any triangle is hit on `[t_min, t_max]`.
+pub fn oracle_any(tris: &[Triangle], ray: &Ray) -> bool {
+    let r = ray.precompute();
+    tris.iter()
+        .any(|t| t.intersect(&r, ray.t_min, ray.t_max).is_some())
+}
+
+/// `(t bits, triangle id)` of a hit: the quantity compared per ray.
+pub fn key(h: Option<Hit>) -> Option<(u32, u32)> {
+    h.map(|h| (h.t.to_bits(), h.prim))
+}
+
+/// Checks one ray on all five CPU structures of `s` ([`AccelKind::ALL`]: BVH2, BVH4, BVH8,
+/// the DST software decoder and the DST pipeline loop) against the oracle over `tris`: the
+/// closest hit's `t` bits and triangle id, and the any-hit answer. `what` names the case in
+/// the failure message.
+///
+/// # Panics
+/// On the first structure that disagrees, naming it and the ray.
+pub fn check_ray(s: &Structures, tris: &[Triangle], ray: &Ray, what: &str) {
+    let want = oracle_closest(tris, ray);
+    let want_any = oracle_any(tris, ray);
+    assert_eq!(
+        want_any,
+        want.is_some(),
+        "{what}: oracle any hit vs closest hit, ray {ray:?}"
+    );
+    for kind in AccelKind::ALL {
+        let got = s.closest_hit(kind, ray, &mut NoObserver);
+        assert_eq!(
+            key(got),
+            key(want),
+            "{what}: {} closest hit vs oracle, ray {ray:?}",
+            kind.name()
+        );
+        assert_eq!(
+            s.any_hit(kind, ray, &mut NoObserver),
+            want_any,
+            "{what}: {} any hit vs oracle, ray {ray:?}",
+            kind.name()
+        );
+    }
+}
+
+/// [`check_ray`] for each of `rays`, named by its index.
+pub fn check_rays(s: &Structures, tris: &[Triangle], rays: &[Ray]) {
+    for (i, ray) in rays.iter().enumerate() {
+        check_ray(s, tris, ray, &format!("ray {i}"));
+    }
+}
