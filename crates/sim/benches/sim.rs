@@ -19,8 +19,8 @@
 
 use divan::counter::ItemsCount;
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
-use dualsplit_sim::engine::{Chip, Thread, WorkSource, run_chip};
 use dualsplit_sim::kernel::{Op, Pipe};
+use dualsplit_sim::{Chip, Thread, WorkSource, run_chip};
 use dualsplit_sim::{SimAccel, SimConfig, simulate};
 use std::sync::OnceLock;
 
@@ -44,7 +44,7 @@ impl WorkSource for Synthetic {
         }
         self.programs_left -= 1;
         let v = self.visits_per_program as usize;
-        let mut ops = std::mem::take(&mut t.ops);
+        let mut ops = t.take_ops();
         ops.clear();
         ops.reserve_exact(3 * v + 2 * (v / 8));
         for v in 0..self.visits_per_program {

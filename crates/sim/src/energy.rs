@@ -2,8 +2,8 @@
 //! Table 6 into DRAM, caches (L1, L2, instruction caches, register files, local stores) and
 //! compute (functional units and pipelines). No on-chip leakage, as in SimTRaX.
 
-use crate::engine::CacheStats;
 use crate::kernel::InstrCounts;
+use crate::memory::CacheStats;
 use crate::memory::DramStats;
 use crate::{EnergySplit, SimConfig};
 

@@ -33,12 +33,17 @@
 //! println!("{} cycles, {:.3} ms", r.cycles, r.frame_ms);
 //! ```
 
+pub mod atomic;
+pub mod chip;
 pub mod config;
+mod cycle;
 pub mod energy;
-pub mod engine;
 pub mod kernel;
 pub mod memory;
+mod scheduler;
 pub mod slots;
+pub mod thread;
+pub mod tm;
 mod workload;
 
 /// Version of the timing and energy model. Bump it whenever a change alters simulated results
@@ -46,18 +51,18 @@ mod workload;
 /// frames are recomputed.
 pub const MODEL_VERSION: u32 = 4;
 
+pub use chip::{Chip, ChipStats, WorkSource, run_chip};
 pub use config::{CacheConfig, ConfigError, DramConfig, EnergyConfig, SimConfig, UnitConfig};
-pub use engine::{CacheStats, Stalls, UnitStats};
+pub use cycle::Cycle;
 pub use kernel::{InstrCounts, Mix};
-pub use memory::DramStats;
+pub use memory::{CacheStats, DramStats};
+pub use thread::{Stalls, Thread};
+pub use tm::{Issued, Tm, UnitStats, WordAddr};
 
 use dualsplit_accel::{AccelKind, Structures};
 use dualsplit_render::RenderSettings;
 use dualsplit_scene::Scene;
 use serde::{Deserialize, Serialize};
-
-/// A core clock cycle.
-pub type Cycle = u64;
 
 /// The eight simulated configurations of the paper (§4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]

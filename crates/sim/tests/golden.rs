@@ -30,8 +30,10 @@ const SCENES: [(&str, bool); 2] = [("builtin:cornell", false), ("dragon_res4.ply
 
 /// Workloads and their resolutions (width, height): small, so all 32 runs per scene take
 /// seconds in a release build.
-const WORKLOADS: [(Workload, &str, u32, u32); 2] =
-    [(Workload::Cast, "cast", 96, 64), (Workload::Path, "path", 48, 32)];
+const WORKLOADS: [(Workload, &str, u32, u32); 2] = [
+    (Workload::Cast, "cast", 96, 64),
+    (Workload::Path, "path", 48, 32),
+];
 
 /// The compared quantities of one run.
 #[derive(Clone, Debug, PartialEq)]
@@ -153,7 +155,9 @@ fn run_all(missing: &mut Vec<String>) -> Vec<Golden> {
         };
         let scene = dualsplit_scene::load(&spec).unwrap_or_else(|e| panic!("{spec}: {e}"));
         let structures = Structures::build(&scene.triangles, &Default::default());
-        let short = name.trim_start_matches("builtin:").trim_end_matches(".ply.gz");
+        let short = name
+            .trim_start_matches("builtin:")
+            .trim_end_matches(".ply.gz");
         for (wl, wl_name, w, h) in WORKLOADS {
             let settings = RenderSettings::new(w, h, wl);
             for accel in SimAccel::ALL {
@@ -220,8 +224,7 @@ fn golden_runs_are_unchanged() {
         .and_then(toml::Value::as_integer)
         .expect("expected.toml: model_version");
     assert_eq!(
-        version,
-        MODEL_VERSION as i64,
+        version, MODEL_VERSION as i64,
         "expected.toml was recorded with model version {version}, the crate is version \
          {MODEL_VERSION}: re-record it (DUALSPLIT_BLESS=1) and list the version in \
          docs/simulator.md, \"Model versions\""
@@ -236,7 +239,9 @@ fn golden_runs_are_unchanged() {
     for r in &runs {
         match expected.iter().find(|e| e.key == r.key) {
             None => diffs.push(format!("{}: not in expected.toml", r.key)),
-            Some(e) if e != r => diffs.push(format!("{}:\n  expected {e:?}\n  got      {r:?}", r.key)),
+            Some(e) if e != r => {
+                diffs.push(format!("{}:\n  expected {e:?}\n  got      {r:?}", r.key))
+            }
             Some(_) => {}
         }
     }

@@ -1,0 +1,4 @@
+//! Simulated time.
+
+/// A core clock cycle.
+pub type Cycle = u64;
