@@ -344,7 +344,7 @@ mod tests {
     #[test]
     fn a_conflicting_miss_replaces_a_line_only_when_its_fill_arrives() {
         // SimTRaX installs lines at their arrival (L1Cache/L2Cache UpdateCache) and finds
-        // lines in flight on its pending lists; model 2 wrote the tag at request time.
+        // lines in flight on its pending lists.
         let cfg = SimConfig::lin2020();
         let mut chip = Chip::new(&cfg, 1);
         // Line 0 cold: 134 (L1 1 + L2 3 + closed row 30).

@@ -196,10 +196,11 @@ pub enum Pipe {
     DualSplit,
 }
 
-/// A macro-operation of a simulated thread (notes §5.2).
+/// A macro-operation of a simulated thread: an instruction run, a load, or a pipeline op.
 ///
 /// Eight bytes (a one-byte tag and narrow fields), so that the replay's op buffers take
-/// half the host cache lines of a 16-byte op (`docs/performance.md`, "Simulator speed").
+/// half the host cache lines of a 16-byte op (`docs/simulator.md`, "How the simulator
+/// runs fast").
 /// The narrow fields are checked where ops are made ([`Op::load`], [`Recorder`]): a value
 /// that does not fit is an [`OpRangeError`], never a silent wrap.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -518,8 +519,8 @@ impl Tally {
 /// Consecutive instruction runs merge into one [`Op::Issue`]. The run being merged is kept
 /// in the recorder, not in the op buffer, and written out when a load or pipeline op follows
 /// or the recording ends ([`Recorder::finish`], [`Recorder::finish_open`]); a kernel step
-/// adds its instruction count to the run and 1 to its kind's counter in the tally
-/// (`docs/performance.md`, "Fifth round"). The ops and counts are exactly those of merging
+/// adds its instruction count to the run and 1 to its kind's counter in the tally (one
+/// add each instead of a read-modify-write of the buffer's last op). The ops and counts are exactly those of merging
 /// into the buffer's last op and adding each step's mix; a test compares both on random
 /// event streams.
 pub struct Recorder<'a> {
@@ -775,8 +776,8 @@ mod tests {
     use super::*;
     use dualsplit_geometry::Pcg32;
 
-    /// The recorder before the fifth round (`docs/performance.md`): every instruction run is
-    /// merged into the op buffer's last op. Kept as the reference of
+    /// A plain recorder: every instruction run is merged into the op buffer's last op. The
+    /// reference of
     /// `recorder_matches_merging_into_the_last_op`.
     struct Reference<'a> {
         accel: SimAccel,
@@ -1127,8 +1128,8 @@ mod tests {
 
     #[test]
     fn frame_totals_do_not_wrap_at_2_pow_32() {
-        // A 512×512 DST* path-traced frame issues ~6·10^9 instructions; model 2's u32
-        // counters wrapped (energy and issue utilisation came out too low).
+        // A 512×512 DST* path-traced frame issues ~6·10^9 instructions: u32 counters would
+        // wrap (energy and issue utilisation would come out too low).
         let mut c = InstrCounts::default();
         let big = InstrCounts {
             mix: Mix::new(3_000_000_000, 0, 0, 0, 0, 2_000_000_000),

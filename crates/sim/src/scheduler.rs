@@ -190,7 +190,7 @@ mod tests {
         }
     }
 
-    /// The previous wheel: one vector per bucket.
+    /// The plain wheel: one vector per bucket (the reference).
     struct VecWheel {
         buckets: Vec<Vec<u32>>,
         now: Cycle,

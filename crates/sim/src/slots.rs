@@ -1,7 +1,7 @@
 //! Reservation tables. [`Slots`]: one resource that accepts one operation per cycle, a
 //! 128-cycle bitmap window, so a request can take a free cycle *before* a later reservation
 //! (a plain next-free counter cannot fill such holes, which serialises threads whose issue
-//! cycles are slightly out of order; notes §5.2 "fluffy time"). [`BankSlots`]: the 16 word
+//! cycles are slightly out of order: Sniper's "fluffy time", snipersim.org/w/Causality). [`BankSlots`]: the 16 word
 //! banks of one TM's L1, one bitmap per bank/cycle diagonal, so the words of a line segment
 //! are placed with one test. [`SparseSlots`]: DRAM buses and activation spacing, whose
 //! reservations can lie far ahead, in a growing bitmap ring.
@@ -99,7 +99,7 @@ impl Slots {
 /// issues one word per cycle, so the consecutive words of a line segment that meet no
 /// conflict lie on one diagonal `d = (bank − cycle) mod banks`. Each diagonal is a bitmap
 /// over cycles, so a whole segment's bank-conflict check is one masked word test instead of
-/// one test per word (notes §5.2).
+/// one test per word.
 ///
 /// Semantics: a word takes the first cycle at or after its request at which its bank is
 /// free, exactly as one [`Slots`] per bank, but without a per-bank window: every
@@ -355,7 +355,7 @@ impl BankSlots {
 /// plane 1 marks reservations still *pending* ([`SparseSlots::reserve_pending`]): a DRAM
 /// channel's in-flight reads, each identified by its data-bus slot, so the read queue's
 /// bookkeeping lives in the host cache line of the bus reservation it belongs to instead
-/// of a separate heap (Lin et al. 2020, §5's GDDR5 model; notes §3.3).
+/// of a separate heap (USIMM's per-channel read queue, `memory_controller.cc`).
 #[derive(Clone, Debug)]
 pub struct SparseSlots<const P: usize = 1> {
     /// First cycle covered (a multiple of 64); the ring covers `[lo, lo + 64 · words.len())`
@@ -707,7 +707,7 @@ mod tests {
         assert_eq!(s.reserve_span(1990, 13), 2300);
     }
 
-    /// `Slots::reserve_slow` before its search was simplified (the test's reference).
+    /// A plain 128-bit-window table searched bit by bit (the test's reference).
     #[derive(Clone, Copy, Default)]
     struct OldSlots {
         base: Cycle,
@@ -954,7 +954,7 @@ mod bank_tests {
     }
 
     /// Under light contention (no request far behind an earlier one on its bank) the
-    /// result is also that of one 128-cycle-window [`Slots`] per bank, the previous model.
+    /// result is also that of one 128-cycle-window [`Slots`] per bank.
     #[test]
     fn bank_runs_match_per_bank_windows_under_light_load() {
         for seed in 0..100 {
@@ -1000,8 +1000,8 @@ mod bank_tests {
         }
     }
 
-    /// The pending plane against a min-heap of the pending cycles (the DRAM read queue's
-    /// previous form): cycles reserved in a jittered order ahead of a rising floor, some far
+    /// The pending plane against a min-heap of the pending cycles (the plain form of a
+    /// DRAM read queue): cycles reserved in a jittered order ahead of a rising floor, some far
     /// ahead, retired in bulk below a limit that moves back and forth (never below the
     /// floor) and one at a time from the earliest, as a full read queue does.
     #[test]

@@ -1,6 +1,7 @@
 //! The workload: threads take pixels from a global atomic counter in scanline order and run
 //! each pixel's [`PixelJob`] through the real traversal with a [`Recorder`] (Lin et al.
-//! 2020, §4.3–4.4; notes §5.2).
+//! 2020, §4.3–4.4). Ray paths do not depend on timing, so tracing them functionally and
+//! replaying the recorded ops is exact.
 
 use crate::chip::{Chip, WorkSource, run_chip};
 use crate::kernel::{Mix, Op, Recorder, Run, Tally};

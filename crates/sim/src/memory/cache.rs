@@ -1,10 +1,11 @@
 //! A set-associative cache of 64-byte lines with fill times in the tags (LRU replacement;
-//! associativity 1 is SimTRaX's direct-mapped cache, notes §1.4), plus the list of lines in
+//! associativity 1 is SimTRaX's direct-mapped cache, `L1Cache.cc`/`L2Cache.cc`), plus the list of lines in
 //! flight (the MSHRs).
 //!
-//! A miss is *reserved* when it is made (it learns its fill cycle at once, notes §5.2), but
-//! the line it brings is only *installed* when that fill arrives, as in SimTRaX ("lines are
-//! installed in L2 and L1 at their arrival cycle", notes §1.4) and in any cache with miss
+//! A miss is *reserved* when it is made (it learns its fill cycle at once: the reservation model), but
+//! the line it brings is only *installed* when that fill arrives, as in SimTRaX
+//! (`L1Cache.cc`/`L2Cache.cc`: `UpdateCache` queues the tag update, `ClockFall` applies it
+//! at the fill cycle) and in any cache with miss
 //! status holding registers (Kroft 1981):
 //!
 //! * the line a miss replaces stays readable until the new line's fill arrives (`prev`), so a
@@ -14,11 +15,11 @@
 //!   the same set has taken its tag (`inflight`, SimTRaX's per-L1 list of in-flight lines
 //!   and L2's pending list), so it is never requested twice.
 //!
-//! (Model versions ≤ 3 wrote the new tag at request time: the replaced line vanished
-//! for the whole miss latency and an in-flight line whose tag was taken by a later conflicting
-//! miss was requested again. Under load the two fed each other — longer latencies, more
-//! re-requests of the top-of-tree lines, hotter L2 banks — which is why TM scaling broke
-//! down at 128 TMs; see `docs/simulator.md`, "TM scaling".)
+//! Writing the tag at request time instead would make the replaced line vanish for the
+//! whole miss latency and request an in-flight line again once a conflicting miss took its
+//! tag; under load the two feed each other (longer latencies, more re-requests of the
+//! top-of-tree lines, hotter L2 banks) and TM scaling breaks down at 128 TMs
+//! (`docs/simulator.md`, "TM scaling").
 
 use crate::Cycle;
 use rustc_hash::FxHashMap;

@@ -1,5 +1,6 @@
 //! GDDR5 main memory: channels of banks with open rows, per-channel data bus, read queue
-//! (notes §1.8 and §3.3; SimTRaX's USIMM configuration `gddr5_8ch.cfg`).
+//! (SimTRaX's USIMM configuration `gddr5_8ch.cfg` and timing file `1Gb_x16_amd2GHz.vi`;
+//! USIMM `memory_controller.cc`, `scheduler.cc`).
 //!
 //! Address mapping (SimTRaX mapping 1), from the low bits up: line offset → column →
 //! channel → bank → row, so one row of one channel holds `row_bytes` contiguous bytes.
@@ -36,9 +37,9 @@
 //! tick and a 64-bit summary of the earlier epochs' rows, so most reads neither expire nor
 //! scan epochs; the epochs themselves (16 bytes each) sit in one slab of per-bank rings; the
 //! read queue is a bit plane of the bus table; the bus and t_RRD tables
-//! ([`SparseSlots`]) settle most requests with one inline word test. The tests keep the
-//! previous implementation (heap, `VecDeque`, plain sets) as a reference and compare every
-//! read's result on random streams.
+//! ([`SparseSlots`]) settle most requests with one inline word test. The tests keep a
+//! plain implementation of the same model (heap, `VecDeque`, plain sets) as a reference and
+//! compare every read's result on random streams.
 
 use crate::Cycle;
 use crate::config::DramConfig;
@@ -459,8 +460,8 @@ mod tests {
         Dram::new(&SimConfig::lin2020().dram)
     }
 
-    /// The DRAM model as it was before the host-speed rework (Lin et al. 2020 §5's GDDR5
-    /// memory, model 4), written for clarity: reservations in plain sets of taken ticks,
+    /// The same DRAM model (Lin et al. 2020 §5's GDDR5 memory) written for clarity, not
+    /// host speed: reservations in plain sets of taken ticks,
     /// the read queue a min-heap of completion ticks, each bank's epochs a `VecDeque`.
     mod reference {
         use super::super::{DramAccess, DramStats, EPOCH_KEEP};
