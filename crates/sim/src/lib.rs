@@ -7,10 +7,12 @@
 //!  workload.rs ── per pixel ──▶ kernel::Recorder ──▶ Vec<Op>  (macro-ops, functional first)
 //!                                                        │
 //!                                                        ▼  timing second
-//!  engine.rs: threads on TMs, heap of wake-up cycles, reservation tables
-//!      ├─ per TM: L1 (banks, tags with fill times), ray-box / ray-triangle / dual-split
-//!      │          pipelines, shared reciprocal unit
-//!      └─ chip:   L2 (banks, tags), memory::dram (GDDR5 row buffers, buses, read queues)
+//!  chip.rs: the event loop; scheduler.rs: timing wheel of thread wake-ups
+//!      ├─ thread.rs: thread processors replaying the ops (single issue, in order)
+//!      ├─ tm.rs (per TM): L1 (banks, tags with fill times), ray-box / ray-triangle /
+//!      │          dual-split pipelines, shared reciprocal unit
+//!      ├─ atomic.rs: the global atomic unit (pixel hand-out)
+//!      └─ memory/: l2.rs (banks, tags), dram.rs (GDDR5 row buffers, buses, read queues)
 //!                                                        │
 //!                                                        ▼
 //!  energy.rs: counts × per-event energy, split like Table 6 ──▶ SimResult
