@@ -20,7 +20,10 @@ pub struct AtomicUnit {
 impl AtomicUnit {
     /// An idle unit whose result returns `latency` cycles after the increment.
     pub fn new(latency: u64) -> Self {
-        Self { free: 0, latency }
+        Self {
+            free: Cycle::ZERO,
+            latency,
+        }
     }
 
     /// An increment requested at `at`: made at the unit's first free cycle from `at` on.

@@ -83,8 +83,10 @@ impl Chip {
     /// One word load by TM `tm` whose L1 bank slot is `slot` (already reserved): the cycle
     /// the data is in the register.
     #[cfg(test)]
-    fn load_word(&mut self, tm: usize, word: u64, slot: Cycle) -> Cycle {
-        self.tms[tm].load_word(&mut self.l2, word, slot)
+    fn load_word(&mut self, tm: usize, word: u64, slot: u64) -> u64 {
+        self.tms[tm]
+            .load_word(&mut self.l2, word, Cycle(slot))
+            .get()
     }
 }
 
@@ -133,9 +135,9 @@ fn run_chip_with(
 ) -> Cycle {
     let mut wheel = Wheel::new(threads.len());
     for i in 0..threads.len() as u32 {
-        wheel.push(0, i);
+        wheel.push(Cycle::ZERO, i);
     }
-    let mut finish = vec![0; threads.len()];
+    let mut finish = vec![Cycle::ZERO; threads.len()];
     while let Some((now, first)) = wheel.next_bucket() {
         let mut touched = 0;
         let mut id = first;
@@ -180,7 +182,7 @@ fn run_chip_with(
             id = next;
         }
     }
-    let end = finish.iter().copied().max().unwrap_or(0);
+    let end = finish.iter().copied().max().unwrap_or(Cycle::ZERO);
     chip.stalls.idle = finish.iter().map(|&f| end - f).sum();
     end
 }
@@ -204,11 +206,11 @@ mod tests {
         }
     }
 
-    fn one_thread(cfg: &SimConfig, box_pipes: u32, prog: Vec<Op>) -> (Cycle, Chip) {
+    fn one_thread(cfg: &SimConfig, box_pipes: u32, prog: Vec<Op>) -> (u64, Chip) {
         let mut chip = Chip::new(cfg, box_pipes);
         let mut th = vec![Thread::new(0)];
         let end = run_chip(&mut chip, &mut th, &mut Programs(vec![prog]));
-        (end, chip)
+        (end.get(), chip)
     }
 
     fn use_data() -> Op {
@@ -445,7 +447,7 @@ mod tests {
             parallel: false,
         };
         let progs = vec![vec![op, use_data()], vec![op, use_data()]];
-        let end = run_chip(&mut chip, &mut th, &mut Programs(progs));
+        let end = run_chip(&mut chip, &mut th, &mut Programs(progs)).get();
         // The second thread gets the pipe at cycle 1: result 9, use ends at 10.
         assert_eq!(end, 10);
         assert_eq!(chip.stats().stalls.pipeline_busy, 1);

@@ -55,7 +55,7 @@ pub const MODEL_VERSION: u32 = 4;
 
 pub use chip::{Chip, ChipStats, WorkSource, run_chip};
 pub use config::{CacheConfig, ConfigError, DramConfig, EnergyConfig, SimConfig, UnitConfig};
-pub use cycle::Cycle;
+pub use cycle::{Cycle, Tick};
 pub use kernel::{InstrCounts, Mix};
 pub use memory::{CacheStats, DramStats};
 pub use thread::{Stalls, Thread};

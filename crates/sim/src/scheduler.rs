@@ -61,7 +61,7 @@ impl Wheel {
                 };
                 threads
             ],
-            now: 0,
+            now: Cycle::ZERO,
             in_wheel: 0,
             overflow: BinaryHeap::new(),
         }
@@ -71,7 +71,7 @@ impl Wheel {
     pub(crate) fn push(&mut self, t: Cycle, id: u32) {
         debug_assert!(t >= self.now);
         if t - self.now < WHEEL {
-            self.append((t % WHEEL) as usize, id);
+            self.append((t.get() % WHEEL) as usize, id);
         } else {
             self.push_overflow(t, id);
         }
@@ -112,7 +112,7 @@ impl Wheel {
         }
         h.copy_within(1.., 0);
         h[HOPS - 1] = 0;
-        Some(self.now + d as Cycle)
+        Some(self.now + d as u64)
     }
 
     /// Appends thread `id` to bucket `b`'s list.
@@ -143,12 +143,12 @@ impl Wheel {
             while let Some(&Reverse((t, id))) = self.overflow.peek() {
                 if t - self.now < WHEEL {
                     self.overflow.pop();
-                    self.append((t % WHEEL) as usize, id);
+                    self.append((t.get() % WHEEL) as usize, id);
                 } else {
                     break;
                 }
             }
-            let b = (self.now % WHEEL) as usize;
+            let b = (self.now.get() % WHEEL) as usize;
             let (first, _) = self.ends[b];
             if first != NONE {
                 self.ends[b] = (NONE, NONE);
@@ -202,7 +202,7 @@ mod tests {
         fn new() -> Self {
             Self {
                 buckets: vec![Vec::new(); WHEEL as usize],
-                now: 0,
+                now: Cycle::ZERO,
                 in_wheel: 0,
                 overflow: BinaryHeap::new(),
             }
@@ -210,7 +210,7 @@ mod tests {
 
         fn push(&mut self, t: Cycle, id: u32) {
             if t - self.now < WHEEL {
-                self.buckets[(t % WHEEL) as usize].push(id);
+                self.buckets[(t.get() % WHEEL) as usize].push(id);
                 self.in_wheel += 1;
             } else {
                 self.overflow.push(Reverse((t, id)));
@@ -226,13 +226,13 @@ mod tests {
                 while let Some(&Reverse((t, id))) = self.overflow.peek() {
                     if t - self.now < WHEEL {
                         self.overflow.pop();
-                        self.buckets[(t % WHEEL) as usize].push(id);
+                        self.buckets[(t.get() % WHEEL) as usize].push(id);
                         self.in_wheel += 1;
                     } else {
                         break;
                     }
                 }
-                let b = (self.now % WHEEL) as usize;
+                let b = (self.now.get() % WHEEL) as usize;
                 if !self.buckets[b].is_empty() {
                     let ids = std::mem::take(&mut self.buckets[b]);
                     self.in_wheel -= ids.len();
@@ -254,8 +254,8 @@ mod tests {
             let mut w = Wheel::new(n);
             let mut v = VecWheel::new();
             for id in 0..n as u32 {
-                w.push(0, id);
-                v.push(0, id);
+                w.push(Cycle::ZERO, id);
+                v.push(Cycle::ZERO, id);
             }
             let mut ids = Vec::new();
             let mut steps = 0;
@@ -295,8 +295,8 @@ mod tests {
             // The reference's pending hops per thread (it wakes the thread at each).
             let mut plan: Vec<Vec<Cycle>> = vec![Vec::new(); n];
             for id in 0..n as u32 {
-                w.push(0, id);
-                v.push(0, id);
+                w.push(Cycle::ZERO, id);
+                v.push(Cycle::ZERO, id);
             }
             let delay = |rng: &mut dualsplit_geometry::Pcg32| match rng.below(10) {
                 0 => WHEEL + rng.below(3 * WHEEL as u32) as u64,
@@ -326,7 +326,7 @@ mod tests {
                         let mut at = t;
                         for h in hops.iter_mut().take(rng.below(HOPS as u32 + 1) as usize) {
                             *h = delay(&mut rng) as u32;
-                            at += *h as Cycle;
+                            at += *h as u64;
                             p.push(at);
                         }
                         w.push_forward(t, hops, id);

@@ -72,8 +72,8 @@ impl Thread {
     pub fn new(tm: usize) -> Self {
         Self {
             tm: tm as u32,
-            t: 0,
-            ready: 0,
+            t: Cycle::ZERO,
+            ready: Cycle::ZERO,
             cause: Cause::Memory,
             ops: Vec::new(),
             pc: 0,
@@ -152,7 +152,7 @@ impl Thread {
             }
             self.pc += 1;
             match op {
-                Op::Issue { n, fpinv: 0 } => self.t += n as Cycle,
+                Op::Issue { n, fpinv: 0 } => self.t += n as u64,
                 Op::Issue { n, fpinv } => self.issue_fpinv(n, fpinv, tm, stalls),
                 Op::Load { word, words } => {
                     let r = tm.load(l2, WordAddr(word as u64), words as u64, self.t, now);
@@ -219,7 +219,7 @@ impl Thread {
                 }
                 Some(&Op::Issue { n, fpinv: 0 }) if n > 0 && self.pc + 1 < self.ops.len() => {
                     self.pc += 1;
-                    self.t += n as Cycle;
+                    self.t += n as u64;
                     *hop = n;
                 }
                 Some(_) => break,
@@ -266,6 +266,6 @@ impl Thread {
             self.result(r.ready, Cause::Fpinv);
             c = r.next_issue;
         }
-        self.t = c + (n - fpinv as u32) as Cycle;
+        self.t = c + (n - fpinv as u32) as u64;
     }
 }

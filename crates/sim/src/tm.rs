@@ -135,11 +135,11 @@ impl Tm {
         let mut c = at;
         let mut w = addr.0;
         let end = w + words;
-        let (mut ready, mut busy) = (0, 0);
+        let (mut ready, mut busy) = (Cycle::ZERO, 0);
         while w < end {
             let seg_end = (((w >> shift) + 1) << shift).min(end);
             let k = seg_end - w;
-            let (last, r) = if self.l1_banks.try_run(w & self.bank_mask, c, k) {
+            let (last, r) = if self.l1_banks.try_run(w & self.bank_mask, c.get(), k) {
                 let (r, fill) = self.first_word(l2, w, c, now);
                 self.count_words(c + 1, k - 1, fill);
                 (c + k - 1, r.max(fill))
@@ -170,14 +170,14 @@ impl Tm {
         while w < end {
             let seg_end = (((w >> shift) + 1) << shift).min(end);
             let k = seg_end - w;
-            let run = self.l1_banks.reserve_run(w & self.bank_mask, c, k, now, c);
+            let run = (self.l1_banks).reserve_run(w & self.bank_mask, c.get(), k, now.get(), 0);
             busy += run.stall;
-            c = run.last + 1;
+            c = Cycle(run.last + 1);
             w = seg_end;
         }
         Issued {
             next_issue: c,
-            ready: c.saturating_sub(1).max(at),
+            ready: Cycle(c.get().saturating_sub(1)).max(at),
             busy,
         }
     }
@@ -199,7 +199,7 @@ impl Tm {
             // One pipe: a parallel op of n > 1 serialises, n = 1 is the same either way.
             let (mut c, mut last, mut busy) = (at, at, 0);
             for _ in 0..n {
-                let s = only.reserve(c);
+                let s = Cycle(only.reserve(c.get()));
                 busy += s - c;
                 last = s;
                 c = s + 1;
@@ -281,7 +281,7 @@ impl Tm {
     /// from the fill on, merged before.
     #[inline(always)]
     fn count_words(&mut self, c: Cycle, n: u64, fill: Cycle) {
-        let hits = slots::at_or_after(c, n, fill);
+        let hits = slots::at_or_after(c.get(), n, fill.get());
         self.l1_accesses += n;
         self.l1_hits += hits;
         self.l1_merged += n - hits;
@@ -300,16 +300,23 @@ impl Tm {
         c: Cycle,
         now: Cycle,
     ) -> (Cycle, Cycle, u64) {
-        let slot = self.l1_banks.reserve_word(w & self.bank_mask, c, now);
+        let slot = Cycle(
+            self.l1_banks
+                .reserve_word(w & self.bank_mask, c.get(), now.get()),
+        );
         let mut stall = slot - c;
         let (r, fill) = self.first_word(l2, w, slot, now);
         let mut last = slot;
         if k > 1 {
-            let run =
-                self.l1_banks
-                    .reserve_run((w + 1) & self.bank_mask, slot + 1, k - 1, now, fill);
+            let run = self.l1_banks.reserve_run(
+                (w + 1) & self.bank_mask,
+                slot.get() + 1,
+                k - 1,
+                now.get(),
+                fill.get(),
+            );
             stall += run.stall;
-            last = run.last;
+            last = Cycle(run.last);
             let hits = run.at_or_after;
             self.l1_accesses += k - 1;
             self.l1_hits += hits;
@@ -322,7 +329,7 @@ impl Tm {
     /// register.
     #[cfg(test)]
     pub(crate) fn load_word(&mut self, l2: &mut L2, word: u64, slot: Cycle) -> Cycle {
-        self.first_word(l2, word, slot, 0).0
+        self.first_word(l2, word, slot, Cycle::ZERO).0
     }
 }
 
@@ -339,7 +346,7 @@ fn pipe_general(pipes: &mut [Slots], n: u8, parallel: bool, at: Cycle) -> (Cycle
     if parallel && pipes.len() >= n as usize {
         let mut s = c;
         loop {
-            let free = pipes.iter().filter(|p| p.peek(s) == s).count();
+            let free = pipes.iter().filter(|p| p.peek(s.get()) == s.get()).count();
             if free >= n as usize {
                 break;
             }
@@ -348,8 +355,8 @@ fn pipe_general(pipes: &mut [Slots], n: u8, parallel: bool, at: Cycle) -> (Cycle
         busy += s - c;
         let mut taken = 0;
         for p in pipes.iter_mut() {
-            if taken < n && p.peek(s) == s {
-                p.reserve(s);
+            if taken < n && p.peek(s.get()) == s.get() {
+                p.reserve(s.get());
                 taken += 1;
             }
         }
@@ -369,11 +376,12 @@ fn pipe_general(pipes: &mut [Slots], n: u8, parallel: bool, at: Cycle) -> (Cycle
 /// Reserves the earliest free cycle at or after `c` on any of `units`.
 #[inline]
 fn earliest(units: &mut [Slots], c: Cycle) -> Cycle {
+    let c = c.get();
     if let [only] = units {
-        return only.reserve(c);
+        return Cycle(only.reserve(c));
     }
     let mut best = 0;
-    let mut best_s = Cycle::MAX;
+    let mut best_s = u64::MAX;
     for (i, u) in units.iter().enumerate() {
         let s = u.peek(c);
         if s < best_s {
@@ -384,7 +392,7 @@ fn earliest(units: &mut [Slots], c: Cycle) -> Cycle {
             }
         }
     }
-    units[best].reserve(c)
+    Cycle(units[best].reserve(c))
 }
 
 #[cfg(test)]
@@ -399,28 +407,27 @@ mod tests {
         let mut l2 = L2::new(&cfg);
         let mut tm = Tm::new(&cfg, 1);
         // A cold 3-word load at byte 0: L1 1 + L2 3 + closed row 30; words at 0, 1, 2.
-        let r = tm.load(&mut l2, WordAddr::from_byte(0), 3, 0, 0);
-        assert_eq!((r.next_issue, r.ready, r.busy), (3, 34, 0));
+        let c = Cycle;
+        let r = tm.load(&mut l2, WordAddr::from_byte(0), 3, c(0), c(0));
+        assert_eq!((r.next_issue, r.ready, r.busy), (c(3), c(34), 0));
         // The same words again: L1 hits, the last at cycle 102, data at 103.
-        let r = tm.load(&mut l2, WordAddr(0), 3, 100, 100);
-        assert_eq!((r.next_issue, r.ready), (103, 103));
+        let r = tm.load(&mut l2, WordAddr(0), 3, c(100), c(100));
+        assert_eq!((r.next_issue, r.ready), (c(103), c(103)));
         // A store to bank 0 in cycle 200 and a load of word 16 (bank 0) in the same cycle:
         // the load waits one cycle for the bank; a store allocates no line.
-        let s = tm.store(WordAddr(32), 1, 200, 200);
-        assert_eq!((s.next_issue, s.ready, s.busy), (201, 200, 0));
-        let r = tm.load(&mut l2, WordAddr(16), 1, 200, 200);
-        assert_eq!((r.next_issue, r.busy), (202, 1));
+        let s = tm.store(WordAddr(32), 1, c(200), c(200));
+        assert_eq!((s.next_issue, s.ready, s.busy), (c(201), c(200), 0));
+        let r = tm.load(&mut l2, WordAddr(16), 1, c(200), c(200));
+        assert_eq!((r.next_issue, r.busy), (c(202), 1));
         // Dual-split op: result after 8 cycles; the pipe is taken in its cycle.
-        let p = tm.pipe(Pipe::DualSplit, 1, false, 300);
-        assert_eq!((p.next_issue, p.ready), (301, 308));
-        let p = tm.pipe(Pipe::DualSplit, 1, false, 300);
-        assert_eq!((p.next_issue, p.ready, p.busy), (302, 309, 1));
+        let p = tm.pipe(Pipe::DualSplit, 1, false, c(300));
+        assert_eq!((p.next_issue, p.ready), (c(301), c(308)));
+        let p = tm.pipe(Pipe::DualSplit, 1, false, c(300));
+        assert_eq!((p.next_issue, p.ready, p.busy), (c(302), c(309), 1));
         // Reciprocal: 16 cycles (lin2020 `fpinv_latency`).
-        let f = tm.reciprocal(400);
-        assert_eq!(
-            (f.next_issue, f.ready),
-            (401, 400 + cfg.units.fpinv_latency)
-        );
+        let f = tm.reciprocal(c(400));
+        let ready = c(400 + cfg.units.fpinv_latency);
+        assert_eq!((f.next_issue, f.ready), (c(401), ready));
         let (mut c, mut u) = (CacheStats::default(), UnitStats::default());
         tm.add_stats(&mut c, &mut u);
         assert_eq!((c.l1_accesses, c.l1_hits), (7, 3));

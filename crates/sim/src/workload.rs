@@ -163,7 +163,7 @@ pub(crate) fn run(
             tally: Tally::new(accel),
         },
     };
-    let cycles = run_chip(&mut chip, &mut threads, &mut work);
+    let cycles = run_chip(&mut chip, &mut threads, &mut work).get();
     if let Some(e) = work.tracer.tally.error() {
         return Err(e.into());
     }

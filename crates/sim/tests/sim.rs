@@ -107,7 +107,7 @@ fn every_request_completes() {
             r.dram.reads
         );
         // Every DRAM read returned before the frame ended.
-        assert!(r.dram.last_done <= r.cycles);
+        assert!(r.dram.last_done.get() <= r.cycles);
         // Every pipeline op that was recorded was executed.
         assert_eq!(r.units.box_ops, r.instructions.box_ops);
         assert_eq!(r.units.tri_ops, r.instructions.tri_ops);
@@ -320,7 +320,7 @@ mod synthetic {
             loads: 0,
         };
         let end = run_chip(&mut chip, &mut th, &mut w);
-        (end, chip, w.loads)
+        (end.get(), chip, w.loads)
     }
 
     #[test]
@@ -334,7 +334,7 @@ mod synthetic {
         let d = stats.dram;
         assert_eq!(c.l2_hits + c.l2_merged + d.reads, c.l2_accesses);
         assert!(d.reads > 100, "the stream must reach DRAM: {}", d.reads);
-        assert!(d.last_done <= end);
+        assert!(d.last_done.get() <= end);
         assert_eq!(stats.units.box_ops, 200 * 20 * 2);
         let (end2, chip2, _) = run(&cfg);
         assert_eq!(end, end2);

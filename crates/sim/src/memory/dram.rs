@@ -41,9 +41,9 @@
 //! plain implementation of the same model (heap, `VecDeque`, plain sets) as a reference and
 //! compare every read's result on random streams.
 
-use crate::Cycle;
 use crate::config::DramConfig;
 use crate::slots::SparseSlots;
+use crate::{Cycle, Tick};
 use serde::{Deserialize, Serialize};
 
 /// How a read found its bank.
@@ -326,7 +326,7 @@ impl Dram {
     /// Reads `line` arriving at core cycle `arrive`; returns the core cycle its data has
     /// arrived and how the bank was found.
     pub fn read(&mut self, line: u64, arrive: Cycle) -> (Cycle, DramAccess) {
-        self.read_at(line, arrive, 0)
+        self.read_at(line, arrive, Cycle::ZERO)
     }
 
     /// As [`Dram::read`], when no read will ever arrive before core cycle `now` (the
@@ -342,9 +342,11 @@ impl Dram {
             self.epochs.grow(&mut self.banks);
         }
         let ch = &mut self.channels[chi];
-        ch.bus.forget_before(self.burst.div(now * tpc));
-        ch.acts.forget_before(now * tpc);
-        let mut a = arrive * tpc;
+        let floor = now.to_ticks(tpc).get();
+        ch.bus.forget_before(self.burst.div(floor));
+        ch.acts.forget_before(floor);
+        // The read's tick; the schedule below is in ticks.
+        let mut a = arrive.to_ticks(tpc).get();
         // Reads complete by `a` leave the queue: slot `s` completes at (s + 1) · t_burst ≤ a,
         // i.e. s < ⌊a / t_burst⌋ (every pending slot is at or after the bus floor, which
         // is at most that: the floor comes from `now ≤ arrive`).
@@ -389,7 +391,7 @@ impl Dram {
             if let Some(slot) = hit {
                 ch.bus.reserve_pending(slot);
                 let done = slot * c.t_burst + c.t_burst;
-                return self.finish(arrive, done, DramAccess::RowHit);
+                return self.finish(arrive, Tick(done), DramAccess::RowHit);
             }
         }
         let (col, kind) = match bank.open_row {
@@ -420,12 +422,12 @@ impl Dram {
         // the effect of FR-FCFS on the bus.
         let data = ch.bus.reserve_pending(self.burst.div_ceil(col + c.t_cas)) * c.t_burst;
         let done = data + c.t_burst;
-        self.finish(arrive, done, kind)
+        self.finish(arrive, Tick(done), kind)
     }
 
     /// Counts a read arriving at core cycle `arrive` whose data is complete at tick `done`.
-    fn finish(&mut self, arrive: Cycle, done: u64, kind: DramAccess) -> (Cycle, DramAccess) {
-        let done_cycle = self.tpc.div_ceil(done);
+    fn finish(&mut self, arrive: Cycle, done: Tick, kind: DramAccess) -> (Cycle, DramAccess) {
+        let done_cycle = Cycle(self.tpc.div_ceil(done.get()));
         let s = &mut self.stats;
         match kind {
             DramAccess::RowHit => s.row_hits += 1,
@@ -455,6 +457,20 @@ mod tests {
     use super::*;
     use crate::SimConfig;
     use dualsplit_geometry::Pcg32;
+
+    impl Dram {
+        /// [`Dram::read`] in plain cycle numbers.
+        fn rd(&mut self, line: u64, arrive: u64) -> (u64, DramAccess) {
+            let (done, kind) = self.read(line, Cycle(arrive));
+            (done.get(), kind)
+        }
+
+        /// [`Dram::read_at`] in plain cycle numbers.
+        fn rd_at(&mut self, line: u64, arrive: u64, now: u64) -> (u64, DramAccess) {
+            let (done, kind) = self.read_at(line, Cycle(arrive), Cycle(now));
+            (done.get(), kind)
+        }
+    }
 
     fn dram() -> Dram {
         Dram::new(&SimConfig::lin2020().dram)
@@ -532,7 +548,7 @@ mod tests {
                 }
             }
 
-            pub fn read(&mut self, line: u64, arrive: Cycle) -> (Cycle, DramAccess) {
+            pub fn read(&mut self, line: u64, arrive: u64) -> (u64, DramAccess) {
                 let c = &self.cfg;
                 let tpc = c.ticks_per_cycle;
                 let x = line / (c.row_bytes / 64);
@@ -622,7 +638,7 @@ mod tests {
                     DramAccess::Conflict => s.row_conflicts += 1,
                 }
                 s.latency_cycles += done_cycle - arrive;
-                s.last_done = s.last_done.max(done_cycle);
+                s.last_done = s.last_done.max(Cycle(done_cycle));
                 (done_cycle, kind)
             }
         }
@@ -663,7 +679,7 @@ mod tests {
                     + ch as u64)
                     * lines_per_row
                     + rng.below(lines_per_row as u32) as u64;
-                let got = d.read_at(line, arrive, now);
+                let got = d.rd_at(line, arrive, now);
                 assert_eq!(got, r.read(line, arrive), "seed {seed}, read {i}");
             }
             assert_eq!(d.stats(), r.stats, "seed {seed}");
@@ -680,14 +696,14 @@ mod tests {
     fn closed_then_hit_then_conflict_exact_latencies() {
         let mut d = dram();
         // Closed: tRCD 14 + tCAS 14 + burst 2 = 30 core cycles.
-        assert_eq!(d.read(0, 1000), (1030, DramAccess::Closed));
+        assert_eq!(d.rd(0, 1000), (1030, DramAccess::Closed));
         // Row hit on the same row (line 1 is column 1 of row 0): tCAS 14 + burst 2.
-        assert_eq!(d.read(1, 2000), (2016, DramAccess::RowHit));
+        assert_eq!(d.rd(1, 2000), (2016, DramAccess::RowHit));
         // Conflict: same channel and bank, next row. Lines per row 128, channels 16, banks 16.
         let other_row = 128 * 16 * 16;
         assert_eq!(d.map(other_row), (0, 0, 1));
         // tRP 14 + tRCD 14 + tCAS 14 + burst 2 = 44.
-        assert_eq!(d.read(other_row, 3000), (3044, DramAccess::Conflict));
+        assert_eq!(d.rd(other_row, 3000), (3044, DramAccess::Conflict));
         let s = d.stats();
         assert_eq!((s.reads, s.activations, s.row_hits), (3, 2, 1));
     }
@@ -695,11 +711,11 @@ mod tests {
     #[test]
     fn conflict_waits_for_t_ras() {
         let mut d = dram();
-        assert_eq!(d.read(0, 0).0, 30);
+        assert_eq!(d.rd(0, 0).0, 30);
         // Immediately conflicting: precharge may not start before act + tRAS (35 ns).
         // act at 0, pre at 35 ns, act at 49 ns (= tRC too), data at 49 + 14 + 14 = 77 ns,
         // rounded up to the 2 ns burst slot grid (78), + burst 2 = 80.
-        assert_eq!(d.read(128 * 16 * 16, 0), (80, DramAccess::Conflict));
+        assert_eq!(d.rd(128 * 16 * 16, 0), (80, DramAccess::Conflict));
     }
 
     #[test]
@@ -707,22 +723,22 @@ mod tests {
         let mut d = dram();
         let row1 = 128 * 16 * 16;
         // A: row 0, closed: act at tick 0, column 28, data slot 14 (ticks 56–60): cycle 30.
-        assert_eq!(d.read(0, 0), (30, DramAccess::Closed));
+        assert_eq!(d.rd(0, 0), (30, DramAccess::Closed));
         // B: row 1, conflict: precharge at t_RAS (70), act 98 (= t_RC), column 126, data at
         // 154 rounded up to the burst grid 156, done 160 ticks: cycle 80. Row 0's epoch now
         // closes at 98 − t_RP 28 − t_RTP 15 = tick 55.
-        assert_eq!(d.read(row1, 0), (80, DramAccess::Conflict));
+        assert_eq!(d.rd(row1, 0), (80, DramAccess::Conflict));
         // C: row 0 again, one cycle after B. In arrival order it would be a second conflict
         // (≥ 49 ns after B's activate). Row-hit-first: row 0 is still open before B's
         // precharge, so C is a row hit: column at 28, data slot 14 is A's, so slot 15
         // (column effectively at 60 − 28 = 32 ≤ 55), done at tick 64: cycle 32, before B.
-        assert_eq!(d.read(1, 1), (32, DramAccess::RowHit));
+        assert_eq!(d.rd(1, 1), (32, DramAccess::RowHit));
         // D: row 0 at cycle 20 (tick 40): column 40, data at 68 = slot 17, done 72: cycle 36.
-        assert_eq!(d.read(2, 20), (36, DramAccess::RowHit));
+        assert_eq!(d.rd(2, 20), (36, DramAccess::RowHit));
         // E: row 0 at cycle 30 (tick 60 > 55): too late for row 0's epoch, so a conflict
         // after B: precharge at B's act 98 + t_RAS 70 = 168, act 196 (= 98 + t_RC), column
         // 224, data 252, done 256 ticks: cycle 128.
-        assert_eq!(d.read(3, 30), (128, DramAccess::Conflict));
+        assert_eq!(d.rd(3, 30), (128, DramAccess::Conflict));
         let s = d.stats();
         assert_eq!(
             (s.reads, s.activations, s.row_hits, s.row_conflicts),
@@ -737,8 +753,8 @@ mod tests {
         let mut d = dram();
         let row1 = 128 * 16 * 16;
         for i in 0..4 {
-            d.read(i, 0);
-            d.read(row1 + i, 0);
+            d.rd(i, 0);
+            d.rd(row1 + i, 0);
         }
         let s = d.stats();
         assert_eq!((s.reads, s.activations, s.row_hits), (8, 2, 6));
@@ -750,12 +766,12 @@ mod tests {
         let row = 128 * 16 * 16;
         // 20 different rows of bank 0 (channel 0), all at cycle 0: each waits t_RC for the
         // previous one, so the last data is ~1 µs ahead.
-        let last = (0..20).map(|r| d.read(r * row, 0).0).max().unwrap();
+        let last = (0..20).map(|r| d.rd(r * row, 0).0).max().unwrap();
         assert!(last > 900, "{last}");
         // Bank 1 of channel 0 at cycle 0: closed row, its activation only spaced t_RRD
         // (13 ticks) after bank 0's first: act 13, column 41, data at 69 rounded to the
         // burst grid 72, done 76 ticks = cycle 38 (not behind bank 0's far-future bursts).
-        assert_eq!(d.read(128 * 16, 0), (38, DramAccess::Closed));
+        assert_eq!(d.rd(128 * 16, 0), (38, DramAccess::Closed));
     }
 
     #[test]
@@ -781,7 +797,7 @@ mod tests {
     fn one_channel_streams_at_one_line_per_burst() {
         let mut d = dram();
         // 100 row-hit reads of one row arriving together: the bus serialises them.
-        let dones: Vec<_> = (0..100).map(|i| d.read(i % 128, 0).0).collect();
+        let dones: Vec<_> = (0..100).map(|i| d.rd(i % 128, 0).0).collect();
         for w in dones.windows(2) {
             assert_eq!(w[1] - w[0], 2, "one 64-B line per 2 ns per channel");
         }
@@ -793,7 +809,7 @@ mod tests {
         let mut d = Dram::new(&cfg.dram);
         // 64 K lines, all requested at cycle 0, spread over every channel and bank.
         let n = 65_536u64;
-        let last = (0..n).map(|l| d.read(l, 0).0).max().unwrap();
+        let last = (0..n).map(|l| d.rd(l, 0).0).max().unwrap();
         let bytes_per_cycle = (n * 64) as f64 / last as f64;
         let peak = cfg.dram_peak_bytes_per_cycle();
         assert_eq!(peak, 512.0);
@@ -812,15 +828,15 @@ mod tests {
         let mut cfg = SimConfig::lin2020().dram;
         cfg.read_queue = 2;
         let mut d = Dram::new(&cfg);
-        d.read(0, 0);
-        d.read(1, 0);
-        d.read(2, 0);
+        d.rd(0, 0);
+        d.rd(1, 0);
+        d.rd(2, 0);
         assert!(d.stats().queue_wait_cycles > 0);
         let mut cfg = SimConfig::lin2020().dram;
         cfg.read_queue = 64;
         let mut d = Dram::new(&cfg);
         (0..3).for_each(|l| {
-            d.read(l, 0);
+            d.rd(l, 0);
         });
         assert_eq!(d.stats().queue_wait_cycles, 0);
     }

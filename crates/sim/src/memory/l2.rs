@@ -53,7 +53,7 @@ impl L2 {
     pub fn read(&mut self, line: u64, word: u64, at: Cycle, now: Cycle) -> Cycle {
         let bank_addr = if self.line_interleaved { line } else { word };
         let b = (bank_addr & self.bank_mask) as usize;
-        let slot = self.banks[b].reserve(at);
+        let slot = Cycle(self.banks[b].reserve(at.get()));
         self.bank_wait += slot - at;
         self.accesses += 1;
         let data = slot + self.hit_latency;
