@@ -84,6 +84,15 @@ impl fmt::Display for Cycle {
 pub struct Tick(pub u64);
 
 impl Tick {
+    /// The latest representable tick.
+    pub const MAX: Tick = Tick(u64::MAX);
+
+    /// The tick `d` ticks later, or [`Tick::MAX`] when that overflows.
+    #[inline(always)]
+    pub const fn saturating_add(self, d: u64) -> Tick {
+        Tick(self.0.saturating_add(d))
+    }
+
     /// The tick number.
     #[inline(always)]
     pub const fn get(self) -> u64 {
@@ -102,6 +111,14 @@ impl Add<u64> for Tick {
     #[inline(always)]
     fn add(self, d: u64) -> Tick {
         Tick(self.0 + d)
+    }
+}
+
+impl Sub<u64> for Tick {
+    type Output = Tick;
+    #[inline(always)]
+    fn sub(self, d: u64) -> Tick {
+        Tick(self.0 - d)
     }
 }
 

@@ -86,7 +86,7 @@ pub struct DramStats {
 struct Epoch {
     row: u64,
     /// Tick of its activate.
-    act: u64,
+    act: Tick,
 }
 
 /// Ticks an epoch is kept after its `close` (reads arrive slightly out of order: fluffy
@@ -105,15 +105,15 @@ struct Bank {
     /// The open row (the last epoch's), or [`NO_ROW`].
     open_row: u64,
     /// Tick of the last activate.
-    act: u64,
+    act: Tick,
     /// Earliest tick of the next column command.
-    col_ready: u64,
+    col_ready: Tick,
     /// Tick of the last column command (for t_RTP).
-    last_col: u64,
+    last_col: Tick,
     /// The earliest epoch expires once a read's tick exceeds this: its close (the next
-    /// epoch's activate − t_RP − t_RTP) + [`EPOCH_KEEP`]; `u64::MAX` while only one epoch
+    /// epoch's activate − t_RP − t_RTP) + [`EPOCH_KEEP`]; `Tick::MAX` while only one epoch
     /// is live.
-    expiry: u64,
+    expiry: Tick,
     /// Bit `row mod 64` set for each live epoch but the last (and possibly for expired
     /// ones: refreshed whenever a read scans them all), so a read whose bit is clear has no
     /// earlier epoch of its row to try.
@@ -128,10 +128,10 @@ impl Default for Bank {
     fn default() -> Self {
         Self {
             open_row: NO_ROW,
-            act: 0,
-            col_ready: 0,
-            last_col: 0,
-            expiry: u64::MAX,
+            act: Tick(0),
+            col_ready: Tick(0),
+            last_col: Tick(0),
+            expiry: Tick::MAX,
             rows: 0,
             head: 0,
             len: 0,
@@ -153,7 +153,13 @@ impl Epochs {
     fn new(banks: usize) -> Self {
         let shift = 3;
         Self {
-            slab: vec![Epoch { row: 0, act: 0 }; banks << shift],
+            slab: vec![
+                Epoch {
+                    row: 0,
+                    act: Tick(0),
+                };
+                banks << shift
+            ],
             shift,
         }
     }
@@ -167,9 +173,9 @@ impl Epochs {
 
     /// `expiry` for bank `b` whose epochs are as they are now (`gap` = t_RP + t_RTP).
     #[inline]
-    fn expiry(&self, b: usize, bank: &Bank, gap: u64) -> u64 {
+    fn expiry(&self, b: usize, bank: &Bank, gap: u64) -> Tick {
         if bank.len < 2 {
-            u64::MAX
+            Tick::MAX
         } else {
             (self.slab[self.at(b, bank, 1)].act - gap).saturating_add(EPOCH_KEEP)
         }
@@ -178,14 +184,14 @@ impl Epochs {
     /// Drops bank `b`'s epochs closed more than [`EPOCH_KEEP`] ticks before tick `a` (the
     /// last epoch never closes).
     #[inline]
-    fn expire(&self, b: usize, bank: &mut Bank, a: u64, gap: u64) {
+    fn expire(&self, b: usize, bank: &mut Bank, a: Tick, gap: u64) {
         if bank.expiry < a {
             self.expire_slow(b, bank, a, gap);
         }
     }
 
     #[inline]
-    fn expire_slow(&self, b: usize, bank: &mut Bank, a: u64, gap: u64) {
+    fn expire_slow(&self, b: usize, bank: &mut Bank, a: Tick, gap: u64) {
         while bank.expiry < a {
             bank.head = bank.head.wrapping_add(1);
             bank.len -= 1;
@@ -196,7 +202,7 @@ impl Epochs {
     /// Opens `row` at tick `act` in bank `b` (the bank's open row and activate are still
     /// the previous epoch's; its ring has room: [`Dram::read_at`] grows it first).
     #[inline]
-    fn push(&mut self, b: usize, bank: &mut Bank, row: u64, act: u64, gap: u64) {
+    fn push(&mut self, b: usize, bank: &mut Bank, row: u64, act: Tick, gap: u64) {
         debug_assert!(bank.len < 1 << self.shift);
         let i = self.at(b, bank, bank.len);
         self.slab[i] = Epoch { row, act };
@@ -213,7 +219,13 @@ impl Epochs {
     #[cold]
     fn grow(&mut self, banks: &mut [Bank]) {
         let shift = self.shift + 1;
-        let mut slab = vec![Epoch { row: 0, act: 0 }; banks.len() << shift];
+        let mut slab = vec![
+            Epoch {
+                row: 0,
+                act: Tick(0),
+            };
+            banks.len() << shift
+        ];
         for (b, bank) in banks.iter_mut().enumerate() {
             for i in 0..bank.len {
                 slab[(b << shift) + i as usize] = self.slab[self.at(b, bank, i)];
@@ -346,15 +358,15 @@ impl Dram {
         ch.bus.forget_before(self.burst.div(floor));
         ch.acts.forget_before(floor);
         // The read's tick; the schedule below is in ticks.
-        let mut a = arrive.to_ticks(tpc).get();
+        let mut a = arrive.to_ticks(tpc);
         // Reads complete by `a` leave the queue: slot `s` completes at (s + 1) · t_burst ≤ a,
         // i.e. s < ⌊a / t_burst⌋ (every pending slot is at or after the bus floor, which
         // is at most that: the floor comes from `now ≤ arrive`).
-        ch.bus.retire_before(self.burst.div(a));
+        ch.bus.retire_before(self.burst.div(a.get()));
         if ch.bus.pending() >= c.read_queue
             && let Some(s) = ch.bus.retire_first()
         {
-            let d = s * c.t_burst + c.t_burst;
+            let d = Tick(s * c.t_burst + c.t_burst);
             self.stats.queue_wait_cycles += self.tpc.div_ceil(d - a);
             a = d;
         }
@@ -379,8 +391,8 @@ impl Dram {
                     continue;
                 }
                 // The column command waits for its data-bus slot (t_CAS before it).
-                let slot = ch.bus.peek(self.burst.div_ceil(col + c.t_cas));
-                if slot * c.t_burst - c.t_cas <= close {
+                let slot = ch.bus.peek(self.burst.div_ceil((col + c.t_cas).get()));
+                if Tick(slot * c.t_burst) - c.t_cas <= close {
                     hit = Some(slot);
                     break;
                 }
@@ -390,8 +402,8 @@ impl Dram {
             }
             if let Some(slot) = hit {
                 ch.bus.reserve_pending(slot);
-                let done = slot * c.t_burst + c.t_burst;
-                return self.finish(arrive, Tick(done), DramAccess::RowHit);
+                let done = Tick(slot * c.t_burst + c.t_burst);
+                return self.finish(arrive, done, DramAccess::RowHit);
             }
         }
         let (col, kind) = match bank.open_row {
@@ -405,10 +417,10 @@ impl Dram {
                 } else {
                     DramAccess::Closed
                 };
-                if open != NO_ROW || bank.act > 0 {
+                if open != NO_ROW || bank.act > Tick(0) {
                     act = act.max(bank.act + c.t_rc);
                 }
-                act = ch.acts.reserve_span(act, c.t_rrd.max(1));
+                act = Tick(ch.acts.reserve_span(act.get(), c.t_rrd.max(1)));
                 epochs.push(b, bank, row, act, gap);
                 bank.act = act;
                 bank.open_row = row;
@@ -420,9 +432,12 @@ impl Dram {
         // The data bus takes the first free burst slot once the data is ready; a read whose
         // row is open can use a slot before a conflicting read reserved earlier, which is
         // the effect of FR-FCFS on the bus.
-        let data = ch.bus.reserve_pending(self.burst.div_ceil(col + c.t_cas)) * c.t_burst;
-        let done = data + c.t_burst;
-        self.finish(arrive, Tick(done), kind)
+        let data = ch
+            .bus
+            .reserve_pending(self.burst.div_ceil((col + c.t_cas).get()))
+            * c.t_burst;
+        let done = Tick(data + c.t_burst);
+        self.finish(arrive, done, kind)
     }
 
     /// Counts a read arriving at core cycle `arrive` whose data is complete at tick `done`.
