@@ -2,6 +2,8 @@
 //! does to an [`Observer`]. The CPU path passes [`NoObserver`], which compiles away;
 //! statistics use [`CountingObserver`]; the simulator records macro-operations.
 
+use crate::dst::pipeline::ReturnCode;
+
 /// The kind of a dual-split tree node (the pipeline's derived 2-bit "node type").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum DstNodeKind {
@@ -29,12 +31,12 @@ pub enum NodeStep {
         hits: u8,
     },
     /// A dual-split tree node step: the node's kind and the pipeline's return code
-    /// (0 miss, 1 one child, 2 both children, 3 leaf; Lin et al. 2020, §3).
+    /// (Lin et al. 2020, §3).
     Dst {
         /// Node kind.
         kind: DstNodeKind,
-        /// Return code 0–3.
-        code: u8,
+        /// The return code: miss, one child, both children, leaf.
+        code: ReturnCode,
         /// For a carving node acting as a leaf (L bit set).
         carving_leaf: bool,
     },
@@ -108,7 +110,7 @@ impl Observer for CountingObserver {
                     self.nodes += 1;
                     self.plane_tests += 2;
                 }
-                self.dst_codes[code as usize & 3] += 1;
+                self.dst_codes[code as usize] += 1;
             }
             NodeStep::Leaf { .. } => self.leaves += 1,
         }

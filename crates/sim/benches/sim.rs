@@ -1,5 +1,5 @@
-//! Simulator speed: simulated node visits per host second (issue 5's speed bar: ≥ 2 M per
-//! core). `cargo bench -p dualsplit-sim`.
+//! Simulator speed: simulated node visits per host second (the project's speed bar: ≥ 2 M
+//! per core). `cargo bench -p dualsplit-sim`.
 //!
 //! `engine_node_visits`: the lin2020 chip (64 TMs × 32 threads) replaying a synthetic
 //! BVH2-like stream: per node visit one 13-word (52-byte) node load at a random node of a
@@ -10,17 +10,18 @@
 //! `frame_atrium`: a whole 64×64 path-traced frame of the builtin architectural scene
 //! (`builtin:atrium`) in each of the eight configurations, counted the same way (a BVH8
 //! visit loads a 200-byte node and tests 8 boxes, a DST visit one 8–20-byte node).
-//! `frame_dragon`: a 128×128 path-traced frame of `../shared/scenes/dragon_box.ply.gz` (the
-//! issue's scene; skipped with a note when the file is absent), every configuration.
+//! `frame_dragon`: a 128×128 path-traced frame of the shipped `dragon_box.ply.gz` (read from
+//! the scenes folder beside the repository; skipped with a note when the file is absent),
+//! every configuration.
 //!
 //! The synthetic stream is a stress case, not a typical frame: 1.54 DRAM reads per visit
 //! and 100-visit programs, where the dragon_box 512² BVH2 path frame makes 0.20 DRAM reads
-//! per visit and 11.7 visits per ray (`docs/performance.md`, "Simulator speed").
+//! per visit and 11.7 visits per ray.
 
 use divan::counter::ItemsCount;
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
-use dualsplit_sim::engine::{Chip, Thread, WorkSource, run_chip};
 use dualsplit_sim::kernel::{Op, Pipe};
+use dualsplit_sim::{Chip, Thread, WorkSource, run_chip};
 use dualsplit_sim::{SimAccel, SimConfig, simulate};
 use std::sync::OnceLock;
 
@@ -44,7 +45,7 @@ impl WorkSource for Synthetic {
         }
         self.programs_left -= 1;
         let v = self.visits_per_program as usize;
-        let mut ops = std::mem::take(&mut t.ops);
+        let mut ops = t.take_ops();
         ops.clear();
         ops.reserve_exact(3 * v + 2 * (v / 8));
         for v in 0..self.visits_per_program {

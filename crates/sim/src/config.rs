@@ -44,7 +44,7 @@ pub struct CacheConfig {
     /// Hit latency in core cycles (for L2: on top of the L1 latency).
     pub hit_latency: u64,
     /// L2 only: bank = line address mod banks (`true`, the default and lin2020) or word
-    /// address mod banks (`false`, SimTRaX's `L2Cache.cc`, notes §1.4; a sensitivity option).
+    /// address mod banks (`false`, SimTRaX's `L2Cache.cc`; a sensitivity option).
     /// An L2 access moves a whole 64-byte line, which a real banked cache keeps in one bank
     /// (sequential interleaving by block address, Hennessy & Patterson, *Computer
     /// Architecture*, 5th ed., §2.2 "multibanked caches"); SimTRaX's word rule sends an L1

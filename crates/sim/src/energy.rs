@@ -1,9 +1,12 @@
-//! Energy: event counts × per-event energies (notes §1.9, §4.2), split like the paper's
+//! Energy: event counts × per-event energies, as SimTRaX counts them (`main.cc`,
+//! `ReadConfig.cc`: one L1 access per load word, one L2 access per L1 miss that reaches it,
+//! one icache fetch and 3 register-file accesses per instruction; per-event energies from
+//! the SimTRaX 65 nm configs and the paper's Table 2), split like the paper's
 //! Table 6 into DRAM, caches (L1, L2, instruction caches, register files, local stores) and
 //! compute (functional units and pipelines). No on-chip leakage, as in SimTRaX.
 
-use crate::engine::CacheStats;
 use crate::kernel::InstrCounts;
+use crate::memory::CacheStats;
 use crate::memory::DramStats;
 use crate::{EnergySplit, SimConfig};
 

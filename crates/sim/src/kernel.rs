@@ -8,6 +8,7 @@
 //! justified one by one in `docs/simulator.md` ("Instruction counts per kernel step").
 
 use crate::SimAccel;
+use dualsplit_accel::dst::pipeline::ReturnCode;
 use dualsplit_accel::{DstNodeKind, NodeStep, Observer};
 use serde::{Deserialize, Serialize};
 
@@ -116,12 +117,12 @@ pub const BVH_SORT_PAIR: Mix = Mix::new(2, 0, 0, 1, 0, 0);
 ///         mov   tmax, tmax_out
 ///         j     LOOP             ; code 2: 8
 /// ```
-pub const fn dst_hw_step(code: u8) -> Mix {
+pub const fn dst_hw_step(code: ReturnCode) -> Mix {
     match code {
-        0 => Mix::new(1, 0, 0, 0, 0, 0),
-        1 => Mix::new(7, 0, 0, 0, 0, 0),
-        2 => Mix::new(8, 0, 0, 0, 0, 0),
-        _ => Mix::new(5, 0, 0, 0, 0, 0),
+        ReturnCode::Miss => Mix::new(1, 0, 0, 0, 0, 0),
+        ReturnCode::OneChild => Mix::new(7, 0, 0, 0, 0, 0),
+        ReturnCode::BothChildren => Mix::new(8, 0, 0, 0, 0, 0),
+        ReturnCode::Leaf => Mix::new(5, 0, 0, 0, 0, 0),
     }
 }
 
@@ -141,8 +142,8 @@ pub const DST_POP: Mix = Mix::new(3, 0, 0, 2, 0, 3);
 /// min/max and the interval tests are FP compares, and a child is addressed from the 26-bit
 /// offset (and B, the left size, for the right child). Every instruction is written out in
 /// `docs/simulator.md` ("DST* decoder sequences").
-pub const fn dst_sw_step(kind: DstNodeKind, code: u8) -> Mix {
-    let hit = code != 0;
+pub const fn dst_sw_step(kind: DstNodeKind, code: ReturnCode) -> Mix {
+    let hit = !matches!(code, ReturnCode::Miss);
     match kind {
         // dispatch 3, axis 1, index 2 + 2 local loads, 2 × (sub, mul), sign select (bltz,
         // mov, j, mul widen), 2 tests (2 cmp, 2 branches); then code 0: j POP (12 int);
@@ -150,9 +151,9 @@ pub const fn dst_sw_step(kind: DstNodeKind, code: u8) -> Mix {
         // (bltz, 2 mov), t_max = min / t_min = max (1 cmp), mov node, j LOOP (23 int); code 2
         // adds the pushed entry's t_min = max(t_min, t2) (1 cmp).
         DstNodeKind::Split => match code {
-            0 => Mix::new(12, 2, 3, 2, 0, 2),
-            1 => Mix::new(23, 2, 3, 3, 0, 2),
-            _ => Mix::new(23, 2, 3, 4, 0, 2),
+            ReturnCode::Miss => Mix::new(12, 2, 3, 2, 0, 2),
+            ReturnCode::OneChild => Mix::new(23, 2, 3, 3, 0, 2),
+            ReturnCode::BothChildren | ReturnCode::Leaf => Mix::new(23, 2, 3, 4, 0, 2),
         },
         // dispatch 5 (bltz, srl, andi, addi, bnez), axis 2 (srl, andi), index 2 + 2 local,
         // 2 × (sub, mul), sign select 3 + mul, lo = max, hi = min (2 cmp), empty test (1 cmp,
@@ -195,10 +196,11 @@ pub enum Pipe {
     DualSplit,
 }
 
-/// A macro-operation of a simulated thread (notes §5.2).
+/// A macro-operation of a simulated thread: an instruction run, a load, or a pipeline op.
 ///
 /// Eight bytes (a one-byte tag and narrow fields), so that the replay's op buffers take
-/// half the host cache lines of a 16-byte op (`docs/performance.md`, "Simulator speed").
+/// half the host cache lines of a 16-byte op (`docs/simulator.md`, "How the simulator
+/// runs fast").
 /// The narrow fields are checked where ops are made ([`Op::load`], [`Recorder`]): a value
 /// that does not fit is an [`OpRangeError`], never a silent wrap.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -361,7 +363,7 @@ const DST_HW_TOTAL: [u64; 4] = {
     let mut t = [0; 4];
     let mut c = 0;
     while c < 4 {
-        t[c] = dst_hw_step(c as u8).total();
+        t[c] = dst_hw_step(ReturnCode::ALL[c]).total();
         c += 1;
     }
     t
@@ -374,7 +376,7 @@ const DST_SW_TOTAL: [[u64; 4]; 4] = {
     while k < 4 {
         let mut c = 0;
         while c < 4 {
-            t[k][c] = dst_sw_step(DST_KINDS[k], c as u8).total();
+            t[k][c] = dst_sw_step(DST_KINDS[k], ReturnCode::ALL[c]).total();
             c += 1;
         }
         k += 1;
@@ -482,11 +484,11 @@ impl Tally {
         m.add(BVH_PER_HIT.times(bvh_hits));
         m.add(BVH_SORT_PAIR.times(bvh_pairs_sum));
         for (kind, row) in DST_KINDS.into_iter().zip(&s.dst) {
-            for (code, &n) in row.iter().enumerate() {
+            for (code, &n) in ReturnCode::ALL.into_iter().zip(row) {
                 let step = if self.accel == SimAccel::Dst {
-                    dst_hw_step(code as u8)
+                    dst_hw_step(code)
                 } else {
-                    dst_sw_step(kind, code as u8)
+                    dst_sw_step(kind, code)
                 };
                 m.add(step.times(n));
             }
@@ -517,8 +519,8 @@ impl Tally {
 /// Consecutive instruction runs merge into one [`Op::Issue`]. The run being merged is kept
 /// in the recorder, not in the op buffer, and written out when a load or pipeline op follows
 /// or the recording ends ([`Recorder::finish`], [`Recorder::finish_open`]); a kernel step
-/// adds its instruction count to the run and 1 to its kind's counter in the tally
-/// (`docs/performance.md`, "Fifth round"). The ops and counts are exactly those of merging
+/// adds its instruction count to the run and 1 to its kind's counter in the tally (one
+/// add each instead of a read-modify-write of the buffer's last op). The ops and counts are exactly those of merging
 /// into the buffer's last op and adding each step's mix; a test compares both on random
 /// event streams.
 pub struct Recorder<'a> {
@@ -729,8 +731,7 @@ impl Observer for Recorder<'_> {
                 }
             }
             NodeStep::Dst { kind, code, .. } => {
-                // Codes above 3 take code 3's mix in both step functions.
-                let (k, c) = (kind as usize & 3, code.min(3) as usize);
+                let (k, c) = (kind as usize, code as usize);
                 self.tally.steps.dst[k][c] += 1;
                 if self.dst_hw {
                     self.pipe(Pipe::DualSplit, 1, false);
@@ -775,8 +776,8 @@ mod tests {
     use super::*;
     use dualsplit_geometry::Pcg32;
 
-    /// The recorder before the fifth round (`docs/performance.md`): every instruction run is
-    /// merged into the op buffer's last op. Kept as the reference of
+    /// A plain recorder: every instruction run is merged into the op buffer's last op. The
+    /// reference of
     /// `recorder_matches_merging_into_the_last_op`.
     struct Reference<'a> {
         accel: SimAccel,
@@ -905,7 +906,7 @@ mod tests {
             }
             2 => obs.step(NodeStep::Dst {
                 kind: DST_KINDS[rng.below(4) as usize],
-                code: rng.below(4) as u8,
+                code: ReturnCode::ALL[rng.below(4) as usize],
                 carving_leaf: rng.below(2) == 1,
             }),
             3 => obs.step(NodeStep::Leaf {
@@ -1127,8 +1128,8 @@ mod tests {
 
     #[test]
     fn frame_totals_do_not_wrap_at_2_pow_32() {
-        // A 512×512 DST* path-traced frame issues ~6·10^9 instructions; model 2's u32
-        // counters wrapped (energy and issue utilisation came out too low).
+        // A 512×512 DST* path-traced frame issues ~6·10^9 instructions: u32 counters would
+        // wrap (energy and issue utilisation would come out too low).
         let mut c = InstrCounts::default();
         let big = InstrCounts {
             mix: Mix::new(3_000_000_000, 0, 0, 0, 0, 2_000_000_000),
@@ -1144,7 +1145,7 @@ mod tests {
     fn dst_hw_is_one_pipeline_op_and_sw_is_instructions() {
         let step = NodeStep::Dst {
             kind: DstNodeKind::Split,
-            code: 2,
+            code: ReturnCode::BothChildren,
             carving_leaf: false,
         };
         let mut ops = Vec::new();

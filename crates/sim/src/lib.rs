@@ -7,10 +7,12 @@
 //!  workload.rs ── per pixel ──▶ kernel::Recorder ──▶ Vec<Op>  (macro-ops, functional first)
 //!                                                        │
 //!                                                        ▼  timing second
-//!  engine.rs: threads on TMs, heap of wake-up cycles, reservation tables
-//!      ├─ per TM: L1 (banks, tags with fill times), ray-box / ray-triangle / dual-split
-//!      │          pipelines, shared reciprocal unit
-//!      └─ chip:   L2 (banks, tags), memory::dram (GDDR5 row buffers, buses, read queues)
+//!  chip.rs: the event loop; scheduler.rs: timing wheel of thread wake-ups
+//!      ├─ thread.rs: thread processors replaying the ops (single issue, in order)
+//!      ├─ tm.rs (per TM): L1 (banks, tags with fill times), ray-box / ray-triangle /
+//!      │          dual-split pipelines, shared reciprocal unit
+//!      ├─ atomic.rs: the global atomic unit (pixel hand-out)
+//!      └─ memory/: l2.rs (banks, tags), dram.rs (GDDR5 row buffers, buses, read queues)
 //!                                                        │
 //!                                                        ▼
 //!  energy.rs: counts × per-event energy, split like Table 6 ──▶ SimResult
@@ -33,12 +35,17 @@
 //! println!("{} cycles, {:.3} ms", r.cycles, r.frame_ms);
 //! ```
 
+pub mod atomic;
+pub mod chip;
 pub mod config;
+mod cycle;
 pub mod energy;
-pub mod engine;
 pub mod kernel;
 pub mod memory;
+mod scheduler;
 pub mod slots;
+pub mod thread;
+pub mod tm;
 mod workload;
 
 /// Version of the timing and energy model. Bump it whenever a change alters simulated results
@@ -46,18 +53,18 @@ mod workload;
 /// frames are recomputed.
 pub const MODEL_VERSION: u32 = 4;
 
+pub use chip::{Chip, ChipStats, WorkSource, run_chip};
 pub use config::{CacheConfig, ConfigError, DramConfig, EnergyConfig, SimConfig, UnitConfig};
-pub use engine::{CacheStats, Stalls, UnitStats};
+pub use cycle::{Cycle, Tick};
 pub use kernel::{InstrCounts, Mix};
-pub use memory::DramStats;
+pub use memory::{CacheStats, DramStats};
+pub use thread::{Stalls, Thread};
+pub use tm::{Issued, Tm, UnitStats, WordAddr};
 
 use dualsplit_accel::{AccelKind, Structures};
 use dualsplit_render::RenderSettings;
 use dualsplit_scene::Scene;
 use serde::{Deserialize, Serialize};
-
-/// A core clock cycle.
-pub type Cycle = u64;
 
 /// The eight simulated configurations of the paper (§4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -1,12 +1,14 @@
 //! Reservation tables. [`Slots`]: one resource that accepts one operation per cycle, a
 //! 128-cycle bitmap window, so a request can take a free cycle *before* a later reservation
 //! (a plain next-free counter cannot fill such holes, which serialises threads whose issue
-//! cycles are slightly out of order; notes §5.2 "fluffy time"). [`BankSlots`]: the 16 word
+//! cycles are slightly out of order: Sniper's "fluffy time", snipersim.org/w/Causality). [`BankSlots`]: the 16 word
 //! banks of one TM's L1, one bitmap per bank/cycle diagonal, so the words of a line segment
 //! are placed with one test. [`SparseSlots`]: DRAM buses and activation spacing, whose
 //! reservations can lie far ahead, in a growing bitmap ring.
 
-use crate::Cycle;
+/// A time slot of a table: a core cycle, a DRAM tick or a DRAM bus burst, as its owner
+/// counts (the units convert their typed time at the call).
+pub type Slot = u64;
 
 const WINDOW: u64 = 128;
 
@@ -15,7 +17,7 @@ const WINDOW: u64 = 128;
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(align(32))]
 pub struct Slots {
-    base: Cycle,
+    base: Slot,
     /// The 128-cycle window as two 64-bit words (bit `i` of word `h`: cycle
     /// `base + 64 h + i` is taken), so the fast path tests and sets one word instead of
     /// shifting a 128-bit value (a dozen instructions on x86-64).
@@ -36,7 +38,7 @@ impl Slots {
 
     /// Reserves the first free cycle at or after `c` and returns it.
     #[inline]
-    pub fn reserve(&mut self, c: Cycle) -> Cycle {
+    pub fn reserve(&mut self, c: Slot) -> Slot {
         // Fast path (most requests): `c` inside the window and a free cycle from `c` on in
         // the same 64-cycle word (bit j of `free`: cycle `c + j` is free; the zeros
         // shifted in at the top are not free). That is the first free cycle from `c`:
@@ -60,7 +62,7 @@ impl Slots {
     /// before it), sliding by half while the window is full from there. The offset stays
     /// below `WINDOW` throughout, so the search is one shift and one bit scan per step.
     #[inline(never)]
-    fn reserve_slow(&mut self, c: Cycle) -> Cycle {
+    fn reserve_slow(&mut self, c: Slot) -> Slot {
         let mut mask = self.mask();
         let mut off = if c >= self.base + WINDOW {
             // Keep the last 64 cycles of history before `c`.
@@ -88,7 +90,7 @@ impl Slots {
 
     /// The first free cycle at or after `c`, without reserving it.
     #[inline]
-    pub fn peek(&self, c: Cycle) -> Cycle {
+    pub fn peek(&self, c: Slot) -> Slot {
         let mut copy = *self;
         copy.reserve(c)
     }
@@ -99,7 +101,7 @@ impl Slots {
 /// issues one word per cycle, so the consecutive words of a line segment that meet no
 /// conflict lie on one diagonal `d = (bank − cycle) mod banks`. Each diagonal is a bitmap
 /// over cycles, so a whole segment's bank-conflict check is one masked word test instead of
-/// one test per word (notes §5.2).
+/// one test per word.
 ///
 /// Semantics: a word takes the first cycle at or after its request at which its bank is
 /// free, exactly as one [`Slots`] per bank, but without a per-bank window: every
@@ -111,14 +113,14 @@ pub struct BankSlots {
     /// `banks − 1` (power-of-two bank count).
     bank_mask: u64,
     /// First cycle covered (a multiple of 64); the ring covers `[lo, lo + 64 · words)`.
-    lo: Cycle,
+    lo: Slot,
     /// 64-cycle words per diagonal (a power of two).
     words: usize,
     /// log2(banks).
     bank_shift: u32,
     /// `lo + 64 · words`: the first cycle past the ring (kept so the fast path's bound is
     /// one compare).
-    end: Cycle,
+    end: Slot,
     /// `bits[(x / 64 mod words) · banks + d]` bit `x mod 64`: bank `(d + x) mod banks` is
     /// taken at cycle `x`.
     bits: Vec<u64>,
@@ -128,9 +130,9 @@ pub struct BankSlots {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Placed {
     /// Cycle of the first word.
-    pub first: Cycle,
+    pub first: Slot,
     /// Cycle of the last word.
-    pub last: Cycle,
+    pub last: Slot,
     /// Cycles the words waited for busy banks (summed over words).
     pub stall: u64,
     /// Words placed at or after the `from` cycle given to `reserve_run`.
@@ -140,7 +142,7 @@ pub struct Placed {
 /// How many of `n` words at consecutive cycles `c .. c + n` are at or after cycle `from`
 /// (the words of a line segment that find its fill arrived: L1 hits).
 #[inline]
-pub fn at_or_after(c: Cycle, n: u64, from: Cycle) -> u64 {
+pub fn at_or_after(c: Slot, n: u64, from: Slot) -> u64 {
     (c + n).saturating_sub(c.max(from)).min(n)
 }
 
@@ -166,7 +168,7 @@ impl BankSlots {
     /// Makes the ring cover `[c, hi]` (`now ≤ c`): recycles cycles before `now`, grows when
     /// that is not enough.
     #[inline]
-    fn cover(&mut self, hi: Cycle, now: Cycle) {
+    fn cover(&mut self, hi: Slot, now: Slot) {
         if hi < self.end {
             return;
         }
@@ -174,7 +176,7 @@ impl BankSlots {
     }
 
     #[inline(never)]
-    fn cover_slow(&mut self, hi: Cycle, now: Cycle) {
+    fn cover_slow(&mut self, hi: Slot, now: Slot) {
         let banks = self.bank_mask as usize + 1;
         let new_lo = (now & !63).max(self.lo);
         let (old_w, new_w) = (self.lo >> 6, new_lo >> 6);
@@ -208,7 +210,7 @@ impl BankSlots {
 
     /// Taken-bits of diagonal `d` for cycles `[c, c + k)`, `1 ≤ k ≤ 64` (bit i: cycle c + i).
     #[inline]
-    fn taken(&self, d: usize, c: Cycle, k: u64) -> u64 {
+    fn taken(&self, d: usize, c: Slot, k: u64) -> u64 {
         let wm = self.words - 1;
         let i = (c >> 6) as usize & wm;
         let sh = c & 63;
@@ -221,7 +223,7 @@ impl BankSlots {
 
     /// Marks cycles `[c, c + k)` of diagonal `d` taken, `1 ≤ k ≤ 64`.
     #[inline]
-    fn take(&mut self, d: usize, c: Cycle, k: u64) {
+    fn take(&mut self, d: usize, c: Slot, k: u64) {
         let wm = self.words - 1;
         let i = (c >> 6) as usize & wm;
         let sh = c & 63;
@@ -239,7 +241,7 @@ impl BankSlots {
     /// same cycles as placing the words one by one on per-bank tables that remember every
     /// reservation. `c ≥ now` (the current event time).
     #[inline]
-    pub fn reserve_run(&mut self, bank: u64, c: Cycle, n: u64, now: Cycle, from: Cycle) -> Placed {
+    pub fn reserve_run(&mut self, bank: u64, c: Slot, n: u64, now: Slot, from: Slot) -> Placed {
         debug_assert!(n >= 1 && c >= now && c >= self.lo);
         // Fast path (most runs): every word's bank is free in its cycle, one word test.
         if self.try_run(bank, c, n) {
@@ -258,7 +260,7 @@ impl BankSlots {
     /// When it does, [`BankSlots::reserve_run`] would have placed the words exactly there
     /// (no stall); when it does not, nothing is taken.
     #[inline]
-    pub fn try_run(&mut self, bank: u64, c: Cycle, n: u64) -> bool {
+    pub fn try_run(&mut self, bank: u64, c: Slot, n: u64) -> bool {
         debug_assert!(n >= 1 && c >= self.lo);
         if n <= 64 && c + n <= self.end {
             let d = (bank.wrapping_sub(c) & self.bank_mask) as usize;
@@ -271,7 +273,7 @@ impl BankSlots {
     }
 
     #[inline(never)]
-    fn reserve_run_slow(&mut self, bank: u64, c: Cycle, n: u64, now: Cycle, from: Cycle) -> Placed {
+    fn reserve_run_slow(&mut self, bank: u64, c: Slot, n: u64, now: Slot, from: Slot) -> Placed {
         let mut bank = bank;
         let mut c = c;
         let mut left = n;
@@ -318,7 +320,7 @@ impl BankSlots {
     /// (its stall is the result − `c`) without a run's bookkeeping, for a line segment's
     /// first word after [`BankSlots::try_run`] found a conflict.
     #[inline]
-    pub fn reserve_word(&mut self, bank: u64, c: Cycle, now: Cycle) -> Cycle {
+    pub fn reserve_word(&mut self, bank: u64, c: Slot, now: Slot) -> Slot {
         let x = self.first_free(bank, c, now);
         let d = (bank.wrapping_sub(x) & self.bank_mask) as usize;
         self.take(d, x, 1);
@@ -326,7 +328,7 @@ impl BankSlots {
     }
 
     /// The first cycle at or after `c` at which `bank` is free.
-    fn first_free(&mut self, bank: u64, c: Cycle, now: Cycle) -> Cycle {
+    fn first_free(&mut self, bank: u64, c: Slot, now: Slot) -> Slot {
         let mut x = c;
         loop {
             self.cover(x, now);
@@ -355,27 +357,27 @@ impl BankSlots {
 /// plane 1 marks reservations still *pending* ([`SparseSlots::reserve_pending`]): a DRAM
 /// channel's in-flight reads, each identified by its data-bus slot, so the read queue's
 /// bookkeeping lives in the host cache line of the bus reservation it belongs to instead
-/// of a separate heap (Lin et al. 2020, §5's GDDR5 model; notes §3.3).
+/// of a separate heap (USIMM's per-channel read queue, `memory_controller.cc`).
 #[derive(Clone, Debug)]
 pub struct SparseSlots<const P: usize = 1> {
     /// First cycle covered (a multiple of 64); the ring covers `[lo, lo + 64 · words.len())`
     /// and every reservation ever made at or after `lo` lies in it.
-    lo: Cycle,
+    lo: Slot,
     /// `words[(x / 64) mod len][p]` bit `x mod 64`: cycle `x` is taken (`p = 0`) or pending
     /// (`p = 1`); power-of-two length.
     words: Box<[[u64; P]]>,
     /// No request starts before this cycle (`forget_before`).
-    floor: Cycle,
+    floor: Slot,
     /// Pending cycles (plane 1).
     pending: u32,
     /// The earliest pending cycle, while `pending > 0`.
-    first_pending: Cycle,
+    first_pending: Slot,
     /// No span of `known_len` cycles starting in `[known_from, known_to)` fits (each
     /// overlaps a reservation): what the last searches found, so the next request in that
     /// range starts searching at `known_to`. Reservations are never removed at or after
     /// the floor, so a start that does not fit never fits later.
-    known_from: Cycle,
-    known_to: Cycle,
+    known_from: Slot,
+    known_to: Slot,
     known_len: u64,
 }
 
@@ -398,37 +400,37 @@ impl<const P: usize> SparseSlots<P> {
     /// Forgets reservations before `floor`: no later request starts before `floor`, so they
     /// can no longer collide with one (results are unchanged).
     #[inline]
-    pub fn forget_before(&mut self, floor: Cycle) {
+    pub fn forget_before(&mut self, floor: Slot) {
         self.floor = self.floor.max(floor);
     }
 
     #[inline]
-    fn end(&self) -> Cycle {
+    fn end(&self) -> Slot {
         self.lo + ((self.words.len() as u64) << 6)
     }
 
     /// Ring index of cycle `x`'s word.
     #[inline]
-    fn index(&self, x: Cycle) -> usize {
+    fn index(&self, x: Slot) -> usize {
         (x >> 6) as usize & (self.words.len() - 1)
     }
 
     #[inline]
-    fn word(&self, x: Cycle) -> u64 {
+    fn word(&self, x: Slot) -> u64 {
         self.words[self.index(x)][0]
     }
 
     /// Makes the ring cover cycle `hi` (recycling cycles before the floor, growing if that
     /// is not enough).
     #[inline]
-    fn cover(&mut self, hi: Cycle) {
+    fn cover(&mut self, hi: Slot) {
         if hi >= self.end() {
             self.cover_slow(hi);
         }
     }
 
     #[inline(never)]
-    fn cover_slow(&mut self, hi: Cycle) {
+    fn cover_slow(&mut self, hi: Slot) {
         let n = self.words.len();
         let new_lo = (self.floor & !63).max(self.lo);
         let (old_w, new_w) = (self.lo >> 6, new_lo >> 6);
@@ -452,7 +454,7 @@ impl<const P: usize> SparseSlots<P> {
     /// Taken-bits of cycles `[s, s + len)`, `1 ≤ len ≤ 64`, `lo ≤ s < end` (bit i: s + i;
     /// cycles past the ring are free).
     #[inline]
-    fn window(&self, s: Cycle, len: u64) -> u64 {
+    fn window(&self, s: Slot, len: u64) -> u64 {
         let sh = s & 63;
         let mut m = self.word(s) >> sh;
         if sh + len > 64 && (s | 63) + 1 < self.end() {
@@ -463,7 +465,7 @@ impl<const P: usize> SparseSlots<P> {
 
     /// Marks cycles `[s, s + len)` taken (`1 ≤ len ≤ 64`, inside the ring).
     #[inline]
-    fn mark(&mut self, s: Cycle, len: u64) {
+    fn mark(&mut self, s: Slot, len: u64) {
         let sh = s & 63;
         let m = u64::MAX >> (64 - len);
         let i = self.index(s);
@@ -481,7 +483,7 @@ impl<const P: usize> SparseSlots<P> {
     /// one, no start in `[s, x]` fits (each such span contains `x`), so the search goes on
     /// from `x + 1`. A saturated backlog (runs of taken words) costs one step per word, a
     /// fragmented one one step per gap.
-    fn find(&self, c: Cycle, len: u64) -> Cycle {
+    fn find(&self, c: Slot, len: u64) -> Slot {
         debug_assert!(c >= self.lo && (1..=64).contains(&len));
         let mut s = c;
         let end = self.end();
@@ -506,14 +508,14 @@ impl<const P: usize> SparseSlots<P> {
     }
 
     /// The first free cycle at or after `c`, without reserving it.
-    pub fn peek(&self, c: Cycle) -> Cycle {
+    pub fn peek(&self, c: Slot) -> Slot {
         debug_assert!(c >= self.floor);
         self.find(c.max(self.lo), 1)
     }
 
     /// Reserves the first free cycle at or after `c` and returns it.
     #[inline]
-    pub fn reserve(&mut self, c: Cycle) -> Cycle {
+    pub fn reserve(&mut self, c: Slot) -> Slot {
         debug_assert!(c >= self.floor);
         // Fast path (most requests): `c` inside the ring and free.
         if c >= self.lo && c < self.end() {
@@ -531,7 +533,7 @@ impl<const P: usize> SparseSlots<P> {
     /// where it overlaps no other span (spans are all `len` long, so starts end up at least
     /// `len` apart: a minimum spacing such as t_RRD between activations).
     #[inline]
-    pub fn reserve_span(&mut self, c: Cycle, len: u64) -> Cycle {
+    pub fn reserve_span(&mut self, c: Slot, len: u64) -> Slot {
         debug_assert!(c >= self.floor && (1..=64).contains(&len));
         // Fast path: the first start not known not to fit (`c`, or the end of the known
         // range when `c` lies in it) is inside the ring and free.
@@ -548,7 +550,7 @@ impl<const P: usize> SparseSlots<P> {
     }
 
     #[inline(never)]
-    fn reserve_slow(&mut self, c: Cycle, len: u64) -> Cycle {
+    fn reserve_slow(&mut self, c: Slot, len: u64) -> Slot {
         let c = c.max(self.lo);
         let known = len == self.known_len && self.known_from <= c && c <= self.known_to;
         let s = self.find(if known { self.known_to } else { c }, len);
@@ -570,7 +572,7 @@ impl SparseSlots<2> {
     /// [`SparseSlots::retire_first`]). The owner retires every pending cycle before it
     /// raises the floor past it.
     #[inline]
-    pub fn reserve_pending(&mut self, c: Cycle) -> Cycle {
+    pub fn reserve_pending(&mut self, c: Slot) -> Slot {
         let s = self.reserve(c);
         let i = self.index(s);
         self.words[i][1] |= 1 << (s & 63);
@@ -589,14 +591,14 @@ impl SparseSlots<2> {
 
     /// Retires every pending cycle before `limit`.
     #[inline]
-    pub fn retire_before(&mut self, limit: Cycle) {
+    pub fn retire_before(&mut self, limit: Slot) {
         if self.pending > 0 && self.first_pending < limit {
             self.retire_before_slow(limit);
         }
     }
 
     #[inline(never)]
-    fn retire_before_slow(&mut self, limit: Cycle) {
+    fn retire_before_slow(&mut self, limit: Slot) {
         let mut x = self.first_pending;
         loop {
             // `x < limit` is the earliest pending cycle: clear its word's bits below `limit`.
@@ -627,7 +629,7 @@ impl SparseSlots<2> {
 
     /// Retires the earliest pending cycle and returns it (`None` when none is pending).
     #[inline]
-    pub fn retire_first(&mut self) -> Option<Cycle> {
+    pub fn retire_first(&mut self) -> Option<Slot> {
         if self.pending == 0 {
             return None;
         }
@@ -649,7 +651,7 @@ impl SparseSlots<2> {
 
     /// The first pending cycle at or after `from` (one exists: `pending > 0` and none
     /// before `from`).
-    fn next_pending(&self, from: Cycle) -> Cycle {
+    fn next_pending(&self, from: Slot) -> Slot {
         let mut x = from;
         loop {
             debug_assert!(x < self.end(), "no pending cycle from {from}");
@@ -707,14 +709,14 @@ mod tests {
         assert_eq!(s.reserve_span(1990, 13), 2300);
     }
 
-    /// `Slots::reserve_slow` before its search was simplified (the test's reference).
+    /// A plain 128-bit-window table searched bit by bit (the test's reference).
     #[derive(Clone, Copy, Default)]
     struct OldSlots {
-        base: Cycle,
+        base: Slot,
         mask: u128,
     }
     impl OldSlots {
-        fn reserve(&mut self, c: Cycle) -> Cycle {
+        fn reserve(&mut self, c: Slot) -> Slot {
             let off = c.wrapping_sub(self.base);
             if off < WINDOW && self.mask & (1u128 << off) == 0 {
                 self.mask |= 1u128 << off;
@@ -828,9 +830,9 @@ mod bank_tests {
 
     /// One bank's reservations, all remembered: the first free cycle at or after a request.
     #[derive(Clone, Default)]
-    struct Ideal(BTreeSet<Cycle>);
+    struct Ideal(BTreeSet<Slot>);
     impl Ideal {
-        fn reserve(&mut self, c: Cycle) -> Cycle {
+        fn reserve(&mut self, c: Slot) -> Slot {
             let mut x = c;
             while self.0.contains(&x) {
                 x += 1;
@@ -842,11 +844,11 @@ mod bank_tests {
 
     /// Places `n` words one by one on per-bank tables: (slots, stall).
     fn word_by_word(
-        banks: &mut [impl FnMut(Cycle) -> Cycle],
+        banks: &mut [impl FnMut(Slot) -> Slot],
         bank: u64,
-        c: Cycle,
+        c: Slot,
         n: u64,
-    ) -> (Vec<Cycle>, u64) {
+    ) -> (Vec<Slot>, u64) {
         let mut x = c;
         let mut stall = 0;
         let mut slots = Vec::new();
@@ -859,7 +861,7 @@ mod bank_tests {
         (slots, stall)
     }
 
-    fn check(p: Placed, slots: &[Cycle], stall: u64, from: Cycle, what: &str) {
+    fn check(p: Placed, slots: &[Slot], stall: u64, from: Slot, what: &str) {
         assert_eq!(p.first, slots[0], "{what}");
         assert_eq!(p.last, *slots.last().unwrap(), "{what}");
         assert_eq!(p.stall, stall, "{what}");
@@ -954,7 +956,7 @@ mod bank_tests {
     }
 
     /// Under light contention (no request far behind an earlier one on its bank) the
-    /// result is also that of one 128-cycle-window [`Slots`] per bank, the previous model.
+    /// result is also that of one 128-cycle-window [`Slots`] per bank.
     #[test]
     fn bank_runs_match_per_bank_windows_under_light_load() {
         for seed in 0..100 {
@@ -1000,8 +1002,8 @@ mod bank_tests {
         }
     }
 
-    /// The pending plane against a min-heap of the pending cycles (the DRAM read queue's
-    /// previous form): cycles reserved in a jittered order ahead of a rising floor, some far
+    /// The pending plane against a min-heap of the pending cycles (the plain form of a
+    /// DRAM read queue): cycles reserved in a jittered order ahead of a rising floor, some far
     /// ahead, retired in bulk below a limit that moves back and forth (never below the
     /// floor) and one at a time from the earliest, as a full read queue does.
     #[test]
@@ -1060,7 +1062,7 @@ mod bank_tests {
                 let far = if rng.below(50) == 0 { 5000 } else { 0 };
                 let c = floor + far + rng.below(spread) as u64;
                 let free =
-                    |set: &BTreeSet<Cycle>, s: Cycle, l: u64| (s..s + l).all(|x| !set.contains(&x));
+                    |set: &BTreeSet<Slot>, s: Slot, l: u64| (s..s + l).all(|x| !set.contains(&x));
                 let mut p = c;
                 while !free(&set, p, 1) {
                     p += 1;

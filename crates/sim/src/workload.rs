@@ -1,9 +1,11 @@
 //! The workload: threads take pixels from a global atomic counter in scanline order and run
 //! each pixel's [`PixelJob`] through the real traversal with a [`Recorder`] (Lin et al.
-//! 2020, §4.3–4.4; notes §5.2).
+//! 2020, §4.3–4.4). Ray paths do not depend on timing, so tracing them functionally and
+//! replaying the recorded ops is exact.
 
-use crate::engine::{Chip, Thread, WorkSource, run_chip};
+use crate::chip::{Chip, WorkSource, run_chip};
 use crate::kernel::{Mix, Op, Recorder, Run, Tally};
+use crate::thread::Thread;
 use crate::{SimAccel, SimConfig, SimError, SimResult, energy};
 use dualsplit_accel::Structures;
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult};
@@ -93,7 +95,7 @@ impl WorkSource for Pixels<'_> {
             return None;
         }
         // The thread's finished program's buffer is reused for its next one.
-        let mut ops = std::mem::take(&mut thread.ops);
+        let mut ops = thread.take_ops();
         ops.clear();
         if let Some(a) = &mut self.active[id] {
             if self.tracer.trace_ray(a, &mut ops) {
@@ -111,7 +113,7 @@ impl WorkSource for Pixels<'_> {
         if self.next >= self.total {
             return None;
         }
-        thread.atomic(chip);
+        chip.atomic(thread);
         self.tracer.tally.atomic();
         let px = self.next;
         self.next += 1;
@@ -161,20 +163,21 @@ pub(crate) fn run(
             tally: Tally::new(accel),
         },
     };
-    let cycles = run_chip(&mut chip, &mut threads, &mut work);
+    let cycles = run_chip(&mut chip, &mut threads, &mut work).get();
     if let Some(e) = work.tracer.tally.error() {
         return Err(e.into());
     }
-    let dram = chip.dram.stats();
-    let c = &chip.caches;
+    let stats = chip.stats();
+    let dram = stats.dram;
+    let c = &stats.caches;
     let ratio = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
     let frame_ms = cycles as f64 / (cfg.clock_ghz * 1e6);
     let counts = work.tracer.tally.counts();
     let cyc_units = cycles.max(1) as f64 * cfg.tms as f64;
     let utilisation = crate::Utilisation {
-        box_pipe: chip.units.box_ops as f64 / (cyc_units * accel.box_pipes(cfg) as f64),
-        tri_pipe: chip.units.tri_ops as f64 / (cyc_units * cfg.units.tri_pipes as f64),
-        dst_pipe: chip.units.dst_ops as f64 / (cyc_units * cfg.units.dst_pipes as f64),
+        box_pipe: stats.units.box_ops as f64 / (cyc_units * accel.box_pipes(cfg) as f64),
+        tri_pipe: stats.units.tri_ops as f64 / (cyc_units * cfg.units.tri_pipes as f64),
+        dst_pipe: stats.units.dst_ops as f64 / (cyc_units * cfg.units.dst_pipes as f64),
         issue: counts.total() as f64 / (cyc_units * cfg.tps_per_tm as f64),
     };
     Ok(SimResult {
@@ -183,7 +186,7 @@ pub(crate) fn run(
         threads: cfg.tms * cfg.tps_per_tm,
         cycles,
         frame_ms,
-        energy: energy::split(cfg, &counts, &chip.caches, &dram, frame_ms),
+        energy: energy::split(cfg, &counts, &stats.caches, &dram, frame_ms),
         dram_lines: dram.reads,
         dram_activations: dram.activations,
         row_hit_rate: ratio(dram.row_hits, dram.reads),
@@ -192,11 +195,11 @@ pub(crate) fn run(
         rays: work.tracer.rays,
         pixels: total,
         instructions: counts,
-        caches: chip.caches,
+        caches: stats.caches,
         dram,
-        units: chip.units,
+        units: stats.units,
         utilisation,
-        stalls: chip.stalls,
+        stalls: stats.stalls,
         radiance: work.radiance,
     })
 }

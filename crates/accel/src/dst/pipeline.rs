@@ -50,6 +50,9 @@ pub enum ReturnCode {
 }
 
 impl ReturnCode {
+    /// The four codes, in order.
+    pub const ALL: [ReturnCode; 4] = [Self::Miss, Self::OneChild, Self::BothChildren, Self::Leaf];
+
     /// From the 2-bit value.
     #[inline(always)]
     pub fn from_bits(b: u8) -> Self {
@@ -223,7 +226,7 @@ impl Dst {
             });
             obs.step(NodeStep::Dst {
                 kind: word.node_kind(),
-                code: out.code as u8,
+                code: out.code,
                 carving_leaf: word.is_carving() & word.is_leaf_flag(),
             });
             match out.code {

@@ -14,7 +14,7 @@
 
 use super::Dst;
 use super::header::HeaderOffset;
-use super::pipeline::le_or_nan;
+use super::pipeline::{ReturnCode, le_or_nan};
 use crate::image::{MemoryImage, RUN_END};
 use crate::observer::{DstNodeKind, NodeStep, Observer};
 use dualsplit_geometry::{Hit, Ray, RayPre, Triangle, cull_limit, widen_exit};
@@ -201,7 +201,7 @@ impl<'a> Tracer<'a> {
 }
 
 #[inline(always)]
-fn dst_step(kind: DstNodeKind, code: u8, carving_leaf: bool) -> NodeStep {
+fn dst_step(kind: DstNodeKind, code: ReturnCode, carving_leaf: bool) -> NodeStep {
     NodeStep::Dst {
         kind,
         code,
@@ -229,7 +229,7 @@ impl Dst {
             // `Some(run)` when the node ends in a triangle run; `None` when it pops.
             let run = match w.node_kind() {
                 DstNodeKind::Leaf => {
-                    obs.step(dst_step(DstNodeKind::Leaf, 3, false));
+                    obs.step(dst_step(DstNodeKind::Leaf, ReturnCode::Leaf, false));
                     Some(w.offset())
                 }
                 DstNodeKind::Split => {
@@ -247,7 +247,7 @@ impl Dst {
                     let far_hit = le_or_nan(t2, t_max);
                     obs.step(dst_step(
                         DstNodeKind::Split,
-                        near_hit as u8 + far_hit as u8,
+                        ReturnCode::from_bits(near_hit as u8 + far_hit as u8),
                         false,
                     ));
                     if far_hit {
@@ -304,7 +304,8 @@ impl Dst {
                     };
                     let hit = le_or_nan(lo, hi);
                     let leaf = w.is_leaf_flag();
-                    obs.step(dst_step(kind, hit as u8 * (1 + 2 * leaf as u8), leaf));
+                    let code = ReturnCode::from_bits(hit as u8 * (1 + 2 * leaf as u8));
+                    obs.step(dst_step(kind, code, leaf));
                     if hit {
                         t_min = lo;
                         t_max = hi;

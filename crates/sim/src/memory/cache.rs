@@ -1,10 +1,11 @@
 //! A set-associative cache of 64-byte lines with fill times in the tags (LRU replacement;
-//! associativity 1 is SimTRaX's direct-mapped cache, notes §1.4), plus the list of lines in
+//! associativity 1 is SimTRaX's direct-mapped cache, `L1Cache.cc`/`L2Cache.cc`), plus the list of lines in
 //! flight (the MSHRs).
 //!
-//! A miss is *reserved* when it is made (it learns its fill cycle at once, notes §5.2), but
-//! the line it brings is only *installed* when that fill arrives, as in SimTRaX ("lines are
-//! installed in L2 and L1 at their arrival cycle", notes §1.4) and in any cache with miss
+//! A miss is *reserved* when it is made (it learns its fill cycle at once: the reservation model), but
+//! the line it brings is only *installed* when that fill arrives, as in SimTRaX
+//! (`L1Cache.cc`/`L2Cache.cc`: `UpdateCache` queues the tag update, `ClockFall` applies it
+//! at the fill cycle) and in any cache with miss
 //! status holding registers (Kroft 1981):
 //!
 //! * the line a miss replaces stays readable until the new line's fill arrives (`prev`), so a
@@ -14,11 +15,11 @@
 //!   the same set has taken its tag (`inflight`, SimTRaX's per-L1 list of in-flight lines
 //!   and L2's pending list), so it is never requested twice.
 //!
-//! (Model versions ≤ 3 wrote the new tag at request time: the replaced line vanished
-//! for the whole miss latency and an in-flight line whose tag was taken by a later conflicting
-//! miss was requested again. Under load the two fed each other — longer latencies, more
-//! re-requests of the top-of-tree lines, hotter L2 banks — which is why TM scaling broke
-//! down at 128 TMs; see `docs/simulator.md`, "TM scaling".)
+//! Writing the tag at request time instead would make the replaced line vanish for the
+//! whole miss latency and request an in-flight line again once a conflicting miss took its
+//! tag; under load the two feed each other (longer latencies, more re-requests of the
+//! top-of-tree lines, hotter L2 banks) and TM scaling breaks down at 128 TMs
+//! (`docs/simulator.md`, "TM scaling").
 
 use crate::Cycle;
 use rustc_hash::FxHashMap;
@@ -113,8 +114,8 @@ fn find<W: Word>(
     s: usize,
     assoc: usize,
     line: u64,
-    now: Cycle,
-) -> Option<Cycle> {
+    now: u64,
+) -> Option<u64> {
     // A line that does not fit was never installed in a narrow array.
     let line = W::fit(line)?;
     if assoc == 1 {
@@ -152,8 +153,8 @@ fn replace<W: Word>(
     assoc: usize,
     line: W,
     fill: W,
-    now: Cycle,
-) -> Option<(u64, Cycle)> {
+    now: u64,
+) -> Option<(u64, u64)> {
     let victim = if assoc == 1 {
         s
     } else {
@@ -201,7 +202,7 @@ pub struct Cache {
     /// Lines in flight whose way has since been taken by a later miss: line → fill cycle.
     /// (Fx hashing: the list is probed on every miss that the set does not answer, and
     /// SipHash's resistance to chosen keys buys nothing for line numbers.)
-    inflight: FxHashMap<u64, Cycle>,
+    inflight: FxHashMap<u64, u64>,
     prune_at: usize,
     /// What may be on `inflight` (host speed only; the answer is the list's).
     filter: InflightFilter,
@@ -216,7 +217,7 @@ struct InflightFilter {
     /// log2 of the bit count (the hash keeps this many top bits).
     log2: u32,
     /// The latest fill of a listed line: nothing is in flight from then on.
-    until: Cycle,
+    until: u64,
 }
 
 impl InflightFilter {
@@ -240,7 +241,7 @@ impl InflightFilter {
 
     /// Records `line`, in flight until `fill`.
     #[inline]
-    fn note(&mut self, line: u64, fill: Cycle) {
+    fn note(&mut self, line: u64, fill: u64) {
         let (i, bit) = self.bit(line);
         self.bits[i] |= bit;
         self.until = self.until.max(fill);
@@ -248,7 +249,7 @@ impl InflightFilter {
 
     /// Whether `line` may be on the list at `now`.
     #[inline]
-    fn may_hold(&self, line: u64, now: Cycle) -> bool {
+    fn may_hold(&self, line: u64, now: u64) -> bool {
         now < self.until && {
             let (i, bit) = self.bit(line);
             self.bits[i] & bit != 0
@@ -256,7 +257,7 @@ impl InflightFilter {
     }
 
     /// Forgets everything and records `list` again.
-    fn rebuild(&mut self, list: &FxHashMap<u64, Cycle>) {
+    fn rebuild(&mut self, list: &FxHashMap<u64, u64>) {
         self.bits.fill(0);
         self.until = 0;
         for (&l, &f) in list {
@@ -299,13 +300,13 @@ impl Cache {
         if let Some(fill) = self.find_direct(line) {
             return Lookup::Present { fill };
         }
-        self.lookup_general(line, now)
+        self.lookup_general(line, now.get())
     }
 
     /// [`Cache::lookup`] in general: any associativity or tag width, the replaced line
     /// still readable, and the in-flight list.
     #[inline(never)]
-    pub(crate) fn lookup_general(&mut self, line: u64, now: Cycle) -> Lookup {
+    fn lookup_general(&mut self, line: u64, now: u64) -> Lookup {
         let s = self.set(line);
         if self.assoc > 1 {
             self.stamp += 1;
@@ -316,13 +317,13 @@ impl Cache {
             Ways::Wide(w) => find(w, &mut self.used, stamp, s, assoc, line, now),
         };
         if let Some(fill) = found {
-            return Lookup::Present { fill };
+            return Lookup::Present { fill: Cycle(fill) };
         }
         if self.filter.may_hold(line, now)
             && let Some(&fill) = self.inflight.get(&line)
             && fill > now
         {
-            return Lookup::Present { fill };
+            return Lookup::Present { fill: Cycle(fill) };
         }
         Lookup::Absent
     }
@@ -333,13 +334,13 @@ impl Cache {
     /// [`Cache::lookup`] answers. Small enough to inline into the load path, so an L1 hit
     /// costs no call.
     #[inline]
-    pub fn find_direct(&self, line: u64) -> Option<Cycle> {
+    fn find_direct(&self, line: u64) -> Option<Cycle> {
         match &self.ways {
             Ways::Narrow(w) if self.assoc == 1 => {
                 let way = w[self.set(line)];
                 // An empty way (`INVALID`) never matches, even line 2^32 − 1.
                 (way.line != u32::INVALID && u64::from(way.line) == line)
-                    .then_some(u64::from(way.fill))
+                    .then_some(Cycle(u64::from(way.fill)))
             }
             _ => None,
         }
@@ -388,6 +389,7 @@ impl Cache {
     /// installs) is served inline; the rest goes through `Cache::install_general`.
     #[inline]
     pub fn install(&mut self, line: u64, fill: Cycle, now: Cycle) {
+        let (fill, now) = (fill.get(), now.get());
         let s = self.set(line);
         if self.assoc == 1
             && let Ways::Narrow(ways) = &mut self.ways
@@ -409,7 +411,7 @@ impl Cache {
     /// [`Cache::install`] in general: any associativity or tag width, and a replaced line
     /// still in flight, which moves to the in-flight list.
     #[inline(never)]
-    fn install_general(&mut self, line: u64, fill: Cycle, now: Cycle) {
+    fn install_general(&mut self, line: u64, fill: u64, now: u64) {
         let s = self.set(line);
         if self.assoc > 1 {
             self.stamp += 1;
@@ -445,40 +447,50 @@ mod tests {
     use super::*;
 
     impl Cache {
+        /// [`Cache::lookup`] at cycle `now`.
+        fn lk(&mut self, line: u64, now: u64) -> Lookup {
+            self.lookup(line, Cycle(now))
+        }
+
+        /// [`Cache::install`] of a fill at cycle `fill` made at `now`.
+        fn ins(&mut self, line: u64, fill: u64, now: u64) {
+            self.install(line, Cycle(fill), Cycle(now))
+        }
+
         /// A lookup at cycle 0 on a copy (no effect on `self`).
         fn lookup_copy(&self, line: u64) -> Lookup {
-            self.clone().lookup(line, 0)
+            self.clone().lk(line, 0)
         }
     }
 
     #[test]
     fn direct_mapped_conflict_evicts_when_the_new_line_arrives() {
         let mut c = Cache::new(1024, 64, 1); // 16 sets
-        c.install(3, 10, 0);
-        assert_eq!(c.lookup(3, 10), Lookup::Present { fill: 10 });
+        c.ins(3, 10, 0);
+        assert_eq!(c.lk(3, 10), Lookup::Present { fill: Cycle(10) });
         // A conflicting miss at cycle 12, filled at 20: line 3 is still there until 20.
-        c.install(3 + 16, 20, 12);
-        assert_eq!(c.lookup(3, 19), Lookup::Present { fill: 10 });
-        assert_eq!(c.lookup(3, 20), Lookup::Absent);
-        assert_eq!(c.lookup(19, 15), Lookup::Present { fill: 20 });
-        assert_eq!(c.lookup(19, 20), Lookup::Present { fill: 20 });
+        c.ins(3 + 16, 20, 12);
+        assert_eq!(c.lk(3, 19), Lookup::Present { fill: Cycle(10) });
+        assert_eq!(c.lk(3, 20), Lookup::Absent);
+        assert_eq!(c.lk(19, 15), Lookup::Present { fill: Cycle(20) });
+        assert_eq!(c.lk(19, 20), Lookup::Present { fill: Cycle(20) });
     }
 
     #[test]
     fn a_line_in_flight_is_found_after_its_tag_is_taken() {
         let mut c = Cache::new(1024, 64, 1);
-        c.install(3, 10, 0);
+        c.ins(3, 10, 0);
         // Line 19 in flight until 100; line 35 (same set) missed at 20, in flight until 50.
-        c.install(19, 100, 11);
-        c.install(35, 50, 20);
+        c.ins(19, 100, 11);
+        c.ins(35, 50, 20);
         // 19 is still pending: merged, not requested again.
-        assert_eq!(c.lookup(19, 30), Lookup::Present { fill: 100 });
-        assert_eq!(c.lookup(35, 30), Lookup::Present { fill: 50 });
+        assert_eq!(c.lk(19, 30), Lookup::Present { fill: Cycle(100) });
+        assert_eq!(c.lk(35, 30), Lookup::Present { fill: Cycle(50) });
         // Line 3 stays readable until the way's latest fill (35 at 50).
-        assert_eq!(c.lookup(3, 30), Lookup::Present { fill: 10 });
-        assert_eq!(c.lookup(3, 50), Lookup::Absent);
+        assert_eq!(c.lk(3, 30), Lookup::Present { fill: Cycle(10) });
+        assert_eq!(c.lk(3, 50), Lookup::Absent);
         // After its fill, 19 (displaced) is gone.
-        assert_eq!(c.lookup(19, 100), Lookup::Absent);
+        assert_eq!(c.lk(19, 100), Lookup::Absent);
     }
 
     /// The in-flight filter never hides a line on the list: random conflicting misses
@@ -502,14 +514,15 @@ mod tests {
                     .iter()
                     .any(|w| w.line.get() == line || (w.prev.get() == line && now < w.fill.get()));
                 let listed = c.inflight.get(&line).copied().filter(|&f| f > now);
-                let got = c.lookup(line, now);
+                let got = c.lk(line, now);
                 if !in_set {
-                    let want = listed.map_or(Lookup::Absent, |fill| Lookup::Present { fill });
+                    let want =
+                        listed.map_or(Lookup::Absent, |fill| Lookup::Present { fill: Cycle(fill) });
                     assert_eq!(got, want, "assoc {assoc}, step {i}, line {line}");
                     found += u64::from(listed.is_some());
                 }
                 if got == Lookup::Absent {
-                    c.install(line, now + 1 + rng.below(500) as u64, now);
+                    c.ins(line, now + 1 + rng.below(500) as u64, now);
                 }
             }
             assert!(
@@ -537,7 +550,7 @@ mod tests {
                     (20_000.., 0) if by_line => far + rng.below(64) as u64,
                     _ => rng.below(1024) as u64,
                 };
-                let at = |c: &mut Cache| c.lookup(line, now);
+                let at = |c: &mut Cache| c.lk(line, now);
                 let got = at(&mut narrow);
                 assert_eq!(got, at(&mut wide), "assoc {assoc}, step {i}, line {line}");
                 if got == Lookup::Absent {
@@ -545,8 +558,8 @@ mod tests {
                     if i >= 25_000 && !by_line {
                         fill += far;
                     }
-                    narrow.install(line, fill, now);
-                    wide.install(line, fill, now);
+                    narrow.ins(line, fill, now);
+                    wide.ins(line, fill, now);
                 }
                 let is_wide = matches!(narrow.ways, Ways::Wide(_));
                 let from = if by_line { 20_000 } else { 25_000 };
@@ -588,7 +601,7 @@ mod tests {
                     answered += 1;
                 }
                 if got == Lookup::Absent {
-                    c.install(line, now + 1 + rng.below(300) as u64, now);
+                    c.ins(line, now + 1 + rng.below(300) as u64, now);
                 }
             }
             if assoc == 1 && !wide {
@@ -602,12 +615,12 @@ mod tests {
     #[test]
     fn two_way_keeps_both_and_evicts_lru() {
         let mut c = Cache::new(1024, 64, 2); // 8 sets
-        c.install(1, 0, 0);
-        c.install(9, 0, 0);
-        assert!(matches!(c.lookup(1, 1), Lookup::Present { .. }));
-        c.install(17, 5, 1); // replaces 9, the least recently used, at cycle 5
-        assert!(matches!(c.lookup(1, 6), Lookup::Present { .. }));
-        assert_eq!(c.lookup(9, 6), Lookup::Absent);
-        assert!(matches!(c.lookup(17, 6), Lookup::Present { .. }));
+        c.ins(1, 0, 0);
+        c.ins(9, 0, 0);
+        assert!(matches!(c.lk(1, 1), Lookup::Present { .. }));
+        c.ins(17, 5, 1); // replaces 9, the least recently used, at cycle 5
+        assert!(matches!(c.lk(1, 6), Lookup::Present { .. }));
+        assert_eq!(c.lk(9, 6), Lookup::Absent);
+        assert!(matches!(c.lk(17, 6), Lookup::Present { .. }));
     }
 }

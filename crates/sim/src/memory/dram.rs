@@ -1,5 +1,6 @@
 //! GDDR5 main memory: channels of banks with open rows, per-channel data bus, read queue
-//! (notes §1.8 and §3.3; SimTRaX's USIMM configuration `gddr5_8ch.cfg`).
+//! (SimTRaX's USIMM configuration `gddr5_8ch.cfg` and timing file `1Gb_x16_amd2GHz.vi`;
+//! USIMM `memory_controller.cc`, `scheduler.cc`).
 //!
 //! Address mapping (SimTRaX mapping 1), from the low bits up: line offset → column →
 //! channel → bank → row, so one row of one channel holds `row_bytes` contiguous bytes.
@@ -36,13 +37,13 @@
 //! tick and a 64-bit summary of the earlier epochs' rows, so most reads neither expire nor
 //! scan epochs; the epochs themselves (16 bytes each) sit in one slab of per-bank rings; the
 //! read queue is a bit plane of the bus table; the bus and t_RRD tables
-//! ([`SparseSlots`]) settle most requests with one inline word test. The tests keep the
-//! previous implementation (heap, `VecDeque`, plain sets) as a reference and compare every
-//! read's result on random streams.
+//! ([`SparseSlots`]) settle most requests with one inline word test. The tests keep a
+//! plain implementation of the same model (heap, `VecDeque`, plain sets) as a reference and
+//! compare every read's result on random streams.
 
-use crate::Cycle;
 use crate::config::DramConfig;
 use crate::slots::SparseSlots;
+use crate::{Cycle, Tick};
 use serde::{Deserialize, Serialize};
 
 /// How a read found its bank.
@@ -85,7 +86,7 @@ pub struct DramStats {
 struct Epoch {
     row: u64,
     /// Tick of its activate.
-    act: u64,
+    act: Tick,
 }
 
 /// Ticks an epoch is kept after its `close` (reads arrive slightly out of order: fluffy
@@ -104,15 +105,15 @@ struct Bank {
     /// The open row (the last epoch's), or [`NO_ROW`].
     open_row: u64,
     /// Tick of the last activate.
-    act: u64,
+    act: Tick,
     /// Earliest tick of the next column command.
-    col_ready: u64,
+    col_ready: Tick,
     /// Tick of the last column command (for t_RTP).
-    last_col: u64,
+    last_col: Tick,
     /// The earliest epoch expires once a read's tick exceeds this: its close (the next
-    /// epoch's activate − t_RP − t_RTP) + [`EPOCH_KEEP`]; `u64::MAX` while only one epoch
+    /// epoch's activate − t_RP − t_RTP) + [`EPOCH_KEEP`]; `Tick::MAX` while only one epoch
     /// is live.
-    expiry: u64,
+    expiry: Tick,
     /// Bit `row mod 64` set for each live epoch but the last (and possibly for expired
     /// ones: refreshed whenever a read scans them all), so a read whose bit is clear has no
     /// earlier epoch of its row to try.
@@ -127,10 +128,10 @@ impl Default for Bank {
     fn default() -> Self {
         Self {
             open_row: NO_ROW,
-            act: 0,
-            col_ready: 0,
-            last_col: 0,
-            expiry: u64::MAX,
+            act: Tick(0),
+            col_ready: Tick(0),
+            last_col: Tick(0),
+            expiry: Tick::MAX,
             rows: 0,
             head: 0,
             len: 0,
@@ -152,7 +153,13 @@ impl Epochs {
     fn new(banks: usize) -> Self {
         let shift = 3;
         Self {
-            slab: vec![Epoch { row: 0, act: 0 }; banks << shift],
+            slab: vec![
+                Epoch {
+                    row: 0,
+                    act: Tick(0),
+                };
+                banks << shift
+            ],
             shift,
         }
     }
@@ -166,9 +173,9 @@ impl Epochs {
 
     /// `expiry` for bank `b` whose epochs are as they are now (`gap` = t_RP + t_RTP).
     #[inline]
-    fn expiry(&self, b: usize, bank: &Bank, gap: u64) -> u64 {
+    fn expiry(&self, b: usize, bank: &Bank, gap: u64) -> Tick {
         if bank.len < 2 {
-            u64::MAX
+            Tick::MAX
         } else {
             (self.slab[self.at(b, bank, 1)].act - gap).saturating_add(EPOCH_KEEP)
         }
@@ -177,14 +184,14 @@ impl Epochs {
     /// Drops bank `b`'s epochs closed more than [`EPOCH_KEEP`] ticks before tick `a` (the
     /// last epoch never closes).
     #[inline]
-    fn expire(&self, b: usize, bank: &mut Bank, a: u64, gap: u64) {
+    fn expire(&self, b: usize, bank: &mut Bank, a: Tick, gap: u64) {
         if bank.expiry < a {
             self.expire_slow(b, bank, a, gap);
         }
     }
 
     #[inline]
-    fn expire_slow(&self, b: usize, bank: &mut Bank, a: u64, gap: u64) {
+    fn expire_slow(&self, b: usize, bank: &mut Bank, a: Tick, gap: u64) {
         while bank.expiry < a {
             bank.head = bank.head.wrapping_add(1);
             bank.len -= 1;
@@ -195,7 +202,7 @@ impl Epochs {
     /// Opens `row` at tick `act` in bank `b` (the bank's open row and activate are still
     /// the previous epoch's; its ring has room: [`Dram::read_at`] grows it first).
     #[inline]
-    fn push(&mut self, b: usize, bank: &mut Bank, row: u64, act: u64, gap: u64) {
+    fn push(&mut self, b: usize, bank: &mut Bank, row: u64, act: Tick, gap: u64) {
         debug_assert!(bank.len < 1 << self.shift);
         let i = self.at(b, bank, bank.len);
         self.slab[i] = Epoch { row, act };
@@ -212,7 +219,13 @@ impl Epochs {
     #[cold]
     fn grow(&mut self, banks: &mut [Bank]) {
         let shift = self.shift + 1;
-        let mut slab = vec![Epoch { row: 0, act: 0 }; banks.len() << shift];
+        let mut slab = vec![
+            Epoch {
+                row: 0,
+                act: Tick(0),
+            };
+            banks.len() << shift
+        ];
         for (b, bank) in banks.iter_mut().enumerate() {
             for i in 0..bank.len {
                 slab[(b << shift) + i as usize] = self.slab[self.at(b, bank, i)];
@@ -325,7 +338,7 @@ impl Dram {
     /// Reads `line` arriving at core cycle `arrive`; returns the core cycle its data has
     /// arrived and how the bank was found.
     pub fn read(&mut self, line: u64, arrive: Cycle) -> (Cycle, DramAccess) {
-        self.read_at(line, arrive, 0)
+        self.read_at(line, arrive, Cycle::ZERO)
     }
 
     /// As [`Dram::read`], when no read will ever arrive before core cycle `now` (the
@@ -341,17 +354,19 @@ impl Dram {
             self.epochs.grow(&mut self.banks);
         }
         let ch = &mut self.channels[chi];
-        ch.bus.forget_before(self.burst.div(now * tpc));
-        ch.acts.forget_before(now * tpc);
-        let mut a = arrive * tpc;
+        let floor = now.to_ticks(tpc).get();
+        ch.bus.forget_before(self.burst.div(floor));
+        ch.acts.forget_before(floor);
+        // The read's tick; the schedule below is in ticks.
+        let mut a = arrive.to_ticks(tpc);
         // Reads complete by `a` leave the queue: slot `s` completes at (s + 1) · t_burst ≤ a,
         // i.e. s < ⌊a / t_burst⌋ (every pending slot is at or after the bus floor, which
         // is at most that: the floor comes from `now ≤ arrive`).
-        ch.bus.retire_before(self.burst.div(a));
+        ch.bus.retire_before(self.burst.div(a.get()));
         if ch.bus.pending() >= c.read_queue
             && let Some(s) = ch.bus.retire_first()
         {
-            let d = s * c.t_burst + c.t_burst;
+            let d = Tick(s * c.t_burst + c.t_burst);
             self.stats.queue_wait_cycles += self.tpc.div_ceil(d - a);
             a = d;
         }
@@ -376,8 +391,8 @@ impl Dram {
                     continue;
                 }
                 // The column command waits for its data-bus slot (t_CAS before it).
-                let slot = ch.bus.peek(self.burst.div_ceil(col + c.t_cas));
-                if slot * c.t_burst - c.t_cas <= close {
+                let slot = ch.bus.peek(self.burst.div_ceil((col + c.t_cas).get()));
+                if Tick(slot * c.t_burst) - c.t_cas <= close {
                     hit = Some(slot);
                     break;
                 }
@@ -387,7 +402,7 @@ impl Dram {
             }
             if let Some(slot) = hit {
                 ch.bus.reserve_pending(slot);
-                let done = slot * c.t_burst + c.t_burst;
+                let done = Tick(slot * c.t_burst + c.t_burst);
                 return self.finish(arrive, done, DramAccess::RowHit);
             }
         }
@@ -402,10 +417,10 @@ impl Dram {
                 } else {
                     DramAccess::Closed
                 };
-                if open != NO_ROW || bank.act > 0 {
+                if open != NO_ROW || bank.act > Tick(0) {
                     act = act.max(bank.act + c.t_rc);
                 }
-                act = ch.acts.reserve_span(act, c.t_rrd.max(1));
+                act = Tick(ch.acts.reserve_span(act.get(), c.t_rrd.max(1)));
                 epochs.push(b, bank, row, act, gap);
                 bank.act = act;
                 bank.open_row = row;
@@ -417,14 +432,17 @@ impl Dram {
         // The data bus takes the first free burst slot once the data is ready; a read whose
         // row is open can use a slot before a conflicting read reserved earlier, which is
         // the effect of FR-FCFS on the bus.
-        let data = ch.bus.reserve_pending(self.burst.div_ceil(col + c.t_cas)) * c.t_burst;
-        let done = data + c.t_burst;
+        let data = ch
+            .bus
+            .reserve_pending(self.burst.div_ceil((col + c.t_cas).get()))
+            * c.t_burst;
+        let done = Tick(data + c.t_burst);
         self.finish(arrive, done, kind)
     }
 
     /// Counts a read arriving at core cycle `arrive` whose data is complete at tick `done`.
-    fn finish(&mut self, arrive: Cycle, done: u64, kind: DramAccess) -> (Cycle, DramAccess) {
-        let done_cycle = self.tpc.div_ceil(done);
+    fn finish(&mut self, arrive: Cycle, done: Tick, kind: DramAccess) -> (Cycle, DramAccess) {
+        let done_cycle = Cycle(self.tpc.div_ceil(done.get()));
         let s = &mut self.stats;
         match kind {
             DramAccess::RowHit => s.row_hits += 1,
@@ -455,12 +473,26 @@ mod tests {
     use crate::SimConfig;
     use dualsplit_geometry::Pcg32;
 
+    impl Dram {
+        /// [`Dram::read`] in plain cycle numbers.
+        fn rd(&mut self, line: u64, arrive: u64) -> (u64, DramAccess) {
+            let (done, kind) = self.read(line, Cycle(arrive));
+            (done.get(), kind)
+        }
+
+        /// [`Dram::read_at`] in plain cycle numbers.
+        fn rd_at(&mut self, line: u64, arrive: u64, now: u64) -> (u64, DramAccess) {
+            let (done, kind) = self.read_at(line, Cycle(arrive), Cycle(now));
+            (done.get(), kind)
+        }
+    }
+
     fn dram() -> Dram {
         Dram::new(&SimConfig::lin2020().dram)
     }
 
-    /// The DRAM model as it was before the host-speed rework (Lin et al. 2020 §5's GDDR5
-    /// memory, model 4), written for clarity: reservations in plain sets of taken ticks,
+    /// The same DRAM model (Lin et al. 2020 §5's GDDR5 memory) written for clarity, not
+    /// host speed: reservations in plain sets of taken ticks,
     /// the read queue a min-heap of completion ticks, each bank's epochs a `VecDeque`.
     mod reference {
         use super::super::{DramAccess, DramStats, EPOCH_KEEP};
@@ -531,7 +563,7 @@ mod tests {
                 }
             }
 
-            pub fn read(&mut self, line: u64, arrive: Cycle) -> (Cycle, DramAccess) {
+            pub fn read(&mut self, line: u64, arrive: u64) -> (u64, DramAccess) {
                 let c = &self.cfg;
                 let tpc = c.ticks_per_cycle;
                 let x = line / (c.row_bytes / 64);
@@ -621,7 +653,7 @@ mod tests {
                     DramAccess::Conflict => s.row_conflicts += 1,
                 }
                 s.latency_cycles += done_cycle - arrive;
-                s.last_done = s.last_done.max(done_cycle);
+                s.last_done = s.last_done.max(Cycle(done_cycle));
                 (done_cycle, kind)
             }
         }
@@ -662,7 +694,7 @@ mod tests {
                     + ch as u64)
                     * lines_per_row
                     + rng.below(lines_per_row as u32) as u64;
-                let got = d.read_at(line, arrive, now);
+                let got = d.rd_at(line, arrive, now);
                 assert_eq!(got, r.read(line, arrive), "seed {seed}, read {i}");
             }
             assert_eq!(d.stats(), r.stats, "seed {seed}");
@@ -679,14 +711,14 @@ mod tests {
     fn closed_then_hit_then_conflict_exact_latencies() {
         let mut d = dram();
         // Closed: tRCD 14 + tCAS 14 + burst 2 = 30 core cycles.
-        assert_eq!(d.read(0, 1000), (1030, DramAccess::Closed));
+        assert_eq!(d.rd(0, 1000), (1030, DramAccess::Closed));
         // Row hit on the same row (line 1 is column 1 of row 0): tCAS 14 + burst 2.
-        assert_eq!(d.read(1, 2000), (2016, DramAccess::RowHit));
+        assert_eq!(d.rd(1, 2000), (2016, DramAccess::RowHit));
         // Conflict: same channel and bank, next row. Lines per row 128, channels 16, banks 16.
         let other_row = 128 * 16 * 16;
         assert_eq!(d.map(other_row), (0, 0, 1));
         // tRP 14 + tRCD 14 + tCAS 14 + burst 2 = 44.
-        assert_eq!(d.read(other_row, 3000), (3044, DramAccess::Conflict));
+        assert_eq!(d.rd(other_row, 3000), (3044, DramAccess::Conflict));
         let s = d.stats();
         assert_eq!((s.reads, s.activations, s.row_hits), (3, 2, 1));
     }
@@ -694,11 +726,11 @@ mod tests {
     #[test]
     fn conflict_waits_for_t_ras() {
         let mut d = dram();
-        assert_eq!(d.read(0, 0).0, 30);
+        assert_eq!(d.rd(0, 0).0, 30);
         // Immediately conflicting: precharge may not start before act + tRAS (35 ns).
         // act at 0, pre at 35 ns, act at 49 ns (= tRC too), data at 49 + 14 + 14 = 77 ns,
         // rounded up to the 2 ns burst slot grid (78), + burst 2 = 80.
-        assert_eq!(d.read(128 * 16 * 16, 0), (80, DramAccess::Conflict));
+        assert_eq!(d.rd(128 * 16 * 16, 0), (80, DramAccess::Conflict));
     }
 
     #[test]
@@ -706,22 +738,22 @@ mod tests {
         let mut d = dram();
         let row1 = 128 * 16 * 16;
         // A: row 0, closed: act at tick 0, column 28, data slot 14 (ticks 56–60): cycle 30.
-        assert_eq!(d.read(0, 0), (30, DramAccess::Closed));
+        assert_eq!(d.rd(0, 0), (30, DramAccess::Closed));
         // B: row 1, conflict: precharge at t_RAS (70), act 98 (= t_RC), column 126, data at
         // 154 rounded up to the burst grid 156, done 160 ticks: cycle 80. Row 0's epoch now
         // closes at 98 − t_RP 28 − t_RTP 15 = tick 55.
-        assert_eq!(d.read(row1, 0), (80, DramAccess::Conflict));
+        assert_eq!(d.rd(row1, 0), (80, DramAccess::Conflict));
         // C: row 0 again, one cycle after B. In arrival order it would be a second conflict
         // (≥ 49 ns after B's activate). Row-hit-first: row 0 is still open before B's
         // precharge, so C is a row hit: column at 28, data slot 14 is A's, so slot 15
         // (column effectively at 60 − 28 = 32 ≤ 55), done at tick 64: cycle 32, before B.
-        assert_eq!(d.read(1, 1), (32, DramAccess::RowHit));
+        assert_eq!(d.rd(1, 1), (32, DramAccess::RowHit));
         // D: row 0 at cycle 20 (tick 40): column 40, data at 68 = slot 17, done 72: cycle 36.
-        assert_eq!(d.read(2, 20), (36, DramAccess::RowHit));
+        assert_eq!(d.rd(2, 20), (36, DramAccess::RowHit));
         // E: row 0 at cycle 30 (tick 60 > 55): too late for row 0's epoch, so a conflict
         // after B: precharge at B's act 98 + t_RAS 70 = 168, act 196 (= 98 + t_RC), column
         // 224, data 252, done 256 ticks: cycle 128.
-        assert_eq!(d.read(3, 30), (128, DramAccess::Conflict));
+        assert_eq!(d.rd(3, 30), (128, DramAccess::Conflict));
         let s = d.stats();
         assert_eq!(
             (s.reads, s.activations, s.row_hits, s.row_conflicts),
@@ -736,8 +768,8 @@ mod tests {
         let mut d = dram();
         let row1 = 128 * 16 * 16;
         for i in 0..4 {
-            d.read(i, 0);
-            d.read(row1 + i, 0);
+            d.rd(i, 0);
+            d.rd(row1 + i, 0);
         }
         let s = d.stats();
         assert_eq!((s.reads, s.activations, s.row_hits), (8, 2, 6));
@@ -749,12 +781,12 @@ mod tests {
         let row = 128 * 16 * 16;
         // 20 different rows of bank 0 (channel 0), all at cycle 0: each waits t_RC for the
         // previous one, so the last data is ~1 µs ahead.
-        let last = (0..20).map(|r| d.read(r * row, 0).0).max().unwrap();
+        let last = (0..20).map(|r| d.rd(r * row, 0).0).max().unwrap();
         assert!(last > 900, "{last}");
         // Bank 1 of channel 0 at cycle 0: closed row, its activation only spaced t_RRD
         // (13 ticks) after bank 0's first: act 13, column 41, data at 69 rounded to the
         // burst grid 72, done 76 ticks = cycle 38 (not behind bank 0's far-future bursts).
-        assert_eq!(d.read(128 * 16, 0), (38, DramAccess::Closed));
+        assert_eq!(d.rd(128 * 16, 0), (38, DramAccess::Closed));
     }
 
     #[test]
@@ -780,7 +812,7 @@ mod tests {
     fn one_channel_streams_at_one_line_per_burst() {
         let mut d = dram();
         // 100 row-hit reads of one row arriving together: the bus serialises them.
-        let dones: Vec<_> = (0..100).map(|i| d.read(i % 128, 0).0).collect();
+        let dones: Vec<_> = (0..100).map(|i| d.rd(i % 128, 0).0).collect();
         for w in dones.windows(2) {
             assert_eq!(w[1] - w[0], 2, "one 64-B line per 2 ns per channel");
         }
@@ -792,7 +824,7 @@ mod tests {
         let mut d = Dram::new(&cfg.dram);
         // 64 K lines, all requested at cycle 0, spread over every channel and bank.
         let n = 65_536u64;
-        let last = (0..n).map(|l| d.read(l, 0).0).max().unwrap();
+        let last = (0..n).map(|l| d.rd(l, 0).0).max().unwrap();
         let bytes_per_cycle = (n * 64) as f64 / last as f64;
         let peak = cfg.dram_peak_bytes_per_cycle();
         assert_eq!(peak, 512.0);
@@ -811,15 +843,15 @@ mod tests {
         let mut cfg = SimConfig::lin2020().dram;
         cfg.read_queue = 2;
         let mut d = Dram::new(&cfg);
-        d.read(0, 0);
-        d.read(1, 0);
-        d.read(2, 0);
+        d.rd(0, 0);
+        d.rd(1, 0);
+        d.rd(2, 0);
         assert!(d.stats().queue_wait_cycles > 0);
         let mut cfg = SimConfig::lin2020().dram;
         cfg.read_queue = 64;
         let mut d = Dram::new(&cfg);
         (0..3).for_each(|l| {
-            d.read(l, 0);
+            d.rd(l, 0);
         });
         assert_eq!(d.stats().queue_wait_cycles, 0);
     }

@@ -1,0 +1,464 @@
+//! The chip and its event loop.
+//!
+//! Hardware (Lin et al. 2020, §2.3, §4, Table 1): `tms` thread multiprocessors of
+//! `tps_per_tm` thread processors each (`thread.rs`); each TM has its L1, pipelines and
+//! reciprocal unit (`tm.rs`); all TMs share the L2 and the DRAM (`memory/`) and the global
+//! atomic unit from which threads take their pixels (`atomic.rs`).
+//!
+//! The event loop ([`run_chip`]): the scheduler (`scheduler.rs`) hands out the threads
+//! whose next op can start in the next cycle with events. Each runs its ops against its
+//! TM's units while they can start in that cycle and goes back to sleep until the cycle it
+//! can continue; a thread whose program is done asks the [`WorkSource`] for the next one
+//! (taking a pixel from the atomic unit) or retires. The frame ends when the last result of
+//! the last thread has arrived. Requests reserve their units at their own start cycle,
+//! never before the current event time, and events are processed in time order, so
+//! reservations are made in (nearly) causal order.
+
+use crate::Cycle;
+use crate::atomic::AtomicUnit;
+use crate::config::SimConfig;
+use crate::kernel::Op;
+use crate::memory::{CacheStats, DramStats, L2};
+use crate::scheduler::{NONE, Wheel};
+use crate::thread::{Stalls, Thread};
+use crate::tm::{Tm, UnitStats};
+
+/// The chip's units.
+pub struct Chip {
+    tms: Vec<Tm>,
+    l2: L2,
+    atomic: AtomicUnit,
+    stalls: Stalls,
+}
+
+/// The chip's counters.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ChipStats {
+    /// L1 and L2 counters, summed over the TMs.
+    pub caches: CacheStats,
+    /// Pipeline and reciprocal-unit ops, summed over the TMs.
+    pub units: UnitStats,
+    /// Where the threads' cycles went, summed over the threads.
+    pub stalls: Stalls,
+    /// DRAM counters.
+    pub dram: DramStats,
+}
+
+impl Chip {
+    /// A cold chip; `box_pipes` ray-box pipelines per TM (the "+" configurations use the
+    /// node arity).
+    pub fn new(cfg: &SimConfig, box_pipes: u32) -> Self {
+        Self {
+            tms: (0..cfg.tms).map(|_| Tm::new(cfg, box_pipes)).collect(),
+            l2: L2::new(cfg),
+            atomic: AtomicUnit::new(cfg.units.atomic_latency),
+            stalls: Stalls::default(),
+        }
+    }
+
+    /// TM `i` and the L2 it sends its misses to: the units a thread processor drives.
+    pub fn tm(&mut self, i: usize) -> (&mut Tm, &mut L2) {
+        (&mut self.tms[i], &mut self.l2)
+    }
+
+    /// Thread `th` takes a value from the global atomic unit (the next pixel).
+    pub fn atomic(&mut self, th: &mut Thread) {
+        th.atomic(&mut self.atomic, &mut self.stalls);
+    }
+
+    /// The counters so far.
+    pub fn stats(&self) -> ChipStats {
+        let mut s = ChipStats {
+            stalls: self.stalls,
+            dram: self.l2.dram_stats(),
+            ..ChipStats::default()
+        };
+        for tm in &self.tms {
+            tm.add_stats(&mut s.caches, &mut s.units);
+        }
+        self.l2.add_stats(&mut s.caches);
+        s
+    }
+
+    /// One word load by TM `tm` whose L1 bank slot is `slot` (already reserved): the cycle
+    /// the data is in the register.
+    #[cfg(test)]
+    fn load_word(&mut self, tm: usize, word: u64, slot: u64) -> u64 {
+        self.tms[tm]
+            .load_word(&mut self.l2, word, Cycle(slot))
+            .get()
+    }
+}
+
+/// Supplies threads with work: called when a thread's program is done; returns the next
+/// program or `None` when there is no work left.
+pub trait WorkSource {
+    /// The next program for thread `id` (its index in `run_chip`'s slice), whose previous
+    /// program is done.
+    fn next(&mut self, id: usize, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>>;
+}
+
+/// Puts thread `id` back into the wheel at its next issue slot, as a forward entry when
+/// `forwards` ([`Thread::skip_ahead`]).
+#[inline(always)]
+fn sleep(th: &mut Thread, wheel: &mut Wheel, stalls: &mut Stalls, id: u32, forwards: bool) {
+    let t = th.next_issue();
+    if forwards {
+        let hops = th.skip_ahead(stalls);
+        wheel.push_forward(t, hops, id);
+    } else {
+        th.forget_next();
+        wheel.push(t, id);
+    }
+}
+
+/// Runs every thread to completion; returns the cycle the last result arrived.
+pub fn run_chip(chip: &mut Chip, threads: &mut [Thread], work: &mut dyn WorkSource) -> Cycle {
+    run_chip_with(chip, threads, work, true)
+}
+
+/// [`run_chip`], with forward wake-ups (`forwards`) or without (the tests compare both).
+///
+/// A thread that goes to sleep until its next issue slot `t` often has nothing to do
+/// there but go back to sleep: its next op is not a load and waits for a result due later
+/// (after a 13-word load, the node's data), or it is a run of plain instructions that
+/// reserves nothing (after a pipeline op's result). Such wake-ups are played ahead when the
+/// thread goes to sleep ([`Thread::skip_ahead`]), and the thread is scheduled as a forward
+/// entry at `t` ([`Wheel::push_forward`]): at each skipped cycle the wheel moves it on to
+/// the next one in the same place in the bucket as the wake-up would have, without reading
+/// the thread's record or op, so every bucket's order, hence every result, stays exact.
+fn run_chip_with(
+    chip: &mut Chip,
+    threads: &mut [Thread],
+    work: &mut dyn WorkSource,
+    forwards: bool,
+) -> Cycle {
+    let mut wheel = Wheel::new(threads.len());
+    for i in 0..threads.len() as u32 {
+        wheel.push(Cycle::ZERO, i);
+    }
+    let mut finish = vec![Cycle::ZERO; threads.len()];
+    while let Some((now, first)) = wheel.next_bucket() {
+        let mut touched = 0;
+        let mut id = first;
+        while id != NONE {
+            if !wheel.is_forward(id) {
+                let th = &threads[id as usize];
+                touched ^= th.touch(&chip.tms[th.tm()], &chip.l2);
+            }
+            id = wheel.after(id);
+        }
+        std::hint::black_box(touched);
+        let mut id = first;
+        while id != NONE {
+            let next = wheel.after(id);
+            wheel.taken();
+            if let Some(to) = wheel.take_forward(id) {
+                wheel.push(to, id);
+                id = next;
+                continue;
+            }
+            let th = &mut threads[id as usize];
+            loop {
+                if th.run(&mut chip.tms[th.tm()], &mut chip.l2, &mut chip.stalls, now) {
+                    sleep(th, &mut wheel, &mut chip.stalls, id, forwards);
+                    break;
+                }
+                // Program finished: the thread takes more work or retires once results are in.
+                match work.next(id as usize, th, chip) {
+                    Some(ops) => {
+                        th.load_program(ops);
+                        if th.next_issue() > now {
+                            sleep(th, &mut wheel, &mut chip.stalls, id, forwards);
+                            break;
+                        }
+                    }
+                    None => {
+                        finish[id as usize] = th.results_ready();
+                        break;
+                    }
+                }
+            }
+            id = next;
+        }
+    }
+    let end = finish.iter().copied().max().unwrap_or(Cycle::ZERO);
+    chip.stalls.idle = finish.iter().map(|&f| end - f).sum();
+    end
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::Op;
+    use crate::kernel::Pipe;
+    use crate::slots::Slots;
+
+    struct Programs(Vec<Vec<Op>>);
+    impl WorkSource for Programs {
+        fn next(&mut self, _id: usize, t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
+            // One program per thread.
+            if t.has_no_program() {
+                self.0.pop()
+            } else {
+                None
+            }
+        }
+    }
+
+    fn one_thread(cfg: &SimConfig, box_pipes: u32, prog: Vec<Op>) -> (u64, Chip) {
+        let mut chip = Chip::new(cfg, box_pipes);
+        let mut th = vec![Thread::new(0)];
+        let end = run_chip(&mut chip, &mut th, &mut Programs(vec![prog]));
+        (end.get(), chip)
+    }
+
+    fn use_data() -> Op {
+        Op::Issue { n: 1, fpinv: 0 }
+    }
+
+    /// Random programs of every op kind on 4 TMs × 8 threads (loads that hit, merge and
+    /// miss, serial and parallel pipeline ops, reciprocal and plain instruction runs,
+    /// atomics between programs): with forward entries every counter and the end cycle
+    /// equal those of the plain wake-ups.
+    #[test]
+    fn forwards_change_no_result() {
+        struct Random(dualsplit_geometry::Pcg32, Vec<u32>);
+        impl WorkSource for Random {
+            fn next(&mut self, id: usize, t: &mut Thread, c: &mut Chip) -> Option<Vec<Op>> {
+                if self.1[id] == 0 {
+                    return None;
+                }
+                self.1[id] -= 1;
+                let r = &mut self.0;
+                if r.below(2) == 0 {
+                    c.atomic(t);
+                }
+                let mut ops = Vec::new();
+                for _ in 0..1 + r.below(40) {
+                    ops.push(match r.below(4) {
+                        0 => Op::Load {
+                            word: r.below(1 << 16),
+                            words: 1 + r.below(20) as u16,
+                        },
+                        1 => Op::Pipe {
+                            pipe: [Pipe::Box, Pipe::Triangle, Pipe::DualSplit][r.below(3) as usize],
+                            n: 1 + r.below(4) as u8,
+                            parallel: r.below(2) == 0,
+                        },
+                        _ => {
+                            let n = r.below(20);
+                            let fpinv = if r.below(4) == 0 { r.below(n + 1) } else { 0 };
+                            Op::Issue {
+                                n,
+                                fpinv: fpinv as u16,
+                            }
+                        }
+                    });
+                }
+                Some(ops)
+            }
+        }
+        let mut cfg = SimConfig::lin2020();
+        cfg.tms = 4;
+        cfg.tps_per_tm = 8;
+        for seed in 0..20 {
+            let run = |forwards| {
+                let mut chip = Chip::new(&cfg, 4);
+                let mut th: Vec<Thread> = (0..32).map(|i| Thread::new(i / 8)).collect();
+                let mut work = Random(dualsplit_geometry::Pcg32::new(seed, 3), vec![6; 32]);
+                let end = run_chip_with(&mut chip, &mut th, &mut work, forwards);
+                (end, chip.stats())
+            };
+            let plain = run(false);
+            assert!(
+                plain.1.stalls.memory > 0 && plain.1.stalls.pipeline_latency > 0,
+                "{plain:?}"
+            );
+            assert_eq!(run(true), plain, "seed {seed}");
+        }
+    }
+
+    /// A thread record and a reservation table each fit one host cache line (64 bytes).
+    #[test]
+    fn host_records_fit_a_cache_line() {
+        assert_eq!(std::mem::size_of::<Thread>(), 64);
+        assert_eq!(std::mem::align_of::<Thread>(), 64);
+        assert_eq!(std::mem::size_of::<Slots>(), 32);
+        assert_eq!(std::mem::align_of::<Slots>(), 32);
+    }
+
+    #[test]
+    fn l1_hit_takes_one_cycle() {
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        // Warm the line, then time a hit directly.
+        let fill = chip.load_word(0, 0, 0);
+        assert_eq!(chip.load_word(0, 1, fill), fill + 1);
+        assert_eq!(chip.stats().caches.l1_hits, 1);
+    }
+
+    #[test]
+    fn cold_load_is_a_closed_row_read_and_reload_hits_l2() {
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        // L1 1 + L2 3 + closed row (tRCD 14 + tCAS 14 + burst 2) = 34.
+        assert_eq!(chip.load_word(0, 0, 100), 134);
+        // Another TM: L1 miss, L2 hit: 1 + 3.
+        assert_eq!(chip.load_word(1, 0, 200), 204);
+        // Same TM, another line in the same DRAM row: row hit, 1 + 3 + 14 + 2 = 20.
+        assert_eq!(chip.load_word(0, 16, 300), 320);
+        assert_eq!(chip.stats().caches.l2_hits, 1);
+        assert_eq!(chip.stats().dram.row_hits, 1);
+    }
+
+    #[test]
+    fn row_conflict_load() {
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        chip.load_word(0, 0, 0);
+        // Same channel and bank, next row: 128 lines × 16 channels × 16 banks × 16 words.
+        let w = 128 * 16 * 16 * 16;
+        // 1 + 3 + tRP 14 + tRCD 14 + tCAS 14 + burst 2 = 48.
+        assert_eq!(chip.load_word(0, w, 1000), 1048);
+        assert_eq!(chip.stats().dram.row_conflicts, 1);
+    }
+
+    #[test]
+    fn l2_banks_interleave_by_word_or_by_line() {
+        // Words 0 and 128 (lines 0 and 8) missing in two TMs in the same cycle: word
+        // interleaving (SimTRaX) puts both on L2 bank 0, so the second waits one cycle; line
+        // interleaving puts them on banks 0 and 8.
+        let mut cfg = SimConfig::lin2020();
+        for (by_line, wait) in [(false, 1), (true, 0)] {
+            cfg.l2.line_interleaved = by_line;
+            let mut chip = Chip::new(&cfg, 1);
+            chip.load_word(0, 0, 10);
+            chip.load_word(1, 128, 10);
+            assert_eq!(
+                chip.stats().caches.l2_bank_wait,
+                wait,
+                "line_interleaved = {by_line}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_conflicting_miss_replaces_a_line_only_when_its_fill_arrives() {
+        // SimTRaX installs lines at their arrival (L1Cache/L2Cache UpdateCache) and finds
+        // lines in flight on its pending lists.
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        // Line 0 cold: 134 (L1 1 + L2 3 + closed row 30).
+        assert_eq!(chip.load_word(0, 0, 100), 134);
+        // Line 1024 (word 16384) maps to the same L1 set (64 KB direct-mapped): a closed-row
+        // read on channel 8, 34 cycles.
+        assert_eq!(chip.load_word(0, 16384, 200), 234);
+        // Line 0 is still in the L1 until 234: a 1-cycle hit, no L2 access.
+        assert_eq!(chip.load_word(0, 1, 202), 203);
+        assert_eq!(chip.stats().caches.l2_accesses, 2);
+        // Line 2048 (same set, channel 0 bank 1, closed row: data at tick 470, rounded up to
+        // the 2 ns burst grid, 472 + 4 = 476 ticks) takes the set's tag while 1024 is still in
+        // flight; 1024 stays on the in-flight list and a miss to it merges.
+        assert_eq!(chip.load_word(0, 32768, 203), 238);
+        assert_eq!(chip.load_word(0, 16385, 205), 234);
+        assert_eq!(chip.stats().caches.l2_accesses, 3);
+        assert_eq!(chip.stats().caches.l1_merged, 1);
+        // Once 2048 has arrived, line 0 is gone: an L1 miss, L2 hit (1 + 3).
+        assert_eq!(chip.load_word(0, 2, 240), 244);
+        assert_eq!(chip.stats().caches.l2_accesses, 4);
+        assert_eq!(chip.stats().dram.reads, 3);
+    }
+
+    #[test]
+    fn miss_to_line_in_flight_merges() {
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        let r0 = chip.load_word(0, 0, 0);
+        let r1 = chip.load_word(0, 1, 1);
+        assert_eq!(r1, r0);
+        assert_eq!(chip.stats().caches.l1_merged, 1);
+        assert_eq!(chip.stats().caches.l2_accesses, 1);
+        assert_eq!(chip.stats().dram.reads, 1);
+    }
+
+    #[test]
+    fn thread_load_then_use_waits_for_data() {
+        let cfg = SimConfig::lin2020();
+        // Load at cycle 0 (cold: 34), use at 34, one issue: finish 35.
+        let (end, chip) = one_thread(&cfg, 1, vec![Op::Load { word: 0, words: 1 }, use_data()]);
+        assert_eq!(end, 35);
+        assert_eq!(chip.stats().stalls.memory, 33);
+    }
+
+    #[test]
+    fn bank_conflict_costs_one_cycle() {
+        let cfg = SimConfig::lin2020();
+        // Two threads on one TM load words 0 and 16 (both bank 0) at cycle 0: the second
+        // gets the bank at cycle 1.
+        let mut chip = Chip::new(&cfg, 1);
+        let mut th = vec![Thread::new(0), Thread::new(0)];
+        let progs = vec![
+            vec![Op::Load { word: 16, words: 1 }],
+            vec![Op::Load { word: 0, words: 1 }],
+        ];
+        run_chip(&mut chip, &mut th, &mut Programs(progs));
+        assert_eq!(chip.stats().stalls.l1_bank, 1);
+        // A single 16-word line load spans all 16 banks without conflict.
+        let (_, chip) = one_thread(&cfg, 1, vec![Op::Load { word: 0, words: 16 }]);
+        assert_eq!(chip.stats().stalls.l1_bank, 0);
+    }
+
+    #[test]
+    fn one_pipeline_op_takes_its_latency() {
+        let cfg = SimConfig::lin2020();
+        let box_op = |n, parallel| Op::Pipe {
+            pipe: Pipe::Box,
+            n,
+            parallel,
+        };
+        // Issue at 0, result at 8, use at 8: end 9.
+        let (end, _) = one_thread(&cfg, 1, vec![box_op(1, false), use_data()]);
+        assert_eq!(end, 9);
+        // Four serial box tests: issue 0..3, last result 11, use: 12.
+        let (end, _) = one_thread(&cfg, 1, vec![box_op(4, false), use_data()]);
+        assert_eq!(end, 12);
+        // Four in parallel on four pipes: one issue, result 8, use: 9.
+        let (end, _) = one_thread(&cfg, 4, vec![box_op(4, true), use_data()]);
+        assert_eq!(end, 9);
+        let dst = Op::Pipe {
+            pipe: Pipe::DualSplit,
+            n: 1,
+            parallel: false,
+        };
+        let (end, chip) = one_thread(&cfg, 1, vec![dst, use_data()]);
+        assert_eq!(end, 9);
+        assert_eq!(chip.stats().units.dst_ops, 1);
+    }
+
+    #[test]
+    fn two_threads_share_one_pipeline() {
+        let cfg = SimConfig::lin2020();
+        let mut chip = Chip::new(&cfg, 1);
+        let mut th = vec![Thread::new(0), Thread::new(0)];
+        let op = Op::Pipe {
+            pipe: Pipe::Box,
+            n: 1,
+            parallel: false,
+        };
+        let progs = vec![vec![op, use_data()], vec![op, use_data()]];
+        let end = run_chip(&mut chip, &mut th, &mut Programs(progs)).get();
+        // The second thread gets the pipe at cycle 1: result 9, use ends at 10.
+        assert_eq!(end, 10);
+        assert_eq!(chip.stats().stalls.pipeline_busy, 1);
+    }
+
+    #[test]
+    fn fpinv_is_shared_and_long() {
+        let cfg = SimConfig::lin2020();
+        // 3 reciprocals at 0, 1, 2 (pipelined unit), last result 18; 5 more issues 3..7;
+        // then use at 18: end 19.
+        let (end, _) = one_thread(&cfg, 1, vec![Op::Issue { n: 8, fpinv: 3 }, use_data()]);
+        assert_eq!(end, 19);
+    }
+}
