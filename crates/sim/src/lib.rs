@@ -38,6 +38,7 @@ pub mod energy;
 pub mod engine;
 pub mod kernel;
 pub mod memory;
+pub mod rv32;
 pub mod slots;
 mod workload;
 
