@@ -47,10 +47,18 @@ static inline float f_signum(float x)
  * from zero and r by a three-part Cody-Waite reduction (k * PIO2_1 is exact for |k| < 2^16),
  * then the Cephes single-precision polynomials on |r| <= pi/4 and the quadrant k mod 4.
  * Accurate to a few ulps for |x| up to about 1e4 (the renderer calls it on [0, 2 pi)). */
-#define FM_FRAC_2_PI 0.636619772f
-#define FM_PIO2_1 1.5703125f
-#define FM_PIO2_2 4.837512969970703125e-4f
-#define FM_PIO2_3 7.54978995489188216e-8f
+#define FM_FRAC_2_PI 0.636619772367581343075535053490057448f /* 0x3F22F983 */
+/* pi/2 = PIO2_1 + PIO2_2 + PIO2_3 (PIO2_1 and PIO2_2 have short mantissas) */
+#define FM_PIO2_1 1.5703125f   /* 0x3FC90000 */
+#define FM_PIO2_2 4.837513e-4f /* 0x39FDA000 */
+#define FM_PIO2_3 7.54979e-8f  /* 0x33A22169 */
+/* Cephes sinf/cosf coefficients rounded to f32 (the literals of fmath.rs) */
+#define FM_S1 -1.9515296e-4f /* 0xB94CA1F9 */
+#define FM_S2 8.332161e-3f   /* 0x3C08839E */
+#define FM_S3 1.6666655e-1f  /* 0x3E2AAAA3 */
+#define FM_C1 2.4433157e-5f  /* 0x37CCF5CE */
+#define FM_C2 1.3887316e-3f  /* 0x3AB6061A */
+#define FM_C3 4.1666646e-2f  /* 0x3D2AAAA5 */
 
 static inline void f_sincos(float x, float *s_out, float *c_out)
 {
@@ -59,10 +67,8 @@ static inline void f_sincos(float x, float *s_out, float *c_out)
     float kf = (float)k;
     float r = ((x - kf * FM_PIO2_1) - kf * FM_PIO2_2) - kf * FM_PIO2_3;
     float z = r * r;
-    float s = ((-1.9515295891e-4f * z + 8.3321608736e-3f) * z - 1.6666654611e-1f) * z * r + r;
-    float c = ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f) *
-                  z * z -
-              0.5f * z + 1.0f;
+    float s = ((FM_S1 * z + FM_S2) * z - FM_S3) * z * r + r;
+    float c = ((FM_C1 * z - FM_C2) * z + FM_C3) * z * z - 0.5f * z + 1.0f;
     switch (k & 3) {
     case 0:
         *s_out = s;

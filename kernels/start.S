@@ -1,5 +1,6 @@
 /* Thread entry (docs/isa.md): sp = top of the thread's local store, run the kernel, ebreak
  * ends the thread. */
+    .file "start.S"
 #include "dualsplit.h"
 
     .section .text.start, "ax"

@@ -37,6 +37,7 @@ pub mod config;
 pub mod energy;
 pub mod engine;
 pub mod kernel;
+pub mod kernels;
 pub mod memory;
 pub mod rv32;
 pub mod slots;
