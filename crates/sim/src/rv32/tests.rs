@@ -558,3 +558,354 @@ fn committed_kernels_load() {
         assert_eq!(prog.first_illegal(), None, "{}", path.display());
     }
 }
+
+/// The ray-tracing instructions against their Rust counterparts (`RayPre::slab`,
+/// `Triangle::intersect`, `dst::pipeline::step`) on random inputs.
+mod custom {
+    use super::*;
+    use dualsplit_accel::dst::HeaderOffset;
+    use dualsplit_accel::dst::pipeline::{PipelineInput, step as dst_step};
+    use dualsplit_geometry::{Ray, RayPre, Triangle, Vec3};
+    use proptest::prelude::*;
+
+    /// Byte address of the triangle in the test image (after 48 box words).
+    const TRI_ADDR: u32 = 48 * 4;
+
+    /// A float that is usually ordinary, sometimes ±0, ±∞ or NaN.
+    fn any_f32() -> impl Strategy<Value = f32> + Clone {
+        prop_oneof![
+            8 => -10.0f32..10.0,
+            1 => Just(0.0f32),
+            1 => Just(-0.0f32),
+            1 => Just(f32::INFINITY),
+            1 => Just(f32::NEG_INFINITY),
+            1 => Just(f32::NAN),
+        ]
+    }
+    /// A direction component: usually ordinary, sometimes ±0.
+    fn dir_f32() -> impl Strategy<Value = f32> + Clone {
+        prop_oneof![8 => -1.0f32..1.0, 1 => Just(0.0f32), 1 => Just(-0.0f32)]
+    }
+    fn vec3(s: impl Strategy<Value = f32> + Clone) -> impl Strategy<Value = Vec3> {
+        (s.clone(), s.clone(), s).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+    }
+    /// A box near the origin (min ≤ max usually, sometimes inverted or degenerate).
+    fn any_box() -> impl Strategy<Value = (Vec3, Vec3)> {
+        prop_oneof![
+            6 => (vec3(-5.0f32..5.0), vec3(0.0f32..3.0)).prop_map(|(lo, ext)| (lo, lo + ext)),
+            1 => (vec3(any_f32()), vec3(any_f32())),
+            1 => Just((Vec3::INFINITY, Vec3::NEG_INFINITY)),
+        ]
+    }
+
+    #[derive(Debug, Clone)]
+    struct Case {
+        origin: Vec3,
+        dir: Vec3,
+        boxes: Vec<(Vec3, Vec3)>,
+        /// funct2 of rt.boxn: N = 2 << log2n.
+        log2n: u32,
+        tri: Triangle,
+        t_lo: f32,
+        t_hi: f32,
+        node: [u32; 3],
+        t_min: f32,
+        t_max: f32,
+    }
+
+    fn case() -> impl Strategy<Value = Case> {
+        let tri = prop_oneof![
+            3 => (vec3(-3.0f32..3.0), vec3(-3.0f32..3.0), vec3(-3.0f32..3.0)),
+            1 => (vec3(any_f32()), vec3(any_f32()), vec3(any_f32())),
+        ];
+        let node = (
+            any::<u32>(),
+            prop_oneof![3 => -5.0f32..5.0, 1 => any_f32()],
+            prop_oneof![3 => -5.0f32..5.0, 1 => any_f32()],
+        );
+        (
+            vec3(-4.0f32..4.0),
+            vec3(dir_f32()),
+            proptest::collection::vec(any_box(), 8),
+            0u32..3,
+            tri,
+            (
+                prop_oneof![3 => 0.0f32..1.0, 1 => any_f32()],
+                prop_oneof![3 => 1.0f32..100.0, 1 => any_f32()],
+            ),
+            node,
+            (
+                prop_oneof![3 => 0.0f32..2.0, 1 => any_f32()],
+                prop_oneof![3 => 1.0f32..100.0, 1 => any_f32()],
+            ),
+            proptest::bool::ANY,
+        )
+            .prop_map(
+                |(
+                    origin,
+                    dir,
+                    boxes,
+                    log2n,
+                    (a, b, c),
+                    (t_lo, t_hi),
+                    (w, p0, p1),
+                    (t_min, t_max),
+                    aim,
+                )| {
+                    // Half the time aim the ray at a point of the triangle, so hits are common.
+                    let dir = if aim {
+                        (a * 0.3 + b * 0.3 + c * 0.4) - origin
+                    } else {
+                        dir
+                    };
+                    // ... and then every other box bounds the triangle, so box hits are common.
+                    let mut boxes = boxes;
+                    if aim {
+                        let bounds = (a.min(b).min(c) - 0.1, a.max(b).max(c) + 0.1);
+                        boxes.iter_mut().step_by(2).for_each(|bx| *bx = bounds);
+                    }
+                    Case {
+                        origin,
+                        dir,
+                        boxes,
+                        log2n,
+                        tri: Triangle { v: [a, b, c] },
+                        t_lo,
+                        t_hi,
+                        node: [w, p0.to_bits(), p1.to_bits()],
+                        t_min,
+                        t_max,
+                    }
+                },
+            )
+    }
+
+    /// The program: set R, rt.box, rt.boxn, 8 × rt.boxget, rt.tri, rt.dst, 3 × rt.dstget,
+    /// rt.rcp, 2 × rt.atominc.
+    fn program(f2: u32) -> Program {
+        let mut w = vec![
+            r4(0x0B, 0, 0, 0, 1, 2, 3),    // rt.setorg f1, f2, f3
+            r4(0x0B, 1, 0, 0, 4, 5, 6),    // rt.setinv f4, f5, f6
+            r4(0x0B, 2, 0, 0, 7, 8, 9),    // rt.setshear f7, f8, f9
+            r(0x0B, 3, 0, 0, 5, 0),        // rt.setk x5
+            r4(0x2B, 0, 0, 10, 6, 11, 12), // f10 = rt.box (x6), f11, f12
+            r4(0x2B, 1, f2, 7, 6, 11, 12), // x7 = rt.boxn
+        ];
+        w.extend((0..8).map(|k| r(0x2B, 2, k, 20 + k, 0, 0))); // f20+k = B[k]
+        w.extend([
+            r4(0x2B, 3, 0, 14, 8, 11, 12), // f14 = rt.tri (x8), f11, f12
+            r4(0x2B, 4, 0, 9, 10, 28, 29), // x9 = rt.dst (x10), f28, f29
+            r(0x2B, 5, 0, 15, 0, 0),       // f15 = D.t_min_out
+            r(0x2B, 5, 1, 16, 0, 0),       // f16 = D.t_max_out
+            r(0x2B, 5, 2, 11, 0, 0),       // x11 = D.offset_stack
+            r(0x0B, 4, 0, 17, 1, 0),       // f17 = rt.rcp f1
+            r(0x0B, 5, 0, 12, 0, 0),       // x12 = rt.atominc G[x0]
+            r(0x0B, 5, 0, 13, 0, 0),       // x13 = rt.atominc G[x0]
+            EBREAK,
+        ]);
+        Program::from_words(BASE, &w)
+    }
+
+    fn check(c: &Case) -> Result<(), TestCaseError> {
+        // N = 2, 4, 8 for funct2 = 0, 1, 2.
+        let n = 2usize << c.log2n;
+        let pre = RayPre::new(&Ray::new(c.origin, c.dir));
+        // The image: 8 boxes at word 0, the triangle after them.
+        let mut image = MemoryImage::with_triangles(48, 0, vec![c.tri].into());
+        for (k, (lo, hi)) in c.boxes.iter().enumerate() {
+            for (j, v) in lo.to_array().into_iter().chain(hi.to_array()).enumerate() {
+                image.words[6 * k + j] = v.to_bits();
+            }
+        }
+        let prog = program(c.log2n);
+        let mut mem = FrameMemory::new(&image, &[], 0);
+        let mut h = Hart::new(&prog, 64);
+        // The DST node in the local store.
+        for (k, w) in c.node.iter().enumerate() {
+            h.local[4 * k..4 * k + 4].copy_from_slice(&w.to_le_bytes());
+        }
+        let f = |v: f32| v.to_bits();
+        let o = pre.ray.origin;
+        let [kx, ky, kz] = pre.k;
+        h.f[1..10].copy_from_slice(&[
+            f(o.x),
+            f(o.y),
+            f(o.z),
+            f(pre.inv_dir.x),
+            f(pre.inv_dir.y),
+            f(pre.inv_dir.z),
+            f(pre.shear.x),
+            f(pre.shear.y),
+            f(pre.shear.z),
+        ]);
+        h.x[5] = (kx | ky << 2 | kz << 4) as u32;
+        h.x[6] = 0;
+        h.x[8] = TRI_ADDR;
+        h.x[10] = LOCAL_STORE_ADDR;
+        h.f[11] = f(c.t_lo);
+        h.f[12] = f(c.t_hi);
+        h.f[28] = f(c.t_min);
+        h.f[29] = f(c.t_max);
+        let mut retired = Vec::new();
+        while !h.halted {
+            retired.push(
+                h.step(&prog, &mut mem)
+                    .map_err(|e| TestCaseError::fail(e.to_string()))?,
+            );
+        }
+        // R is exactly RayPre's fields.
+        prop_assert_eq!(h.ray.ray.origin.to_array().map(f), o.to_array().map(f));
+        prop_assert_eq!(
+            h.ray.inv_dir.to_array().map(f),
+            pre.inv_dir.to_array().map(f)
+        );
+        prop_assert_eq!(h.ray.neg, pre.neg);
+        prop_assert_eq!(h.ray.k, pre.k);
+        prop_assert_eq!(h.ray.shear.to_array().map(f), pre.shear.to_array().map(f));
+        // rt.box, rt.boxn, rt.boxget.
+        let slab = |(lo, hi): (Vec3, Vec3)| {
+            let (entry, exit) = pre.slab(lo, hi, c.t_lo, c.t_hi);
+            if entry <= exit {
+                (true, entry.to_bits())
+            } else {
+                (false, CANONICAL_NAN)
+            }
+        };
+        prop_assert_eq!(h.f[10], slab(c.boxes[0]).1);
+        let mut mask = 0;
+        for k in 0..n {
+            let (hit, entry) = slab(c.boxes[k]);
+            mask |= (hit as u32) << k;
+            prop_assert_eq!(h.f[20 + k], entry, "B[{}]", k);
+        }
+        prop_assert_eq!(h.x[7], mask);
+        // rt.tri.
+        let t = c
+            .tri
+            .intersect(&pre, c.t_lo, c.t_hi)
+            .map_or(CANONICAL_NAN, |hit| hit.t.to_bits());
+        prop_assert_eq!(h.f[14], t);
+        // rt.dst, rt.dstget.
+        let out = dst_step(&PipelineInput {
+            word: HeaderOffset::from_bits(c.node[0]),
+            p0: f32::from_bits(c.node[1]),
+            p1: f32::from_bits(c.node[2]),
+            origin: o.to_array(),
+            inv_dir: pre.inv_dir.to_array(),
+            t_min: c.t_min,
+            t_max: c.t_max,
+        });
+        prop_assert_eq!(h.x[9], out.code as u32 | out.offset << 2);
+        prop_assert_eq!(h.f[15], out.t_min_out.to_bits());
+        prop_assert_eq!(h.f[16], out.t_max_out.to_bits());
+        prop_assert_eq!(h.x[11], out.offset_stack);
+        // rt.rcp, rt.atominc.
+        let rcp = 1.0 / o.x;
+        prop_assert_eq!(
+            h.f[17],
+            if rcp.is_nan() {
+                CANONICAL_NAN
+            } else {
+                rcp.to_bits()
+            }
+        );
+        prop_assert_eq!((h.x[12], h.x[13], mem.globals[0]), (0, 1, 2));
+        // The memory operands as the timing model sees them.
+        let acc = |addr, words, local| MemAccess {
+            addr,
+            words,
+            store: false,
+            local,
+        };
+        prop_assert_eq!(retired[4].mem, acc(0, 6, false));
+        prop_assert_eq!(retired[4].fu(), FuClass::BoxPipe(1));
+        prop_assert_eq!(retired[5].mem, acc(0, 6 * n as u8, false));
+        prop_assert_eq!(retired[5].fu(), FuClass::BoxPipe(n as u8));
+        prop_assert_eq!(retired[14].mem, acc(TRI_ADDR, 9, false));
+        prop_assert_eq!(retired[14].fu(), FuClass::TriPipe);
+        prop_assert_eq!(retired[15].mem, acc(LOCAL_STORE_ADDR, 3, true));
+        prop_assert_eq!(retired[15].fu(), FuClass::DstPipe);
+        Ok(())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+        #[test]
+        fn custom_instructions_match_rust(c in case()) {
+            check(&c)?;
+        }
+    }
+
+    /// Hits are common enough in the random cases that the comparison means something.
+    #[test]
+    fn random_cases_hit() {
+        use proptest::strategy::ValueTree;
+        use proptest::test_runner::TestRunner;
+        let mut runner = TestRunner::deterministic();
+        let (mut tri_hits, mut box_hits, mut codes) = (0, 0, [0; 4]);
+        for _ in 0..500 {
+            let c = case().new_tree(&mut runner).unwrap().current();
+            let pre = RayPre::new(&Ray::new(c.origin, c.dir));
+            tri_hits += c.tri.intersect(&pre, c.t_lo, c.t_hi).is_some() as u32;
+            let (en, ex) = pre.slab(c.boxes[0].0, c.boxes[0].1, c.t_lo, c.t_hi);
+            box_hits += (en <= ex) as u32;
+            let out = dst_step(&PipelineInput {
+                word: HeaderOffset::from_bits(c.node[0]),
+                p0: f32::from_bits(c.node[1]),
+                p1: f32::from_bits(c.node[2]),
+                origin: c.origin.to_array(),
+                inv_dir: pre.inv_dir.to_array(),
+                t_min: c.t_min,
+                t_max: c.t_max,
+            });
+            codes[out.code as usize] += 1;
+        }
+        assert!(tri_hits > 50, "{tri_hits} triangle hits");
+        assert!(box_hits > 50, "{box_hits} box hits");
+        assert!(codes.iter().all(|&k| k > 20), "return codes {codes:?}");
+    }
+
+    #[test]
+    fn custom_faults() {
+        let image = MemoryImage::default();
+        let run1 = |word: u32, init: &dyn Fn(&mut Hart)| {
+            let prog = Program::from_words(BASE, &[word, EBREAK]);
+            let mut mem = FrameMemory::new(&image, &[], 0);
+            let mut h = Hart::new(&prog, 64);
+            init(&mut h);
+            h.step(&prog, &mut mem)
+        };
+        let pc = BASE;
+        // rt.setk with an axis of 3.
+        assert_eq!(
+            run1(r(0x0B, 3, 0, 0, 5, 0), &|h| h.x[5] = 3),
+            Err(ExecError::BadAxes { pc, value: 3 })
+        );
+        // rt.atominc on a missing global register.
+        assert_eq!(
+            run1(r(0x0B, 5, 0, 12, 5, 0), &|h| h.x[5] = 99),
+            Err(ExecError::NoGlobal { pc, index: 99 })
+        );
+        // rt.box at a misaligned and an unmapped address.
+        let bx = r4(0x2B, 0, 0, 10, 6, 11, 12);
+        assert_eq!(
+            run1(bx, &|h| h.x[6] = LOCAL_STORE_ADDR + 2),
+            Err(ExecError::Misaligned {
+                pc,
+                addr: LOCAL_STORE_ADDR + 2,
+                bytes: 4
+            })
+        );
+        assert_eq!(
+            run1(bx, &|h| h.x[6] = LOCAL_STORE_ADDR + 48),
+            Err(ExecError::Unmapped {
+                pc,
+                addr: LOCAL_STORE_ADDR + 48
+            })
+        );
+        assert_eq!(
+            run1(bx, &|h| h.x[6] = 0),
+            Err(ExecError::Unmapped { pc, addr: 0 })
+        );
+    }
+}
