@@ -36,7 +36,7 @@ use crate::config::UnitConfig;
 use crate::fu::Pools;
 use crate::kernel::Pipe;
 use crate::memory::L2;
-use crate::rv32::{ExecError, FrameMemory, FuClass, Hart, Latches, Op, Program};
+use crate::rv32::{ExecError, FrameMemory, FuClass, Hart, LOCAL_STORE_ADDR, Latches, Op, Program};
 use crate::thread::Stalls;
 use crate::tm::{Issued, Tm, WordAddr};
 
@@ -207,11 +207,20 @@ impl Tp {
                 }
                 self.t = at;
             }
-            let shared = on_shared_unit(info.fu);
+            let shared = match info.fu {
+                // A load or store is the L1's unless it addresses the local store.
+                FuClass::Load | FuClass::Store => {
+                    let addr = self.hart.x[ins.rs1 as usize].wrapping_add(ins.imm as u32);
+                    addr < LOCAL_STORE_ADDR
+                }
+                fu => on_shared_unit(fu),
+            };
             if (shared && self.t > now) || self.t > now + LOOKAHEAD {
                 return Ok(Next::Sleep(self.t));
             }
             let r = self.hart.step(prog, mem)?;
+            // The executed class (a load or store whose address is the local store's).
+            let info = r.info;
             counts[crate::rv32::run::fu_index(info.fu)] += 1;
             self.rays += (ins.op == Op::RtSetOrg) as u64;
             let dst = info.dst.index();
@@ -356,9 +365,7 @@ fn pool(p: &mut crate::fu::Pool, t: Cycle, stalls: &mut Stalls) -> (Cycle, u64, 
 fn on_shared_unit(fu: FuClass) -> bool {
     matches!(
         fu,
-        FuClass::Load
-            | FuClass::Store
-            | FuClass::BoxPipe(_)
+        FuClass::BoxPipe(_)
             | FuClass::TriPipe
             | FuClass::DstPipe
             | FuClass::IntDiv
