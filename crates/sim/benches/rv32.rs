@@ -13,7 +13,7 @@ fn main() {
 
 const ITERS: u32 = 100_000;
 
-/// The loop: x1 = ITERS; loop { x2 += 1; x3 += x2; x4 ^= x3; x5 = x4 << 1; bne x2, x1 }
+/// The loop: x1 = ITERS; loop { x6 += 1; x3 += x6; x4 ^= x3; x5 = x4 << 1; bne x6, x1 }
 fn int_loop() -> Program {
     let lui = |rd: u32, imm: u32| (imm & 0xFFFF_F000) | (rd << 7) | 0x37;
     let itype = |f3: u32, rd: u32, rs1: u32, imm: i32| {
@@ -40,11 +40,11 @@ fn int_loop() -> Program {
         &[
             lui(1, hi),
             itype(0, 1, 1, lo),
-            itype(0, 2, 2, 1),
-            rtype(0, 0, 3, 3, 2),
+            itype(0, 6, 6, 1),
+            rtype(0, 0, 3, 3, 6),
             rtype(0, 4, 4, 4, 3),
             itype(1, 5, 4, 1),
-            bne(2, 1, -16),
+            bne(6, 1, -16),
             0x0010_0073,
         ],
     )
@@ -58,7 +58,7 @@ fn int_loop_instructions(bencher: divan::Bencher) {
     let mut hart = Hart::new(&prog, 4096);
     let mut mem = FrameMemory::new(&image, &[], 0);
     assert_eq!(run_fast(&mut hart, &prog, &mut mem, u64::MAX).unwrap(), n);
-    assert_eq!(hart.x[2], ITERS);
+    assert_eq!(hart.x[6], ITERS);
     bencher.counter(ItemsCount::new(n)).bench_local(|| {
         hart.reset(&prog);
         run_fast(&mut hart, &prog, &mut mem, u64::MAX).unwrap()
