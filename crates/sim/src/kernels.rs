@@ -20,7 +20,7 @@ pub const FRAME_BUFFER_ADDR: u32 = 0x7800_0000;
 /// Byte address of a thread's local store (its stack grows down from the top).
 pub const LOCAL_STORE_ADDR: u32 = 0xF000_0000;
 /// Bytes of a thread's local store (`LOCAL_STORE_BYTES` in `kernels/dualsplit.h`): the
-/// deepest traversal stack (192 BVH entries of 8 B or 128 DST entries of 12 B) and the
+/// deepest traversal stack (256 BVH entries of 8 B or 192 DST entries of 12 B) and the
 /// renderer's frames.
 pub const LOCAL_STORE_BYTES: u32 = 4096;
 /// Floats per pixel in the frame buffer (the kernels write the grey radiance three times).
