@@ -2,9 +2,15 @@
 //! second on one core. `cargo bench -p dualsplit-sim --bench rv32`.
 //!
 //! `int_loop`: a counted loop of integer instructions (`addi`, `add`, `xor`, `slli`, `bne`).
+//! `kernel_frame`: a compiled kernel (`kernels/build`) rendering a 32×32 path-traced frame
+//! of `builtin:cornell` on one hart, BVH2 and DST: real code (floats, loads, stack, the
+//! ray-tracing instructions), counted in instructions.
 
 use divan::counter::ItemsCount;
-use dualsplit_accel::MemoryImage;
+use dualsplit_accel::{MemoryImage, Structures};
+use dualsplit_render::{RenderSettings, Workload};
+use dualsplit_sim::SimAccel;
+use dualsplit_sim::kernels::{LOCAL_STORE_BYTES, Params, elf};
 use dualsplit_sim::rv32::{FrameMemory, Hart, Program, run_fast};
 
 fn main() {
@@ -63,4 +69,21 @@ fn int_loop_instructions(bencher: divan::Bencher) {
         hart.reset(&prog);
         run_fast(&mut hart, &prog, &mut mem, u64::MAX).unwrap()
     });
+}
+
+#[divan::bench(args = [SimAccel::Bvh2, SimAccel::Dst])]
+fn kernel_frame(bencher: divan::Bencher, accel: SimAccel) {
+    let scene = dualsplit_scene::load("builtin:cornell").unwrap();
+    let structures = Structures::build(&scene.triangles, &Default::default());
+    let settings = RenderSettings::new(32, 32, Workload::Path);
+    let prog = Program::from_elf(elf(accel, settings.workload)).unwrap();
+    let params = Params::new(&scene, &structures, accel, &settings);
+    let image = structures.image(accel.kind());
+    let run = || {
+        let mut mem = FrameMemory::new(image, params.as_bytes(), params.frame_bytes());
+        let mut hart = Hart::new(&prog, LOCAL_STORE_BYTES);
+        run_fast(&mut hart, &prog, &mut mem, u64::MAX).unwrap()
+    };
+    let n = run();
+    bencher.counter(ItemsCount::new(n)).bench_local(run);
 }
