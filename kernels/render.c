@@ -301,6 +301,8 @@ static float render_pixel(const struct Params *P, uint32_t x, uint32_t y)
 void kernel_main(void)
 {
     const struct Params *P = PARAMS;
+    if (P->workload != WORKLOAD_PATH)
+        kernel_fault(); /* the host loaded the other workload's kernel */
     uint32_t pixels = P->width * P->height;
     float *fb = (float *)(uintptr_t)P->frame_buffer;
     for (;;) {

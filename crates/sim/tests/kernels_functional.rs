@@ -142,3 +142,23 @@ fn dragon_box() {
         check(&scene, &structures, &RenderSettings::new(24, 24, workload));
     }
 }
+
+/// A kernel handed the other workload's parameters stops with a fault (a store to the
+/// read-only parameter block) instead of rendering the wrong image.
+#[test]
+fn a_kernel_given_the_other_workload_faults() {
+    let scene = load("builtin:cornell").unwrap();
+    let structures = Structures::build(&scene.triangles, &Default::default());
+    let settings = RenderSettings::new(4, 4, Workload::Cast);
+    let params = Params::new(&scene, &structures, SimAccel::Bvh2, &settings);
+    let prog = Program::from_elf(elf(SimAccel::Bvh2, Workload::Path)).unwrap();
+    let run = run_frame(
+        &prog,
+        structures.image(SimAccel::Bvh2.kind()),
+        params.as_bytes(),
+        params.frame_bytes(),
+        LOCAL_STORE_BYTES,
+        1_000_000,
+    );
+    assert!(run.is_err(), "the path kernel ran with cast parameters");
+}
