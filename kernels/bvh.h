@@ -30,7 +30,9 @@ struct Entry {
 };
 
 #define ENTRY_LEAF 0x80000000u
-#define STACK_SIZE 192
+#define STACK_SIZE 256
+_Static_assert(STACK_SIZE * sizeof(struct Entry) <= LOCAL_STORE_BYTES * 5 / 8,
+               "the traversal stack leaves room for the renderer's frames");
 
 static inline uint32_t node_offset(const Node *n)
 {
@@ -111,7 +113,7 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
         /* The hit children: the nearest in `cur`, the others on the stack above `base`,
          * nearest on top; ordered by entry distance, ties in slot order. */
         if (sp > STACK_SIZE - BVH_ARITY)
-            __builtin_trap(); /* deeper than any tree the builder makes */
+            kernel_fault(); /* deeper than any tree the builder makes */
         int base = sp;
         uint32_t addr = node_offset(node);
 #if BVH_WIDE_BOX

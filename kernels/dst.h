@@ -35,7 +35,7 @@ static int traverse(const struct Ray *ray, const struct RayPre *r, int any, stru
         }
         if (code == CODE_BOTH_CHILDREN) {
             if (sp == STACK_SIZE)
-                __builtin_trap(); /* deeper than any tree the converter makes */
+                kernel_fault(); /* deeper than any tree the converter makes */
             stack[sp].node = rt_dst_offset_stack();
             stack[sp].t_min = rt_dst_tmin();
             stack[sp].t_max = t_max;

@@ -8,7 +8,9 @@ struct Entry {
     float t_max;
 };
 
-#define STACK_SIZE 128
+#define STACK_SIZE 192
+_Static_assert(STACK_SIZE * sizeof(struct Entry) <= LOCAL_STORE_BYTES * 5 / 8,
+               "the traversal stack leaves room for the renderer's frames");
 
 /* RayPre::slab of the scene box on [t_lo, t_hi]: the clipped interval, non-empty when the
  * ray meets the box. Near and far planes by the ray's signs; far planes widened; NaN plane

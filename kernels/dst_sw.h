@@ -64,7 +64,7 @@ static int traverse(const struct Ray *ray, const struct RayPre *r, int any, stru
                 if (far_hit) {
                     if (near_hit) {
                         if (sp == STACK_SIZE)
-                            __builtin_trap(); /* deeper than any tree the converter makes */
+                            kernel_fault(); /* deeper than any tree the converter makes */
                         stack[sp].node = far;
                         stack[sp].t_min = f_max(t_min, t2);
                         stack[sp].t_max = t_max;

@@ -17,6 +17,14 @@
 #define PARAMS ((const struct Params *)PARAMS_ADDR)
 #define WORD_ADDR(i) ((const uint32_t *)(uintptr_t)((i) * 4u))
 
+/* A kernel bug or a tree deeper than the traversal stack: store to the read-only parameter
+ * block (the simulator stops with a fault naming this pc), then end the thread. */
+static inline void kernel_fault(void)
+{
+    *(volatile uint32_t *)PARAMS_ADDR = 0;
+    __builtin_trap();
+}
+
 /* ---- vectors (glam's Vec3 arithmetic, operation for operation) -------------------------- */
 
 struct Vec3 {
@@ -293,6 +301,8 @@ static float render_pixel(const struct Params *P, uint32_t x, uint32_t y)
 void kernel_main(void)
 {
     const struct Params *P = PARAMS;
+    if (P->workload != WORKLOAD_PATH)
+        kernel_fault(); /* the host loaded the other workload's kernel */
     uint32_t pixels = P->width * P->height;
     float *fb = (float *)(uintptr_t)P->frame_buffer;
     for (;;) {

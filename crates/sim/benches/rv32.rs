@@ -2,9 +2,15 @@
 //! second on one core. `cargo bench -p dualsplit-sim --bench rv32`.
 //!
 //! `int_loop`: a counted loop of integer instructions (`addi`, `add`, `xor`, `slli`, `bne`).
+//! `kernel_frame`: a compiled kernel (`kernels/build`) rendering a 32×32 path-traced frame
+//! of `builtin:cornell` on one hart, BVH2 and DST: real code (floats, loads, stack, the
+//! ray-tracing instructions), counted in instructions.
 
 use divan::counter::ItemsCount;
-use dualsplit_accel::MemoryImage;
+use dualsplit_accel::{MemoryImage, Structures};
+use dualsplit_render::{RenderSettings, Workload};
+use dualsplit_sim::SimAccel;
+use dualsplit_sim::kernels::{LOCAL_STORE_BYTES, Params, elf};
 use dualsplit_sim::rv32::{FrameMemory, Hart, Program, run_fast};
 
 fn main() {
@@ -13,7 +19,7 @@ fn main() {
 
 const ITERS: u32 = 100_000;
 
-/// The loop: x1 = ITERS; loop { x2 += 1; x3 += x2; x4 ^= x3; x5 = x4 << 1; bne x2, x1 }
+/// The loop: x1 = ITERS; loop { x6 += 1; x3 += x6; x4 ^= x3; x5 = x4 << 1; bne x6, x1 }
 fn int_loop() -> Program {
     let lui = |rd: u32, imm: u32| (imm & 0xFFFF_F000) | (rd << 7) | 0x37;
     let itype = |f3: u32, rd: u32, rs1: u32, imm: i32| {
@@ -40,11 +46,11 @@ fn int_loop() -> Program {
         &[
             lui(1, hi),
             itype(0, 1, 1, lo),
-            itype(0, 2, 2, 1),
-            rtype(0, 0, 3, 3, 2),
+            itype(0, 6, 6, 1),
+            rtype(0, 0, 3, 3, 6),
             rtype(0, 4, 4, 4, 3),
             itype(1, 5, 4, 1),
-            bne(2, 1, -16),
+            bne(6, 1, -16),
             0x0010_0073,
         ],
     )
@@ -58,9 +64,26 @@ fn int_loop_instructions(bencher: divan::Bencher) {
     let mut hart = Hart::new(&prog, 4096);
     let mut mem = FrameMemory::new(&image, &[], 0);
     assert_eq!(run_fast(&mut hart, &prog, &mut mem, u64::MAX).unwrap(), n);
-    assert_eq!(hart.x[2], ITERS);
+    assert_eq!(hart.x[6], ITERS);
     bencher.counter(ItemsCount::new(n)).bench_local(|| {
         hart.reset(&prog);
         run_fast(&mut hart, &prog, &mut mem, u64::MAX).unwrap()
     });
+}
+
+#[divan::bench(args = [SimAccel::Bvh2, SimAccel::Dst])]
+fn kernel_frame(bencher: divan::Bencher, accel: SimAccel) {
+    let scene = dualsplit_scene::load("builtin:cornell").unwrap();
+    let structures = Structures::build(&scene.triangles, &Default::default());
+    let settings = RenderSettings::new(32, 32, Workload::Path);
+    let prog = Program::from_elf(elf(accel, settings.workload)).unwrap();
+    let params = Params::new(&scene, &structures, accel, &settings);
+    let image = structures.image(accel.kind());
+    let run = || {
+        let mut mem = FrameMemory::new(image, params.as_bytes(), params.frame_bytes());
+        let mut hart = Hart::new(&prog, LOCAL_STORE_BYTES);
+        run_fast(&mut hart, &prog, &mut mem, u64::MAX).unwrap()
+    };
+    let n = run();
+    bencher.counter(ItemsCount::new(n)).bench_local(run);
 }

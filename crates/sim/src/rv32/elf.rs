@@ -232,7 +232,7 @@ impl Program {
         let in_exec = segs
             .iter()
             .any(|s| s.exec && entry >= s.vaddr as u64 && entry < (s.vaddr + s.memsz) as u64);
-        if !in_exec || entry % 4 != 0 {
+        if !in_exec || !entry.is_multiple_of(4) {
             return Err(ElfError::Entry(entry));
         }
         Ok(Program::from_parts(
