@@ -375,3 +375,103 @@ fn on_shared_unit(fu: FuClass) -> bool {
             | FuClass::Atomic
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::chip::{Chip, run_compiled};
+    use crate::config::SimConfig;
+    use crate::rv32::PROGRAM_BASE;
+    use crate::rv32::tests::asm::*;
+    use dualsplit_accel::MemoryImage;
+
+    /// Runs `words` (an `ebreak` appended) on `threads` TPs of one TM; returns the end
+    /// cycle and the stalls.
+    fn run(cfg: &SimConfig, words: &[u32], threads: u32) -> (u64, Stalls) {
+        let mut w = words.to_vec();
+        w.push(EBREAK);
+        let prog = Program::from_words(PROGRAM_BASE, &w);
+        let image = MemoryImage::with_triangles(64, 0, Vec::new().into());
+        let mut mem = FrameMemory::new(&image, &[], 64);
+        let mut chip = Chip::new(cfg, 1);
+        let mut pools = vec![Pools::new(&cfg.units)];
+        let mut tps: Vec<Tp> = (0..threads).map(|_| Tp::new(&prog, 0, 4096)).collect();
+        let mut counts = [0; crate::rv32::run::FU_CLASSES];
+        let end = run_compiled(
+            &mut chip,
+            &mut pools,
+            &mut tps,
+            &prog,
+            &mut mem,
+            &cfg.units,
+            &mut counts,
+            &mut |_| {},
+        )
+        .unwrap();
+        (end.get(), chip.stats().stalls)
+    }
+
+    fn fadd(rd: u32, rs1: u32, rs2: u32) -> u32 {
+        fp(0x00, 0, rd, rs1, rs2)
+    }
+
+    #[test]
+    fn independent_instructions_issue_one_per_cycle() {
+        // addi ×3 at cycles 0, 1, 2; ebreak at 3; the last result is in at 3.
+        let (end, s) = run(
+            &SimConfig::lin2020(),
+            &[addi(1, 0, 1), addi(2, 0, 2), addi(3, 0, 3)],
+            1,
+        );
+        assert_eq!(end, 3);
+        assert_eq!(s.dependency, 0);
+    }
+
+    #[test]
+    fn a_dependent_fp_add_waits_for_the_adders_latency() {
+        // fadd f1 at 0 (ready at 2), fadd f2 = f1 + f1 waits to 2 (1 dependency cycle),
+        // ready at 4; ebreak at 3.
+        let cfg = SimConfig::lin2020();
+        assert_eq!(cfg.units.fpadd_latency, 2);
+        let (end, s) = run(&cfg, &[fadd(1, 0, 0), fadd(2, 1, 1)], 1);
+        assert_eq!(s.dependency, 1);
+        assert_eq!(end, 4);
+    }
+
+    #[test]
+    fn a_full_pool_delays_the_second_thread() {
+        // Two threads multiply at cycle 0 on a TM with one integer multiplier: the second
+        // issues at 1, its ebreak at 2.
+        let mut cfg = SimConfig::lin2020();
+        cfg.units.intmul_units = 1;
+        let mul = r(0x33, 0, 1, 3, 1, 2);
+        let (end, s) = run(&cfg, &[mul], 2);
+        assert_eq!(s.fu_busy, 1);
+        assert_eq!(end, 2);
+    }
+
+    #[test]
+    fn a_load_use_waits_for_memory_and_is_counted_as_memory() {
+        // lw x1, 0(x0) misses everywhere; addi x2, x1, 1 waits for it.
+        let cfg = SimConfig::lin2020();
+        let (end, s) = run(&cfg, &[i(0x03, 2, 1, 0, 0), addi(2, 1, 1)], 1);
+        // A closed-row DRAM read: at least t_rcd + t_cas = 28 ns at lin2020.
+        assert!(s.memory >= 28, "{s:?}");
+        assert_eq!(s.dependency, 0);
+        // lw at 0, its data in at 1 + memory, addi then, ebreak the cycle after.
+        assert_eq!(end, 1 + s.memory + 1);
+    }
+
+    #[test]
+    fn local_store_accesses_do_not_touch_the_l1() {
+        // sw x0, -4(sp) at 0; lw x1, -4(sp) at 1, in at 2; addi at 2; ebreak at 3.
+        let cfg = SimConfig::lin2020();
+        let (end, s) = run(
+            &cfg,
+            &[s(0x23, 2, 2, 0, -4), i(0x03, 2, 1, 2, -4), addi(3, 1, 1)],
+            1,
+        );
+        assert_eq!(s.memory, 0);
+        assert_eq!(end, 3);
+    }
+}

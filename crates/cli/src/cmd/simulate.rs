@@ -81,9 +81,15 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         let total = settings.width as u64 * settings.height as u64;
         let bar = ctx.bar(total, format!("{} {}", accel.label(), workload.name()));
         let t0 = Instant::now();
-        let r = simulate_model(model, &scene, &structures, accel, &settings, &cfg, &|done, _| {
-            bar.set_position(done)
-        })
+        let r = simulate_model(
+            model,
+            &scene,
+            &structures,
+            accel,
+            &settings,
+            &cfg,
+            &|done, _| bar.set_position(done),
+        )
         .with_context(|| format!("simulating {}", accel.label()))?;
         let host = t0.elapsed();
         bar.finish_and_clear();

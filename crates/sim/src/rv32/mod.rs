@@ -72,7 +72,7 @@ pub mod hart;
 pub mod memory;
 pub mod run;
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 
 pub use decode::{DecodeError, FuClass, Info, Instr, Latches, Op, Reg, decode};
 pub use elf::{ElfError, PROGRAM_BASE, PROGRAM_END, Program};
