@@ -30,6 +30,7 @@
 //!   with `min`, so all structures still reach the same leaves and return bit-identical hits.
 
 mod aabb;
+pub mod fmath;
 mod hit;
 mod ray;
 mod rng;

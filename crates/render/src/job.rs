@@ -28,7 +28,7 @@
 //! bounce rays then start at `t_min = 0` from that point; a shadow ray is the segment
 //! `[0, 1 − 1e-4]` of the unnormalised vector toward the light sample.
 
-use dualsplit_geometry::{Hit, Ray, Vec3, hash_u32s};
+use dualsplit_geometry::{Hit, Ray, Vec3, fmath, hash_u32s};
 use dualsplit_scene::Scene;
 use serde::{Deserialize, Serialize};
 
@@ -191,6 +191,57 @@ enum Pending {
     },
 }
 
+/// The per-frame constants every [`PixelJob`] of a scene derives from it: the camera basis,
+/// the self-intersection offset and the light's power. The simulated threads' kernels get
+/// exactly these values in their parameter block (`kernels/dualsplit.h`), so they need no
+/// `tan` and compute the same rays.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameConstants {
+    /// Camera eye.
+    pub eye: Vec3,
+    /// `(target − eye).normalize()`.
+    pub fwd: Vec3,
+    /// `fwd × up`, normalised.
+    pub right: Vec3,
+    /// `right × fwd`.
+    pub up: Vec3,
+    /// `tan(fov_y / 2)`.
+    pub tan_half_fov: f32,
+    /// Self-intersection offset along the normal (see the module docs).
+    pub eps: f32,
+    /// The light's power `2 · intensity · d²` (see the module docs).
+    pub light_power: f32,
+}
+
+impl FrameConstants {
+    /// The constants of `scene`.
+    pub fn new(scene: &Scene) -> Self {
+        let b = &scene.bounds;
+        let ext = b.extent().max_element();
+        let mag = b.min.abs().max(b.max.abs()).max_element();
+        let eps = (ext.max(mag) * 2e-5).max(1e-9);
+        // Distance² from the light to the scene centre, floored at (1 % of the extent)² so a
+        // light placed at the centre still lights the scene.
+        let dc = (scene.light.position - b.center())
+            .length_squared()
+            .max((ext * 0.01).powi(2))
+            .max(1e-12);
+        let c = &scene.camera;
+        let fwd = (c.target - c.eye).normalize();
+        let right = fwd.cross(c.up).normalize();
+        let up = right.cross(fwd);
+        Self {
+            eye: c.eye,
+            fwd,
+            right,
+            up,
+            tan_half_fov: (c.fov_y_deg.to_radians() * 0.5).tan(),
+            eps,
+            light_power: scene.light.intensity * dc * 2.0,
+        }
+    }
+}
+
 /// The pinhole camera's basis, computed once per job.
 #[derive(Clone, Copy, Debug)]
 struct CameraBasis {
@@ -244,20 +295,7 @@ pub struct PixelJob<'a> {
 impl<'a> PixelJob<'a> {
     /// The job of pixel `(x, y)` (origin top-left).
     pub fn new(scene: &'a Scene, settings: &RenderSettings, x: u32, y: u32) -> Self {
-        let b = &scene.bounds;
-        let ext = b.extent().max_element();
-        let mag = b.min.abs().max(b.max.abs()).max_element();
-        let eps = (ext.max(mag) * 2e-5).max(1e-9);
-        // Distance² from the light to the scene centre, floored at (1 % of the extent)² so a
-        // light placed at the centre still lights the scene.
-        let dc = (scene.light.position - b.center())
-            .length_squared()
-            .max((ext * 0.01).powi(2))
-            .max(1e-12);
-        let c = &scene.camera;
-        let fwd = (c.target - c.eye).normalize();
-        let right = fwd.cross(c.up).normalize();
-        let up = right.cross(fwd);
+        let fc = FrameConstants::new(scene);
         let mut job = Self {
             scene,
             settings: *settings,
@@ -268,14 +306,14 @@ impl<'a> PixelJob<'a> {
             radiance: 0.0,
             next: None,
             pending: None,
-            eps,
-            light_power: scene.light.intensity * dc * 2.0,
+            eps: fc.eps,
+            light_power: fc.light_power,
             cam: CameraBasis {
-                eye: c.eye,
-                fwd,
-                right,
-                up,
-                k: (c.fov_y_deg.to_radians() * 0.5).tan(),
+                eye: fc.eye,
+                fwd: fc.fwd,
+                right: fc.right,
+                up: fc.up,
+                k: fc.tan_half_fov,
             },
         };
         job.start_sample();
@@ -382,7 +420,8 @@ impl<'a> PixelJob<'a> {
         let z = 1.0 - 2.0 * u1;
         let r = (1.0 - z * z).max(0.0).sqrt();
         let phi = std::f32::consts::TAU * u2;
-        let lp = light.position + Vec3::new(r * phi.cos(), r * phi.sin(), z) * light.radius;
+        let (sin_phi, cos_phi) = fmath::sin_cos(phi);
+        let lp = light.position + Vec3::new(r * cos_phi, r * sin_phi, z) * light.radius;
         let to_l = lp - p;
         let d2 = to_l.length_squared();
         let cos = if d2 > 0.0 {
@@ -418,7 +457,8 @@ impl<'a> PixelJob<'a> {
         let r = u1.sqrt();
         let phi = std::f32::consts::TAU * u2;
         let (t, b) = n.any_orthonormal_pair();
-        let dir = t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt();
+        let (sin_phi, cos_phi) = fmath::sin_cos(phi);
+        let dir = t * (r * cos_phi) + b * (r * sin_phi) + n * (1.0 - u1).max(0.0).sqrt();
         self.throughput *= ALBEDO;
         self.next = Some(RayQuery {
             ray: Ray::new(p, dir),

@@ -62,6 +62,7 @@ pub use error::RenderError;
 pub use frame::{Frame, TILE, render, render_records, tile_count, validate};
 pub use image::{Image, ImageFormat, srgb_encode};
 pub use job::{
-    ALBEDO, AMBIENT, PixelJob, RayKind, RayQuery, RenderSettings, SKY, TraceResult, Workload,
+    ALBEDO, AMBIENT, FrameConstants, PixelJob, RayKind, RayQuery, RenderSettings, SKY, TraceResult,
+    Workload,
 };
 pub use trace::{PixelRecord, TracedRay, run_job, trace_pixel, trace_query};

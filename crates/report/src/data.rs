@@ -41,6 +41,9 @@ pub struct ReportSettings {
     pub cpu_res: u32,
     /// Whether this is the paper's full setup (`--full`).
     pub full: bool,
+    /// How the simulated threads executed their kernels.
+    #[serde(default)]
+    pub thread_model: dualsplit_sim::ThreadModel,
 }
 
 /// A scene that was asked for but could not be loaded.

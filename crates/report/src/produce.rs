@@ -23,7 +23,7 @@ use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
 use dualsplit_geometry::Hit;
 use dualsplit_render::{PixelJob, RayKind, RayQuery, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::Scene;
-use dualsplit_sim::{SimAccel, SimConfig, SimResult};
+use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel};
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, OnceLock};
@@ -70,17 +70,23 @@ pub type SimulateFn<'a> = dyn Fn(
     + Sync
     + 'a;
 
-/// The real simulator ([`dualsplit_sim::simulate`]), errors as "simulator unavailable: …".
+/// The real simulator with thread model `model` ([`dualsplit_sim::simulate_model`]),
+/// errors as "simulator unavailable: …".
 pub fn real_simulator(
-    scene: &Scene,
-    structures: &Structures,
-    accel: SimAccel,
-    settings: &RenderSettings,
-    cfg: &SimConfig,
-    progress: &(dyn Fn(u64, u64) + Sync),
-) -> Result<SimResult, String> {
-    dualsplit_sim::simulate(scene, structures, accel, settings, cfg, progress)
-        .map_err(|e| format!("simulator unavailable: {e}"))
+    model: ThreadModel,
+) -> impl Fn(
+    &Scene,
+    &Structures,
+    SimAccel,
+    &RenderSettings,
+    &SimConfig,
+    &(dyn Fn(u64, u64) + Sync),
+) -> Result<SimResult, String>
++ Sync {
+    move |scene, structures, accel, settings, cfg, progress| {
+        dualsplit_sim::simulate_model(model, scene, structures, accel, settings, cfg, progress)
+            .map_err(|e| format!("simulator unavailable: {e}"))
+    }
 }
 
 /// One simulation to run.
@@ -237,7 +243,7 @@ impl<'a> Producer<'a> {
                 let key = CacheKey::new(
                     "sim",
                     &hashes[i],
-                    accel.name(),
+                    &format!("{}@{}", accel.name(), self.settings.thread_model.name()),
                     workload.name(),
                     &serde_json::to_string(&cfg).unwrap_or_default(),
                     (self.settings.width, self.settings.height),

@@ -292,11 +292,12 @@ pub fn table45(data: &ReportData, workload: Workload) -> Section {
         tables.push(Table {
             id: format!("table{num}-{}", scene_id(i, s)),
             caption: format!(
-                "{} — {what}, {}×{}, {} TMs",
+                "{} — {what}, {}×{}, {} TMs, {} thread model",
                 s.label(),
                 data.settings.width,
                 data.settings.height,
-                tms
+                tms,
+                data.settings.thread_model.name()
             ),
             paper_columns: (first_paper..ncols).collect(),
             header,

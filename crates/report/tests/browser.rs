@@ -106,6 +106,7 @@ fn synthetic_report() -> ReportData {
             base_tms: 64,
             cpu_res: 32,
             full: false,
+            thread_model: dualsplit_sim::ThreadModel::Fast,
         },
         scenes: vec![
             synthetic_scene("dragon_box", "scenes/dragon_box.ply.gz", 0, &[64]),

@@ -25,6 +25,7 @@ fn settings(width: u32) -> ReportSettings {
         base_tms: 64,
         cpu_res: 4,
         full: false,
+        thread_model: dualsplit_sim::ThreadModel::Fast,
     }
 }
 

@@ -17,11 +17,15 @@
 use crate::Cycle;
 use crate::atomic::AtomicUnit;
 use crate::config::SimConfig;
+use crate::config::UnitConfig;
+use crate::fu::Pools;
 use crate::kernel::Op;
 use crate::memory::{CacheStats, DramStats, L2};
+use crate::rv32::{ExecError, FrameMemory, Program};
 use crate::scheduler::{NONE, Wheel};
 use crate::thread::{Stalls, Thread};
 use crate::tm::{Tm, UnitStats};
+use crate::tp::{ClassCounts, Next, Tp, Units};
 
 /// The chip's units.
 pub struct Chip {
@@ -185,6 +189,56 @@ fn run_chip_with(
     let end = finish.iter().copied().max().unwrap_or(Cycle::ZERO);
     chip.stalls.idle = finish.iter().map(|&f| end - f).sum();
     end
+}
+
+/// Runs threads that execute the compiled kernel `prog` to completion (`tp.rs`): each
+/// thread is woken at the cycle its next instruction on a shared unit can issue; the
+/// frame ends when the last result of the last thread has arrived. `progress` sees the
+/// pixels handed out so far (global register 0).
+#[allow(clippy::too_many_arguments)]
+pub fn run_compiled(
+    chip: &mut Chip,
+    pools: &mut [Pools],
+    tps: &mut [Tp],
+    prog: &Program,
+    mem: &mut FrameMemory<'_>,
+    cfg: &UnitConfig,
+    counts: &mut ClassCounts,
+    progress: &mut dyn FnMut(u32),
+) -> Result<Cycle, ExecError> {
+    let mut wheel = Wheel::new(tps.len());
+    for i in 0..tps.len() as u32 {
+        wheel.push(Cycle::ZERO, i);
+    }
+    let mut finish = vec![Cycle::ZERO; tps.len()];
+    let mut handed_out = 0;
+    while let Some((now, first)) = wheel.next_bucket() {
+        let mut id = first;
+        while id != NONE {
+            let next = wheel.after(id);
+            wheel.taken();
+            let tp = &mut tps[id as usize];
+            let tm = tp.tm();
+            let units = Units {
+                tm: &mut chip.tms[tm],
+                pools: &mut pools[tm],
+                l2: &mut chip.l2,
+                atomic: &mut chip.atomic,
+            };
+            match tp.run(prog, mem, cfg, units, &mut chip.stalls, counts, now)? {
+                Next::Sleep(t) => wheel.push(t, id),
+                Next::Halted(t) => finish[id as usize] = t,
+            }
+            id = next;
+        }
+        if mem.globals[0] >= handed_out + 1024 {
+            handed_out = mem.globals[0];
+            progress(handed_out);
+        }
+    }
+    let end = finish.iter().copied().max().unwrap_or(Cycle::ZERO);
+    chip.stalls.idle = finish.iter().map(|&f| end - f).sum();
+    Ok(end)
 }
 
 #[cfg(test)]

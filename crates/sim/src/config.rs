@@ -123,6 +123,36 @@ pub struct UnitConfig {
     pub fpinv_latency: u64,
     /// Latency of the global atomic increment that hands out pixels.
     pub atomic_latency: u64,
+    /// Compiled kernels: latency of a TP's own integer ALU (also FP sign/move ops).
+    pub int_latency: u64,
+    /// Compiled kernels: latency of a TP's own FP adder.
+    pub fpadd_latency: u64,
+    /// Compiled kernels: latency of a TP's own FP multiplier.
+    pub fpmul_latency: u64,
+    /// Compiled kernels: FP compare units per TM (shared pool).
+    pub fpcmp_units: u32,
+    /// Their latency.
+    pub fpcmp_latency: u64,
+    /// Compiled kernels: FP min/max units per TM (shared pool).
+    pub fpminmax_units: u32,
+    /// Their latency.
+    pub fpminmax_latency: u64,
+    /// Compiled kernels: int/FP conversion units per TM (shared pool).
+    pub conv_units: u32,
+    /// Their latency.
+    pub conv_latency: u64,
+    /// Compiled kernels: branch units per TM (shared pool).
+    pub branch_units: u32,
+    /// Their latency.
+    pub branch_latency: u64,
+    /// Compiled kernels: integer multipliers per TM (shared pool).
+    pub intmul_units: u32,
+    /// Their latency.
+    pub intmul_latency: u64,
+    /// Compiled kernels: latency of a TP's local store (its stack).
+    pub local_store_latency: u64,
+    /// Compiled kernels: bytes of each TP's local store.
+    pub local_store_bytes: u32,
 }
 
 /// Energy per event in nanojoules (65 nm).
@@ -252,6 +282,21 @@ impl SimConfig {
                 fpinv_units: 1,
                 fpinv_latency: 16,
                 atomic_latency: 4,
+                int_latency: 1,
+                fpadd_latency: 2,
+                fpmul_latency: 2,
+                fpcmp_units: 16,
+                fpcmp_latency: 1,
+                fpminmax_units: 16,
+                fpminmax_latency: 1,
+                conv_units: 16,
+                conv_latency: 1,
+                branch_units: 16,
+                branch_latency: 1,
+                intmul_units: 2,
+                intmul_latency: 1,
+                local_store_latency: 1,
+                local_store_bytes: 4096,
             },
             energy: EnergyConfig {
                 int_nj: 0.000572,
@@ -346,6 +391,26 @@ impl SimConfig {
         pos("units.tri_pipes", self.units.tri_pipes as u64)?;
         pos("units.dst_pipes", self.units.dst_pipes as u64)?;
         pos("units.fpinv_units", self.units.fpinv_units as u64)?;
+        let u = &self.units;
+        for (f, v) in [
+            ("units.fpcmp_units", u.fpcmp_units),
+            ("units.fpminmax_units", u.fpminmax_units),
+            ("units.conv_units", u.conv_units),
+            ("units.branch_units", u.branch_units),
+            ("units.intmul_units", u.intmul_units),
+        ] {
+            pos(f, v as u64)?;
+        }
+        if u.local_store_bytes < 1024
+            || u.local_store_bytes > 1 << 20
+            || u.local_store_bytes % 16 != 0
+        {
+            return Err(ConfigError::Invalid {
+                field: "units.local_store_bytes",
+                value: u.local_store_bytes as u64,
+                reason: "must be a multiple of 16 from 1024 to 1048576",
+            });
+        }
         if !(self.clock_ghz > 0.0 && self.clock_ghz.is_finite()) {
             return Err(ConfigError::Invalid {
                 field: "clock_ghz",

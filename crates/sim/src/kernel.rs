@@ -297,6 +297,40 @@ pub struct InstrCounts {
 }
 
 impl InstrCounts {
+    /// The counts of a compiled-kernel frame from its instructions per
+    /// [`FuClass`](crate::rv32::FuClass) (indexed by [`crate::rv32::fu_index`]) and the TMs'
+    /// pipeline op counts, in the classes the energy model prices: integer ALU, branch,
+    /// integer multiply and conversion/move instructions as `int`; FP add as `fpadd`; FP
+    /// multiply and fused multiply-add as `fpmul`; FP compare and min/max as `fpcmp`;
+    /// divides, square roots and reciprocals (the TM's FPINV unit) as `fpinv`; local-store
+    /// accesses as `local`; global loads and stores as `loads`.
+    pub fn from_classes(c: &crate::tp::ClassCounts, units: &crate::tm::UnitStats) -> Self {
+        use crate::rv32::{FuClass as F, run::fu_index};
+        let n = |f: F| c[fu_index(f)];
+        InstrCounts {
+            mix: Mix {
+                int: n(F::IntAlu)
+                    + n(F::Branch)
+                    + n(F::IntMul)
+                    + n(F::FpConv)
+                    + n(F::FpMove)
+                    + n(F::Halt),
+                fpadd: n(F::FpAdd),
+                fpmul: n(F::FpMul) + n(F::FpFma),
+                fpcmp: n(F::FpCmp) + n(F::FpMinMax),
+                fpinv: n(F::IntDiv) + n(F::FpDiv) + n(F::FpSqrt) + n(F::Rcp),
+                local: n(F::LocalLoad) + n(F::LocalStore),
+            },
+            loads: n(F::Load) + n(F::Store),
+            box_ops: units.box_ops,
+            box_issues: n(F::BoxPipe(1)),
+            tri_ops: n(F::TriPipe),
+            dst_ops: n(F::DstPipe),
+            node_steps: 0,
+            atomics: n(F::Atomic),
+        }
+    }
+
     /// All issued instructions.
     pub fn total(&self) -> u64 {
         self.mix_total() + self.loads + self.box_issues + self.tri_ops + self.dst_ops + self.atomics

@@ -37,21 +37,26 @@
 
 pub mod atomic;
 pub mod chip;
+mod compiled;
 pub mod config;
 mod cycle;
 pub mod energy;
+pub mod fu;
 pub mod kernel;
+pub mod kernels;
 pub mod memory;
+pub mod rv32;
 mod scheduler;
 pub mod slots;
 pub mod thread;
 pub mod tm;
+pub mod tp;
 mod workload;
 
 /// Version of the timing and energy model. Bump it whenever a change alters simulated results
 /// for the same inputs; the report's result cache includes it in every key, so stale cached
 /// frames are recomputed.
-pub const MODEL_VERSION: u32 = 4;
+pub const MODEL_VERSION: u32 = 5;
 
 pub use chip::{Chip, ChipStats, WorkSource, run_chip};
 pub use config::{CacheConfig, ConfigError, DramConfig, EnergyConfig, SimConfig, UnitConfig};
@@ -164,6 +169,35 @@ impl SimAccel {
     }
 }
 
+/// How the simulated threads execute their kernel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ThreadModel {
+    /// Compiled RV32IMF kernels (`kernels/`) executed instruction by instruction on
+    /// thread processors with a register scoreboard (`tp.rs`): the reference model.
+    #[default]
+    Rv32,
+    /// The traversal replayed as macro-ops with per-step instruction counts (`kernel.rs`,
+    /// `thread.rs`): faster, an approximation of [`ThreadModel::Rv32`].
+    Fast,
+}
+
+impl ThreadModel {
+    /// Both, reference first.
+    pub const ALL: [ThreadModel; 2] = [ThreadModel::Rv32, ThreadModel::Fast];
+    /// Command-line name: `rv32` or `fast`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ThreadModel::Rv32 => "rv32",
+            ThreadModel::Fast => "fast",
+        }
+    }
+    /// Parses a command-line name.
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == s)
+    }
+}
+
 /// Energy split like the paper's Table 6, in joules.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EnergySplit {
@@ -200,6 +234,9 @@ pub struct Utilisation {
 pub struct SimResult {
     /// Configuration simulated.
     pub accel: Option<SimAccel>,
+    /// How the threads executed the kernel.
+    #[serde(default)]
+    pub thread_model: ThreadModel,
     /// Thread multiprocessors simulated.
     pub tms: u32,
     /// Hardware threads (TMs × TPs per TM).
@@ -258,11 +295,40 @@ pub enum SimError {
     /// A traversal step does not fit the replay's 8-byte ops (e.g. an image beyond 16 GiB).
     #[error(transparent)]
     Op(#[from] kernel::OpRangeError),
+    /// A committed kernel did not load.
+    #[error("kernel: {0}")]
+    Kernel(#[from] rv32::ElfError),
+    /// A kernel instruction failed (an address outside the memory map, an illegal
+    /// instruction).
+    #[error("kernel: {0}")]
+    Exec(#[from] rv32::ExecError),
 }
 
-/// Simulates one frame of `settings` on `scene` with configuration `accel`; `progress` is
-/// called with (pixels done, pixels total).
+/// Simulates one frame of `settings` on `scene` with configuration `accel`, the threads
+/// executing the compiled kernels ([`ThreadModel::Rv32`]); `progress` is called with
+/// (pixels done, pixels total).
 pub fn simulate(
+    scene: &Scene,
+    structures: &Structures,
+    accel: SimAccel,
+    settings: &RenderSettings,
+    cfg: &SimConfig,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<SimResult, SimError> {
+    simulate_model(
+        ThreadModel::Rv32,
+        scene,
+        structures,
+        accel,
+        settings,
+        cfg,
+        progress,
+    )
+}
+
+/// [`simulate`] with the threads' execution model `model`.
+pub fn simulate_model(
+    model: ThreadModel,
     scene: &Scene,
     structures: &Structures,
     accel: SimAccel,
@@ -277,5 +343,60 @@ pub fn simulate(
             height: settings.height,
         });
     }
-    workload::run(scene, structures, accel, settings, cfg, progress)
+    match model {
+        ThreadModel::Rv32 => compiled::run(scene, structures, accel, settings, cfg, progress),
+        ThreadModel::Fast => workload::run(scene, structures, accel, settings, cfg, progress),
+    }
+}
+
+impl SimResult {
+    /// The result of a frame from the chip's counters after `cycles`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn assemble(
+        accel: SimAccel,
+        thread_model: ThreadModel,
+        cfg: &SimConfig,
+        cycles: Cycle,
+        stats: ChipStats,
+        instructions: InstrCounts,
+        rays: u64,
+        pixels: u64,
+        radiance: Vec<f32>,
+    ) -> SimResult {
+        let dram = stats.dram;
+        let c = &stats.caches;
+        let ratio = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
+        let cycles = cycles.get();
+        let frame_ms = cycles as f64 / (cfg.clock_ghz * 1e6);
+        let cyc_units = cycles.max(1) as f64 * cfg.tms as f64;
+        let utilisation = Utilisation {
+            box_pipe: stats.units.box_ops as f64 / (cyc_units * accel.box_pipes(cfg) as f64),
+            tri_pipe: stats.units.tri_ops as f64 / (cyc_units * cfg.units.tri_pipes as f64),
+            dst_pipe: stats.units.dst_ops as f64 / (cyc_units * cfg.units.dst_pipes as f64),
+            issue: instructions.total() as f64 / (cyc_units * cfg.tps_per_tm as f64),
+        };
+        SimResult {
+            accel: Some(accel),
+            thread_model,
+            tms: cfg.tms,
+            threads: cfg.tms * cfg.tps_per_tm,
+            cycles,
+            frame_ms,
+            energy: energy::split(cfg, &instructions, &stats.caches, &dram, frame_ms),
+            dram_lines: dram.reads,
+            dram_activations: dram.activations,
+            row_hit_rate: ratio(dram.row_hits, dram.reads),
+            l1_hit_rate: ratio(c.l1_hits, c.l1_accesses),
+            l2_hit_rate: ratio(c.l2_hits, c.l2_accesses),
+            rays,
+            pixels,
+            instructions,
+            caches: stats.caches,
+            dram,
+            units: stats.units,
+            utilisation,
+            stalls: stats.stalls,
+            radiance,
+        }
+    }
 }

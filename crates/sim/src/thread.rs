@@ -34,6 +34,13 @@ pub struct Stalls {
     pub atomic: u64,
     /// Finished early while other threads still ran.
     pub idle: u64,
+    /// Compiled kernels: waiting for an operand from a functional unit's latency (ALU, FP,
+    /// pools, the reciprocal unit, the local store).
+    #[serde(default)]
+    pub dependency: u64,
+    /// Compiled kernels: waiting for a free unit of a shared pool or the reciprocal unit.
+    #[serde(default)]
+    pub fu_busy: u64,
 }
 
 /// Which resource a thread's pending result comes from.

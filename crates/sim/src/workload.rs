@@ -6,7 +6,7 @@
 use crate::chip::{Chip, WorkSource, run_chip};
 use crate::kernel::{Mix, Op, Recorder, Run, Tally};
 use crate::thread::Thread;
-use crate::{SimAccel, SimConfig, SimError, SimResult, energy};
+use crate::{SimAccel, SimConfig, SimError, SimResult, ThreadModel};
 use dualsplit_accel::Structures;
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult};
 use dualsplit_scene::Scene;
@@ -163,43 +163,19 @@ pub(crate) fn run(
             tally: Tally::new(accel),
         },
     };
-    let cycles = run_chip(&mut chip, &mut threads, &mut work).get();
+    let cycles = run_chip(&mut chip, &mut threads, &mut work);
     if let Some(e) = work.tracer.tally.error() {
         return Err(e.into());
     }
-    let stats = chip.stats();
-    let dram = stats.dram;
-    let c = &stats.caches;
-    let ratio = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
-    let frame_ms = cycles as f64 / (cfg.clock_ghz * 1e6);
-    let counts = work.tracer.tally.counts();
-    let cyc_units = cycles.max(1) as f64 * cfg.tms as f64;
-    let utilisation = crate::Utilisation {
-        box_pipe: stats.units.box_ops as f64 / (cyc_units * accel.box_pipes(cfg) as f64),
-        tri_pipe: stats.units.tri_ops as f64 / (cyc_units * cfg.units.tri_pipes as f64),
-        dst_pipe: stats.units.dst_ops as f64 / (cyc_units * cfg.units.dst_pipes as f64),
-        issue: counts.total() as f64 / (cyc_units * cfg.tps_per_tm as f64),
-    };
-    Ok(SimResult {
-        accel: Some(accel),
-        tms: cfg.tms,
-        threads: cfg.tms * cfg.tps_per_tm,
+    Ok(SimResult::assemble(
+        accel,
+        ThreadModel::Fast,
+        cfg,
         cycles,
-        frame_ms,
-        energy: energy::split(cfg, &counts, &stats.caches, &dram, frame_ms),
-        dram_lines: dram.reads,
-        dram_activations: dram.activations,
-        row_hit_rate: ratio(dram.row_hits, dram.reads),
-        l1_hit_rate: ratio(c.l1_hits, c.l1_accesses),
-        l2_hit_rate: ratio(c.l2_hits, c.l2_accesses),
-        rays: work.tracer.rays,
-        pixels: total,
-        instructions: counts,
-        caches: stats.caches,
-        dram,
-        units: stats.units,
-        utilisation,
-        stalls: stats.stalls,
-        radiance: work.radiance,
-    })
+        chip.stats(),
+        work.tracer.tally.counts(),
+        work.tracer.rays,
+        total,
+        work.radiance,
+    ))
 }

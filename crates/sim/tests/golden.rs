@@ -1,6 +1,7 @@
 //! Golden runs: the simulated results that define "the model did not change".
 //!
-//! Every configuration of [`SimAccel::ALL`] on the `tiny` chip (`configs/tiny.toml`), both
+//! Both thread models ([`ThreadModel::ALL`]: the compiled kernels and the macro-op replay),
+//! every configuration of [`SimAccel::ALL`] on the `tiny` chip (`configs/tiny.toml`), both
 //! workloads, on `builtin:cornell` and on the shipped `dragon_res4.ply.gz` (11 K triangles,
 //! read from `../shared/scenes` beside the repository), at small resolutions. For each run
 //! the test compares exact cycles, instructions, DRAM reads and activations, L1 and L2 hits
@@ -20,7 +21,7 @@
 
 use dualsplit_accel::Structures;
 use dualsplit_render::{RenderSettings, Workload};
-use dualsplit_sim::{MODEL_VERSION, SimAccel, SimConfig, SimResult, simulate};
+use dualsplit_sim::{MODEL_VERSION, SimAccel, SimConfig, SimResult, ThreadModel, simulate_model};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -160,11 +161,25 @@ fn run_all(missing: &mut Vec<String>) -> Vec<Golden> {
             .trim_end_matches(".ply.gz");
         for (wl, wl_name, w, h) in WORKLOADS {
             let settings = RenderSettings::new(w, h, wl);
-            for accel in SimAccel::ALL {
-                let r = simulate(&scene, &structures, accel, &settings, &cfg, &|_, _| {})
+            for model in ThreadModel::ALL {
+                for accel in SimAccel::ALL {
+                    let r = simulate_model(
+                        model,
+                        &scene,
+                        &structures,
+                        accel,
+                        &settings,
+                        &cfg,
+                        &|_, _| {},
+                    )
                     .unwrap_or_else(|e| panic!("{short} {wl_name} {}: {e}", accel.name()));
-                let key = format!("{short} {wl_name} {w}x{h} {}", accel.name());
-                out.push(Golden::of(key, &r));
+                    let key = format!(
+                        "{} {short} {wl_name} {w}x{h} {}",
+                        model.name(),
+                        accel.name()
+                    );
+                    out.push(Golden::of(key, &r));
+                }
             }
         }
     }
@@ -175,7 +190,7 @@ fn render_file(runs: &[Golden]) -> String {
     let mut s = String::new();
     s.push_str(
         "# Golden runs of crates/sim/tests/golden.rs: the tiny chip (configs/tiny.toml), every\n\
-         # configuration, cast and path. Re-record only together with a MODEL_VERSION bump\n\
+         # configuration, cast and path, both thread models. Re-record only together with a MODEL_VERSION bump\n\
          # (listed in docs/simulator.md, \"Model versions\"):\n\
          #   DUALSPLIT_BLESS=1 cargo test --release -p dualsplit-sim --test golden\n\n",
     );

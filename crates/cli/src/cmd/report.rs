@@ -10,6 +10,7 @@ use anyhow::Context;
 use dualsplit_report::data::{ReportSettings, Skipped};
 use dualsplit_report::produce::real_simulator;
 use dualsplit_report::{Cache, Producer, Progress};
+use dualsplit_sim::ThreadModel;
 use indicatif::ProgressBar;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -60,6 +61,11 @@ pub struct Args {
     /// TM counts of the scaling study (Table 7); Tables 4–6 use 64 when listed.
     #[arg(long, value_delimiter = ',', default_values_t = DEFAULT_TMS)]
     tms: Vec<u32>,
+    /// Thread model: rv32 (the compiled kernels instruction by instruction; the default
+    /// with --full) or fast (the macro-op replay; the default otherwise, so the default
+    /// report takes minutes).
+    #[arg(long)]
+    model: Option<String>,
 }
 
 /// indicatif bars behind the report's `Progress` trait.
@@ -181,6 +187,12 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         );
     }
 
+    let thread_model = match args.model.as_deref() {
+        None if args.full => ThreadModel::Rv32,
+        None => ThreadModel::Fast,
+        Some(m) => ThreadModel::parse(m)
+            .ok_or_else(|| anyhow::anyhow!("unknown --model `{m}` (expected rv32 or fast)"))?,
+    };
     let settings = ReportSettings {
         width: res,
         height: res,
@@ -188,7 +200,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         base_tms,
         cpu_res: CPU_RES,
         full: args.full,
+        thread_model,
     };
+    let simulate = real_simulator(thread_model);
     let bars = Bars {
         ctx,
         bar: Mutex::new(None),
@@ -197,7 +211,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         Cache::new(args.out.join("cache")),
         settings,
         &bars,
-        &real_simulator,
+        &simulate,
     );
     let data = producer.run(&scenes, skipped)?;
     let written = dualsplit_report::write_report(&data, &args.out)?;

@@ -2,7 +2,7 @@
 use crate::progress::Ctx;
 use anyhow::{Context, bail};
 use dualsplit_render::{RenderSettings, Workload};
-use dualsplit_sim::{SimAccel, SimConfig, SimResult, simulate};
+use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel, simulate_model};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
@@ -26,6 +26,10 @@ pub struct Args {
     /// Hardware configuration TOML (default: the built-in lin2020 = configs/lin2020.toml).
     #[arg(long)]
     config: Option<std::path::PathBuf>,
+    /// Thread model: rv32 (the compiled kernels, instruction by instruction; the reference)
+    /// or fast (the macro-op replay).
+    #[arg(long, default_value = "rv32")]
+    model: String,
     /// Print JSON (an array of results) instead of a table.
     #[arg(long)]
     json: bool,
@@ -48,6 +52,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         "cast" => Workload::Cast,
         "path" => Workload::Path,
         w => bail!("unknown --workload `{w}` (expected cast or path)"),
+    };
+    let Some(model) = ThreadModel::parse(&args.model) else {
+        bail!("unknown --model `{}` (expected rv32 or fast)", args.model);
     };
     if args.res == 0 {
         bail!("--res must be at least 1");
@@ -74,9 +81,15 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         let total = settings.width as u64 * settings.height as u64;
         let bar = ctx.bar(total, format!("{} {}", accel.label(), workload.name()));
         let t0 = Instant::now();
-        let r = simulate(&scene, &structures, accel, &settings, &cfg, &|done, _| {
-            bar.set_position(done)
-        })
+        let r = simulate_model(
+            model,
+            &scene,
+            &structures,
+            accel,
+            &settings,
+            &cfg,
+            &|done, _| bar.set_position(done),
+        )
         .with_context(|| format!("simulating {}", accel.label()))?;
         let host = t0.elapsed();
         bar.finish_and_clear();
@@ -108,14 +121,15 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&results)?);
     } else {
         println!(
-            "scene {} ({} triangles), {}×{} {}, {} TMs × {} TPs",
+            "scene {} ({} triangles), {}×{} {}, {} TMs × {} TPs, {} thread model",
             scene.name,
             scene.triangles.len(),
             args.res,
             args.res,
             workload.name(),
             cfg.tms,
-            cfg.tps_per_tm
+            cfg.tps_per_tm,
+            model.name()
         );
         for (r, host) in &results {
             print_result(r, *host);
@@ -125,7 +139,8 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
 }
 
 /// Prints one configuration's result; `host` is the wall time its simulation took on this
-/// machine (one core), shown with the simulator's speed in node visits per second.
+/// machine (one core), shown with the simulator's speed in simulated instructions per host
+/// second.
 fn print_result(r: &SimResult, host: Duration) {
     let label = r.accel.map_or("?", |a| a.label());
     let e = &r.energy;
@@ -134,8 +149,12 @@ fn print_result(r: &SimResult, host: Duration) {
     let u = &r.utilisation;
     println!("== {label}");
     println!(
-        "  frame time     {:.3} ms ({} cycles), {} rays, {} node visits",
-        r.frame_ms, r.cycles, r.rays, r.instructions.node_steps
+        "  frame time     {:.3} ms ({} cycles), {} rays, {:.0} instructions and {:.0} thread-cycles per ray",
+        r.frame_ms,
+        r.cycles,
+        r.rays,
+        r.instructions.total() as f64 / r.rays.max(1) as f64,
+        r.cycles as f64 * r.threads as f64 / r.rays.max(1) as f64
     );
     println!(
         "  energy         {:.4} J total: DRAM {:.4} J, caches {:.4} J, compute {:.4} J",
@@ -182,10 +201,12 @@ fn print_result(r: &SimResult, host: Duration) {
     let tot = (r.cycles as f64 * r.threads as f64).max(1.0);
     let pct = |x: u64| 100.0 * x as f64 / tot;
     println!(
-        "  stalls (% of thread-cycles)  memory {:.1}, pipeline latency {:.1}, pipeline busy {:.1}, fpinv {:.1}, L1 bank {:.1}, atomic {:.1}, idle at end {:.1}",
+        "  stalls (% of thread-cycles)  memory {:.1}, pipeline latency {:.1}, pipeline busy {:.1}, dependency {:.1}, busy unit {:.1}, fpinv {:.1}, L1 bank {:.1}, atomic {:.1}, idle at end {:.1}",
         pct(s.memory),
         pct(s.pipeline_latency),
         pct(s.pipeline_busy),
+        pct(s.dependency),
+        pct(s.fu_busy),
         pct(s.fpinv),
         pct(s.l1_bank),
         pct(s.atomic),
@@ -193,8 +214,8 @@ fn print_result(r: &SimResult, host: Duration) {
     );
     let secs = host.as_secs_f64();
     println!(
-        "  host           {:.2} s on one core, {:.2} M simulated node visits/s",
+        "  host           {:.2} s on one core, {:.1} M simulated instructions/s (MIPS)",
         secs,
-        r.instructions.node_steps as f64 / secs.max(1e-9) / 1e6
+        r.instructions.total() as f64 / secs.max(1e-9) / 1e6
     );
 }

@@ -1,0 +1,69 @@
+//! A frame of compiled kernels: every thread of the chip runs the configuration's RV32IMF
+//! kernel (`kernels/`, loaded from the committed ELF), taking pixels from the global atomic
+//! counter until they run out, and writes each pixel's radiance to the frame buffer
+//! (Lin et al. 2020, §4.3–4.4; the memory map of `docs/isa.md`).
+
+use crate::fu::Pools;
+use crate::kernels::{FRAME_FLOATS_PER_PIXEL, Params, elf};
+use crate::rv32::{FrameMemory, Program};
+use crate::tp::{ClassCounts, Tp};
+use crate::{Chip, SimAccel, SimConfig, SimError, SimResult, ThreadModel, chip::run_compiled};
+use dualsplit_accel::Structures;
+use dualsplit_render::RenderSettings;
+use dualsplit_scene::Scene;
+
+/// Runs one frame of `accel`'s compiled kernel for `settings` on the chip of `cfg`.
+pub(crate) fn run(
+    scene: &Scene,
+    structures: &Structures,
+    accel: SimAccel,
+    settings: &RenderSettings,
+    cfg: &SimConfig,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<SimResult, SimError> {
+    let prog = Program::from_elf(elf(accel, settings.workload))?;
+    let params = Params::new(scene, structures, accel, settings);
+    let image = structures.image(accel.kind());
+    let mut mem = FrameMemory::new(image, params.as_bytes(), params.frame_bytes());
+    let mut chip = Chip::new(cfg, accel.box_pipes(cfg));
+    let mut pools: Vec<Pools> = (0..cfg.tms).map(|_| Pools::new(&cfg.units)).collect();
+    let mut tps: Vec<Tp> = (0..cfg.tms * cfg.tps_per_tm)
+        .map(|i| {
+            Tp::new(
+                &prog,
+                (i / cfg.tps_per_tm) as usize,
+                cfg.units.local_store_bytes,
+            )
+        })
+        .collect();
+    let total = settings.width as u64 * settings.height as u64;
+    let mut counts: ClassCounts = [0; crate::rv32::run::FU_CLASSES];
+    let cycles = run_compiled(
+        &mut chip,
+        &mut pools,
+        &mut tps,
+        &prog,
+        &mut mem,
+        &cfg.units,
+        &mut counts,
+        &mut |done| progress((done as u64).min(total), total),
+    )?;
+    progress(total, total);
+    let rays = tps.iter().map(Tp::rays).sum();
+    let stats = chip.stats();
+    let instructions = crate::kernel::InstrCounts::from_classes(&counts, &stats.units);
+    Ok(SimResult::assemble(
+        accel,
+        ThreadModel::Rv32,
+        cfg,
+        cycles,
+        stats,
+        instructions,
+        rays,
+        total,
+        mem.frame_f32()
+            .into_iter()
+            .step_by(FRAME_FLOATS_PER_PIXEL)
+            .collect(),
+    ))
+}

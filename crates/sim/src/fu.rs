@@ -1,0 +1,115 @@
+//! A TM's pools of shared functional units.
+//!
+//! Hardware (Lin et al. 2020, §2.3; SimTRaX `ReadConfig.cc` and `samples/configs/*.config`,
+//! whose lines read `UNIT latency count`): a thread processor owns its basic datapath (integer
+//! ALU, FP add/sub, FP multiply); the rest of a TM's functional units are pools shared by
+//! its threads. A pool of `width` fully pipelined units accepts up to `width` operations per
+//! cycle from all of the TM's threads together; an operation that finds the pool full in its
+//! cycle waits for the next cycle with a free unit (an *FU-contention* stall in SimTRaX's
+//! `IssueUnit.cc`). The reciprocal/divide unit, the ray pipelines and the L1 are the TM's
+//! own units (`tm.rs`), not pools.
+
+use crate::Cycle;
+use crate::config::UnitConfig;
+
+/// Cycles a pool remembers around the current time. Requests are made at most
+/// [`crate::tp::LOOKAHEAD`] cycles after the current event time and never before it, so
+/// two live cycles are never this far apart and never share a ring entry.
+const RING: usize = 1024;
+
+/// One pool: `width` units, each accepting one operation per cycle.
+#[derive(Clone, Debug)]
+pub struct Pool {
+    width: u32,
+    latency: u64,
+    /// Per ring entry: the cycle it counts and how many units that cycle has taken. An
+    /// entry whose cycle is not the one asked about belongs to a cycle that is over.
+    ring: Vec<(Cycle, u32)>,
+}
+
+impl Pool {
+    /// A pool of `width` units whose results are ready `latency` cycles after issue.
+    pub fn new(width: u32, latency: u64) -> Self {
+        Self {
+            width: width.max(1),
+            latency,
+            ring: vec![(Cycle::MAX, 0); RING],
+        }
+    }
+
+    /// Takes a unit in the first cycle at or after `at` with one free; returns that cycle.
+    #[inline]
+    pub fn reserve(&mut self, at: Cycle) -> Cycle {
+        let mut c = at;
+        loop {
+            let e = &mut self.ring[(c.get() % RING as u64) as usize];
+            if e.0 != c {
+                *e = (c, 0);
+            }
+            if e.1 < self.width {
+                e.1 += 1;
+                return c;
+            }
+            c += 1;
+        }
+    }
+
+    /// The pool's result latency.
+    #[inline]
+    pub fn latency(&self) -> u64 {
+        self.latency
+    }
+}
+
+/// The pools of one TM, one per shared class of SimTRaX's unit list.
+#[derive(Clone, Debug)]
+pub struct Pools {
+    /// FP compare (`feq`, `flt`, `fle`, `fclass`): SimTRaX `FPCMP`.
+    pub fpcmp: Pool,
+    /// FP min/max: SimTRaX `FPMIN`.
+    pub fpminmax: Pool,
+    /// Int ↔ FP conversions: SimTRaX `CONV`.
+    pub conv: Pool,
+    /// Branches and jumps: SimTRaX `BLT`.
+    pub branch: Pool,
+    /// Integer multiply: SimTRaX `INTMUL`.
+    pub intmul: Pool,
+}
+
+impl Pools {
+    /// The pools of one TM as `units` configures them.
+    pub fn new(units: &UnitConfig) -> Self {
+        Self {
+            fpcmp: Pool::new(units.fpcmp_units, units.fpcmp_latency),
+            fpminmax: Pool::new(units.fpminmax_units, units.fpminmax_latency),
+            conv: Pool::new(units.conv_units, units.conv_latency),
+            branch: Pool::new(units.branch_units, units.branch_latency),
+            intmul: Pool::new(units.intmul_units, units.intmul_latency),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_full_cycle_sends_the_next_request_to_the_next_cycle() {
+        let mut p = Pool::new(2, 1);
+        assert_eq!(p.reserve(Cycle(10)), Cycle(10));
+        assert_eq!(p.reserve(Cycle(10)), Cycle(10));
+        assert_eq!(p.reserve(Cycle(10)), Cycle(11));
+        assert_eq!(p.reserve(Cycle(11)), Cycle(11));
+        assert_eq!(p.reserve(Cycle(10)), Cycle(12));
+        assert_eq!(p.reserve(Cycle(9)), Cycle(9));
+    }
+
+    #[test]
+    fn a_cycle_far_later_reuses_a_ring_entry_from_zero() {
+        let mut p = Pool::new(1, 1);
+        assert_eq!(p.reserve(Cycle(3)), Cycle(3));
+        let later = Cycle(3 + RING as u64);
+        assert_eq!(p.reserve(later), later);
+        assert_eq!(p.reserve(later), later + 1);
+    }
+}

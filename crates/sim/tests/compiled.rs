@@ -1,0 +1,44 @@
+//! The compiled-kernel thread model against the renderer: every pixel bit for bit, the same
+//! ray count, for all eight configurations and both workloads.
+
+use dualsplit_accel::Structures;
+use dualsplit_render::{RenderSettings, Workload};
+use dualsplit_sim::{SimAccel, SimConfig, ThreadModel, simulate_model};
+
+fn tiny() -> SimConfig {
+    SimConfig::from_toml(include_str!("../../../configs/tiny.toml")).unwrap()
+}
+
+#[test]
+fn compiled_kernels_give_the_renderers_pixels() {
+    let scene = dualsplit_scene::load("builtin:cornell").unwrap();
+    let s = Structures::build(&scene.triangles, &Default::default());
+    let cfg = tiny();
+    for workload in Workload::ALL {
+        let settings = RenderSettings::new(12, 12, workload);
+        for accel in SimAccel::ALL {
+            let run =
+                |m| simulate_model(m, &scene, &s, accel, &settings, &cfg, &|_, _| {}).unwrap();
+            let (rv, fast) = (run(ThreadModel::Rv32), run(ThreadModel::Fast));
+            for (i, (a, b)) in rv.radiance.iter().zip(&fast.radiance).enumerate() {
+                assert_eq!(
+                    a.to_bits(),
+                    b.to_bits(),
+                    "{} {}: pixel {i}: {a} vs {b}",
+                    accel.name(),
+                    workload.name()
+                );
+            }
+            assert_eq!(rv.rays, fast.rays, "{} {}", accel.name(), workload.name());
+            eprintln!(
+                "{} {}: rv32 {} cycles {} instr, fast {} cycles {} instr",
+                accel.name(),
+                workload.name(),
+                rv.cycles,
+                rv.instructions.total(),
+                fast.cycles,
+                fast.instructions.total()
+            );
+        }
+    }
+}

@@ -1,0 +1,169 @@
+/* BVH2/4/8 traversal (crates/accel/src/wide/traverse.rs), included by render.c.
+ *
+ * BVH_ARITY = 2, 4 or 8. BVH_WIDE_BOX = 0: each child box is tested with its own rt.box
+ * (one ray-box pipeline per TM); 1: the "+" configurations, one rt.boxn tests all of a
+ * node's boxes and rt.boxget reads the entries.
+ *
+ * Per internal node: slab-test every non-empty child box against [t_min, cull_limit(best)],
+ * continue with the nearest hit child and push the others far-first (ties in slot order);
+ * a popped entry beyond cull_limit(best) is dropped. Per leaf: read the leaf word, then test
+ * the triangles of its index run on [t_min, best_t], keeping the closest by (t, id). */
+
+#if BVH_ARITY == 2
+typedef struct Node2 Node;
+#define NODE_WORDS 13u
+#elif BVH_ARITY == 4
+typedef struct Node4 Node;
+#define NODE_WORDS 25u
+#elif BVH_ARITY == 8
+typedef struct Node8 Node;
+#define NODE_WORDS 50u
+#else
+#error "BVH_ARITY must be 2, 4 or 8"
+#endif
+
+/* Entries of the traversal stack: the entry distance and the word of the child (its node, or
+ * for a leaf its leaf word, with bit 31 set). */
+struct Entry {
+    float t;
+    uint32_t word;
+};
+
+#define ENTRY_LEAF 0x80000000u
+#define STACK_SIZE 256
+_Static_assert(STACK_SIZE * sizeof(struct Entry) <= LOCAL_STORE_BYTES * 5 / 8,
+               "the traversal stack leaves room for the renderer's frames");
+
+static inline uint32_t node_offset(const Node *n)
+{
+#if BVH_ARITY == 2
+    return n->packed & NODE2_OFFSET_MASK;
+#elif BVH_ARITY == 4
+    return n->packed & NODE4_OFFSET_MASK;
+#else
+    return n->offset;
+#endif
+}
+
+/* The kind of slot k: empty (degenerate box, min.x > max.x), leaf or internal. */
+static inline int child_kind(const Node *n, int k)
+{
+#if BVH_ARITY == 8
+    uint32_t t = (n->types >> (2 * k)) & 3u;
+    return t == NODE8_INTERNAL ? CHILD_INTERNAL : t == NODE8_LEAF ? CHILD_LEAF : CHILD_EMPTY;
+#else
+    if (n->box[k].lo[0] > n->box[k].hi[0])
+        return CHILD_EMPTY;
+#if BVH_ARITY == 2
+    uint32_t bit = 31 - k;
+#else
+    uint32_t bit = 28 + k;
+#endif
+    return (n->packed >> bit) & 1u ? CHILD_LEAF : CHILD_INTERNAL;
+#endif
+}
+
+static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, struct Hit *best)
+{
+    (void)pre;
+    struct Entry stack[STACK_SIZE];
+    int sp = 0;
+    int have = 0;
+    float best_t = ray->t_max;
+    float limit = cull_limit(best_t);
+    const float t_min = ray->t_min;
+    /* The current entry: the root node. */
+    int have_cur = 1;
+    struct Entry cur = {t_min, PARAMS->root};
+    for (;;) {
+        struct Entry e;
+        if (have_cur) {
+            e = cur;
+            have_cur = 0;
+        } else {
+            for (;;) {
+                if (sp == 0)
+                    return have;
+                e = stack[--sp];
+                if (e.t <= limit)
+                    break;
+            }
+        }
+        if (e.word & ENTRY_LEAF) {
+            uint32_t run = *WORD_ADDR(e.word & ~ENTRY_LEAF);
+            for (const uint32_t *idx = WORD_ADDR(run);; idx++) {
+                uint32_t entry = *idx;
+                uint32_t prim = entry & ~LAST_IN_RUN;
+                float t = rt_tri(triangle(prim), t_min, best_t);
+                if (t == t && (!have || !closer_than(best, t, prim))) {
+                    best->t = t;
+                    best->prim = prim;
+                    have = 1;
+                    if (any)
+                        return 1;
+                    best_t = t;
+                    limit = cull_limit(best_t);
+                }
+                if (entry & LAST_IN_RUN)
+                    break;
+            }
+            continue;
+        }
+        const Node *node = (const Node *)WORD_ADDR(e.word);
+        /* The hit children: the nearest in `cur`, the others on the stack above `base`,
+         * nearest on top; ordered by entry distance, ties in slot order. */
+        if (sp > STACK_SIZE - BVH_ARITY)
+            kernel_fault(); /* deeper than any tree the builder makes */
+        int base = sp;
+        uint32_t addr = node_offset(node);
+#if BVH_WIDE_BOX
+        uint32_t mask = rt_boxn(BVH_ARITY, node->box, t_min, limit);
+#endif
+#if BVH_WIDE_BOX
+#define BOX_ENTRY(k) ((mask >> (k)) & 1u ? rt_boxget(k) : __builtin_nanf(""))
+#else
+#define BOX_ENTRY(k) rt_box(&node->box[k], t_min, limit)
+#endif
+#define CHILD(k)                                                                       \
+    do {                                                                               \
+        int kind = child_kind(node, k);                                                \
+        if (kind != CHILD_EMPTY) {                                                     \
+            float entry = BOX_ENTRY(k);                                                \
+            if (entry == entry) {                                                      \
+                struct Entry c = {entry, kind == CHILD_LEAF ? addr | ENTRY_LEAF : addr}; \
+                if (!have_cur) {                                                       \
+                    cur = c;                                                           \
+                    have_cur = 1;                                                      \
+                } else if (entry < cur.t) {                                            \
+                    /* A later slot is nearer only when strictly nearer. */            \
+                    stack[sp++] = cur;                                                 \
+                    cur = c;                                                           \
+                } else {                                                               \
+                    /* Below the stacked entries that are nearer or equally near. */   \
+                    int j = sp++;                                                      \
+                    while (j > base && stack[j - 1].t <= entry) {                      \
+                        stack[j] = stack[j - 1];                                       \
+                        j--;                                                           \
+                    }                                                                  \
+                    stack[j] = c;                                                      \
+                }                                                                      \
+            }                                                                          \
+        }                                                                              \
+        addr += kind == CHILD_INTERNAL ? NODE_WORDS : kind == CHILD_LEAF ? 1u : 0u;    \
+    } while (0)
+        CHILD(0);
+        CHILD(1);
+#if BVH_ARITY >= 4
+        CHILD(2);
+        CHILD(3);
+#endif
+#if BVH_ARITY == 8
+        CHILD(4);
+        CHILD(5);
+        CHILD(6);
+        CHILD(7);
+#endif
+#undef CHILD
+#undef BOX_ENTRY
+    }
+}

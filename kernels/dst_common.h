@@ -1,0 +1,61 @@
+/* What both DST traversals share (crates/accel/src/dst/traverse.rs, `Tracer`): the clip to
+ * the scene box, the triangle runs, the stack and the pop rule. Included by dst_sw.h and
+ * dst.h. Each stack entry carries its node and its interval [t_min, t_max]. */
+
+struct Entry {
+    uint32_t node;
+    float t_min;
+    float t_max;
+};
+
+#define STACK_SIZE 192
+_Static_assert(STACK_SIZE * sizeof(struct Entry) <= LOCAL_STORE_BYTES * 5 / 8,
+               "the traversal stack leaves room for the renderer's frames");
+
+/* RayPre::slab of the scene box on [t_lo, t_hi]: the clipped interval, non-empty when the
+ * ray meets the box. Near and far planes by the ray's signs; far planes widened; NaN plane
+ * distances ignored (f_max/f_min return the other operand). */
+static void scene_slab(const struct RayPre *r, float t_lo, float t_hi, float *entry,
+                       float *exit)
+{
+    const struct Params *P = PARAMS;
+    float lo = t_lo, hi = t_hi;
+    for (int a = 0; a < 3; a++) {
+        float near = r->neg[a] ? P->scene_max[a] : P->scene_min[a];
+        lo = f_max(lo, (near - r->org[a]) * r->inv[a]);
+    }
+    for (int a = 0; a < 3; a++) {
+        float far = r->neg[a] ? P->scene_min[a] : P->scene_max[a];
+        hi = f_min(hi, (far - r->org[a]) * r->inv[a] * EXIT_WIDEN);
+    }
+    *entry = lo;
+    *exit = hi;
+}
+
+/* Intersects the triangle run starting at index entry `first` on [ray.t_min, best_t];
+ * returns 1 when an any-hit traversal is done. */
+static inline int test_run(uint32_t first, float t_lo, int any, int *have, struct Hit *best,
+                           float *best_t)
+{
+    for (const uint32_t *idx = WORD_ADDR(PARAMS->indices_start + first);; idx++) {
+        uint32_t entry = *idx;
+        uint32_t prim = entry & ~LAST_IN_RUN;
+        float t = rt_tri(triangle(prim), t_lo, *best_t);
+        if (t == t) {
+            if (any) {
+                best->t = t;
+                best->prim = prim;
+                *have = 1;
+                return 1;
+            }
+            if (!*have || !closer_than(best, t, prim)) {
+                best->t = t;
+                best->prim = prim;
+                *have = 1;
+                *best_t = t;
+            }
+        }
+        if (entry & LAST_IN_RUN)
+            return 0;
+    }
+}

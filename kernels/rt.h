@@ -1,0 +1,130 @@
+/* The ray-tracing instructions of docs/isa.md as inline functions (RISC-V custom-0 0x0B and
+ * custom-1 0x2B opcodes, emitted with .insn). Every instruction that reads or writes the
+ * thread's ray registers, latches or global registers is `asm volatile`, so the compiler
+ * keeps them in program order; the memory the box, triangle and DST instructions read is the
+ * read-only structure image. */
+#ifndef RT_H
+#define RT_H
+
+#include <stdint.h>
+
+/* ---- custom-0: ray registers, reciprocal, atomic increment ---------------------------- */
+
+/* R.o = (x, y, z) */
+static inline void rt_setorg(float x, float y, float z)
+{
+    __asm__ volatile(".insn r4 0x0B, 0, 0, x0, %0, %1, %2" : : "f"(x), "f"(y), "f"(z));
+}
+
+/* R.inv = (x, y, z): 1/dir per component */
+static inline void rt_setinv(float x, float y, float z)
+{
+    __asm__ volatile(".insn r4 0x0B, 1, 0, x0, %0, %1, %2" : : "f"(x), "f"(y), "f"(z));
+}
+
+/* R.shear = (Sx, Sy, Sz) */
+static inline void rt_setshear(float x, float y, float z)
+{
+    __asm__ volatile(".insn r4 0x0B, 2, 0, x0, %0, %1, %2" : : "f"(x), "f"(y), "f"(z));
+}
+
+/* R.k = kx | ky << 2 | kz << 4 */
+static inline void rt_setk(uint32_t k)
+{
+    __asm__ volatile(".insn r 0x0B, 3, 0, x0, %0, x0" : : "r"(k));
+}
+
+/* 1.0f / x, correctly rounded, on the reciprocal unit */
+static inline float rt_rcp(float x)
+{
+    float r;
+    __asm__(".insn r 0x0B, 4, 0, %0, %1, x0" : "=f"(r) : "f"(x));
+    return r;
+}
+
+/* G[g] += 1, returning the old value */
+static inline uint32_t rt_atominc(uint32_t g)
+{
+    uint32_t r;
+    __asm__ volatile(".insn r 0x0B, 5, 0, %0, %1, x0" : "=r"(r) : "r"(g));
+    return r;
+}
+
+/* ---- custom-1: ray-box, ray-triangle, dual-split --------------------------------------- */
+
+/* Slab test of the box at `box` (min xyz, max xyz) on [t_lo, t_hi]: the entry distance when
+ * the ray meets it, else NaN. */
+static inline float rt_box(const void *box, float t_lo, float t_hi)
+{
+    float r;
+    __asm__ volatile(".insn r4 0x2B, 0, 0, %0, %1, %2, %3"
+                     : "=f"(r)
+                     : "r"(box), "f"(t_lo), "f"(t_hi));
+    return r;
+}
+
+/* `rt.box` on N consecutive boxes at once (N = 2, 4, 8 -> funct2 = 0, 1, 2): bit k of the
+ * result is set when box k is hit; the entries go to the box latch (rt_boxget). The funct2
+ * must be a constant, so this is a macro. */
+#define RT_BOXN_F2(n) ((n) == 2 ? 0 : (n) == 4 ? 1 : 2)
+#define rt_boxn(n, boxes, t_lo, t_hi)                                                \
+    ({                                                                               \
+        uint32_t mask_;                                                              \
+        __asm__ volatile(".insn r4 0x2B, 1, %4, %0, %1, %2, %3"                      \
+                         : "=r"(mask_)                                               \
+                         : "r"(boxes), "f"(t_lo), "f"(t_hi), "i"(RT_BOXN_F2(n)));    \
+        mask_;                                                                       \
+    })
+
+/* Entry distance of box k of the last rt_boxn (k a constant 0-7). */
+#define rt_boxget(k)                                                                 \
+    ({                                                                               \
+        float entry_;                                                                \
+        __asm__ volatile(".insn r 0x2B, 2, %1, %0, x0, x0" : "=f"(entry_) : "i"(k)); \
+        entry_;                                                                      \
+    })
+
+/* Watertight test of the triangle at `tri` (v0, v1, v2) on [t_lo, t_hi]: t of the hit, else
+ * NaN. */
+static inline float rt_tri(const void *tri, float t_lo, float t_hi)
+{
+    float r;
+    __asm__ volatile(".insn r4 0x2B, 3, 0, %0, %1, %2, %3"
+                     : "=f"(r)
+                     : "r"(tri), "f"(t_lo), "f"(t_hi));
+    return r;
+}
+
+/* One dual-split pipeline step on the node at `node`: code | offset << 2; the rest goes to
+ * the DST latch (rt_dst_tmin, rt_dst_tmax, rt_dst_offset_stack). */
+static inline uint32_t rt_dst(const void *node, float t_min, float t_max)
+{
+    uint32_t r;
+    __asm__ volatile(".insn r4 0x2B, 4, 0, %0, %1, %2, %3"
+                     : "=r"(r)
+                     : "r"(node), "f"(t_min), "f"(t_max));
+    return r;
+}
+
+static inline float rt_dst_tmin(void)
+{
+    float r;
+    __asm__ volatile(".insn r 0x2B, 5, 0, %0, x0, x0" : "=f"(r));
+    return r;
+}
+
+static inline float rt_dst_tmax(void)
+{
+    float r;
+    __asm__ volatile(".insn r 0x2B, 5, 1, %0, x0, x0" : "=f"(r));
+    return r;
+}
+
+static inline uint32_t rt_dst_offset_stack(void)
+{
+    uint32_t r;
+    __asm__ volatile(".insn r 0x2B, 5, 2, %0, x0, x0" : "=r"(r));
+    return r;
+}
+
+#endif
