@@ -71,8 +71,9 @@ impl fmt::Debug for Reg {
     }
 }
 
-/// The functional unit an instruction issues to (SimTRaX's FU classes, simulator notes
-/// §1.3, §1.7, plus the ray-tracing units of `docs/isa.md`). Loads and stores are
+/// The functional unit an instruction issues to (SimTRaX's FU classes: `sim/ReadConfig.cc`
+/// and the unit lines of `samples/configs/bigcache.config`, plus the ray-tracing units of
+/// `docs/isa.md`). Loads and stores are
 /// [`FuClass::Load`]/[`FuClass::Store`] in the decoded [`Info`]; the executor turns them into
 /// [`FuClass::LocalLoad`]/[`FuClass::LocalStore`] when the address is in the local store.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
