@@ -72,21 +72,11 @@ pub type SimulateFn<'a> = dyn Fn(
 
 /// The real simulator with thread model `model` ([`dualsplit_sim::simulate_model`]),
 /// errors as "simulator unavailable: …".
-pub fn real_simulator(
-    model: ThreadModel,
-) -> impl Fn(
-    &Scene,
-    &Structures,
-    SimAccel,
-    &RenderSettings,
-    &SimConfig,
-    &(dyn Fn(u64, u64) + Sync),
-) -> Result<SimResult, String>
-+ Sync {
-    move |scene, structures, accel, settings, cfg, progress| {
+pub fn real_simulator(model: ThreadModel) -> Box<SimulateFn<'static>> {
+    Box::new(move |scene, structures, accel, settings, cfg, progress| {
         dualsplit_sim::simulate_model(model, scene, structures, accel, settings, cfg, progress)
             .map_err(|e| format!("simulator unavailable: {e}"))
-    }
+    })
 }
 
 /// One simulation to run.

@@ -403,7 +403,7 @@ impl SimConfig {
         }
         if u.local_store_bytes < 1024
             || u.local_store_bytes > 1 << 20
-            || u.local_store_bytes % 16 != 0
+            || !u.local_store_bytes.is_multiple_of(16)
         {
             return Err(ConfigError::Invalid {
                 field: "units.local_store_bytes",

@@ -211,7 +211,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         Cache::new(args.out.join("cache")),
         settings,
         &bars,
-        &simulate,
+        &*simulate,
     );
     let data = producer.run(&scenes, skipped)?;
     let written = dualsplit_report::write_report(&data, &args.out)?;
