@@ -36,7 +36,9 @@ use crate::config::UnitConfig;
 use crate::fu::Pools;
 use crate::kernel::Pipe;
 use crate::memory::L2;
-use crate::rv32::{ExecError, FrameMemory, FuClass, Hart, LOCAL_STORE_ADDR, Latches, Op, Program};
+use crate::rv32::{
+    ExecError, FrameMemory, FuClass, Hart, LOCAL_STORE_ADDR, Latches, Op, Program, Retired,
+};
 use crate::thread::Stalls;
 use crate::tm::{Issued, Tm, WordAddr};
 
@@ -150,7 +152,7 @@ impl Tp {
         prog: &Program,
         mem: &mut FrameMemory<'_>,
         cfg: &UnitConfig,
-        u: Units<'_>,
+        mut u: Units<'_>,
         stalls: &mut Stalls,
         counts: &mut ClassCounts,
         now: Cycle,
@@ -249,14 +251,7 @@ impl Tp {
                     one_slot(i, Producer::Atomic)
                 }
                 FuClass::Load => {
-                    let i = u.tm.load(
-                        u.l2,
-                        WordAddr::from_byte(r.mem.addr as u64),
-                        r.mem.words as u64,
-                        t,
-                        now,
-                    );
-                    stalls.l1_bank += i.busy;
+                    let i = l1_load(&mut u, &r, t, now, stalls);
                     self.t = i.next_issue;
                     self.write(dst, i.ready, Producer::Memory);
                     continue;
@@ -279,14 +274,7 @@ impl Tp {
                         FuClass::TriPipe => (Pipe::Triangle, 1),
                         _ => (Pipe::DualSplit, 1),
                     };
-                    let i = u.tm.load(
-                        u.l2,
-                        WordAddr::from_byte(r.mem.addr as u64),
-                        r.mem.words as u64,
-                        t,
-                        now,
-                    );
-                    stalls.l1_bank += i.busy;
+                    let i = l1_load(&mut u, &r, t, now, stalls);
                     let w = Waiting {
                         pipe,
                         n,
@@ -341,6 +329,16 @@ impl Tp {
         }
         self.last = self.last.max(at);
     }
+}
+
+/// The L1 load of an executed instruction's memory words from cycle `t`.
+#[inline]
+fn l1_load(u: &mut Units<'_>, r: &Retired, t: Cycle, now: Cycle, stalls: &mut Stalls) -> Issued {
+    let words = r.mem.words as u64;
+    let i =
+        u.tm.load(u.l2, WordAddr::from_byte(r.mem.addr as u64), words, t, now);
+    stalls.l1_bank += i.busy;
+    i
 }
 
 /// A one-slot request's timing as (issue cycle, latency, producer).
