@@ -1,4 +1,4 @@
-//! Emission of the DST memory image (dst-spec §3): node words depth-first with the two
+//! Emission of the DST memory image (`docs/dst-encoding.md`, §2): node words depth-first with the two
 //! children of every splitting node adjacent (left, then right at left + left size), a
 //! carving node's child placed by bump allocation, leaves as runs in one triangle-index list
 //! (the last entry of a run has bit 31 set), then the triangle region (the scene's

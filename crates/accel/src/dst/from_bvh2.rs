@@ -1,5 +1,5 @@
 //! BVH2 → DST conversion: the SAH choice of carving chains and of each split's child order
-//! (Lin et al. 2020, §4.2; Lin et al. 2019; dst-spec §5).
+//! (Lin et al. 2020, §4.2; Lin et al. 2019; `docs/dst-encoding.md`, §3).
 //!
 //! With identical bounds the region entering every splitting node is exactly its BVH node's
 //! box, so each child subtree costs the same whatever its parent chooses. The only choices
@@ -205,7 +205,9 @@ fn step_for(fi: usize, fj: Option<usize>, target: &Aabb, c: &DstCosts) -> CarveS
             let a = fi >> 1;
             let upper = fi & 1 == 1;
             if c.single_carve <= c.dual_carve {
-                // Single-axis node whose other plane is a ±∞ no-op (never 0.0: dst-spec §4.4).
+                // Single-axis node whose other plane is a ±∞ no-op: (±∞ − o)·inv is never
+                // NaN for a finite origin, and 0.0 as "no plane" would be a real plane at
+                // coordinate 0.
                 CarveStep {
                     kind: CarveKind::Single(a),
                     p0: if upper { target.max[a] } else { f32::INFINITY },
@@ -249,7 +251,7 @@ fn step_for(fi: usize, fj: Option<usize>, target: &Aabb, c: &DstCosts) -> CarveS
     }
 }
 
-/// The exact chain DP of one child box against its parent's box (dst-spec §5.2).
+/// The exact chain DP of one child box against its parent's box (`docs/dst-encoding.md`, §3).
 ///
 /// States are subsets S of the faces F where the parent box differs from the child box; the
 /// region in state S is the parent box with the faces in S already at the child's values.
