@@ -1,5 +1,9 @@
-//! Simulator speed: simulated node visits per host second (the project's speed bar: ≥ 2 M
-//! per core). `cargo bench -p dualsplit-sim`.
+//! Simulator speed. `cargo bench -p dualsplit-sim`.
+//!
+//! `frame_dragon_rv32`: the compiled kernels (thread model `rv32`) on a 64×64 path-traced
+//! frame of the shipped `dragon_box.ply.gz`, BVH2 and DST, counted in simulated
+//! instructions (the bar: ≥ 10 M per host second per core). The other benches time the
+//! `fast` thread model (the macro-op replay), counted in simulated node visits:
 //!
 //! `engine_node_visits`: the lin2020 chip (64 TMs × 32 threads) replaying a synthetic
 //! BVH2-like stream: per node visit one 13-word (52-byte) node load at a random node of a
@@ -22,7 +26,7 @@ use divan::counter::ItemsCount;
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
 use dualsplit_sim::kernel::{Op, Pipe};
 use dualsplit_sim::{Chip, Thread, WorkSource, run_chip};
-use dualsplit_sim::{SimAccel, SimConfig, simulate};
+use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel, simulate_model};
 use std::sync::OnceLock;
 
 fn main() {
@@ -124,21 +128,32 @@ fn prepared(
     .as_ref()
 }
 
-/// Simulates a `res`² path-traced frame of the prepared scene once to count its node
-/// visits, then times it.
+/// Simulates a `res`² path-traced frame of the prepared scene with the `fast` thread model
+/// once to count its node visits, then times it.
 fn bench_frame(b: divan::Bencher, prepared: Option<&'static Built>, accel: SimAccel, res: u32) {
+    bench_model(b, prepared, ThreadModel::Fast, accel, res, |r| {
+        r.instructions.node_steps
+    });
+}
+
+/// Simulates a `res`² path-traced frame once with thread model `model` to count `items`,
+/// then times it.
+fn bench_model(
+    b: divan::Bencher,
+    prepared: Option<&'static Built>,
+    model: ThreadModel,
+    accel: SimAccel,
+    res: u32,
+    items: fn(&SimResult) -> u64,
+) {
     let Some((scene, s)) = prepared else {
         return;
     };
     let settings =
         dualsplit_render::RenderSettings::new(res, res, dualsplit_render::Workload::Path);
     let cfg = SimConfig::lin2020();
-    let nodes = simulate(scene, s, accel, &settings, &cfg, &|_, _| {})
-        .unwrap()
-        .instructions
-        .node_steps;
-    b.counter(ItemsCount::new(nodes))
-        .bench(|| simulate(scene, s, accel, &settings, &cfg, &|_, _| {}).unwrap());
+    let sim = || simulate_model(model, scene, s, accel, &settings, &cfg, &|_, _| {}).unwrap();
+    b.counter(ItemsCount::new(items(&sim()))).bench(sim);
 }
 
 #[divan::bench(args = [SimAccel::Bvh2, SimAccel::Dst], sample_count = 3)]
@@ -177,13 +192,24 @@ fn frame_atrium(b: divan::Bencher, accel: SimAccel) {
 
 #[divan::bench(args = SimAccel::ALL, sample_count = 3)]
 fn frame_dragon(b: divan::Bencher, accel: SimAccel) {
+    bench_frame(b, dragon(), accel, 128);
+}
+
+#[divan::bench(args = [SimAccel::Bvh2, SimAccel::Dst], sample_count = 3)]
+fn frame_dragon_rv32(b: divan::Bencher, accel: SimAccel) {
+    bench_model(b, dragon(), ThreadModel::Rv32, accel, 64, |r| {
+        r.instructions.total()
+    });
+}
+
+/// The shipped Dragon Box, built once.
+fn dragon() -> Option<&'static Built> {
     static DRAGON: OnceLock<Prepared> = OnceLock::new();
-    let dragon = prepared(&DRAGON, || {
+    prepared(&DRAGON, || {
         let path = concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../../shared/scenes/dragon_box.ply.gz"
         );
         dualsplit_scene::load(path).map_err(|e| e.to_string())
-    });
-    bench_frame(b, dragon, accel, 128);
+    })
 }
