@@ -5,7 +5,7 @@
 
 use crate::fu::Pools;
 use crate::kernels::{FRAME_FLOATS_PER_PIXEL, Params, elf};
-use crate::rv32::{FrameMemory, Program};
+use crate::rv32::{FRAME_BUFFER_ADDR, FrameMemory, PARAMS_ADDR, PROGRAM_BASE, Program};
 use crate::tp::{ClassCounts, Tp};
 use crate::{Chip, SimAccel, SimConfig, SimError, SimResult, ThreadModel, chip::run_compiled};
 use dualsplit_accel::Structures;
@@ -22,8 +22,29 @@ pub(crate) fn run(
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<SimResult, SimError> {
     let prog = Program::from_elf(elf(accel, settings.workload))?;
-    let params = Params::new(scene, structures, accel, settings);
     let image = structures.image(accel.kind());
+    // The memory map of docs/isa.md: the image below the parameter block, the frame
+    // buffer below the program.
+    let image_bytes = image.triangles.end as u64 * 4;
+    let frame_bytes =
+        settings.width as u64 * settings.height as u64 * 4 * FRAME_FLOATS_PER_PIXEL as u64;
+    for (region, bytes, limit) in [
+        ("memory image", image_bytes, PARAMS_ADDR as u64),
+        (
+            "frame buffer",
+            frame_bytes,
+            (PROGRAM_BASE - FRAME_BUFFER_ADDR) as u64,
+        ),
+    ] {
+        if bytes > limit {
+            return Err(SimError::MemoryMap {
+                region,
+                bytes,
+                limit,
+            });
+        }
+    }
+    let params = Params::new(scene, structures, accel, settings);
     let mut mem = FrameMemory::new(image, params.as_bytes(), params.frame_bytes());
     let mut chip = Chip::new(cfg, accel.box_pipes(cfg));
     let mut pools: Vec<Pools> = (0..cfg.tms).map(|_| Pools::new(&cfg.units)).collect();

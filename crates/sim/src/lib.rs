@@ -298,6 +298,16 @@ pub enum SimError {
     /// A committed kernel did not load.
     #[error("kernel: {0}")]
     Kernel(#[from] rv32::ElfError),
+    /// The frame does not fit the compiled kernels' 32-bit memory map (`docs/isa.md`).
+    #[error("the {region} takes {bytes} bytes; the kernels' memory map holds at most {limit}")]
+    MemoryMap {
+        /// `memory image` or `frame buffer`.
+        region: &'static str,
+        /// Its size.
+        bytes: u64,
+        /// The room the map gives it.
+        limit: u64,
+    },
     /// A kernel instruction failed (an address outside the memory map, an illegal
     /// instruction).
     #[error("kernel: {0}")]

@@ -42,3 +42,31 @@ fn compiled_kernels_give_the_renderers_pixels() {
         }
     }
 }
+
+#[test]
+fn a_frame_beyond_the_memory_map_is_a_typed_error() {
+    let scene = dualsplit_scene::load("builtin:cornell").unwrap();
+    let s = Structures::build(&scene.triangles, &Default::default());
+    // 4096² pixels × 12 bytes is beyond the 128 MiB between the frame buffer and the program.
+    let settings = RenderSettings::new(4096, 4096, Workload::Cast);
+    let e = simulate_model(
+        ThreadModel::Rv32,
+        &scene,
+        &s,
+        SimAccel::Dst,
+        &settings,
+        &tiny(),
+        &|_, _| {},
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            dualsplit_sim::SimError::MemoryMap {
+                region: "frame buffer",
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
