@@ -38,10 +38,14 @@ pub const FULL_RES: u32 = 1024;
 pub const DEFAULT_TMS: [u32; 3] = [32, 64, 128];
 /// Square resolution of the CPU ray sets (path workload rays).
 pub const CPU_RES: u32 = 64;
-/// Simulated rays per second of wall time on a 2-core machine, two simulations side by side;
-/// used only for the `--full` up-front estimate. Measured: about 38K simulated rays per CPU
-/// second (release build, `lin2020` config, the default builtins at 64×64).
+/// Simulated rays per second of wall time on a 2-core machine, two simulations side by side,
+/// with the `fast` thread model; used only for the `--full` up-front estimate. Measured:
+/// about 38K simulated rays per CPU second (release build, `lin2020` config, the default
+/// builtins at 64×64).
 pub const SIM_RAYS_PER_SECOND: f64 = 40_000.0;
+/// The same with the compiled kernels (`rv32`). Measured: dragon_box 256² path, all eight
+/// configurations two at a time, 3.82 M rays in about 260 s of wall time.
+pub const SIM_RAYS_PER_SECOND_RV32: f64 = 14_000.0;
 
 /// Arguments of `dualsplit report`.
 #[derive(clap::Args)]
@@ -61,11 +65,10 @@ pub struct Args {
     /// TM counts of the scaling study (Table 7); Tables 4–6 use 64 when listed.
     #[arg(long, value_delimiter = ',', default_values_t = DEFAULT_TMS)]
     tms: Vec<u32>,
-    /// Thread model: rv32 (the compiled kernels instruction by instruction; the default
-    /// with --full) or fast (the macro-op replay; the default otherwise, so the default
-    /// report takes minutes).
-    #[arg(long)]
-    model: Option<String>,
+    /// Thread model: rv32 (the compiled kernels instruction by instruction, the reference)
+    /// or fast (the macro-op replay: about 8× faster, an uncalibrated approximation).
+    #[arg(long, default_value = "rv32")]
+    model: String,
 }
 
 /// indicatif bars behind the report's `Progress` trait.
@@ -153,6 +156,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         }
     }
 
+    let thread_model = ThreadModel::parse(&args.model).ok_or_else(|| {
+        anyhow::anyhow!("unknown --model `{}` (expected rv32 or fast)", args.model)
+    })?;
     if scenes.is_empty() {
         anyhow::bail!(
             "no scene could be loaded: {}",
@@ -175,7 +181,11 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         let frames = scenes.len() * 16 + scaling * extra_tms * 8;
         let rays = 8.0 * pixels * (1.5 + 6.0) * scenes.len() as f64
             + (scaling * extra_tms * 8) as f64 * pixels * 6.0;
-        let secs = rays / SIM_RAYS_PER_SECOND;
+        let secs = rays
+            / match thread_model {
+                ThreadModel::Rv32 => SIM_RAYS_PER_SECOND_RV32,
+                ThreadModel::Fast => SIM_RAYS_PER_SECOND,
+            };
         let when = if secs >= 3600.0 {
             format!("{:.1} hours", secs / 3600.0)
         } else {
@@ -187,12 +197,6 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         );
     }
 
-    let thread_model = match args.model.as_deref() {
-        None if args.full => ThreadModel::Rv32,
-        None => ThreadModel::Fast,
-        Some(m) => ThreadModel::parse(m)
-            .ok_or_else(|| anyhow::anyhow!("unknown --model `{m}` (expected rv32 or fast)"))?,
-    };
     let settings = ReportSettings {
         width: res,
         height: res,
