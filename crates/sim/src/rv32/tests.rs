@@ -200,6 +200,11 @@ fn branches_and_jumps() {
     assert_eq!(h.x[1], BASE + 4);
     assert_eq!(h.x[5], BASE + 12);
     assert_eq!(h.x[3], 0);
+    // jalr with rd = rs1 jumps to the old value.
+    let h = run_with(&[i(0x67, 0, 6, 6, 8), addi(3, 0, 9), addi(3, 0, 9)], |h| {
+        h.x[6] = BASE + 4 // -> BASE + 12 (the ebreak)
+    });
+    assert_eq!((h.x[6], h.x[3]), (BASE + 4, 0));
     // Retired records a taken branch.
     let prog = Program::from_words(BASE, &[b(0, 0, 0, 8), EBREAK, EBREAK]);
     let image = MemoryImage::default();
