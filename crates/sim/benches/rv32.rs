@@ -85,6 +85,5 @@ fn kernel_frame(bencher: divan::Bencher, accel: SimAccel) {
         run_fast(&mut hart, &prog, &mut mem, u64::MAX).unwrap()
     };
     let n = run();
-    eprintln!("kernel_frame {}: {n} instructions per frame", accel.name());
     bencher.counter(ItemsCount::new(n)).bench_local(run);
 }

@@ -1,6 +1,6 @@
 //! One hardware thread (a TP's thread): architectural state and the functional executor.
 
-use super::decode::{CSR_FCSR, CSR_FRM, FuClass, Info, Instr, Op, decode};
+use super::decode::{CSR_FCSR, CSR_FRM, FuClass, Info, Op, decode};
 use super::elf::Program;
 use super::memory::{LOCAL_STORE_ADDR, MemFault, Memory};
 use dualsplit_accel::dst::HeaderOffset;
@@ -471,25 +471,28 @@ impl Hart {
     #[inline]
     pub fn step<M: Memory>(&mut self, prog: &Program, mem: &mut M) -> Result<Retired, ExecError> {
         let pc = self.pc;
-        let Some(&ins) = prog.fetch(pc) else {
+        let Some(ins) = prog.fetch(pc) else {
             return Err(ExecError::Fetch { pc });
         };
-        let Instr {
-            op,
-            rd,
-            rs1,
-            rs2,
-            rs3,
-            imm,
-            mut info,
-        } = ins;
-        // `& 31` lets the compiler drop the register files' bounds checks.
-        let (rd, rs1, rs2, rs3) = (
-            rd as usize & 31,
-            rs1 as usize & 31,
-            rs2 as usize & 31,
-            rs3 as usize & 31,
-        );
+        let (op, imm) = (ins.op, ins.imm);
+        // Register numbers are read where used; `& 31` lets the compiler drop the register
+        // files' bounds checks.
+        macro_rules! rd {
+            () => {
+                (ins.rd as usize & 31)
+            };
+        }
+        let rs1 = ins.rs1 as usize & 31;
+        macro_rules! rs2 {
+            () => {
+                (ins.rs2 as usize & 31)
+            };
+        }
+        macro_rules! rs3 {
+            () => {
+                (ins.rs3 as usize & 31)
+            };
+        }
         let mut next = pc.wrapping_add(4);
         let mut acc = MemAccess::NONE;
         let mut taken = false;
@@ -502,7 +505,7 @@ impl Hart {
         }
         macro_rules! b {
             () => {
-                self.x[rs2]
+                self.x[rs2!()]
             };
         }
         macro_rules! fa {
@@ -512,12 +515,12 @@ impl Hart {
         }
         macro_rules! fb {
             () => {
-                f32::from_bits(self.f[rs2])
+                f32::from_bits(self.f[rs2!()])
             };
         }
         macro_rules! fc {
             () => {
-                f32::from_bits(self.f[rs3])
+                f32::from_bits(self.f[rs3!()])
             };
         }
         macro_rules! ea {
@@ -527,12 +530,12 @@ impl Hart {
         }
         macro_rules! wx {
             ($v:expr) => {{
-                self.x[rd] = $v;
+                self.x[rd!()] = $v;
             }};
         }
         macro_rules! wf {
             ($v:expr) => {{
-                self.f[rd] = $v;
+                self.f[rd!()] = $v;
             }};
         }
         macro_rules! branch {
@@ -589,7 +592,7 @@ impl Hart {
             Sh => self.store::<2, M>(mem, ea!(), (b!() as u16).to_le_bytes(), &mut acc)?,
             Sw => self.store::<4, M>(mem, ea!(), b!().to_le_bytes(), &mut acc)?,
             Fsw => {
-                let v = self.f[rs2];
+                let v = self.f[rs2!()];
                 self.store::<4, M>(mem, ea!(), v.to_le_bytes(), &mut acc)?
             }
             Addi => wx!(ea!()),
@@ -664,11 +667,11 @@ impl Hart {
             FmulS => wf!(canon(fa!() * fb!())),
             FdivS => wf!(canon(fa!() / fb!())),
             FsqrtS => wf!(canon(fa!().sqrt())),
-            FsgnjS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (self.f[rs2] & 0x8000_0000)),
-            FsgnjnS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (!self.f[rs2] & 0x8000_0000)),
-            FsgnjxS => wf!(self.f[rs1] ^ (self.f[rs2] & 0x8000_0000)),
-            FminS => wf!(fmin(self.f[rs1], self.f[rs2])),
-            FmaxS => wf!(fmax(self.f[rs1], self.f[rs2])),
+            FsgnjS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (self.f[rs2!()] & 0x8000_0000)),
+            FsgnjnS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (!self.f[rs2!()] & 0x8000_0000)),
+            FsgnjxS => wf!(self.f[rs1] ^ (self.f[rs2!()] & 0x8000_0000)),
+            FminS => wf!(fmin(self.f[rs1], self.f[rs2!()])),
+            FmaxS => wf!(fmax(self.f[rs1], self.f[rs2!()])),
             FcvtWS => wx!(fcvt_w_s(self.f[rs1], imm)),
             FcvtWuS => wx!(fcvt_wu_s(self.f[rs1], imm)),
             FmvXW => wx!(self.f[rs1]),
@@ -769,6 +772,7 @@ impl Hart {
         }
         self.x[0] = 0;
         self.pc = next;
+        let mut info = ins.info;
         if acc.local && matches!(info.fu, FuClass::Load | FuClass::Store) {
             info.fu = if acc.store {
                 FuClass::LocalStore
