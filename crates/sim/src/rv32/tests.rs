@@ -251,6 +251,54 @@ fn loads_and_stores() {
 }
 
 #[test]
+fn retired_records_local_accesses_csr_and_fence() {
+    let ls = LOCAL_STORE_ADDR;
+    let words = [
+        s(0x23, 2, 2, 1, -4),    // sw x1, -4(sp): local store
+        i(0x03, 2, 3, 2, -4),    // lw x3, -4(sp)
+        i(0x73, 5, 4, 0, 1),     // csrrwi x4, fflags, 0
+        i(0x73, 6, 5, 0, 2),     // csrrsi x5, frm, 0 (no write)
+        i(0x73, 3, 6, 7, 3),     // csrrc x6, fcsr, x7
+        i(0x0F, 0, 0, 0, 0x0FF), // fence
+        EBREAK,
+    ];
+    let prog = Program::from_words(BASE, &words);
+    let image = MemoryImage::default();
+    let mut mem = FrameMemory::new(&image, &[], 0);
+    let mut h = Hart::new(&prog, 64);
+    assert_eq!(h.x[2], ls + 64);
+    h.x[1] = 0xDEAD_BEEF;
+    h.x[4] = 1;
+    h.x[5] = 1;
+    h.x[6] = 1;
+    let r = h.step(&prog, &mut mem).unwrap();
+    assert_eq!(r.fu(), FuClass::LocalStore);
+    assert_eq!(
+        r.mem,
+        MemAccess {
+            addr: ls + 60,
+            words: 1,
+            store: true,
+            local: true
+        }
+    );
+    assert_eq!(r.info.src, [Reg::x(2), Reg::x(1), Reg::NONE]);
+    let r = h.step(&prog, &mut mem).unwrap();
+    assert_eq!(r.fu(), FuClass::LocalLoad);
+    assert_eq!(r.info.dst, Reg::x(3));
+    assert_eq!(h.x[3], 0xDEAD_BEEF);
+    for _ in 0..4 {
+        let r = h.step(&prog, &mut mem).unwrap();
+        assert_eq!(r.fu(), FuClass::IntAlu);
+        assert!(!r.mem.is_some() && !r.taken);
+    }
+    assert_eq!((h.x[4], h.x[5], h.x[6]), (0, 0, 0));
+    let r = h.step(&prog, &mut mem).unwrap();
+    assert!(r.is_halt() && h.halted);
+    assert_eq!(h.pc, BASE + 24);
+}
+
+#[test]
 fn memory_regions_and_faults() {
     let image = MemoryImage::default();
     let params = [1u8, 0, 0, 0, 2, 0, 0, 0];
