@@ -63,7 +63,7 @@
 //!   (read-only), local store at `0xF000_0000` (read-write, per thread). Misaligned and
 //!   unmapped accesses are typed errors naming the pc and address.
 //!
-//! Decoding is hand-written ([`decode`]'s module doc says why); ELF parsing uses the
+//! Decoding is hand-written ([`mod@decode`]'s module doc says why); ELF parsing uses the
 //! `object` crate ([`elf`]).
 
 pub mod decode;
