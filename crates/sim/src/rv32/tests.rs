@@ -962,3 +962,67 @@ mod custom {
         );
     }
 }
+
+/// Random words never make the decoder or the executor panic: every outcome is an
+/// instruction or a typed error.
+mod fuzz {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Random words, biased toward the opcodes we decode so that execution gets going.
+    fn word() -> impl Strategy<Value = u32> {
+        let opcodes = prop::sample::select(vec![
+            0x37u32, 0x17, 0x6F, 0x67, 0x63, 0x03, 0x23, 0x13, 0x33, 0x0F, 0x73, 0x07, 0x27, 0x43,
+            0x47, 0x4B, 0x4F, 0x53, 0x0B, 0x2B,
+        ]);
+        prop_oneof![
+            1 => any::<u32>(),
+            4 => (opcodes, any::<u32>()).prop_map(|(op, w)| (w & !0x7F) | op),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(3000))]
+        #[test]
+        fn random_programs_never_panic(
+            words in proptest::collection::vec(word(), 1..48),
+            regs in proptest::collection::vec(any::<u32>(), 64),
+        ) {
+            for &w in &words {
+                if let Ok(ins) = decode(w) {
+                    // Unused register fields are zeroed; x0 is never a source or destination.
+                    prop_assert!(ins.info.src.iter().all(|r| *r != Reg::x(0) || r.is_none()));
+                    prop_assert!(ins.rd < 32 && ins.rs1 < 32 && ins.rs2 < 32 && ins.rs3 < 32);
+                }
+            }
+            let tri = dualsplit_geometry::Triangle::default();
+            let mut image = MemoryImage::with_triangles(64, 0, vec![tri; 2].into());
+            for (k, w) in image.words.iter_mut().enumerate() {
+                *w = regs[k % 64];
+            }
+            let prog = Program::from_words(BASE, &words);
+            let mut mem = FrameMemory::new(&image, &[0; 16], 64);
+            let mut h = Hart::new(&prog, 256);
+            // Registers point into the regions half the time.
+            for k in 1..32 {
+                let r = regs[k];
+                h.x[k] = match r % 6 {
+                    0 => r % 256,
+                    1 => PARAMS_ADDR + r % 16,
+                    2 => FRAME_BUFFER_ADDR + r % 64,
+                    3 => LOCAL_STORE_ADDR + r % 256,
+                    4 => BASE + 4 * (r % words.len() as u32),
+                    _ => r,
+                };
+                h.f[k] = regs[32 + k];
+            }
+            for _ in 0..200 {
+                match h.step(&prog, &mut mem) {
+                    Ok(_) if h.halted => break,
+                    Ok(_) => {}
+                    Err(_) => break,
+                }
+            }
+        }
+    }
+}
