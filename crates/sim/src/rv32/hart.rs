@@ -1,6 +1,6 @@
 //! One hardware thread (a TP's thread): architectural state and the functional executor.
 
-use super::decode::{CSR_FCSR, CSR_FRM, FuClass, Info, Instr, Op, decode};
+use super::decode::{CSR_FCSR, CSR_FRM, FuClass, Info, Op, decode};
 use super::elf::Program;
 use super::memory::{LOCAL_STORE_ADDR, MemFault, Memory};
 use dualsplit_accel::dst::HeaderOffset;
@@ -471,35 +471,71 @@ impl Hart {
     #[inline]
     pub fn step<M: Memory>(&mut self, prog: &Program, mem: &mut M) -> Result<Retired, ExecError> {
         let pc = self.pc;
-        let Some(&ins) = prog.fetch(pc) else {
+        let Some(ins) = prog.fetch(pc) else {
             return Err(ExecError::Fetch { pc });
         };
-        let Instr {
-            op,
-            rd,
-            rs1,
-            rs2,
-            rs3,
-            imm,
-            mut info,
-        } = ins;
-        let (rd, rs1, rs2, rs3) = (rd as usize, rs1 as usize, rs2 as usize, rs3 as usize);
+        let (op, imm) = (ins.op, ins.imm);
+        // Register numbers are read where used; `& 31` lets the compiler drop the register
+        // files' bounds checks.
+        macro_rules! rd {
+            () => {
+                (ins.rd as usize & 31)
+            };
+        }
+        let rs1 = ins.rs1 as usize & 31;
+        macro_rules! rs2 {
+            () => {
+                (ins.rs2 as usize & 31)
+            };
+        }
+        macro_rules! rs3 {
+            () => {
+                (ins.rs3 as usize & 31)
+            };
+        }
         let mut next = pc.wrapping_add(4);
         let mut acc = MemAccess::NONE;
         let mut taken = false;
-        let a = self.x[rs1];
-        let b = self.x[rs2];
-        let fa = f32::from_bits(self.f[rs1]);
-        let fb = f32::from_bits(self.f[rs2]);
-        let fc = f32::from_bits(self.f[rs3]);
+        // Operands are read by the arms that use them (reading all five up front costs
+        // more than the dispatch).
+        macro_rules! a {
+            () => {
+                self.x[rs1]
+            };
+        }
+        macro_rules! b {
+            () => {
+                self.x[rs2!()]
+            };
+        }
+        macro_rules! fa {
+            () => {
+                f32::from_bits(self.f[rs1])
+            };
+        }
+        macro_rules! fb {
+            () => {
+                f32::from_bits(self.f[rs2!()])
+            };
+        }
+        macro_rules! fc {
+            () => {
+                f32::from_bits(self.f[rs3!()])
+            };
+        }
+        macro_rules! ea {
+            () => {
+                self.x[rs1].wrapping_add(imm as u32)
+            };
+        }
         macro_rules! wx {
             ($v:expr) => {{
-                self.x[rd] = $v;
+                self.x[rd!()] = $v;
             }};
         }
         macro_rules! wf {
             ($v:expr) => {{
-                self.f[rd] = $v;
+                self.f[rd!()] = $v;
             }};
         }
         macro_rules! branch {
@@ -510,7 +546,6 @@ impl Hart {
                 }
             }};
         }
-        let ea = a.wrapping_add(imm as u32);
         use Op::*;
         match op {
             Lui => wx!(imm as u32),
@@ -521,70 +556,80 @@ impl Hart {
                 taken = true;
             }
             Jalr => {
+                let target = ea!() & !1; // read before the link write (rd may be rs1)
                 wx!(next);
-                next = ea & !1;
+                next = target;
                 taken = true;
             }
-            Beq => branch!(a == b),
-            Bne => branch!(a != b),
-            Blt => branch!((a as i32) < (b as i32)),
-            Bge => branch!((a as i32) >= (b as i32)),
-            Bltu => branch!(a < b),
-            Bgeu => branch!(a >= b),
-            Lb => wx!(self.load::<1, M>(prog, mem, ea, &mut acc)?[0] as i8 as i32 as u32),
-            Lbu => wx!(self.load::<1, M>(prog, mem, ea, &mut acc)?[0] as u32),
+            Beq => branch!(a!() == b!()),
+            Bne => branch!(a!() != b!()),
+            Blt => branch!((a!() as i32) < (b!() as i32)),
+            Bge => branch!((a!() as i32) >= (b!() as i32)),
+            Bltu => branch!(a!() < b!()),
+            Bgeu => branch!(a!() >= b!()),
+            Lb => wx!(self.load::<1, M>(prog, mem, ea!(), &mut acc)?[0] as i8 as i32 as u32),
+            Lbu => wx!(self.load::<1, M>(prog, mem, ea!(), &mut acc)?[0] as u32),
             Lh => {
-                wx!(i16::from_le_bytes(self.load::<2, M>(prog, mem, ea, &mut acc)?) as i32 as u32)
+                wx!(
+                    i16::from_le_bytes(self.load::<2, M>(prog, mem, ea!(), &mut acc)?) as i32
+                        as u32
+                )
             }
-            Lhu => wx!(u16::from_le_bytes(self.load::<2, M>(prog, mem, ea, &mut acc)?) as u32),
-            Lw => wx!(u32::from_le_bytes(
-                self.load::<4, M>(prog, mem, ea, &mut acc)?
-            )),
-            Flw => wf!(u32::from_le_bytes(
-                self.load::<4, M>(prog, mem, ea, &mut acc)?
-            )),
-            Sb => self.store::<1, M>(mem, ea, [b as u8], &mut acc)?,
-            Sh => self.store::<2, M>(mem, ea, (b as u16).to_le_bytes(), &mut acc)?,
-            Sw => self.store::<4, M>(mem, ea, b.to_le_bytes(), &mut acc)?,
+            Lhu => wx!(u16::from_le_bytes(self.load::<2, M>(prog, mem, ea!(), &mut acc)?) as u32),
+            Lw => wx!(u32::from_le_bytes(self.load::<4, M>(
+                prog,
+                mem,
+                ea!(),
+                &mut acc
+            )?)),
+            Flw => wf!(u32::from_le_bytes(self.load::<4, M>(
+                prog,
+                mem,
+                ea!(),
+                &mut acc
+            )?)),
+            Sb => self.store::<1, M>(mem, ea!(), [b!() as u8], &mut acc)?,
+            Sh => self.store::<2, M>(mem, ea!(), (b!() as u16).to_le_bytes(), &mut acc)?,
+            Sw => self.store::<4, M>(mem, ea!(), b!().to_le_bytes(), &mut acc)?,
             Fsw => {
-                let v = self.f[rs2];
-                self.store::<4, M>(mem, ea, v.to_le_bytes(), &mut acc)?
+                let v = self.f[rs2!()];
+                self.store::<4, M>(mem, ea!(), v.to_le_bytes(), &mut acc)?
             }
-            Addi => wx!(ea),
-            Slti => wx!(((a as i32) < imm) as u32),
-            Sltiu => wx!((a < imm as u32) as u32),
-            Xori => wx!(a ^ imm as u32),
-            Ori => wx!(a | imm as u32),
-            Andi => wx!(a & imm as u32),
-            Slli => wx!(a << imm),
-            Srli => wx!(a >> imm),
-            Srai => wx!(((a as i32) >> imm) as u32),
-            Add => wx!(a.wrapping_add(b)),
-            Sub => wx!(a.wrapping_sub(b)),
-            Sll => wx!(a << (b & 31)),
-            Slt => wx!(((a as i32) < (b as i32)) as u32),
-            Sltu => wx!((a < b) as u32),
-            Xor => wx!(a ^ b),
-            Srl => wx!(a >> (b & 31)),
-            Sra => wx!(((a as i32) >> (b & 31)) as u32),
-            Or => wx!(a | b),
-            And => wx!(a & b),
-            Mul => wx!(a.wrapping_mul(b)),
-            Mulh => wx!(((a as i32 as i64 * b as i32 as i64) >> 32) as u32),
-            Mulhsu => wx!(((a as i32 as i64 * b as i64) >> 32) as u32),
-            Mulhu => wx!(((a as u64 * b as u64) >> 32) as u32),
-            Div => wx!(if b == 0 {
+            Addi => wx!(ea!()),
+            Slti => wx!(((a!() as i32) < imm) as u32),
+            Sltiu => wx!((a!() < imm as u32) as u32),
+            Xori => wx!(a!() ^ imm as u32),
+            Ori => wx!(a!() | imm as u32),
+            Andi => wx!(a!() & imm as u32),
+            Slli => wx!(a!() << imm),
+            Srli => wx!(a!() >> imm),
+            Srai => wx!(((a!() as i32) >> imm) as u32),
+            Add => wx!(a!().wrapping_add(b!())),
+            Sub => wx!(a!().wrapping_sub(b!())),
+            Sll => wx!(a!() << (b!() & 31)),
+            Slt => wx!(((a!() as i32) < (b!() as i32)) as u32),
+            Sltu => wx!((a!() < b!()) as u32),
+            Xor => wx!(a!() ^ b!()),
+            Srl => wx!(a!() >> (b!() & 31)),
+            Sra => wx!(((a!() as i32) >> (b!() & 31)) as u32),
+            Or => wx!(a!() | b!()),
+            And => wx!(a!() & b!()),
+            Mul => wx!(a!().wrapping_mul(b!())),
+            Mulh => wx!(((a!() as i32 as i64 * b!() as i32 as i64) >> 32) as u32),
+            Mulhsu => wx!(((a!() as i32 as i64 * b!() as i64) >> 32) as u32),
+            Mulhu => wx!(((a!() as u64 * b!() as u64) >> 32) as u32),
+            Div => wx!(if b!() == 0 {
                 u32::MAX
             } else {
-                (a as i32).wrapping_div(b as i32) as u32
+                (a!() as i32).wrapping_div(b!() as i32) as u32
             }),
-            Divu => wx!(a.checked_div(b).unwrap_or(u32::MAX)),
-            Rem => wx!(if b == 0 {
-                a
+            Divu => wx!(a!().checked_div(b!()).unwrap_or(u32::MAX)),
+            Rem => wx!(if b!() == 0 {
+                a!()
             } else {
-                (a as i32).wrapping_rem(b as i32) as u32
+                (a!() as i32).wrapping_rem(b!() as i32) as u32
             }),
-            Remu => wx!(if b == 0 { a } else { a % b }),
+            Remu => wx!(if b!() == 0 { a!() } else { a!() % b!() }),
             Fence => {}
             Ebreak => {
                 self.halted = true;
@@ -593,7 +638,7 @@ impl Hart {
             Csrrw | Csrrs | Csrrc | Csrrwi | Csrrsi | Csrrci => {
                 // fflags, frm and fcsr all read 0 (fflags not modelled, frm = RNE).
                 let src = if matches!(op, Csrrw | Csrrs | Csrrc) {
-                    a
+                    a!()
                 } else {
                     rs1 as u32
                 };
@@ -613,64 +658,64 @@ impl Hart {
                 }
                 wx!(0);
             }
-            FmaddS => wf!(canon(fa.mul_add(fb, fc))),
-            FmsubS => wf!(canon(fa.mul_add(fb, -fc))),
-            FnmsubS => wf!(canon((-fa).mul_add(fb, fc))),
-            FnmaddS => wf!(canon((-fa).mul_add(fb, -fc))),
-            FaddS => wf!(canon(fa + fb)),
-            FsubS => wf!(canon(fa - fb)),
-            FmulS => wf!(canon(fa * fb)),
-            FdivS => wf!(canon(fa / fb)),
-            FsqrtS => wf!(canon(fa.sqrt())),
-            FsgnjS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (self.f[rs2] & 0x8000_0000)),
-            FsgnjnS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (!self.f[rs2] & 0x8000_0000)),
-            FsgnjxS => wf!(self.f[rs1] ^ (self.f[rs2] & 0x8000_0000)),
-            FminS => wf!(fmin(self.f[rs1], self.f[rs2])),
-            FmaxS => wf!(fmax(self.f[rs1], self.f[rs2])),
+            FmaddS => wf!(canon(fa!().mul_add(fb!(), fc!()))),
+            FmsubS => wf!(canon(fa!().mul_add(fb!(), -fc!()))),
+            FnmsubS => wf!(canon((-fa!()).mul_add(fb!(), fc!()))),
+            FnmaddS => wf!(canon((-fa!()).mul_add(fb!(), -fc!()))),
+            FaddS => wf!(canon(fa!() + fb!())),
+            FsubS => wf!(canon(fa!() - fb!())),
+            FmulS => wf!(canon(fa!() * fb!())),
+            FdivS => wf!(canon(fa!() / fb!())),
+            FsqrtS => wf!(canon(fa!().sqrt())),
+            FsgnjS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (self.f[rs2!()] & 0x8000_0000)),
+            FsgnjnS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (!self.f[rs2!()] & 0x8000_0000)),
+            FsgnjxS => wf!(self.f[rs1] ^ (self.f[rs2!()] & 0x8000_0000)),
+            FminS => wf!(fmin(self.f[rs1], self.f[rs2!()])),
+            FmaxS => wf!(fmax(self.f[rs1], self.f[rs2!()])),
             FcvtWS => wx!(fcvt_w_s(self.f[rs1], imm)),
             FcvtWuS => wx!(fcvt_wu_s(self.f[rs1], imm)),
             FmvXW => wx!(self.f[rs1]),
-            FeqS => wx!((fa == fb) as u32),
-            FltS => wx!((fa < fb) as u32),
-            FleS => wx!((fa <= fb) as u32),
+            FeqS => wx!((fa!() == fb!()) as u32),
+            FltS => wx!((fa!() < fb!()) as u32),
+            FleS => wx!((fa!() <= fb!()) as u32),
             FclassS => wx!(fclass(self.f[rs1])),
-            FcvtSW => wf!((a as i32 as f32).to_bits()),
-            FcvtSWu => wf!((a as f32).to_bits()),
-            FmvWX => wf!(a),
-            RtSetOrg => self.ray.ray.origin = Vec3::new(fa, fb, fc),
+            FcvtSW => wf!((a!() as i32 as f32).to_bits()),
+            FcvtSWu => wf!((a!() as f32).to_bits()),
+            FmvWX => wf!(a!()),
+            RtSetOrg => self.ray.ray.origin = Vec3::new(fa!(), fb!(), fc!()),
             RtSetInv => {
-                self.ray.inv_dir = Vec3::new(fa, fb, fc);
+                self.ray.inv_dir = Vec3::new(fa!(), fb!(), fc!());
                 self.ray.neg = [
-                    fa.is_sign_negative(),
-                    fb.is_sign_negative(),
-                    fc.is_sign_negative(),
+                    fa!().is_sign_negative(),
+                    fb!().is_sign_negative(),
+                    fc!().is_sign_negative(),
                 ];
             }
-            RtSetShear => self.ray.shear = Vec3::new(fa, fb, fc),
+            RtSetShear => self.ray.shear = Vec3::new(fa!(), fb!(), fc!()),
             RtSetK => {
-                let k = [a & 3, (a >> 2) & 3, (a >> 4) & 3];
-                if a >> 6 != 0 || k.contains(&3) {
-                    return Err(ExecError::BadAxes { pc, value: a });
+                let k = [a!() & 3, (a!() >> 2) & 3, (a!() >> 4) & 3];
+                if a!() >> 6 != 0 || k.contains(&3) {
+                    return Err(ExecError::BadAxes { pc, value: a!() });
                 }
                 self.ray.k = k.map(|v| v as usize);
             }
-            RtRcp => wf!(canon(1.0 / fa)),
+            RtRcp => wf!(canon(1.0 / fa!())),
             RtAtomInc => {
-                let old = mem.atominc(a).map_err(|f| self.fault(f, 0, a))?;
+                let old = mem.atominc(a!()).map_err(|f| self.fault(f, 0, a!()))?;
                 wx!(old);
             }
             RtBox => {
                 let mut w = [0u32; 6];
-                self.operand_words(prog, mem, a, &mut w, &mut acc)?;
-                wf!(self.box_test(&w, fb, fc).1);
+                self.operand_words(prog, mem, a!(), &mut w, &mut acc)?;
+                wf!(self.box_test(&w, fb!(), fc!()).1);
             }
             RtBoxN => {
                 let n = imm as usize;
                 let mut w = [0u32; 48];
-                self.operand_words(prog, mem, a, &mut w[..6 * n], &mut acc)?;
+                self.operand_words(prog, mem, a!(), &mut w[..6 * n], &mut acc)?;
                 let mut mask = 0;
                 for k in 0..n {
-                    let (hit, entry) = self.box_test(&w[6 * k..6 * k + 6], fb, fc);
+                    let (hit, entry) = self.box_test(&w[6 * k..6 * k + 6], fb!(), fc!());
                     mask |= (hit as u32) << k;
                     self.box_latch[k] = f32::from_bits(entry);
                 }
@@ -679,7 +724,7 @@ impl Hart {
             RtBoxGet => wf!(self.box_latch[imm as usize & 7].to_bits()),
             RtTri => {
                 let mut w = [0u32; 9];
-                self.operand_words(prog, mem, a, &mut w, &mut acc)?;
+                self.operand_words(prog, mem, a!(), &mut w, &mut acc)?;
                 let v = |k: usize| {
                     Vec3::new(
                         f32::from_bits(w[3 * k]),
@@ -690,22 +735,22 @@ impl Hart {
                 let tri = Triangle {
                     v: [v(0), v(1), v(2)],
                 };
-                wf!(match tri.intersect(&self.ray, fb, fc) {
+                wf!(match tri.intersect(&self.ray, fb!(), fc!()) {
                     Some(h) => h.t.to_bits(),
                     None => CANONICAL_NAN,
                 });
             }
             RtDst => {
                 let mut w = [0u32; 3];
-                self.operand_words(prog, mem, a, &mut w, &mut acc)?;
+                self.operand_words(prog, mem, a!(), &mut w, &mut acc)?;
                 let out = dst_step(&PipelineInput {
                     word: HeaderOffset::from_bits(w[0]),
                     p0: f32::from_bits(w[1]),
                     p1: f32::from_bits(w[2]),
                     origin: self.ray.ray.origin.to_array(),
                     inv_dir: self.ray.inv_dir.to_array(),
-                    t_min: fb,
-                    t_max: fc,
+                    t_min: fb!(),
+                    t_max: fc!(),
                 });
                 self.dst_latch = DstLatch {
                     t_min_out: out.t_min_out,
@@ -727,6 +772,7 @@ impl Hart {
         }
         self.x[0] = 0;
         self.pc = next;
+        let mut info = ins.info;
         if acc.local && matches!(info.fu, FuClass::Load | FuClass::Store) {
             info.fu = if acc.store {
                 FuClass::LocalStore

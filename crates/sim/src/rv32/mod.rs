@@ -24,7 +24,7 @@
 //! # fn params_bytes() -> Vec<u8> { vec![0; 156] }
 //! # let image = dualsplit_accel::MemoryImage::default();
 //! let prog = Program::from_elf(&std::fs::read("kernels/build/dst-cast.elf").unwrap()).unwrap();
-//! let params = params_bytes(); // struct Params of kernels/dualsplit.h, little-endian
+//! let params = params_bytes(); // kernels::Params::new(..).as_bytes() (kernels/dualsplit.h)
 //! let (w, h) = (64, 64);
 //! let (frame, stats) = run_frame(&prog, &image, &params, w * h * 12, 4096, u64::MAX).unwrap();
 //! let rgb: Vec<f32> = frame.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
@@ -63,7 +63,7 @@
 //!   (read-only), local store at `0xF000_0000` (read-write, per thread). Misaligned and
 //!   unmapped accesses are typed errors naming the pc and address.
 //!
-//! Decoding is hand-written ([`decode`]'s module doc says why); ELF parsing uses the
+//! Decoding is hand-written ([`mod@decode`]'s module doc says why); ELF parsing uses the
 //! `object` crate ([`elf`]).
 
 pub mod decode;

@@ -200,6 +200,11 @@ fn branches_and_jumps() {
     assert_eq!(h.x[1], BASE + 4);
     assert_eq!(h.x[5], BASE + 12);
     assert_eq!(h.x[3], 0);
+    // jalr with rd = rs1 jumps to the old value.
+    let h = run_with(&[i(0x67, 0, 6, 6, 8), addi(3, 0, 9), addi(3, 0, 9)], |h| {
+        h.x[6] = BASE + 4 // -> BASE + 12 (the ebreak)
+    });
+    assert_eq!((h.x[6], h.x[3]), (BASE + 4, 0));
     // Retired records a taken branch.
     let prog = Program::from_words(BASE, &[b(0, 0, 0, 8), EBREAK, EBREAK]);
     let image = MemoryImage::default();
@@ -243,6 +248,54 @@ fn loads_and_stores() {
     assert_eq!(h.x[15], 0x8000_FF80);
     assert_eq!(h.f[1], 0x1234_FF80);
     assert_eq!(h.x[16], 0x1234_FF80);
+}
+
+#[test]
+fn retired_records_local_accesses_csr_and_fence() {
+    let ls = LOCAL_STORE_ADDR;
+    let words = [
+        s(0x23, 2, 2, 1, -4),    // sw x1, -4(sp): local store
+        i(0x03, 2, 3, 2, -4),    // lw x3, -4(sp)
+        i(0x73, 5, 4, 0, 1),     // csrrwi x4, fflags, 0
+        i(0x73, 6, 5, 0, 2),     // csrrsi x5, frm, 0 (no write)
+        i(0x73, 3, 6, 7, 3),     // csrrc x6, fcsr, x7
+        i(0x0F, 0, 0, 0, 0x0FF), // fence
+        EBREAK,
+    ];
+    let prog = Program::from_words(BASE, &words);
+    let image = MemoryImage::default();
+    let mut mem = FrameMemory::new(&image, &[], 0);
+    let mut h = Hart::new(&prog, 64);
+    assert_eq!(h.x[2], ls + 64);
+    h.x[1] = 0xDEAD_BEEF;
+    h.x[4] = 1;
+    h.x[5] = 1;
+    h.x[6] = 1;
+    let r = h.step(&prog, &mut mem).unwrap();
+    assert_eq!(r.fu(), FuClass::LocalStore);
+    assert_eq!(
+        r.mem,
+        MemAccess {
+            addr: ls + 60,
+            words: 1,
+            store: true,
+            local: true
+        }
+    );
+    assert_eq!(r.info.src, [Reg::x(2), Reg::x(1), Reg::NONE]);
+    let r = h.step(&prog, &mut mem).unwrap();
+    assert_eq!(r.fu(), FuClass::LocalLoad);
+    assert_eq!(r.info.dst, Reg::x(3));
+    assert_eq!(h.x[3], 0xDEAD_BEEF);
+    for _ in 0..4 {
+        let r = h.step(&prog, &mut mem).unwrap();
+        assert_eq!(r.fu(), FuClass::IntAlu);
+        assert!(!r.mem.is_some() && !r.taken);
+    }
+    assert_eq!((h.x[4], h.x[5], h.x[6]), (0, 0, 0));
+    let r = h.step(&prog, &mut mem).unwrap();
+    assert!(r.is_halt() && h.halted);
+    assert_eq!(h.pc, BASE + 24);
 }
 
 #[test]
@@ -907,5 +960,69 @@ mod custom {
             run1(bx, &|h| h.x[6] = 0),
             Err(ExecError::Unmapped { pc, addr: 0 })
         );
+    }
+}
+
+/// Random words never make the decoder or the executor panic: every outcome is an
+/// instruction or a typed error.
+mod fuzz {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Random words, biased toward the opcodes we decode so that execution gets going.
+    fn word() -> impl Strategy<Value = u32> {
+        let opcodes = prop::sample::select(vec![
+            0x37u32, 0x17, 0x6F, 0x67, 0x63, 0x03, 0x23, 0x13, 0x33, 0x0F, 0x73, 0x07, 0x27, 0x43,
+            0x47, 0x4B, 0x4F, 0x53, 0x0B, 0x2B,
+        ]);
+        prop_oneof![
+            1 => any::<u32>(),
+            4 => (opcodes, any::<u32>()).prop_map(|(op, w)| (w & !0x7F) | op),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(3000))]
+        #[test]
+        fn random_programs_never_panic(
+            words in proptest::collection::vec(word(), 1..48),
+            regs in proptest::collection::vec(any::<u32>(), 64),
+        ) {
+            for &w in &words {
+                if let Ok(ins) = decode(w) {
+                    // Unused register fields are zeroed; x0 is never a source or destination.
+                    prop_assert!(ins.info.src.iter().all(|r| *r != Reg::x(0) || r.is_none()));
+                    prop_assert!(ins.rd < 32 && ins.rs1 < 32 && ins.rs2 < 32 && ins.rs3 < 32);
+                }
+            }
+            let tri = dualsplit_geometry::Triangle::default();
+            let mut image = MemoryImage::with_triangles(64, 0, vec![tri; 2].into());
+            for (k, w) in image.words.iter_mut().enumerate() {
+                *w = regs[k % 64];
+            }
+            let prog = Program::from_words(BASE, &words);
+            let mut mem = FrameMemory::new(&image, &[0; 16], 64);
+            let mut h = Hart::new(&prog, 256);
+            // Registers point into the regions half the time.
+            for k in 1..32 {
+                let r = regs[k];
+                h.x[k] = match r % 6 {
+                    0 => r % 256,
+                    1 => PARAMS_ADDR + r % 16,
+                    2 => FRAME_BUFFER_ADDR + r % 64,
+                    3 => LOCAL_STORE_ADDR + r % 256,
+                    4 => BASE + 4 * (r % words.len() as u32),
+                    _ => r,
+                };
+                h.f[k] = regs[32 + k];
+            }
+            for _ in 0..200 {
+                match h.step(&prog, &mut mem) {
+                    Ok(_) if h.halted => break,
+                    Ok(_) => {}
+                    Err(_) => break,
+                }
+            }
+        }
     }
 }
