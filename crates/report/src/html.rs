@@ -99,7 +99,7 @@ pub fn index_html(data: &ReportData) -> Result<String, ReportError> {
     let _ = writeln!(
         h,
         "<p class=\"meta\">Reproduces the results section of Lin, Vasiou, Yuksel, Kopta and Brunvand, HPG 2020 (§4, Tables 3–7, Figures 7–9). \
-Simulated at {}×{}, 1 spp, {} TMs for Tables 4–6, TM scaling over {:?}{}. Code version {}. Grey columns and faded bars are the paper's published values; \
+Simulated at {}×{}, 1 spp, {} TMs for Tables 4–6, TM scaling over {:?}{}; the threads {}. Code version {}. Grey columns and faded bars are the paper's published values; \
 scenes marked “stand-in” are not the paper's meshes, so compare trends rather than values.</p>",
         st.width,
         st.height,
@@ -109,6 +109,12 @@ scenes marked “stand-in” are not the paper's meshes, so compare trends rathe
             " (the paper's full setup)"
         } else {
             " (the quick default setup; `--full` runs the paper's)"
+        },
+        match st.thread_model {
+            dualsplit_sim::ThreadModel::Rv32 =>
+                "execute the compiled RV32IMF kernels instruction by instruction (thread model rv32)",
+            dualsplit_sim::ThreadModel::Fast =>
+                "replay hand-counted instruction costs (thread model fast, an uncalibrated approximation)",
         },
         esc(&data.code_version)
     );
