@@ -33,6 +33,8 @@ enum Command {
     Simulate(cmd::simulate::Args),
     /// Regenerate the paper's tables and figures.
     Report(cmd::report::Args),
+    /// Measure the fast thread model's per-event costs from the compiled kernels.
+    Calibrate(cmd::calibrate::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -46,6 +48,7 @@ fn main() -> std::process::ExitCode {
         Command::Bench(a) => cmd::bench::run(a, &ctx),
         Command::Simulate(a) => cmd::simulate::run(a, &ctx),
         Command::Report(a) => cmd::report::run(a, &ctx),
+        Command::Calibrate(a) => cmd::calibrate::run(a, &ctx),
     };
     match result {
         Ok(code) => code,

@@ -11,6 +11,7 @@
 
 use crate::Cycle;
 use crate::config::UnitConfig;
+use crate::rv32::FuClass;
 
 /// Cycles a pool remembers around the current time. Requests are made at most
 /// [`crate::tp::LOOKAHEAD`] cycles after the current event time and never before it, so
@@ -87,6 +88,27 @@ impl Pools {
             intmul: Pool::new(units.intmul_units, units.intmul_latency),
         }
     }
+}
+
+/// The result latency of an instruction of class `fu` on a functional unit (the TP's own
+/// ALU, FP adder and multiplier and local store, the TM's pools and its reciprocal unit);
+/// `None` for the memory, pipeline and atomic classes, whose answers the memory system and
+/// the pipelines time.
+pub fn unit_latency(fu: FuClass, cfg: &UnitConfig) -> Option<u64> {
+    use FuClass as F;
+    Some(match fu {
+        F::IntAlu | F::FpMove | F::Halt => cfg.int_latency,
+        F::FpAdd => cfg.fpadd_latency,
+        F::FpMul | F::FpFma => cfg.fpmul_latency,
+        F::LocalLoad | F::LocalStore => cfg.local_store_latency,
+        F::FpCmp => cfg.fpcmp_latency,
+        F::FpMinMax => cfg.fpminmax_latency,
+        F::FpConv => cfg.conv_latency,
+        F::Branch => cfg.branch_latency,
+        F::IntMul => cfg.intmul_latency,
+        F::IntDiv | F::FpDiv | F::FpSqrt | F::Rcp => cfg.fpinv_latency,
+        F::Load | F::Store | F::BoxPipe(_) | F::TriPipe | F::DstPipe | F::Atomic => return None,
+    })
 }
 
 #[cfg(test)]

@@ -36,6 +36,7 @@
 //! ```
 
 pub mod atomic;
+pub mod calibrate;
 pub mod chip;
 mod compiled;
 pub mod config;
@@ -56,7 +57,7 @@ mod workload;
 /// Version of the timing and energy model. Bump it whenever a change alters simulated results
 /// for the same inputs; the report's result cache includes it in every key, so stale cached
 /// frames are recomputed.
-pub const MODEL_VERSION: u32 = 5;
+pub const MODEL_VERSION: u32 = 6;
 
 pub use chip::{Chip, ChipStats, WorkSource, run_chip};
 pub use config::{CacheConfig, ConfigError, DramConfig, EnergyConfig, SimConfig, UnitConfig};
@@ -177,8 +178,9 @@ pub enum ThreadModel {
     /// thread processors with a register scoreboard (`tp.rs`): the reference model.
     #[default]
     Rv32,
-    /// The traversal replayed as macro-ops with per-step instruction counts (`kernel.rs`,
-    /// `thread.rs`): faster, an approximation of [`ThreadModel::Rv32`].
+    /// The traversal replayed as macro-ops with per-event costs measured from the compiled
+    /// kernels (`kernel.rs`, `calibrate.rs`, `thread.rs`): faster, an approximation of
+    /// [`ThreadModel::Rv32`].
     Fast,
 }
 
@@ -312,6 +314,9 @@ pub enum SimError {
     /// instruction).
     #[error("kernel: {0}")]
     Exec(#[from] rv32::ExecError),
+    /// The `fast` model's measured costs are missing or unreadable.
+    #[error("fast model: {0}")]
+    Calibration(#[from] calibrate::CalibrationError),
 }
 
 /// Simulates one frame of `settings` on `scene` with configuration `accel`, the threads

@@ -3,23 +3,14 @@
 //! 2020, §4.3–4.4). Ray paths do not depend on timing, so tracing them functionally and
 //! replaying the recorded ops is exact.
 
+use crate::calibrate::trace_ray;
 use crate::chip::{Chip, WorkSource, run_chip};
-use crate::kernel::{Mix, Op, Recorder, Run, Tally};
+use crate::kernel::{Event, Op, Recorder, Run, Tally};
 use crate::thread::Thread;
 use crate::{SimAccel, SimConfig, SimError, SimResult, ThreadModel};
 use dualsplit_accel::Structures;
-use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult};
+use dualsplit_render::{PixelJob, RenderSettings};
 use dualsplit_scene::Scene;
-
-/// After an any-hit (shadow) ray: branch on the answer, add the light's contribution.
-const SHADOW_FINISH: Mix = Mix {
-    int: 3,
-    fpadd: 1,
-    fpmul: 1,
-    fpcmp: 0,
-    fpinv: 0,
-    local: 0,
-};
 
 /// The pixel a thread is working on: its job (the renderer's path state) and the Issue op
 /// held back from its last ray's program.
@@ -30,6 +21,8 @@ struct Active<'a> {
     /// recorder merges the next ray's set-up into it, exactly as when the whole pixel is
     /// recorded into one program.
     carry: Option<Run>,
+    /// Its pixel event is not charged yet (it is, with the first ray's instructions).
+    first: bool,
 }
 
 /// What tracing a ray needs and gathers: the structures and configuration, the rays and
@@ -62,22 +55,13 @@ impl<'a> Tracer<'a> {
         let Some(q) = a.job.next_ray() else {
             return false;
         };
-        let kind = self.accel.kind();
         let mut rec = Recorder::resume(&mut self.tally, ops, a.carry.take());
+        if a.first {
+            rec.event(Event::Pixel);
+            a.first = false;
+        }
         self.rays += 1;
-        rec.issue(crate::kernel::RAY_SETUP);
-        let result = match q.kind {
-            RayKind::Shadow => {
-                let occ = self.structures.any_hit(kind, &q.ray, &mut rec);
-                rec.issue(SHADOW_FINISH);
-                TraceResult::Occluded(occ)
-            }
-            RayKind::Primary | RayKind::Diffuse => {
-                let hit = self.structures.closest_hit(kind, &q.ray, &mut rec);
-                rec.issue(crate::kernel::RAY_FINISH);
-                TraceResult::Closest(hit)
-            }
-        };
+        let result = trace_ray(self.structures, self.accel, q.kind, &q.ray, &mut rec);
         // The ray's last instructions stay open for the next ray of the pixel.
         a.carry = rec.finish_open();
         a.job.submit(result);
@@ -104,9 +88,9 @@ impl WorkSource for Pixels<'_> {
             self.radiance[a.px as usize] = a.job.radiance();
             let carry = a.carry;
             self.active[id] = None;
-            if let Some(run) = carry {
+            if let Some(op) = carry.and_then(Run::op) {
                 // The pixel's last instructions.
-                ops.push(run.op());
+                ops.push(op);
                 return Some(ops);
             }
         }
@@ -123,6 +107,7 @@ impl WorkSource for Pixels<'_> {
             px,
             job: PixelJob::new(self.scene, self.settings, x, y),
             carry: None,
+            first: true,
         });
         if !self.tracer.trace_ray(a, &mut ops) {
             self.radiance[px as usize] = a.job.radiance();
@@ -160,19 +145,22 @@ pub(crate) fn run(
             structures,
             accel,
             rays: 0,
-            tally: Tally::new(accel),
+            tally: Tally::new(accel, crate::calibrate::costs(accel, settings.workload)?),
         },
     };
     let cycles = run_chip(&mut chip, &mut threads, &mut work);
     if let Some(e) = work.tracer.tally.error() {
         return Err(e.into());
     }
+    // The measured dependency stalls are part of the issue runs the threads replayed.
+    let mut stats = chip.stats();
+    stats.stalls.dependency += work.tracer.tally.dependency_cycles();
     Ok(SimResult::assemble(
         accel,
         ThreadModel::Fast,
         cfg,
         cycles,
-        chip.stats(),
+        stats,
         work.tracer.tally.counts(),
         work.tracer.rays,
         total,

@@ -4,7 +4,6 @@ use dualsplit_accel::{DstNodeKind, NoObserver, NodeStep, Observer, Structures};
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::Scene;
-use dualsplit_sim::kernel::{dst_hw_step, dst_sw_step};
 use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel, simulate, simulate_model};
 
 fn config(name: &str) -> String {
@@ -235,12 +234,6 @@ fn dst_and_dst_sw_pixels_equal_the_renderers_and_use_their_units() {
         assert_eq!(sw_rv32.radiance, sw.radiance);
         assert_eq!(hw.instructions.node_steps, counter.nodes);
         assert_eq!(sw.instructions.node_steps, counter.nodes);
-        // DST* pays the decoder per node kind and outcome where DST pays the pipeline op's
-        // return-code dispatch (pushes, pops and leaves cost both the same).
-        assert_eq!(
-            sw.instructions.mix.total() + counter.hw_decode,
-            hw.instructions.mix.total() + counter.sw_decode
-        );
         assert_eq!(hw.units.box_ops, 0);
         assert_eq!(sw.units.dst_ops, 0);
         assert_eq!(sw.units.box_ops, 0);
@@ -254,41 +247,43 @@ fn dst_and_dst_sw_pixels_equal_the_renderers_and_use_their_units() {
     }
 }
 
-/// Counts DST node steps and the software decoder's instructions for them.
+/// Counts DST node steps.
 #[derive(Debug, Default)]
 struct DstSteps {
     steps: u64,
     nodes: u64,
-    sw_decode: u64,
-    hw_decode: u64,
 }
 
 impl Observer for DstSteps {
     fn step(&mut self, step: NodeStep) {
-        if let NodeStep::Dst { kind, code, .. } = step {
+        if let NodeStep::Dst { kind, .. } = step {
             self.steps += 1;
             self.nodes += u64::from(kind != DstNodeKind::Leaf);
-            self.sw_decode += dst_sw_step(kind, code).total();
-            self.hw_decode += dst_hw_step(code).total();
         }
     }
 }
 
 #[test]
-fn parallel_box_pipelines_are_not_slower() {
+fn parallel_box_pipelines_issue_once_per_node() {
     let (scene, s) = scene();
     let cfg = tiny();
-    let serial = run(&scene, &s, SimAccel::Bvh4, Workload::Cast, &cfg);
-    let plus = run(&scene, &s, SimAccel::Bvh4Plus, Workload::Cast, &cfg);
-    // Same rays, same memory stream: only the box issue changes.
-    assert_eq!(serial.instructions.box_ops, plus.instructions.box_ops);
-    assert!(plus.instructions.box_issues <= serial.instructions.box_issues);
-    assert!(
-        plus.cycles <= serial.cycles,
-        "{} > {}",
-        plus.cycles,
-        serial.cycles
-    );
+    for model in ThreadModel::ALL {
+        let serial = run_model(model, &scene, &s, SimAccel::Bvh4, Workload::Cast, &cfg);
+        let plus = run_model(model, &scene, &s, SimAccel::Bvh4Plus, Workload::Cast, &cfg);
+        // Same rays; the "+" kernel issues one box instruction per node. (Frame times are
+        // not compared: the two kernels differ in their other instructions too, and the
+        // `fast` model charges each its own measured costs. The compiled "+" kernel tests
+        // a node's empty child slots too, so only the `fast` model's box ops are equal.)
+        if model == ThreadModel::Fast {
+            assert_eq!(serial.units.box_ops, plus.units.box_ops);
+        }
+        assert!(
+            plus.instructions.box_issues * 2 <= serial.instructions.box_issues,
+            "{model:?}: {} vs {}",
+            plus.instructions.box_issues,
+            serial.instructions.box_issues
+        );
+    }
 }
 
 #[test]

@@ -1,0 +1,101 @@
+//! The `fast` thread model's calibration: the committed costs are what the compiled kernels
+//! measure, and the `fast` model built on them is compared with the instruction-level model
+//! on scenes the calibration never saw.
+
+use dualsplit_accel::Structures;
+use dualsplit_render::{RenderSettings, Workload};
+use dualsplit_sim::calibrate::{CALIBRATION_TOML, FRAMES, calibrate, to_toml};
+use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel, simulate_model};
+
+#[test]
+fn committed_calibration_is_what_the_kernels_measure() {
+    let loaded: Vec<_> = FRAMES
+        .iter()
+        .map(|&(spec, w, h)| {
+            let scene = dualsplit_scene::load(spec).unwrap();
+            let s = Structures::build(&scene.triangles, &Default::default());
+            (spec, scene, s, w, h)
+        })
+        .collect();
+    let frames: Vec<_> = loaded
+        .iter()
+        .map(|(spec, scene, s, w, h)| (*spec, scene, s, *w, *h))
+        .collect();
+    let cal = calibrate(
+        &frames,
+        &SimConfig::lin2020().units,
+        "lin2020",
+        &mut |_, _| {},
+    )
+    .unwrap();
+    // Every table reproduces its frames' totals per class within 2 % (the pixel and ray
+    // events act as an intercept unless the non-negative fit drops one), and fits its
+    // segments.
+    for t in &cal.tables {
+        for (k, e) in t.total_error.iter().enumerate() {
+            assert!(
+                e.abs() < 0.02,
+                "{:?} {}: quantity {k} off by {e}",
+                t.accel,
+                t.workload
+            );
+        }
+        assert!(
+            t.r2[0] > 0.9,
+            "{:?} {}: int R² {}",
+            t.accel,
+            t.workload,
+            t.r2[0]
+        );
+    }
+    assert!(
+        to_toml(&cal).unwrap() == CALIBRATION_TOML,
+        "crates/sim/calibration.toml is stale: run `dualsplit calibrate -o crates/sim/calibration.toml`"
+    );
+}
+
+fn run(model: ThreadModel, spec: &str, accel: SimAccel, wl: Workload) -> SimResult {
+    let scene = dualsplit_scene::load(spec).unwrap();
+    let s = Structures::build(&scene.triangles, &Default::default());
+    let mut cfg = SimConfig::lin2020();
+    // 256 threads for 4096 pixels: the chip stays busy to the end of the frame.
+    cfg.tms = 8;
+    let settings = RenderSettings::new(64, 64, wl);
+    simulate_model(model, &scene, &s, accel, &settings, &cfg, &|_, _| {}).unwrap()
+}
+
+/// The `fast` model against the compiled kernels on scenes outside the calibration set:
+/// its issued instructions (all classes) within 10 %. This is
+/// weaker than the bound the model is meant to meet (frame time, energy and DRAM lines
+/// within 10 %), which it does not yet: the ratios are printed, and `docs/simulator.md`
+/// ("The `fast` thread model") gives the measured errors and their causes.
+#[test]
+fn fast_model_issues_the_kernels_instructions() {
+    let mut failures = Vec::new();
+    for spec in [
+        "builtin:atrium?triangles=20000",
+        "builtin:hairball?triangles=30000",
+    ] {
+        for wl in [Workload::Cast, Workload::Path] {
+            for accel in SimAccel::ALL {
+                let rv32 = run(ThreadModel::Rv32, spec, accel, wl);
+                let fast = run(ThreadModel::Fast, spec, accel, wl);
+                let ratio = |f: u64, r: u64| f as f64 / r.max(1) as f64;
+                let instr = ratio(fast.instructions.mix.total(), rv32.instructions.mix.total());
+                let dep = ratio(fast.stalls.dependency, rv32.stalls.dependency);
+                if (instr - 1.0).abs() > 0.10 {
+                    failures.push(format!("{spec} {wl:?} {accel:?}: instructions {instr:.3}"));
+                }
+                eprintln!(
+                    "{spec} {wl:?} {:9}: fast/rv32 instructions {instr:.3}, dependency {dep:.3}, \
+                     frame time {:.3}, energy {:.3}, DRAM lines {:.3}",
+                    accel.name(),
+                    ratio(fast.cycles, rv32.cycles),
+                    fast.energy.total() / rv32.energy.total(),
+                    ratio(fast.dram_lines, rv32.dram_lines),
+                );
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
