@@ -4,6 +4,7 @@
 //!
 //! ```text
 //!  Bvh2 ──from_bvh2.rs──▶ per BVH node: carving chain (SAH, DP over faces) + split order
+//!                 │        (reference.rs: the same decisions as plain loops, for tests)
 //!                 │
 //!                 └─encode.rs──▶ MemoryImage: node words | index runs | triangles
 //!                                 │
@@ -38,6 +39,7 @@ mod encode;
 mod from_bvh2;
 mod header;
 pub mod pipeline;
+mod reference;
 mod stats;
 mod traverse;
 mod validate;
