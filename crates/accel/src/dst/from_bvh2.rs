@@ -478,96 +478,15 @@ impl ChainDp {
                 dp.k += 1;
             }
         }
-        // Chains of at most two faces (three quarters of dragon_box's), and of three with
-        // cheap pairs, are solved in closed form; the others by the DP, compiled once per
-        // chain length.
-        let c_lone = costs.single_carve.min(costs.dual_carve);
-        let pairs_cheap = costs.single_carve <= c_lone && costs.dual_carve <= c_lone;
+        // Compiled once per chain length: the loops over the 2^k states unroll.
         match dp.k {
-            0 => dp.fill_closed::<0>(region, target, costs, leaf_tris),
-            1 => dp.fill_closed::<1>(region, target, costs, leaf_tris),
-            2 => dp.fill_closed::<2>(region, target, costs, leaf_tris),
-            3 if pairs_cheap => dp.fill_closed::<3>(region, target, costs, leaf_tris),
+            0 => dp.fill::<0>(region, target, costs, leaf_tris),
+            1 => dp.fill::<1>(region, target, costs, leaf_tris),
+            2 => dp.fill::<2>(region, target, costs, leaf_tris),
             3 => dp.fill::<3>(region, target, costs, leaf_tris),
             4 => dp.fill::<4>(region, target, costs, leaf_tris),
             5 => dp.fill::<5>(region, target, costs, leaf_tris),
             _ => dp.fill::<6>(region, target, costs, leaf_tris),
-        }
-    }
-
-    /// [`ChainDp::solve`] in closed form for `K` ≤ 2 faces, and for `K` = 3 when every pair
-    /// node is no dearer than a lone-face node (the hardware preset): the DP of
-    /// [`ChainDp::fill`] written out state by state, with the same float expressions, the
-    /// same options in the same order and the same strict `<`, so it decides exactly what
-    /// the DP decides (ties included; `tests/dst_convert_reference.rs`).
-    #[inline(always)]
-    fn fill_closed<const K: usize>(
-        &mut self,
-        region: &Aabb,
-        target: &Aabb,
-        costs: &DstCosts,
-        leaf_tris: Option<u32>,
-    ) {
-        let full = (1usize << K) - 1;
-        let c_lone = costs.single_carve.min(costs.dual_carve);
-        let mut sa = [0f32; 8];
-        state_areas::<K>(&self.faces, region, target, leaf_tris.is_some(), &mut sa);
-        let tri_weight = leaf_tris.map(|n| costs.triangle * n as f32);
-        self.base = leaf_tris.map_or(0.0, |n| costs.triangle * n as f32 * sa[full]);
-        let base = self.base;
-        // The cheapest option of a state among `options` (mask, cost), the first on ties;
-        // with similar partitioning the chain may also stop (choice 0).
-        let best = |sa_s: f32, options: &[(u8, f32)]| {
-            let mut b = (tri_weight.map_or(f32::INFINITY, |w| w * sa_s - base), 0u8);
-            for &(t, c) in options {
-                if c < b.0 {
-                    b = (c, t);
-                }
-            }
-            b
-        };
-        // The cost of a pair node carving faces i and j.
-        let w_pair = |i: usize, j: usize| {
-            if self.faces[i] >> 1 == self.faces[j] >> 1 {
-                costs.single_carve
-            } else {
-                costs.dual_carve
-            }
-        };
-        self.cost[full] = 0.0;
-        match K {
-            0 => {}
-            1 => {
-                (self.cost[0], self.choice[0]) = best(sa[0], &[(1, c_lone * sa[0] + 0.0)]);
-            }
-            2 => {
-                for (s, rem) in [(2, 1), (1, 2)] {
-                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, c_lone * sa[s] + 0.0)]);
-                }
-                let w = w_pair(0, 1);
-                let pair = (3, w * sa[0] + 0.0);
-                (self.cost[0], self.choice[0]) = if w <= c_lone {
-                    // Carving a face alone is dominated while its partner remains.
-                    best(sa[0], &[pair])
-                } else {
-                    let lone = |t: u8| (t, c_lone * sa[0] + self.cost[t as usize]);
-                    best(sa[0], &[lone(1), pair, lone(2)])
-                };
-            }
-            _ => {
-                // Every pair is cheap ([`OPTIONS_PAIRS_CHEAP`]): a last face is carved alone,
-                // two remaining faces as a pair, and from three the three pairs are tried.
-                for (s, rem) in [(6, 1), (5, 2), (3, 4)] {
-                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, c_lone * sa[s] + 0.0)]);
-                }
-                let w = [w_pair(0, 1), w_pair(0, 2), w_pair(1, 2)];
-                for (s, rem, w) in [(4, 3, w[0]), (2, 5, w[1]), (1, 6, w[2])] {
-                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, w * sa[s] + 0.0)]);
-                }
-                let pair = |t: u8, w: f32| (t, w * sa[0] + self.cost[t as usize]);
-                (self.cost[0], self.choice[0]) =
-                    best(sa[0], &[pair(3, w[0]), pair(5, w[1]), pair(6, w[2])]);
-            }
         }
     }
 

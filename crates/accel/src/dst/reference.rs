@@ -1,5 +1,5 @@
 //! The reference converter: the SAH decisions of [`super::from_bvh2`] written as plain nested
-//! loops, with no tables, closed forms or reused arrays (Lin et al. 2020, §4.2;
+//! loops, with no tables, specialisations or reused arrays (Lin et al. 2020, §4.2;
 //! `docs/dst-encoding.md`, §3). [`Dst::from_bvh2_reference`] emits its decisions through the
 //! same encoder as [`Dst::from_bvh2`], so the two images are equal byte for byte exactly when
 //! every decision is (`tests/dst_convert_reference.rs`).
