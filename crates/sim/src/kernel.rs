@@ -9,7 +9,8 @@
 
 use crate::SimAccel;
 use dualsplit_accel::dst::pipeline::ReturnCode;
-use dualsplit_accel::{DstNodeKind, NodeStep, Observer};
+use dualsplit_accel::{ByteAddr, DstNodeKind, NodeStep, Observer};
+use dualsplit_geometry::PrimId;
 use serde::{Deserialize, Serialize};
 
 /// Instruction mix of one kernel step, by functional-unit class (energy and issue slots);
@@ -737,7 +738,7 @@ impl<'a> Recorder<'a> {
 
 impl Observer for Recorder<'_> {
     #[inline(always)]
-    fn fetch(&mut self, addr: u64, bytes: u32) {
+    fn fetch(&mut self, ByteAddr(addr): ByteAddr, bytes: u32) {
         // Words from the one holding byte `addr` to the one holding byte `addr + bytes − 1`.
         let words = ((addr & 3) + bytes as u64).div_ceil(4);
         if words == 0 {
@@ -782,7 +783,7 @@ impl Observer for Recorder<'_> {
     }
 
     #[inline(always)]
-    fn triangle_test(&mut self, _prim: u32, hit: bool) {
+    fn triangle_test(&mut self, _prim: PrimId, hit: bool) {
         self.pipe(Pipe::Triangle, 1, false);
         self.tally.steps.tri_test += 1;
         self.extend_run(TRI_TEST.total());
@@ -861,7 +862,7 @@ mod tests {
     }
 
     impl Observer for Reference<'_> {
-        fn fetch(&mut self, addr: u64, bytes: u32) {
+        fn fetch(&mut self, ByteAddr(addr): ByteAddr, bytes: u32) {
             let first = addr & !3;
             let words = ((addr + bytes as u64).div_ceil(4) * 4 - first) / 4;
             if words == 0 {
@@ -909,7 +910,7 @@ mod tests {
                 NodeStep::Leaf { .. } => self.issue(LEAF),
             }
         }
-        fn triangle_test(&mut self, _prim: u32, hit: bool) {
+        fn triangle_test(&mut self, _prim: PrimId, hit: bool) {
             self.pipe(Pipe::Triangle, 1, false);
             self.issue(TRI_TEST);
             if hit {
@@ -931,7 +932,7 @@ mod tests {
         issue: &mut impl FnMut(&mut O, Mix),
     ) {
         match rng.below(9) {
-            0 => obs.fetch(rng.below(1 << 20) as u64, rng.below(220)),
+            0 => obs.fetch(ByteAddr(rng.below(1 << 20) as u64), rng.below(220)),
             1 => {
                 let arity = [2u8, 4, 8][rng.below(3) as usize];
                 let valid = rng.below(arity as u32 + 1) as u8;
@@ -946,7 +947,7 @@ mod tests {
             3 => obs.step(NodeStep::Leaf {
                 count: rng.below(8),
             }),
-            4 => obs.triangle_test(rng.below(1000), rng.below(2) == 1),
+            4 => obs.triangle_test(PrimId(rng.below(1000)), rng.below(2) == 1),
             5 => obs.push(),
             6 => obs.pop(),
             7 => issue(obs, RAY_SETUP),
@@ -1016,8 +1017,8 @@ mod tests {
         let mut ops = Vec::new();
         let mut tally = Tally::new(SimAccel::Bvh2);
         let mut r = Recorder::new(&mut tally, &mut ops);
-        r.fetch(52, 52);
-        r.fetch(6, 4); // straddles two words
+        r.fetch(ByteAddr(52), 52);
+        r.fetch(ByteAddr(6), 4); // straddles two words
         assert_eq!(r.tally().counts().loads, 15);
         assert_eq!(
             ops,
@@ -1054,10 +1055,10 @@ mod tests {
         let mut ops = Vec::new();
         let mut tally = Tally::new(SimAccel::Bvh2);
         let mut r = Recorder::new(&mut tally, &mut ops);
-        r.fetch(8, 4);
+        r.fetch(ByteAddr(8), 4);
         assert_eq!(r.tally().error(), None);
-        r.fetch(top + 8, 4);
-        r.fetch(0, 4 * 70_000);
+        r.fetch(ByteAddr(top + 8), 4);
+        r.fetch(ByteAddr(0), 4 * 70_000);
         assert_eq!(
             r.tally().error(),
             Some(OpRangeError::Address { addr: top + 8 })
@@ -1114,7 +1115,7 @@ mod tests {
                 let run = r.finish_open();
                 assert_eq!(run.map(|r| r.n), Some(u32::MAX));
             } else {
-                r.fetch(0, 4);
+                r.fetch(ByteAddr(0), 4);
                 assert_eq!(
                     ops[0],
                     Op::Issue {
