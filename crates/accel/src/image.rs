@@ -44,7 +44,7 @@
 mod words;
 
 use crate::observer::Observer;
-use dualsplit_geometry::{Aabb, Triangle, Vec3};
+use dualsplit_geometry::{Aabb, PrimId, Triangle, Vec3};
 use std::ops::Range;
 use std::sync::Arc;
 pub use words::{MAPPED_MIN_BYTES, Words};
@@ -107,8 +107,8 @@ impl MemoryImage {
 
     /// Byte address of word `i`.
     #[inline(always)]
-    pub fn addr(word: usize) -> u64 {
-        word as u64 * 4
+    pub fn addr(word: usize) -> ByteAddr {
+        ByteAddr(word as u64 * 4)
     }
     /// Bytes of the node region.
     pub fn node_bytes(&self) -> u64 {
@@ -138,12 +138,17 @@ impl MemoryImage {
     }
     /// Triangle `prim`, read from the image, reporting the 36-byte fetch to `obs`.
     #[inline(always)]
-    pub fn fetch_triangle<O: Observer>(&self, prim: u32, obs: &mut O) -> Triangle {
-        let w = self.triangles.start + 9 * prim as usize;
+    pub fn fetch_triangle<O: Observer>(&self, prim: PrimId, obs: &mut O) -> Triangle {
+        let w = self.triangles.start + 9 * prim.index();
         obs.fetch(Self::addr(w), 36);
-        self.triangle_slice()[prim as usize]
+        self.triangle_slice()[prim.index()]
     }
 }
+
+/// A byte address in a memory image (word `i` is at byte `4 i`): what a traversal reports
+/// to its [`Observer`] for every read, and where the simulator's loads go.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct ByteAddr(pub u64);
 
 /// Errors while encoding a memory image.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

@@ -20,7 +20,7 @@ pub mod validate;
 pub mod wide;
 
 pub use build::{BuildConfig, Bvh2, Bvh2Node};
-pub use image::{ImageError, MemoryImage, SharedTriangles};
+pub use image::{ByteAddr, ImageError, MemoryImage, SharedTriangles};
 pub use observer::{CountingObserver, DstNodeKind, NoObserver, NodeStep, Observer};
 pub use stats::StructureStats;
 pub use validate::ValidationReport;

@@ -3,6 +3,8 @@
 //! statistics use [`CountingObserver`]; the simulator records macro-operations.
 
 use crate::dst::pipeline::ReturnCode;
+use crate::image::ByteAddr;
+use dualsplit_geometry::PrimId;
 
 /// The kind of a dual-split tree node (the pipeline's derived 2-bit "node type").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -52,13 +54,13 @@ pub trait Observer {
     /// The kernel reads `bytes` contiguous bytes at byte address `addr` of the structure's
     /// memory image (node words, triangle-index entries, triangle vertices).
     #[inline(always)]
-    fn fetch(&mut self, _addr: u64, _bytes: u32) {}
+    fn fetch(&mut self, _addr: ByteAddr, _bytes: u32) {}
     /// A node step.
     #[inline(always)]
     fn step(&mut self, _step: NodeStep) {}
     /// A ray–triangle test of triangle `prim`; `hit` when it was accepted.
     #[inline(always)]
-    fn triangle_test(&mut self, _prim: u32, _hit: bool) {}
+    fn triangle_test(&mut self, _prim: PrimId, _hit: bool) {}
     /// A traversal-stack push.
     #[inline(always)]
     fn push(&mut self) {}
@@ -95,7 +97,7 @@ pub struct CountingObserver {
 
 impl Observer for CountingObserver {
     #[inline]
-    fn fetch(&mut self, _addr: u64, bytes: u32) {
+    fn fetch(&mut self, _addr: ByteAddr, bytes: u32) {
         self.bytes += bytes as u64;
     }
     #[inline]
@@ -116,7 +118,7 @@ impl Observer for CountingObserver {
         }
     }
     #[inline]
-    fn triangle_test(&mut self, _prim: u32, _hit: bool) {
+    fn triangle_test(&mut self, _prim: PrimId, _hit: bool) {
         self.triangle_tests += 1;
     }
     #[inline]

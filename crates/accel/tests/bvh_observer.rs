@@ -1,14 +1,16 @@
 //! The observer sees exactly what the kernel reads and does (contract 2): exact event
 //! sequences on a tiny scene, and fetch addresses inside the image regions on a larger one.
 
-use dualsplit_accel::{AccelKind, BuildConfig, MemoryImage, NodeStep, Observer, Structures};
-use dualsplit_geometry::{Pcg32, Ray, Triangle, Vec3};
+use dualsplit_accel::{
+    AccelKind, BuildConfig, ByteAddr, MemoryImage, NodeStep, Observer, Structures,
+};
+use dualsplit_geometry::{Pcg32, PrimId, Ray, Triangle, Vec3};
 
 #[derive(Debug, PartialEq, Clone)]
 enum Ev {
-    Fetch(u64, u32),
+    Fetch(ByteAddr, u32),
     Step(NodeStep),
-    Tri(u32, bool),
+    Tri(PrimId, bool),
     Push,
     Pop,
 }
@@ -17,13 +19,13 @@ enum Ev {
 struct Rec(Vec<Ev>);
 
 impl Observer for Rec {
-    fn fetch(&mut self, addr: u64, bytes: u32) {
+    fn fetch(&mut self, addr: ByteAddr, bytes: u32) {
         self.0.push(Ev::Fetch(addr, bytes));
     }
     fn step(&mut self, s: NodeStep) {
         self.0.push(Ev::Step(s));
     }
-    fn triangle_test(&mut self, prim: u32, hit: bool) {
+    fn triangle_test(&mut self, prim: PrimId, hit: bool) {
         self.0.push(Ev::Tri(prim, hit));
     }
     fn push(&mut self) {
@@ -57,11 +59,11 @@ fn single_triangle_event_sequence() {
         assert_eq!(img.words[img.indices.start], 1 << 31);
         let mut rec = Rec::default();
         let hit = s.closest_hit(kind, &ray, &mut rec).unwrap();
-        assert_eq!((hit.t, hit.prim), (2.0, 0));
+        assert_eq!((hit.t, hit.prim), (2.0, PrimId(0)));
         assert_eq!(
             rec.0,
             vec![
-                Ev::Fetch(0, node_bytes),
+                Ev::Fetch(ByteAddr(0), node_bytes),
                 Ev::Step(NodeStep::Bvh {
                     arity,
                     valid: 1,
@@ -71,7 +73,7 @@ fn single_triangle_event_sequence() {
                 Ev::Fetch(MemoryImage::addr(img.indices.start), 4),
                 Ev::Step(NodeStep::Leaf { count: 1 }),
                 Ev::Fetch(MemoryImage::addr(img.triangles.start), 36),
-                Ev::Tri(0, true),
+                Ev::Tri(PrimId(0), true),
             ],
             "{kind:?}"
         );
@@ -101,7 +103,7 @@ fn fetches_stay_inside_regions_and_match_node_sizes() {
             let (mut pushes, mut pops) = (0, 0);
             for e in &rec.0 {
                 match *e {
-                    Ev::Fetch(a, b) => {
+                    Ev::Fetch(ByteAddr(a), b) => {
                         let w = (a / 4) as usize;
                         let end = w + (b / 4) as usize;
                         let inside = |r: &std::ops::Range<usize>| r.start <= w && end <= r.end;

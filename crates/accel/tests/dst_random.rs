@@ -4,7 +4,7 @@
 
 use dualsplit_accel::BuildConfig;
 use dualsplit_accel::dst::DstConfig;
-use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3};
+use dualsplit_geometry::{Aabb, Pcg32, PrimId, Triangle, Vec3};
 use dualsplit_testkit::dst::{build, build_with, check_all, check_dst_ray, dst_presets};
 use dualsplit_testkit::grazing::{GRAZING_CASES, grazing_case};
 use dualsplit_testkit::oracle::oracle_closest;
@@ -169,7 +169,7 @@ fn regression_ray_at_corner_vertex() {
         let oracle = oracle_closest(&tris, &ray);
         assert_eq!(
             oracle.map(|h| h.prim),
-            Some(0),
+            Some(PrimId(0)),
             "case {i}: premise, oracle hits the target"
         );
         let bcfg = BuildConfig {

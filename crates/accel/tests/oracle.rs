@@ -13,7 +13,7 @@
 
 use dualsplit_accel::dst::{DstConfig, DstError};
 use dualsplit_accel::{AccelError, AccelKind, BuildConfig, Structures};
-use dualsplit_geometry::{Ray, Triangle, Vec3};
+use dualsplit_geometry::{PrimId, Ray, Triangle, Vec3};
 use dualsplit_testkit::dst::dst_presets;
 use dualsplit_testkit::oracle::{check_ray, key, oracle_closest};
 use dualsplit_testkit::scenes::cuboid;
@@ -259,7 +259,7 @@ fn edge_cases_on_every_structure() {
                 Expect::Miss => assert_eq!(key(oracle), None, "{} ray {i}", case.name),
                 Expect::Hit { t, prim } => assert_eq!(
                     key(oracle),
-                    Some((t.to_bits(), prim)),
+                    Some((t.to_bits(), PrimId(prim))),
                     "{} ray {i}: oracle {oracle:?}",
                     case.name
                 ),

@@ -1,3 +1,22 @@
+/// A triangle id: the triangle's index in the scene's triangle array, which every
+/// structure's leaves and the hit it returns name it by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct PrimId(pub u32);
+
+impl PrimId {
+    /// The id as an index into the triangle array.
+    #[inline(always)]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+impl std::fmt::Display for PrimId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
 /// A closest-hit result: the ray parameter and the triangle id (index into the scene's
 /// triangle array), plus the barycentric coordinates of the hit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -5,7 +24,7 @@ pub struct Hit {
     /// Ray parameter of the hit point.
     pub t: f32,
     /// Triangle id.
-    pub prim: u32,
+    pub prim: PrimId,
     /// Barycentric u (weight of vertex 1).
     pub u: f32,
     /// Barycentric v (weight of vertex 2).
@@ -17,7 +36,7 @@ impl Hit {
     /// to the smaller triangle id. Using it everywhere makes results independent of the
     /// order in which a structure visits its leaves.
     #[inline]
-    pub fn closer_than(&self, t: f32, prim: u32) -> bool {
+    pub fn closer_than(&self, t: f32, prim: PrimId) -> bool {
         self.t < t || (self.t == t && self.prim < prim)
     }
 }

@@ -38,7 +38,7 @@ mod triangle;
 
 pub use aabb::Aabb;
 pub use glam::Vec3;
-pub use hit::{Hit, cull_limit};
+pub use hit::{Hit, PrimId, cull_limit};
 pub use ray::{EXIT_WIDEN, Ray, RayPre, gamma, widen_exit};
 pub use rng::{Pcg32, hash_u32s};
 pub use triangle::{Triangle, TriangleHit};

@@ -401,7 +401,7 @@ impl<'a> PixelJob<'a> {
     }
 
     fn on_hit(&mut self, ray: &Ray, hit: &Hit, depth: u32) {
-        let tri = &self.scene.triangles[hit.prim as usize];
+        let tri = &self.scene.triangles[hit.prim.index()];
         let mut n = tri.normal().normalize_or_zero();
         if n == Vec3::ZERO {
             // A sliver whose normal underflows: shade it as if it faced the ray.

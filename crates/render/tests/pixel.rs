@@ -169,7 +169,7 @@ fn cast_shading_follows_the_lambert_point_light_formula() {
         .unwrap();
     job.submit(TraceResult::Closest(Some(dualsplit_geometry::Hit {
         t: hit.t,
-        prim: 0,
+        prim: dualsplit_geometry::PrimId(0),
         u: hit.u,
         v: hit.v,
     })));

@@ -13,7 +13,8 @@
 use crate::SimAccel;
 use crate::calibrate::Costs;
 use dualsplit_accel::dst::pipeline::ReturnCode;
-use dualsplit_accel::{DstNodeKind, NodeStep, Observer};
+use dualsplit_accel::{ByteAddr, DstNodeKind, NodeStep, Observer};
+use dualsplit_geometry::PrimId;
 use serde::{Deserialize, Serialize};
 
 /// Instruction mix by functional-unit class (energy and issue slots), as frame totals in
@@ -607,7 +608,7 @@ impl<'a> Recorder<'a> {
 
 impl Observer for Recorder<'_> {
     #[inline(always)]
-    fn fetch(&mut self, addr: u64, bytes: u32) {
+    fn fetch(&mut self, ByteAddr(addr): ByteAddr, bytes: u32) {
         // Words from the one holding byte `addr` to the one holding byte `addr + bytes − 1`.
         let words = ((addr & 3) + bytes as u64).div_ceil(4);
         if words == 0 {
@@ -653,7 +654,7 @@ impl Observer for Recorder<'_> {
     }
 
     #[inline(always)]
-    fn triangle_test(&mut self, _prim: u32, hit: bool) {
+    fn triangle_test(&mut self, _prim: PrimId, hit: bool) {
         self.push_op(Op::Pipe {
             pipe: Pipe::Triangle,
             n: 1,
@@ -698,7 +699,7 @@ mod tests {
     /// One random traversal or workload event.
     fn random_event(rng: &mut Pcg32, r: &mut Recorder) {
         match rng.below(8) {
-            0 => r.fetch(rng.below(1 << 20) as u64, rng.below(220)),
+            0 => r.fetch(ByteAddr(rng.below(1 << 20) as u64), rng.below(220)),
             1 => {
                 let arity = [2u8, 4, 8][rng.below(3) as usize];
                 let valid = rng.below(arity as u32 + 1) as u8;
@@ -713,7 +714,7 @@ mod tests {
             3 => r.step(NodeStep::Leaf {
                 count: rng.below(8),
             }),
-            4 => r.triangle_test(rng.below(1000), rng.below(2) == 1),
+            4 => r.triangle_test(PrimId(rng.below(1000)), rng.below(2) == 1),
             5 => r.push(),
             6 => r.pop(),
             _ => r.event(Event::all()[rng.below(5) as usize]),
@@ -790,8 +791,8 @@ mod tests {
         let mut ops = Vec::new();
         let mut tally = Tally::new(SimAccel::Bvh2, random_costs(1));
         let mut r = Recorder::new(&mut tally, &mut ops);
-        r.fetch(52, 52);
-        r.fetch(6, 4); // straddles two words
+        r.fetch(ByteAddr(52), 52);
+        r.fetch(ByteAddr(6), 4); // straddles two words
         assert_eq!(r.tally().counts().loads, 15);
         assert_eq!(
             ops,
@@ -828,10 +829,10 @@ mod tests {
         let mut ops = Vec::new();
         let mut tally = Tally::new(SimAccel::Bvh2, random_costs(2));
         let mut r = Recorder::new(&mut tally, &mut ops);
-        r.fetch(8, 4);
+        r.fetch(ByteAddr(8), 4);
         assert_eq!(r.tally().error(), None);
-        r.fetch(top + 8, 4);
-        r.fetch(0, 4 * 70_000);
+        r.fetch(ByteAddr(top + 8), 4);
+        r.fetch(ByteAddr(0), 4 * 70_000);
         assert_eq!(
             r.tally().error(),
             Some(OpRangeError::Address { addr: top + 8 })
@@ -846,7 +847,7 @@ mod tests {
         let mut r = Recorder::new(&mut tally, &mut ops);
         r.push();
         r.push();
-        r.fetch(0, 4);
+        r.fetch(ByteAddr(0), 4);
         assert_eq!(
             r.tally().error(),
             Some(OpRangeError::Fpinv { fpinv: 80_000 })

@@ -2,7 +2,7 @@
 //! in `(t, triangle id)` order. Every structure must match it bit for bit, ray by ray.
 
 use dualsplit_accel::{AccelKind, NoObserver, Structures};
-use dualsplit_geometry::{Hit, Ray, Triangle};
+use dualsplit_geometry::{Hit, PrimId, Ray, Triangle};
 
 /// Closest hit over all triangles on `[t_min, t_max]`, ordered by `(t, triangle id)`: equal
 /// `t` goes to the smaller id.
@@ -13,7 +13,7 @@ pub fn oracle_closest(tris: &[Triangle], ray: &Ray) -> Option<Hit> {
         let Some(h) = tri.intersect(&r, ray.t_min, ray.t_max) else {
             continue;
         };
-        let prim = i as u32;
+        let prim = PrimId(i as u32);
         if best.is_none_or(|b| !b.closer_than(h.t, prim)) {
             best = Some(Hit {
                 t: h.t,
@@ -34,7 +34,7 @@ pub fn oracle_any(tris: &[Triangle], ray: &Ray) -> bool {
 }
 
 /// `(t bits, triangle id)` of a hit: the quantity compared per ray.
-pub fn key(h: Option<Hit>) -> Option<(u32, u32)> {
+pub fn key(h: Option<Hit>) -> Option<(u32, PrimId)> {
     h.map(|h| (h.t.to_bits(), h.prim))
 }
 

@@ -17,7 +17,7 @@
 //! The image's words live in one allocation ([`crate::image::Words`]: huge pages where the
 //! kernel allows, so first-touch page faults do not dominate). The layout is the one a fully
 //! sequential depth-first emission with bump allocation gives, whatever the thread count
-//! (`tests/dst_convert_golden.rs`).
+//! (`tests/dst_convert_reference.rs`).
 
 use super::from_bvh2::{Chain, ChainDp, StepTable, plan_split, plane_values};
 use super::header::{HeaderOffset, OFFSET_LIMIT};
@@ -206,6 +206,7 @@ struct Encoder<'a> {
     triangles: usize,
     cfg: &'a DstConfig,
     steps: StepTable,
+    planner: Planner,
 }
 
 impl Encoder<'_> {
@@ -251,7 +252,10 @@ impl Encoder<'_> {
     /// [`Encoder::close`]).
     #[inline(always)]
     fn new_rec(&self, n: u32, dps: &mut [ChainDp; 2]) -> Rec {
-        let p = plan_split(self.bvh, n, self.cfg, dps);
+        let p = match self.planner {
+            Planner::Fast => plan_split(self.bvh, n, self.cfg, dps),
+            Planner::Reference => super::reference::plan_split(self.bvh, n, self.cfg),
+        };
         Rec {
             chains: [p.left_chain, p.right_chain],
             left_entries: 0,
@@ -480,78 +484,82 @@ impl Encoder<'_> {
     }
 }
 
-impl Dst {
-    /// Converts a BVH2 over `triangles` into a DST (Lin et al. 2020, §4.2). In
-    /// [`super::Partitioning::Identical`] mode the region entering every splitting node and
-    /// leaf is exactly its BVH node's box. Time and memory are linear in the BVH's nodes.
-    ///
-    /// Errors: malformed BVH links, non-finite boxes, triangle ids out of range, and
-    /// offsets beyond the 26-bit field ([`DstError::OffsetOverflow`]).
-    pub fn from_bvh2(
-        bvh: &Bvh2,
-        triangles: impl Into<SharedTriangles>,
-        cfg: &DstConfig,
-    ) -> Result<Dst, DstError> {
-        let triangles = triangles.into();
-        let enc = Encoder {
-            bvh,
-            triangles: triangles.len(),
-            cfg,
-            steps: StepTable::new(&cfg.costs)?,
-        };
-        let empty = bvh.prim_ids.is_empty() || bvh.nodes.is_empty();
-        let (plan, root_slot, size) = if empty {
-            (Plan::Seq(Vec::new()), 0, Size::default())
-        } else {
-            let (plan, size) = enc.plan(0, Chain::EMPTY, 0)?;
-            (plan, slot_size(bvh, 0, Chain::EMPTY), size)
-        };
-        let n_nodes = root_slot as u64 + size.words;
-        if n_nodes > OFFSET_LIMIT {
-            return Err(DstError::OffsetOverflow {
-                given: n_nodes,
-                limit: OFFSET_LIMIT,
-            });
-        }
-        let (n_nodes, n_idx) = (n_nodes as usize, size.entries as usize);
-        // One allocation for the node and index regions (fresh pages, first touched by
-        // the threads that fill them; huge pages where the kernel allows, see
-        // `image::Words`); the triangle region is the scene's, shared.
-        let mut image = MemoryImage::with_triangles(n_nodes, n_idx, triangles);
-        let (node_words, entries) = image.words.split_at_mut(n_nodes);
-        let mut stats = if empty {
-            DstStats::default()
-        } else {
-            let (slot, node_words) = node_words.split_at_mut(root_slot);
-            let out = Out {
-                slot,
-                words: node_words,
-                at: root_slot as u64,
-                entries,
-                entries_at: 0,
-            };
-            enc.emit_plan(&plan, 0, Chain::EMPTY, out)?
-        };
-        let scene_box = if empty {
-            Aabb::EMPTY
-        } else {
-            bvh.nodes[0].bounds
-        };
-        stats.node_bytes = image.node_bytes();
-        stats.index_bytes = image.index_bytes();
-        stats.total_bytes = stats.node_bytes + stats.index_bytes + 24;
-        // The BVH2's size in the paper's layout (`stats::bvh2_size_bytes`): one 52-byte
-        // node per internal node, and every internal node became one splitting node.
-        stats.bvh2_bytes = if empty {
-            0
-        } else {
-            52 * stats.splitting + 4 * bvh.prim_ids.len() as u64
-        };
-        Ok(Dst {
-            image,
-            scene_box,
-            config: *cfg,
-            stats,
-        })
+/// Who makes the decisions the encoder emits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Planner {
+    /// The fast chain DP of [`super::from_bvh2`].
+    Fast,
+    /// The plain DP of [`super::reference`].
+    Reference,
+}
+
+/// Converts `bvh` into a DST over `triangles` with the decisions of `planner`: plans every
+/// split, checks the image fits the 26-bit offsets, then emits it (see the module doc).
+pub(super) fn encode(
+    bvh: &Bvh2,
+    triangles: SharedTriangles,
+    cfg: &DstConfig,
+    planner: Planner,
+) -> Result<Dst, DstError> {
+    let enc = Encoder {
+        bvh,
+        triangles: triangles.len(),
+        cfg,
+        steps: StepTable::new(&cfg.costs)?,
+        planner,
+    };
+    let empty = bvh.prim_ids.is_empty() || bvh.nodes.is_empty();
+    let (plan, root_slot, size) = if empty {
+        (Plan::Seq(Vec::new()), 0, Size::default())
+    } else {
+        let (plan, size) = enc.plan(0, Chain::EMPTY, 0)?;
+        (plan, slot_size(bvh, 0, Chain::EMPTY), size)
+    };
+    let n_nodes = root_slot as u64 + size.words;
+    if n_nodes > OFFSET_LIMIT {
+        return Err(DstError::OffsetOverflow {
+            given: n_nodes,
+            limit: OFFSET_LIMIT,
+        });
     }
+    let (n_nodes, n_idx) = (n_nodes as usize, size.entries as usize);
+    // One allocation for the node and index regions (fresh pages, first touched by
+    // the threads that fill them; huge pages where the kernel allows, see
+    // `image::Words`); the triangle region is the scene's, shared.
+    let mut image = MemoryImage::with_triangles(n_nodes, n_idx, triangles);
+    let (node_words, entries) = image.words.split_at_mut(n_nodes);
+    let mut stats = if empty {
+        DstStats::default()
+    } else {
+        let (slot, node_words) = node_words.split_at_mut(root_slot);
+        let out = Out {
+            slot,
+            words: node_words,
+            at: root_slot as u64,
+            entries,
+            entries_at: 0,
+        };
+        enc.emit_plan(&plan, 0, Chain::EMPTY, out)?
+    };
+    let scene_box = if empty {
+        Aabb::EMPTY
+    } else {
+        bvh.nodes[0].bounds
+    };
+    stats.node_bytes = image.node_bytes();
+    stats.index_bytes = image.index_bytes();
+    stats.total_bytes = stats.node_bytes + stats.index_bytes + 24;
+    // The BVH2's size in the paper's layout (`stats::bvh2_size_bytes`): one 52-byte
+    // node per internal node, and every internal node became one splitting node.
+    stats.bvh2_bytes = if empty {
+        0
+    } else {
+        52 * stats.splitting + 4 * bvh.prim_ids.len() as u64
+    };
+    Ok(Dst {
+        image,
+        scene_box,
+        config: *cfg,
+        stats,
+    })
 }

@@ -1,5 +1,6 @@
-//! BVH2 → DST conversion: the SAH choice of carving chains and of each split's child order
-//! (Lin et al. 2020, §4.2; Lin et al. 2019; `docs/dst-encoding.md`, §3).
+//! BVH2 → DST conversion: [`Dst::from_bvh2`], and the SAH choice of carving chains and of
+//! each split's child order (Lin et al. 2020, §4.2; Lin et al. 2019; `docs/dst-encoding.md`,
+//! §3). The emission of the decided tree is [`super::encode`].
 //!
 //! With identical bounds the region entering every splitting node is exactly its BVH node's
 //! box, so each child subtree costs the same whatever its parent chooses. The only choices
@@ -10,19 +11,38 @@
 //!
 //! A carving chain covers the set F of faces where the incoming region differs from the
 //! target box. [`ChainDp`] solves it exactly by dynamic programming over the 2^|F| subsets
-//! of carved faces (one DP per child prices all six split choices): a step carves one face or two (two on
-//! one axis = single-axis carving node, on two axes = dual-axis carving node); a lone face
-//! is carved by the cheaper node type with a ±∞ no-op partner plane.
+//! of carved faces (one DP per child prices all six split choices): a step carves one face
+//! or two (two on one axis = single-axis carving node, on two axes = dual-axis carving
+//! node); a lone face is carved by the cheaper node type with a ±∞ no-op partner plane.
 //!
-//! Speed: each state's options come from a table built at compile time ([`OPTIONS`]) in
-//! the order of the original nested loops, and the cheapest is selected without branches,
-//! with the same strict `<` and the same float expressions, so every decision (ties
-//! included) is the one the plain loops made (`tests/dst_convert_golden.rs`).
+//! This is the plain DP of [`super::reference`] made fast: each state's options come from
+//! a table built at compile time ([`OPTIONS`]) in the reference's loop order, and the
+//! cheapest is selected without branches, with the same strict `<` and the same float
+//! expressions, so every decision (ties included) is the reference's
+//! (`tests/dst_convert_reference.rs`).
 
+use super::encode::{Planner, encode};
 use super::header::{AxisPair, Corner, HeaderOffset};
-use super::{DstConfig, DstCosts, DstError, Partitioning};
+use super::{Dst, DstConfig, DstCosts, DstError, Partitioning};
 use crate::build::Bvh2;
+use crate::image::SharedTriangles;
 use dualsplit_geometry::{Aabb, Vec3};
+
+impl Dst {
+    /// Converts a BVH2 over `triangles` into a DST (Lin et al. 2020, §4.2). In
+    /// [`super::Partitioning::Identical`] mode the region entering every splitting node and
+    /// leaf is exactly its BVH node's box. Time and memory are linear in the BVH's nodes.
+    ///
+    /// Errors: malformed BVH links, non-finite boxes, triangle ids out of range, and
+    /// offsets beyond the 26-bit field ([`DstError::OffsetOverflow`]).
+    pub fn from_bvh2(
+        bvh: &Bvh2,
+        triangles: impl Into<SharedTriangles>,
+        cfg: &DstConfig,
+    ) -> Result<Dst, DstError> {
+        encode(bvh, triangles.into(), cfg, Planner::Fast)
+    }
+}
 
 /// A carving node the converter decided to emit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,7 +85,7 @@ impl Chain {
 
     /// Appends a step carving the faces in `faces` (one or two bits).
     #[inline(always)]
-    fn push(&mut self, faces: u64) {
+    pub fn push(&mut self, faces: u64) {
         let n = self.len();
         self.0 = (self.0 & ((1 << 36) - 1)) | faces << (6 * n) | ((n + 1) as u64) << 36;
     }
@@ -166,7 +186,7 @@ pub(super) fn plane_values(target: &Aabb) -> [f32; 8] {
 
 /// Face `f` of a box: axis `f >> 1`, the max face when `f & 1 == 1`.
 #[inline(always)]
-fn face(b: &Aabb, f: usize) -> f32 {
+pub(super) fn face(b: &Aabb, f: usize) -> f32 {
     if f & 1 == 1 {
         b.max[f >> 1]
     } else {
@@ -438,7 +458,7 @@ impl ChainDp {
     /// partitioning is on: the chain may then stop early, paying `C_tri · n · SA` of the
     /// looser region instead. Costs are SAH-weighted by the area of the region in which
     /// each node is tested.
-    // Out of line: one copy serves both children (inlined twice, the split choice was 45 KB
+    // Out of line: one copy serves both children (inlined twice, the split choice is 45 KB
     // of code; out of line about 17 KB and a few percent faster, single-thread bench).
     #[inline(never)]
     pub fn solve(
@@ -458,96 +478,15 @@ impl ChainDp {
                 dp.k += 1;
             }
         }
-        // Chains of at most two faces (three quarters of dragon_box's), and of three with
-        // cheap pairs, are solved in closed form; the others by the DP, compiled once per
-        // chain length.
-        let c_lone = costs.single_carve.min(costs.dual_carve);
-        let pairs_cheap = costs.single_carve <= c_lone && costs.dual_carve <= c_lone;
+        // Compiled once per chain length: the loops over the 2^k states unroll.
         match dp.k {
-            0 => dp.fill_closed::<0>(region, target, costs, leaf_tris),
-            1 => dp.fill_closed::<1>(region, target, costs, leaf_tris),
-            2 => dp.fill_closed::<2>(region, target, costs, leaf_tris),
-            3 if pairs_cheap => dp.fill_closed::<3>(region, target, costs, leaf_tris),
+            0 => dp.fill::<0>(region, target, costs, leaf_tris),
+            1 => dp.fill::<1>(region, target, costs, leaf_tris),
+            2 => dp.fill::<2>(region, target, costs, leaf_tris),
             3 => dp.fill::<3>(region, target, costs, leaf_tris),
             4 => dp.fill::<4>(region, target, costs, leaf_tris),
             5 => dp.fill::<5>(region, target, costs, leaf_tris),
             _ => dp.fill::<6>(region, target, costs, leaf_tris),
-        }
-    }
-
-    /// [`ChainDp::solve`] in closed form for `K` ≤ 2 faces, and for `K` = 3 when every pair
-    /// node is no dearer than a lone-face node (the hardware preset): the DP of
-    /// [`ChainDp::fill`] written out state by state, with the same float expressions, the
-    /// same options in the same order and the same strict `<`, so it decides exactly what
-    /// the DP decides (ties included; `tests/dst_convert_golden.rs`).
-    #[inline(always)]
-    fn fill_closed<const K: usize>(
-        &mut self,
-        region: &Aabb,
-        target: &Aabb,
-        costs: &DstCosts,
-        leaf_tris: Option<u32>,
-    ) {
-        let full = (1usize << K) - 1;
-        let c_lone = costs.single_carve.min(costs.dual_carve);
-        let mut sa = [0f32; 8];
-        state_areas::<K>(&self.faces, region, target, leaf_tris.is_some(), &mut sa);
-        let tri_weight = leaf_tris.map(|n| costs.triangle * n as f32);
-        self.base = leaf_tris.map_or(0.0, |n| costs.triangle * n as f32 * sa[full]);
-        let base = self.base;
-        // The cheapest option of a state among `options` (mask, cost), the first on ties;
-        // with similar partitioning the chain may also stop (choice 0).
-        let best = |sa_s: f32, options: &[(u8, f32)]| {
-            let mut b = (tri_weight.map_or(f32::INFINITY, |w| w * sa_s - base), 0u8);
-            for &(t, c) in options {
-                if c < b.0 {
-                    b = (c, t);
-                }
-            }
-            b
-        };
-        // The cost of a pair node carving faces i and j.
-        let w_pair = |i: usize, j: usize| {
-            if self.faces[i] >> 1 == self.faces[j] >> 1 {
-                costs.single_carve
-            } else {
-                costs.dual_carve
-            }
-        };
-        self.cost[full] = 0.0;
-        match K {
-            0 => {}
-            1 => {
-                (self.cost[0], self.choice[0]) = best(sa[0], &[(1, c_lone * sa[0] + 0.0)]);
-            }
-            2 => {
-                for (s, rem) in [(2, 1), (1, 2)] {
-                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, c_lone * sa[s] + 0.0)]);
-                }
-                let w = w_pair(0, 1);
-                let pair = (3, w * sa[0] + 0.0);
-                (self.cost[0], self.choice[0]) = if w <= c_lone {
-                    // Carving a face alone is dominated while its partner remains.
-                    best(sa[0], &[pair])
-                } else {
-                    let lone = |t: u8| (t, c_lone * sa[0] + self.cost[t as usize]);
-                    best(sa[0], &[lone(1), pair, lone(2)])
-                };
-            }
-            _ => {
-                // Every pair is cheap ([`OPTIONS_PAIRS_CHEAP`]): a last face is carved alone,
-                // two remaining faces as a pair, and from three the three pairs are tried.
-                for (s, rem) in [(6, 1), (5, 2), (3, 4)] {
-                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, c_lone * sa[s] + 0.0)]);
-                }
-                let w = [w_pair(0, 1), w_pair(0, 2), w_pair(1, 2)];
-                for (s, rem, w) in [(4, 3, w[0]), (2, 5, w[1]), (1, 6, w[2])] {
-                    (self.cost[s], self.choice[s]) = best(sa[s], &[(rem, w * sa[s] + 0.0)]);
-                }
-                let pair = |t: u8, w: f32| (t, w * sa[0] + self.cost[t as usize]);
-                (self.cost[0], self.choice[0]) =
-                    best(sa[0], &[pair(3, w[0]), pair(5, w[1]), pair(6, w[2])]);
-            }
         }
     }
 
@@ -599,7 +538,7 @@ impl ChainDp {
             }
         }
         // The options of every state come from a table built at compile time, in the order
-        // of the original loops (lone i, then pairs (i, j > i), for i ascending), so ties
+        // of the reference's loops (lone i, then pairs (i, j > i), for i ascending), so ties
         // go to the same option; the selection is branch-free.
         let inputs = DpInputs {
             full,
@@ -702,17 +641,19 @@ pub(super) struct SplitPlan {
     pub right_chain: Chain,
 }
 
-fn leaf_tris(bvh: &Bvh2, n: u32, cfg: &DstConfig) -> Option<u32> {
+/// The triangle count of BVH node `n` when it is a leaf and partitioning is similar (its
+/// chain may then stop early), else `None`.
+pub(super) fn leaf_tris(bvh: &Bvh2, n: u32, cfg: &DstConfig) -> Option<u32> {
     let node = &bvh.nodes[n as usize];
     (cfg.partitioning == Partitioning::Similar && node.is_leaf()).then_some(node.count)
 }
 
 /// Face index of the max face on `axis` (carved for the left child by P0) and of the min
 /// face (carved for the right child by P1).
-const fn max_face(axis: usize) -> usize {
+pub(super) const fn max_face(axis: usize) -> usize {
     2 * axis + 1
 }
-const fn min_face(axis: usize) -> usize {
+pub(super) const fn min_face(axis: usize) -> usize {
     2 * axis
 }
 

@@ -4,6 +4,7 @@
 //!
 //! ```text
 //!  Bvh2 ──from_bvh2.rs──▶ per BVH node: carving chain (SAH, DP over faces) + split order
+//!                 │        (reference.rs: the same decisions as plain loops, for tests)
 //!                 │
 //!                 └─encode.rs──▶ MemoryImage: node words | index runs | triangles
 //!                                 │
@@ -19,7 +20,7 @@
 //! ```
 //! use dualsplit_accel::{BuildConfig, Bvh2, NoObserver};
 //! use dualsplit_accel::dst::{Dst, DstConfig};
-//! use dualsplit_geometry::{Aabb, Ray, Triangle, Vec3};
+//! use dualsplit_geometry::{Aabb, PrimId, Ray, Triangle, Vec3};
 //! let tris = vec![
 //!     Triangle::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0)),
 //!     Triangle::new(Vec3::new(-1.0, -1.0, 3.0), Vec3::new(1.0, -1.0, 3.0), Vec3::new(0.0, 1.0, 3.0)),
@@ -31,13 +32,14 @@
 //! let dst = Dst::from_bvh2(&bvh, &tris[..], &DstConfig::hardware()).unwrap();
 //! dst.validate(&bvh).unwrap();
 //! let hit = dst.closest_hit(&Ray::new(Vec3::ZERO, Vec3::Z), &mut NoObserver).unwrap();
-//! assert_eq!((hit.t, hit.prim), (2.0, 0));
+//! assert_eq!((hit.t, hit.prim), (2.0, PrimId(0)));
 //! ```
 
 mod encode;
 mod from_bvh2;
 mod header;
 pub mod pipeline;
+mod reference;
 mod stats;
 mod traverse;
 mod validate;

@@ -17,7 +17,7 @@ use super::header::HeaderOffset;
 use super::pipeline::{ReturnCode, le_or_nan};
 use crate::image::{MemoryImage, RUN_END};
 use crate::observer::{DstNodeKind, NodeStep, Observer};
-use dualsplit_geometry::{Hit, Ray, RayPre, Triangle, cull_limit, widen_exit};
+use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, Triangle, cull_limit, widen_exit};
 
 /// A traversal-stack entry: a node word index and its ray interval.
 #[derive(Clone, Copy, Debug, Default)]
@@ -154,10 +154,10 @@ impl<'a> Tracer<'a> {
         let t_lo = self.r.ray.t_min;
         for i in start..start + count {
             let e = self.words[i];
-            let p = e & !RUN_END;
+            let p = PrimId(e & !RUN_END);
             obs.fetch(MemoryImage::addr(i), 4);
-            obs.fetch(MemoryImage::addr(self.tri_base + 9 * p as usize), 36);
-            let h = self.tris[p as usize].intersect(&self.r, t_lo, self.best_t);
+            obs.fetch(MemoryImage::addr(self.tri_base + 9 * p.index()), 36);
+            let h = self.tris[p.index()].intersect(&self.r, t_lo, self.best_t);
             obs.triangle_test(p, h.is_some());
             if let Some(h) = h {
                 if ANY {

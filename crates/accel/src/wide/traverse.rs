@@ -18,7 +18,7 @@
 
 use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
 use crate::observer::{NodeStep, Observer};
-use dualsplit_geometry::{Hit, Ray, RayPre, cull_limit, widen_exit};
+use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, cull_limit, widen_exit};
 use std::cell::Cell;
 
 #[derive(Clone, Copy)]
@@ -102,7 +102,7 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
                 count: count as u32,
             });
             for &entry in &words[run..run + count] {
-                let p = entry & !RUN_END;
+                let p = PrimId(entry & !RUN_END);
                 let tri = img.fetch_triangle(p, obs);
                 let Some(h) = tri.intersect(&r, ray.t_min, best_t) else {
                     obs.triangle_test(p, false);

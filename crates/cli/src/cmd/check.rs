@@ -130,7 +130,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
 /// rays whether anything blocks the segment.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Answer {
-    Closest(Option<(u32, u32)>),
+    Closest(Option<(u32, dualsplit_geometry::PrimId)>),
     Occluded(bool),
 }
 
