@@ -11,8 +11,20 @@
 //!   compare/min-max, reciprocal, local store: [`InstrCounts::from_classes`]), and
 //! * the dependency stall cycles of its instruction chain: the cycles an in-order,
 //!   single-issue thread waits for an operand from a functional unit's latency
-//!   (`units.*_latency` of the configuration; loads, pipelines and the atomic unit answer at
-//!   once here, since the `fast` model times those itself).
+//!   (`units.*_latency` of the configuration; loads and the atomic unit answer at once
+//!   here, since the `fast` model times those itself), and
+//! * apart from those, the cycles it waits for a ray pipeline's result (ray-box,
+//!   ray-triangle, dual-split: `units.box_latency`, `tri_latency`, `dst_latency`). How much
+//!   of a pipeline's latency the kernel hides behind independent work is a property of its
+//!   code (a serial BVH kernel consumes each box result before the next child's test; the
+//!   "+" kernels decode child slots while the wide test runs), so it is measured here and
+//!   the `fast` model's pipeline ops time only the pipes' occupancy, and
+//! * the words it reads through the L1 (loads and the ray instructions' memory operands,
+//!   from the image, the parameter block and the program's constants) beyond the words the
+//!   Rust traversal fetches in the same segment: the kernel reads a node's child words
+//!   once to find the slot's kind and again in the box test, and each pixel and ray reads
+//!   the parameter block. The `fast` model replays them as re-reads (one issue slot and one
+//!   L1 access per word, as the TP's word reads).
 //!
 //! The same frames traced by the Rust traversal give each segment's events (the pixel, the
 //! ray's kind, and its traversal events, by [`Recorder`]). A least-squares fit with
@@ -26,7 +38,7 @@
 
 use crate::kernel::{EVENTS, Event, InstrCounts, Recorder, Tally};
 use crate::kernels::{Params, elf};
-use crate::rv32::{FrameMemory, FuClass, Hart, Latches, Op, Program, RunError};
+use crate::rv32::{FrameMemory, FuClass, Hart, LOCAL_STORE_ADDR, Latches, Op, Program, RunError};
 use crate::{SimAccel, SimError, UnitConfig};
 use dualsplit_accel::Structures;
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
@@ -37,9 +49,10 @@ use std::sync::OnceLock;
 
 /// Fractional bits of the stored costs.
 pub const FRAC_BITS: u32 = 8;
-/// Measured quantities per event: the six instruction classes of [`crate::Mix`], then the
-/// dependency stall cycles.
-pub const TARGETS: usize = 7;
+/// Measured quantities per event: the six instruction classes of [`crate::Mix`], the
+/// dependency and pipeline-latency stall cycles, then the L1 words read beyond the
+/// traversal's fetches.
+pub const TARGETS: usize = 9;
 /// The quantities' names, in order.
 pub const TARGET_NAMES: [&str; TARGETS] = [
     "int",
@@ -49,9 +62,15 @@ pub const TARGET_NAMES: [&str; TARGETS] = [
     "fpinv",
     "local",
     "dependency",
+    "pipeline",
+    "l1_words",
 ];
 /// Index of the dependency stall cycles.
 pub const DEPENDENCY: usize = 6;
+/// Index of the pipeline-latency stall cycles.
+pub const PIPELINE: usize = 7;
+/// Index of the L1 words read beyond the traversal's fetches.
+pub const L1_WORDS: usize = 8;
 /// Index of the reciprocal ops.
 const FPINV: usize = 4;
 
@@ -81,9 +100,18 @@ impl Costs {
         per_event: [[0; TARGETS]; EVENTS],
     };
 
-    /// Issue cycles of event `e` (instructions and dependency stalls), fixed point.
+    /// Issue cycles of event `e` (instructions, dependency and pipeline-latency stalls),
+    /// fixed point.
     pub fn cycles(&self, e: usize) -> u64 {
-        self.per_event[e].iter().map(|&x| x as u64).sum()
+        self.per_event[e][..L1_WORDS]
+            .iter()
+            .map(|&x| x as u64)
+            .sum()
+    }
+
+    /// L1 words event `e` reads beyond the traversal's fetches, fixed point.
+    pub fn l1_words(&self, e: usize) -> u64 {
+        self.per_event[e][L1_WORDS] as u64
     }
 
     /// Reciprocal ops of event `e`, fixed point.
@@ -280,7 +308,7 @@ pub(crate) fn trace_ray(
 /// One measured segment: whether it is a pixel's (not a ray's), and its quantities.
 struct Segment {
     pixel: bool,
-    y: [u64; TARGETS],
+    y: [i64; TARGETS],
 }
 
 /// Runs `prog` functionally on one thread over the whole frame and cuts it into segments.
@@ -296,8 +324,11 @@ fn kernel_segments(
         y: [0; TARGETS],
     }];
     let mut classes = [0u64; crate::rv32::run::FU_CLASSES];
-    // Dependency chain: the cycle each register (and the ray registers) is ready.
-    let (mut t, mut ready, mut ray_ready) = (0u64, [0u64; 64], 0u64);
+    // Dependency chain: the cycle each register (and the ray, box and dual-split latches)
+    // is ready, and whether a pipeline produces it.
+    let mut t = 0u64;
+    let mut ready = [(0u64, false); 64];
+    let (mut ray_ready, mut box_ready, mut dst_ready) = ((0u64, false), (0u64, true), (0u64, true));
     let flush = |segs: &mut Vec<Segment>, classes: &mut [u64; crate::rv32::run::FU_CLASSES]| {
         let m = InstrCounts::from_classes(classes, &Default::default()).mix;
         let y = &mut segs.last_mut().expect("a segment is open").y;
@@ -305,7 +336,7 @@ fn kernel_segments(
             .into_iter()
             .enumerate()
         {
-            y[k] += v;
+            y[k] += v as i64;
         }
         *classes = [0; crate::rv32::run::FU_CLASSES];
     };
@@ -325,25 +356,54 @@ fn kernel_segments(
                 y: [0; TARGETS],
             });
         }
-        let mut at = t;
-        for r in info.src {
-            if let Some(i) = r.index() {
-                at = at.max(ready[i]);
+        // The operand the instruction waits for longest (the first such, as the TP
+        // attributes it).
+        let mut at = (t, false);
+        let l = info.latches;
+        let latches = [
+            (l.has(Latches::READS_RAY), ray_ready),
+            (l.has(Latches::READS_BOX), box_ready),
+            (l.has(Latches::READS_DST), dst_ready),
+        ];
+        let regs = info.src.iter().filter_map(|r| r.index()).map(|i| ready[i]);
+        for r in regs.chain(latches.into_iter().filter(|x| x.0).map(|x| x.1)) {
+            if r.0 > at.0 {
+                at = r;
             }
         }
-        if info.latches.has(Latches::READS_RAY) {
-            at = at.max(ray_ready);
-        }
-        segs.last_mut().expect("a segment is open").y[DEPENDENCY] += at - t;
+        let y = &mut segs.last_mut().expect("a segment is open").y;
+        y[if at.1 { PIPELINE } else { DEPENDENCY }] += (at.0 - t) as i64;
+        let at = at.0;
         t = at + 1;
         let r = hart.step(prog, mem)?;
         classes[crate::rv32::run::fu_index(r.info.fu)] += 1;
-        let done = crate::fu::unit_latency(r.info.fu, units).map_or(0, |l| at + l);
+        let through_l1 = matches!(
+            r.info.fu,
+            FuClass::Load | FuClass::BoxPipe(_) | FuClass::TriPipe | FuClass::DstPipe
+        );
+        if through_l1 && r.mem.addr < LOCAL_STORE_ADDR {
+            segs.last_mut().expect("a segment is open").y[L1_WORDS] += r.mem.words as i64;
+        }
+        let done = match r.info.fu {
+            FuClass::BoxPipe(_) => (at + units.box_latency, true),
+            FuClass::TriPipe => (at + units.tri_latency, true),
+            FuClass::DstPipe => (at + units.dst_latency, true),
+            fu => (
+                crate::fu::unit_latency(fu, units).map_or(0, |l| at + l),
+                false,
+            ),
+        };
         if let Some(i) = r.info.dst.index() {
             ready[i] = done;
         }
-        if info.latches.has(Latches::WRITES_RAY) {
+        if l.has(Latches::WRITES_RAY) {
             ray_ready = done;
+        }
+        if l.has(Latches::WRITES_BOX) {
+            box_ready = done;
+        }
+        if l.has(Latches::WRITES_DST) {
+            dst_ready = done;
         }
         if hart.halted {
             flush(&mut segs, &mut classes);
@@ -352,20 +412,21 @@ fn kernel_segments(
     }
 }
 
-/// The traversal's events of the same frame, segment by segment (pixel, then its rays).
+/// The traversal's events of the same frame, segment by segment (pixel, then its rays), with
+/// the words each segment fetches.
 fn event_segments(
     scene: &Scene,
     structures: &Structures,
     accel: SimAccel,
     settings: &RenderSettings,
-) -> Vec<(bool, [u64; EVENTS])> {
+) -> Vec<(bool, [u64; EVENTS], u64)> {
     let mut segs = Vec::new();
     let mut ops = Vec::new();
     for y in 0..settings.height {
         for x in 0..settings.width {
             let mut pixel = [0; EVENTS];
             pixel[Event::Pixel.index()] = 1;
-            segs.push((true, pixel));
+            segs.push((true, pixel, 0));
             let mut job = PixelJob::new(scene, settings, x, y);
             while let Some(q) = job.next_ray() {
                 let mut tally = Tally::new(accel, &Costs::ZERO);
@@ -374,7 +435,7 @@ fn event_segments(
                 let result = trace_ray(structures, accel, q.kind, &q.ray, &mut rec);
                 rec.finish();
                 job.submit(result);
-                segs.push((false, *tally.events()));
+                segs.push((false, *tally.events(), tally.counts().loads));
             }
         }
     }
@@ -403,14 +464,14 @@ impl Normal {
 
     // Index loops read as the matrix algebra they are.
     #[allow(clippy::needless_range_loop)]
-    fn add(&mut self, x: &[u64; EVENTS], y: &[u64; TARGETS]) {
+    fn add(&mut self, x: &[u64; EVENTS], y: &[i64; TARGETS]) {
         let nz: Vec<usize> = (0..EVENTS).filter(|&i| x[i] != 0).collect();
         for &i in &nz {
             for &j in &nz {
                 self.xtx[i][j] += (x[i] * x[j]) as f64;
             }
             for k in 0..TARGETS {
-                self.xty[k][i] += (x[i] * y[k]) as f64;
+                self.xty[k][i] += x[i] as f64 * y[k] as f64;
             }
         }
         for k in 0..TARGETS {
@@ -540,7 +601,7 @@ fn measure(
     let prog = Program::from_elf(elf(accel, workload))?;
     let mut normal = Normal::new();
     let (mut seen, mut instructions) = ([false; EVENTS], 0);
-    let (mut measured, mut counts) = ([0u128; TARGETS], [0u64; EVENTS]);
+    let (mut measured, mut counts) = ([0i128; TARGETS], [0u64; EVENTS]);
     for &(name, scene, structures, w, h) in frames {
         let settings = RenderSettings::new(w, h, workload);
         let params = Params::new(scene, structures, accel, &settings);
@@ -570,14 +631,16 @@ fn measure(
             });
         }
         instructions += prog_instructions(&kernel);
-        for (k, (_, x)) in inner.iter().zip(&events) {
-            normal.add(x, &k.y);
+        for (k, (_, x, fetched)) in inner.iter().zip(&events) {
+            let mut y = k.y;
+            y[L1_WORDS] -= *fetched as i64;
+            normal.add(x, &y);
             for (i, &n) in x.iter().enumerate() {
                 seen[i] |= n != 0;
                 counts[i] += n;
             }
-            for (t, &v) in measured.iter_mut().zip(&k.y) {
-                *t += v as u128;
+            for (t, &v) in measured.iter_mut().zip(&y) {
+                *t += v as i128;
             }
         }
     }
@@ -624,7 +687,7 @@ fn measure(
 /// Instructions of all segments (the pixel hand-outs', rays', start-up and end).
 fn prog_instructions(segs: &[Segment]) -> u64 {
     segs.iter()
-        .map(|s| s.y[..DEPENDENCY].iter().sum::<u64>())
+        .map(|s| s.y[..DEPENDENCY].iter().sum::<i64>() as u64)
         .sum()
 }
 

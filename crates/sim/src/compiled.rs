@@ -4,7 +4,7 @@
 //! (Lin et al. 2020, §4.3–4.4; the memory map of `docs/isa.md`).
 
 use crate::fu::Pools;
-use crate::kernels::{FRAME_FLOATS_PER_PIXEL, Params, elf};
+use crate::kernels::{FRAME_FLOATS_PER_PIXEL, Params, elf, placement};
 use crate::rv32::{FRAME_BUFFER_ADDR, FrameMemory, PARAMS_ADDR, PROGRAM_BASE, Program};
 use crate::tp::{ClassCounts, Tp};
 use crate::{Chip, SimAccel, SimConfig, SimError, SimResult, ThreadModel, chip::run_compiled};
@@ -46,6 +46,7 @@ pub(crate) fn run(
     }
     let params = Params::new(scene, structures, accel, settings);
     let mut mem = FrameMemory::new(image, params.as_bytes(), params.frame_bytes());
+    let placement = placement(&params, &prog, image, cfg.l1.line_bytes);
     let mut chip = Chip::new(cfg, accel.box_pipes(cfg));
     let mut pools: Vec<Pools> = (0..cfg.tms).map(|_| Pools::new(&cfg.units)).collect();
     let mut tps: Vec<Tp> = (0..cfg.tms * cfg.tps_per_tm)
@@ -65,6 +66,7 @@ pub(crate) fn run(
         &mut tps,
         &prog,
         &mut mem,
+        &placement,
         &cfg.units,
         &mut counts,
         &mut |done| progress((done as u64).min(total), total),

@@ -369,12 +369,20 @@ pub struct Tally {
     /// units of 2^-[`FRAC_BITS`](crate::calibrate::FRAC_BITS).
     cycles: [u64; EVENTS],
     fpinv: [u64; EVENTS],
+    /// Per event: L1 words read beyond the traversal's fetches, same units.
+    words: [u64; EVENTS],
     events: [u64; EVENTS],
     /// BVH nodes with at least one valid child (one box issue each on parallel pipes).
     boxed_nodes: u64,
     /// Loads and atomics.
     counts: InstrCounts,
     error: Option<OpRangeError>,
+    /// Physical address of the memory image's byte 0 (`memory::Placement::image_base`):
+    /// the recorders' loads are placed there.
+    image_base: u64,
+    /// What a recorder re-reads before its first fetch: the parameter block's first words
+    /// (physical word address, words).
+    params: (u32, u16),
 }
 
 impl Tally {
@@ -382,20 +390,33 @@ impl Tally {
     pub fn new(accel: SimAccel, costs: &'static Costs) -> Self {
         let mut cycles = [0; EVENTS];
         let mut fpinv = [0; EVENTS];
+        let mut words = [0; EVENTS];
         for e in 0..EVENTS {
             cycles[e] = costs.cycles(e);
             fpinv[e] = costs.fpinv(e);
+            words[e] = costs.l1_words(e);
         }
         Self {
             accel,
             costs,
             cycles,
             fpinv,
+            words,
             events: [0; EVENTS],
             boxed_nodes: 0,
             counts: InstrCounts::default(),
             error: None,
+            image_base: 0,
+            params: (0, 1),
         }
+    }
+
+    /// The same tally with the recorders' loads placed at physical address `image_base` for
+    /// the image's byte 0, and the parameter block's `params_words` words at physical 0.
+    pub fn placed_at(mut self, image_base: u64, params_words: u16) -> Self {
+        self.image_base = image_base;
+        self.params = (0, params_words.max(1));
+        self
     }
 
     /// Events counted so far, by [`Event::index`].
@@ -408,7 +429,7 @@ impl Tally {
     pub fn counts(&self) -> InstrCounts {
         let e = &self.events;
         let mut c = self.counts;
-        let [int, fpadd, fpmul, fpcmp, fpinv, local, _] = self.costs.totals(e);
+        let [int, fpadd, fpmul, fpcmp, fpinv, local, ..] = self.costs.totals(e);
         c.mix = Mix {
             int,
             fpadd,
@@ -440,6 +461,11 @@ impl Tally {
     /// Dependency stall cycles the measured events carry (part of their issue runs).
     pub fn dependency_cycles(&self) -> u64 {
         self.costs.totals(&self.events)[crate::calibrate::DEPENDENCY]
+    }
+
+    /// Pipeline-latency stall cycles the measured events carry (part of their issue runs).
+    pub fn pipeline_cycles(&self) -> u64 {
+        self.costs.totals(&self.events)[crate::calibrate::PIPELINE]
     }
 
     /// The first step that did not fit an [`Op`] (a program is then incomplete).
@@ -479,6 +505,9 @@ pub struct Recorder<'a> {
     dst_hw: bool,
     /// The "+" configurations: all child boxes in one issue slot.
     parallel_boxes: bool,
+    /// The last fetch (physical word address, words): the measured extra L1 words are
+    /// re-reads of it.
+    last: (u32, u16),
 }
 
 /// An instruction run being merged, fixed point (see [`Recorder`]).
@@ -488,6 +517,9 @@ pub struct Run {
     pub cycles: u64,
     /// Of which reciprocal / inverse-square-root ops, in the same units.
     pub fpinv: u64,
+    /// L1 words to re-read (the events' measured extra words not yet written as loads),
+    /// same units.
+    pub words: u64,
 }
 
 impl Run {
@@ -518,7 +550,7 @@ impl<'a> Recorder<'a> {
     /// run of the previous recording, see [`Recorder::finish_open`]).
     #[inline]
     pub fn resume(tally: &'a mut Tally, ops: &'a mut Vec<Op>, run: Option<Run>) -> Self {
-        let accel = tally.accel;
+        let (accel, last) = (tally.accel, tally.params);
         Self {
             ops,
             tally,
@@ -526,6 +558,7 @@ impl<'a> Recorder<'a> {
             run: run.unwrap_or_default(),
             dst_hw: accel == SimAccel::Dst,
             parallel_boxes: accel.parallel_boxes(),
+            last,
         }
     }
 
@@ -537,6 +570,7 @@ impl<'a> Recorder<'a> {
     /// Ends the recording with the open run written to the ops.
     pub fn finish(mut self) {
         self.close_run();
+        self.reread();
     }
 
     /// Ends the recording leaving the open run out of the ops: it is returned, to be
@@ -545,6 +579,7 @@ impl<'a> Recorder<'a> {
     #[inline]
     pub fn finish_open(mut self) -> Option<Run> {
         // A closed run may still carry a fraction of a cycle.
+        self.reread();
         if !self.open && self.run == Run::default() {
             return None;
         }
@@ -565,6 +600,7 @@ impl<'a> Recorder<'a> {
         t.events[e] += k;
         self.run.cycles += k * t.cycles[e];
         self.run.fpinv += k * t.fpinv[e];
+        self.run.words += k * t.words[e];
         self.open = true;
     }
 
@@ -592,16 +628,33 @@ impl<'a> Recorder<'a> {
             self.ops.push(op);
         }
         let mask = (1 << crate::calibrate::FRAC_BITS) - 1;
-        self.run = Run {
-            cycles: self.run.cycles & mask,
-            fpinv: self.run.fpinv & mask,
-        };
+        self.run.cycles &= mask;
+        self.run.fpinv &= mask;
     }
 
-    /// Appends a load or pipeline op after the open run.
+    /// Writes the whole extra L1 words due so far as re-reads of the last fetch (its
+    /// fraction stays).
+    #[inline(always)]
+    fn reread(&mut self) {
+        let mut n = self.run.words >> crate::calibrate::FRAC_BITS;
+        if n == 0 {
+            return;
+        }
+        self.run.words &= (1 << crate::calibrate::FRAC_BITS) - 1;
+        self.tally.counts.loads += n;
+        let (word, len) = self.last;
+        while n > 0 {
+            let words = n.min(len as u64) as u16;
+            self.ops.push(Op::Load { words, word });
+            n -= words as u64;
+        }
+    }
+
+    /// Appends a load or pipeline op after the open run and the extra words due.
     #[inline(always)]
     fn push_op(&mut self, op: Op) {
         self.close_run();
+        self.reread();
         self.ops.push(op);
     }
 }
@@ -609,6 +662,7 @@ impl<'a> Recorder<'a> {
 impl Observer for Recorder<'_> {
     #[inline(always)]
     fn fetch(&mut self, ByteAddr(addr): ByteAddr, bytes: u32) {
+        let addr = addr + self.tally.image_base;
         // Words from the one holding byte `addr` to the one holding byte `addr + bytes − 1`.
         let words = ((addr & 3) + bytes as u64).div_ceil(4);
         if words == 0 {
@@ -616,7 +670,12 @@ impl Observer for Recorder<'_> {
         }
         self.tally.counts.loads += words;
         match Op::load(addr & !3, words) {
-            Ok(op) => self.push_op(op),
+            Ok(op) => {
+                self.push_op(op);
+                if let Op::Load { word, words } = op {
+                    self.last = (word, words);
+                }
+            }
             Err(e) => self.tally.fail(e),
         }
     }
@@ -686,6 +745,10 @@ mod tests {
     /// Costs with random fractional instruction counts per event (leaked: tallies take
     /// `'static` costs).
     fn random_costs(seed: u64) -> &'static Costs {
+        Box::leak(Box::new(Costs::from_fixed(random_fixed(seed))))
+    }
+
+    fn random_fixed(seed: u64) -> [[u32; TARGETS]; EVENTS] {
         let mut rng = Pcg32::new(seed, 9);
         let mut per_event = [[0u32; TARGETS]; EVENTS];
         for row in &mut per_event {
@@ -693,7 +756,7 @@ mod tests {
                 *x = rng.below(12 << FRAC_BITS);
             }
         }
-        Box::leak(Box::new(Costs::from_fixed(per_event)))
+        per_event
     }
 
     /// One random traversal or workload event.
@@ -783,6 +846,81 @@ mod tests {
                         .count() as u64
                 );
             }
+        }
+    }
+
+    /// The measured extra L1 words are re-read as loads: the words loaded beyond the
+    /// fetches are the events' summed extra words (whole words; the fraction is carried
+    /// from ray to ray), and each re-read lies within the last fetch.
+    #[test]
+    fn extra_l1_words_are_rereads_of_the_last_fetch() {
+        for seed in 0..40u64 {
+            let accel = SimAccel::ALL[seed as usize % SimAccel::ALL.len()];
+            let costs = random_costs(seed);
+            let mut fixed = random_fixed(seed);
+            for row in &mut fixed {
+                row[crate::calibrate::L1_WORDS] = 0;
+            }
+            let no_extra: &'static Costs = Box::leak(Box::new(Costs::from_fixed(fixed)));
+            let record = |costs: &'static Costs| {
+                let (mut ops, mut run) = (Vec::new(), None);
+                let mut tally = Tally::new(accel, costs);
+                let (mut rng, mut cuts) = (Pcg32::new(seed, 1), Pcg32::new(seed, 2));
+                let mut left = 1 + Pcg32::new(seed, 7).below(300);
+                while left > 0 {
+                    let n = (1 + cuts.below(40)).min(left);
+                    left -= n;
+                    let mut r = Recorder::resume(&mut tally, &mut ops, run);
+                    for _ in 0..n {
+                        random_event(&mut rng, &mut r);
+                    }
+                    run = r.finish_open();
+                }
+                let loaded: u64 = ops
+                    .iter()
+                    .map(|op| match op {
+                        Op::Load { words, .. } => *words as u64,
+                        _ => 0,
+                    })
+                    .sum();
+                assert_eq!(loaded, tally.counts().loads, "seed {seed}");
+                (ops, tally)
+            };
+            let (ops, tally) = record(costs);
+            let (plain, _) = record(no_extra);
+            let extra: u64 = (0..EVENTS)
+                .map(|e| tally.events()[e] * costs.l1_words(e))
+                .sum::<u64>()
+                >> FRAC_BITS;
+            let loads = |ops: &[Op]| -> Vec<(u32, u16)> {
+                ops.iter()
+                    .filter_map(|op| match *op {
+                        Op::Load { word, words } => Some((word, words)),
+                        _ => None,
+                    })
+                    .collect()
+            };
+            let (with, without) = (loads(&ops), loads(&plain));
+            let sum = |v: &[(u32, u16)]| v.iter().map(|l| l.1 as u64).sum::<u64>();
+            assert_eq!(sum(&with) - sum(&without), extra, "seed {seed}");
+            // Every load of the plain recording is a fetch; the others re-read within the
+            // fetch before them, or (a recording's first re-reads, before its first fetch)
+            // the parameter block's first word, as the tally's default placement has it.
+            let mut last = (0u32, 1u16);
+            let mut fetches = without.iter().peekable();
+            for l in with {
+                if fetches.peek() == Some(&&l) {
+                    fetches.next();
+                    last = l;
+                } else {
+                    let params = l.0 == 0 && l.1 == 1;
+                    assert!(
+                        params || (l.0 == last.0 && l.1 <= last.1),
+                        "seed {seed}: {l:?} after {last:?}"
+                    );
+                }
+            }
+            assert!(fetches.next().is_none());
         }
     }
 

@@ -9,16 +9,13 @@
 //! image's regions are.
 
 use crate::SimAccel;
-use dualsplit_accel::Structures;
+use crate::memory::Placement;
+pub use crate::rv32::{FRAME_BUFFER_ADDR, LOCAL_STORE_ADDR, PARAMS_ADDR};
+use crate::rv32::{PROGRAM_BASE, Program};
+use dualsplit_accel::{MemoryImage, Structures};
 use dualsplit_render::{FrameConstants, RenderSettings, Workload};
 use dualsplit_scene::Scene;
 
-/// Byte address of the parameter block.
-pub const PARAMS_ADDR: u32 = 0x7000_0000;
-/// Byte address of the frame buffer (3 f32 per pixel, row-major).
-pub const FRAME_BUFFER_ADDR: u32 = 0x7800_0000;
-/// Byte address of a thread's local store (its stack grows down from the top).
-pub const LOCAL_STORE_ADDR: u32 = 0xF000_0000;
 /// Bytes of a thread's local store (`LOCAL_STORE_BYTES` in `kernels/dualsplit.h`): the
 /// deepest traversal stack (256 BVH entries of 8 B or 192 DST entries of 12 B) and the
 /// renderer's frames.
@@ -139,6 +136,24 @@ impl Params {
     pub fn frame_bytes(&self) -> usize {
         self.width as usize * self.height as usize * FRAME_FLOATS_PER_PIXEL * 4
     }
+}
+
+/// Where a frame's regions lie in the caches and DRAM (`memory::placement`): the parameter
+/// block, the program `prog`, the memory `image`, then the frame buffer, from line
+/// boundaries of `line_bytes`.
+pub fn placement(
+    params: &Params,
+    prog: &Program,
+    image: &MemoryImage,
+    line_bytes: u64,
+) -> Placement {
+    let program_bytes = (prog.data_base() - PROGRAM_BASE) as u64 + prog.bytes().len() as u64;
+    Placement::new(
+        params.as_bytes().len() as u64,
+        program_bytes,
+        image.triangles.end as u64 * 4,
+        line_bytes,
+    )
 }
 
 /// The file name of a kernel: `<config>-<workload>.elf`, as `kernels/Makefile` names it.

@@ -35,7 +35,7 @@ use crate::atomic::AtomicUnit;
 use crate::config::UnitConfig;
 use crate::fu::Pools;
 use crate::kernel::Pipe;
-use crate::memory::L2;
+use crate::memory::{L2, Placement};
 use crate::rv32::{
     ExecError, FrameMemory, FuClass, Hart, LOCAL_STORE_ADDR, Latches, Op, Program, Retired,
 };
@@ -89,6 +89,8 @@ pub struct Units<'a> {
     pub l2: &'a mut L2,
     /// The global atomic unit.
     pub atomic: &'a mut AtomicUnit,
+    /// Where the thread's addresses lie in the caches and DRAM.
+    pub placement: &'a Placement,
 }
 
 /// Instructions retired, by [`FuClass`] (indexed by [`crate::rv32::fu_index`]).
@@ -258,7 +260,7 @@ impl Tp {
                 }
                 FuClass::Store => {
                     let i = u.tm.store(
-                        WordAddr::from_byte(r.mem.addr as u64),
+                        WordAddr::from_byte(u.placement.physical(r.mem.addr)),
                         r.mem.words as u64,
                         t,
                         now,
@@ -335,8 +337,13 @@ impl Tp {
 #[inline]
 fn l1_load(u: &mut Units<'_>, r: &Retired, t: Cycle, now: Cycle, stalls: &mut Stalls) -> Issued {
     let words = r.mem.words as u64;
-    let i =
-        u.tm.load(u.l2, WordAddr::from_byte(r.mem.addr as u64), words, t, now);
+    let i = u.tm.load(
+        u.l2,
+        WordAddr::from_byte(u.placement.physical(r.mem.addr)),
+        words,
+        t,
+        now,
+    );
     stalls.l1_bank += i.busy;
     i
 }
@@ -401,6 +408,7 @@ mod tests {
             &mut tps,
             &prog,
             &mut mem,
+            &crate::memory::Placement::new(0, 4 * w.len() as u64, 64, 64),
             &cfg.units,
             &mut counts,
             &mut |_| {},

@@ -6,6 +6,8 @@
 use crate::calibrate::trace_ray;
 use crate::chip::{Chip, WorkSource, run_chip};
 use crate::kernel::{Event, Op, Recorder, Run, Tally};
+use crate::kernels::{Params, elf, placement};
+use crate::rv32::Program;
 use crate::thread::Thread;
 use crate::{SimAccel, SimConfig, SimError, SimResult, ThreadModel};
 use dualsplit_accel::Structures;
@@ -129,6 +131,15 @@ pub(crate) fn run(
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<SimResult, SimError> {
     let total = settings.width as u64 * settings.height as u64;
+    // The compiled kernel's placement of the frame's regions, so that the replayed loads
+    // meet the caches where the kernel's do.
+    let params = Params::new(scene, structures, accel, settings);
+    let placement = placement(
+        &params,
+        &Program::from_elf(elf(accel, settings.workload))?,
+        structures.image(accel.kind()),
+        cfg.l1.line_bytes,
+    );
     let mut chip = Chip::new(cfg, accel.box_pipes(cfg));
     let mut threads: Vec<Thread> = (0..cfg.tms * cfg.tps_per_tm)
         .map(|i| Thread::new((i / cfg.tps_per_tm) as usize))
@@ -145,7 +156,8 @@ pub(crate) fn run(
             structures,
             accel,
             rays: 0,
-            tally: Tally::new(accel, crate::calibrate::costs(accel, settings.workload)?),
+            tally: Tally::new(accel, crate::calibrate::costs(accel, settings.workload)?)
+                .placed_at(placement.image_base(), (params.as_bytes().len() / 4) as u16),
         },
     };
     let cycles = run_chip(&mut chip, &mut threads, &mut work);
@@ -155,6 +167,7 @@ pub(crate) fn run(
     // The measured dependency stalls are part of the issue runs the threads replayed.
     let mut stats = chip.stats();
     stats.stalls.dependency += work.tracer.tally.dependency_cycles();
+    stats.stalls.pipeline_latency += work.tracer.tally.pipeline_cycles();
     Ok(SimResult::assemble(
         accel,
         ThreadModel::Fast,

@@ -65,12 +65,11 @@ fn run(model: ThreadModel, spec: &str, accel: SimAccel, wl: Workload) -> SimResu
 }
 
 /// The `fast` model against the compiled kernels on scenes outside the calibration set:
-/// its issued instructions (all classes) within 10 %. This is
-/// weaker than the bound the model is meant to meet (frame time, energy and DRAM lines
-/// within 10 %), which it does not yet: the ratios are printed, and `docs/simulator.md`
-/// ("The `fast` thread model") gives the measured errors and their causes.
+/// frame time, energy and DRAM lines within 10 % (the bound the `fast` model is built to
+/// meet), and its issued instructions (all classes) too. The ratios are printed;
+/// `docs/simulator.md` ("The `fast` model's calibration") records them.
 #[test]
-fn fast_model_issues_the_kernels_instructions() {
+fn fast_model_is_within_ten_percent_of_the_kernels() {
     let mut failures = Vec::new();
     for spec in [
         "builtin:atrium?triangles=20000",
@@ -81,18 +80,25 @@ fn fast_model_issues_the_kernels_instructions() {
                 let rv32 = run(ThreadModel::Rv32, spec, accel, wl);
                 let fast = run(ThreadModel::Fast, spec, accel, wl);
                 let ratio = |f: u64, r: u64| f as f64 / r.max(1) as f64;
-                let instr = ratio(fast.instructions.mix.total(), rv32.instructions.mix.total());
-                let dep = ratio(fast.stalls.dependency, rv32.stalls.dependency);
-                if (instr - 1.0).abs() > 0.10 {
-                    failures.push(format!("{spec} {wl:?} {accel:?}: instructions {instr:.3}"));
+                let checks = [
+                    (
+                        "instructions",
+                        ratio(fast.instructions.mix.total(), rv32.instructions.mix.total()),
+                    ),
+                    ("frame time", ratio(fast.cycles, rv32.cycles)),
+                    ("energy", fast.energy.total() / rv32.energy.total()),
+                    ("DRAM lines", ratio(fast.dram_lines, rv32.dram_lines)),
+                ];
+                for (what, r) in checks {
+                    if (r - 1.0).abs() > 0.10 || r.is_nan() {
+                        failures.push(format!("{spec} {wl:?} {accel:?}: {what} {r:.3}"));
+                    }
                 }
+                let [i, t, e, d] = checks.map(|c| c.1);
                 eprintln!(
-                    "{spec} {wl:?} {:9}: fast/rv32 instructions {instr:.3}, dependency {dep:.3}, \
-                     frame time {:.3}, energy {:.3}, DRAM lines {:.3}",
+                    "{spec} {wl:?} {:9}: fast/rv32 instructions {i:.3}, frame time {t:.3}, \
+                     energy {e:.3}, DRAM lines {d:.3}",
                     accel.name(),
-                    ratio(fast.cycles, rv32.cycles),
-                    fast.energy.total() / rv32.energy.total(),
-                    ratio(fast.dram_lines, rv32.dram_lines),
                 );
             }
         }

@@ -11,10 +11,12 @@
 pub mod cache;
 pub mod dram;
 pub mod l2;
+pub mod placement;
 
 pub use cache::{Cache, Lookup};
 pub use dram::{Dram, DramAccess, DramStats};
 pub use l2::L2;
+pub use placement::Placement;
 
 use serde::{Deserialize, Serialize};
 
