@@ -55,6 +55,13 @@ pub trait Observer {
     /// memory image (node words, triangle-index entries, triangle vertices).
     #[inline(always)]
     fn fetch(&mut self, _addr: ByteAddr, _bytes: u32) {}
+    /// The kernel reads one child box (`bytes` at `addr`) of the BVH node whose header it
+    /// fetched last, to test it. A serial kernel reads each box as it tests it; a wide-box
+    /// instruction reads the node's boxes at once, so an observer may join them.
+    #[inline(always)]
+    fn fetch_box(&mut self, addr: ByteAddr, bytes: u32) {
+        self.fetch(addr, bytes);
+    }
     /// A node step.
     #[inline(always)]
     fn step(&mut self, _step: NodeStep) {}

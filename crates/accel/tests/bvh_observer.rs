@@ -9,6 +9,7 @@ use dualsplit_geometry::{Pcg32, PrimId, Ray, Triangle, Vec3};
 #[derive(Debug, PartialEq, Clone)]
 enum Ev {
     Fetch(ByteAddr, u32),
+    FetchBox(ByteAddr, u32),
     Step(NodeStep),
     Tri(PrimId, bool),
     Push,
@@ -21,6 +22,9 @@ struct Rec(Vec<Ev>);
 impl Observer for Rec {
     fn fetch(&mut self, addr: ByteAddr, bytes: u32) {
         self.0.push(Ev::Fetch(addr, bytes));
+    }
+    fn fetch_box(&mut self, addr: ByteAddr, bytes: u32) {
+        self.0.push(Ev::FetchBox(addr, bytes));
     }
     fn step(&mut self, s: NodeStep) {
         self.0.push(Ev::Step(s));
@@ -60,10 +64,13 @@ fn single_triangle_event_sequence() {
         let mut rec = Rec::default();
         let hit = s.closest_hit(kind, &ray, &mut rec).unwrap();
         assert_eq!((hit.t, hit.prim), (2.0, PrimId(0)));
+        // The node's header (after its boxes), then the one present child's box.
+        let boxes = 24 * arity as u32;
         assert_eq!(
             rec.0,
             vec![
-                Ev::Fetch(ByteAddr(0), node_bytes),
+                Ev::Fetch(ByteAddr(boxes as u64), node_bytes - boxes),
+                Ev::FetchBox(ByteAddr(0), 24),
                 Ev::Step(NodeStep::Bvh {
                     arity,
                     valid: 1,
@@ -93,14 +100,17 @@ fn fetches_stay_inside_regions_and_match_node_sizes() {
     let s = Structures::build(&tris, &BuildConfig::default());
     for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
         let img = s.image(kind);
-        let node_bytes = s.encoded(kind).expect("a BVH kind").arity as u32 * 24
-            + if kind == AccelKind::Bvh8 { 8 } else { 4 };
+        let arity = s.encoded(kind).expect("a BVH kind").arity as u64;
+        let header_bytes = if kind == AccelKind::Bvh8 { 8 } else { 4 };
         for i in 0..200 {
             let o = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 20.0;
             let d = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5;
             let mut rec = Rec::default();
             let hit = s.closest_hit(kind, &Ray::new(o, d), &mut rec);
             let (mut pushes, mut pops) = (0, 0);
+            // The node whose header was fetched last (its byte address) and the slots of
+            // the boxes fetched since.
+            let (mut node, mut slots) = (None, Vec::new());
             for e in &rec.0 {
                 match *e {
                     Ev::Fetch(ByteAddr(a), b) => {
@@ -108,11 +118,24 @@ fn fetches_stay_inside_regions_and_match_node_sizes() {
                         let end = w + (b / 4) as usize;
                         let inside = |r: &std::ops::Range<usize>| r.start <= w && end <= r.end;
                         assert!(
-                            (inside(&img.nodes) && (b == node_bytes || b == 4))
+                            (inside(&img.nodes) && (b == header_bytes || b == 4))
                                 || inside(&img.indices)
                                 || (inside(&img.triangles) && b == 36),
                             "{kind:?} ray {i}: fetch {a}+{b}"
                         );
+                        node = (b == header_bytes && inside(&img.nodes)).then(|| a - 24 * arity);
+                        slots.clear();
+                    }
+                    Ev::FetchBox(ByteAddr(a), b) => {
+                        let n = node.expect("a box is fetched after its node's header");
+                        assert!(b == 24 && a >= n && (a - n) % 24 == 0, "{kind:?} ray {i}");
+                        let k = (a - n) / 24;
+                        assert!(k < arity && slots.last().is_none_or(|&j| j < k));
+                        slots.push(k);
+                    }
+                    Ev::Step(NodeStep::Bvh { valid, .. }) => {
+                        // Every present child's box, each once, in slot order.
+                        assert_eq!(slots.len(), valid as usize, "{kind:?} ray {i}");
                     }
                     Ev::Push => pushes += 1,
                     Ev::Pop => pops += 1,

@@ -508,6 +508,8 @@ pub struct Recorder<'a> {
     /// The last fetch (physical word address, words): the measured extra L1 words are
     /// re-reads of it.
     last: (u32, u16),
+    /// Boxes fetched since the last other fetch (a BVH node's header).
+    boxes: u8,
 }
 
 /// An instruction run being merged, fixed point (see [`Recorder`]).
@@ -559,6 +561,7 @@ impl<'a> Recorder<'a> {
             dst_hw: accel == SimAccel::Dst,
             parallel_boxes: accel.parallel_boxes(),
             last,
+            boxes: 0,
         }
     }
 
@@ -657,11 +660,9 @@ impl<'a> Recorder<'a> {
         self.reread();
         self.ops.push(op);
     }
-}
-
-impl Observer for Recorder<'_> {
+    /// Appends the load of the words holding `bytes` bytes at image address `addr`.
     #[inline(always)]
-    fn fetch(&mut self, ByteAddr(addr): ByteAddr, bytes: u32) {
+    fn load(&mut self, ByteAddr(addr): ByteAddr, bytes: u32) {
         let addr = addr + self.tally.image_base;
         // Words from the one holding byte `addr` to the one holding byte `addr + bytes − 1`.
         let words = ((addr & 3) + bytes as u64).div_ceil(4);
@@ -680,15 +681,75 @@ impl Observer for Recorder<'_> {
         }
     }
 
+    /// Widens the last op, a load, to cover the words holding `bytes` bytes at image address
+    /// `addr` too; false (nothing changed) when the union does not fit one load op.
+    #[inline(always)]
+    fn join(&mut self, ByteAddr(addr): ByteAddr, bytes: u32) -> bool {
+        let addr = addr + self.tally.image_base;
+        let (word, end) = (addr / 4, (addr + bytes as u64).div_ceil(4));
+        let Some(Op::Load {
+            word: w0,
+            words: n0,
+        }) = self.ops.last_mut()
+        else {
+            return false;
+        };
+        let start = word.min(*w0 as u64);
+        let stop = end.max(*w0 as u64 + *n0 as u64);
+        let (Ok(start), Ok(n)) = (u32::try_from(start), u16::try_from(stop - start)) else {
+            return false;
+        };
+        self.tally.counts.loads += n as u64 - *n0 as u64;
+        (*w0, *n0) = (start, n);
+        self.last = (start, n);
+        true
+    }
+}
+
+impl Observer for Recorder<'_> {
+    #[inline(always)]
+    fn fetch(&mut self, addr: ByteAddr, bytes: u32) {
+        self.boxes = 0;
+        self.load(addr, bytes);
+    }
+
+    /// The kernels read a BVH node's header and use it (the child slots' kinds and the
+    /// children's offset) before they read a box: the first box waits for the header's
+    /// words. A serial kernel then tests each box as it has read it, one after another; the
+    /// "+" kernels' wide-box instruction reads the node's boxes together, so a box joins the
+    /// previous box's load.
+    #[inline(always)]
+    fn fetch_box(&mut self, addr: ByteAddr, bytes: u32) {
+        let loaded_last = !self.open
+            && matches!(self.ops.last(), Some(&Op::Load { word, words }) if (word, words) == self.last);
+        let first = self.boxes == 0;
+        self.boxes = self.boxes.saturating_add(1);
+        if first && loaded_last {
+            // Waits for the header's words, issues nothing.
+            self.ops.push(Op::Issue { n: 0, fpinv: 0 });
+        } else if self.parallel_boxes && loaded_last && self.join(addr, bytes) {
+            return;
+        }
+        self.load(addr, bytes);
+        if !self.parallel_boxes {
+            self.push_op(Op::Pipe {
+                pipe: Pipe::Box,
+                n: 1,
+                parallel: false,
+            });
+        }
+    }
+
     #[inline(always)]
     fn step(&mut self, step: NodeStep) {
         match step {
             NodeStep::Bvh { valid, hits, .. } => {
-                if valid != 0 {
+                // Serial box tests were recorded with their boxes' fetches.
+                if valid != 0 && self.parallel_boxes {
                     self.push_op(Op::Pipe {
                         pipe: Pipe::Box,
                         n: valid,
-                        parallel: self.parallel_boxes,
+                        parallel: true,
                     });
                     self.tally.boxed_nodes += 1;
                 }

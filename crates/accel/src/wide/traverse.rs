@@ -2,7 +2,7 @@
 //! reading nodes, leaf words, index runs and triangles from the [`MemoryImage`] and telling
 //! the [`Observer`] every fetch and step (the one-traversal contract: README, "What is where").
 //!
-//! Per internal node: fetch the node, slab-test every non-empty child box against
+//! Per internal node: fetch the node's header, fetch and slab-test every non-empty child box against
 //! `[ray.t_min, cull_limit(best_t)]` (the arithmetic of [`dualsplit_geometry::RayPre::slab`],
 //! whose far-plane exits are widened by `1 + 2γ₃` (Ize 2013) so a ray aimed at a vertex on a
 //! box corner is never rounded away, evaluated on the node's stored box words by `BoxSlab`:
@@ -128,7 +128,13 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
             continue;
         }
         let w = e.word as usize;
-        obs.fetch(MemoryImage::addr(w), (L::WORDS * 4) as u32);
+        // The node's header (after its boxes in every layout), then each present child's
+        // box as it is tested.
+        let boxes = 6 * L::ARITY;
+        obs.fetch(
+            MemoryImage::addr(w + boxes),
+            ((L::WORDS - boxes) * 4) as u32,
+        );
         let node = L::read(words, w);
         // The hit children: the nearest in `near`, the others on the stack above `base`,
         // nearest on top; order by entry distance, ties in slot order.
@@ -144,6 +150,7 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
                 let kind = node.kind(k);
                 if kind != ChildKind::Empty {
                     valid += 1;
+                    obs.fetch_box(MemoryImage::addr(w + 6 * k), 24);
                     let (entry, exit) = if fast {
                         slab.test(node.box_words(k), ray.t_min, limit)
                     } else {
