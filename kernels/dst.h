@@ -12,11 +12,8 @@
 static int traverse(const struct Ray *ray, const struct RayPre *r, int any, struct Hit *best)
 {
     const struct Params *P = PARAMS;
-    if (P->nodes_end == P->nodes_start)
-        return 0;
     float t_min, t_max;
-    scene_slab(r, ray->t_min, cull_limit(ray->t_max), &t_min, &t_max);
-    if (t_min > t_max)
+    if (!dst_clip(ray, r, &t_min, &t_max))
         return 0;
     struct Entry stack[STACK_SIZE];
     int sp = 0;

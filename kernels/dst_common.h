@@ -32,6 +32,18 @@ static void scene_slab(const struct RayPre *r, float t_lo, float t_hi, float *en
     *exit = hi;
 }
 
+/* The start of both traversals: the ray's interval clipped to the scene box in *t_min,
+ * *t_max; 0 when the tree is empty or the ray misses the box (nothing to traverse). */
+static inline int dst_clip(const struct Ray *ray, const struct RayPre *r, float *t_min,
+                           float *t_max)
+{
+    const struct Params *P = PARAMS;
+    if (P->nodes_end == P->nodes_start)
+        return 0;
+    scene_slab(r, ray->t_min, cull_limit(ray->t_max), t_min, t_max);
+    return !(*t_min > *t_max);
+}
+
 /* Intersects the triangle run starting at index entry `first` on [ray.t_min, best_t];
  * returns 1 when an any-hit traversal is done. */
 static inline int test_run(uint32_t first, float t_lo, int any, int *have, struct Hit *best,

@@ -820,10 +820,35 @@ mod tests {
         per_event
     }
 
+    /// A random stream of events of `seed` recorded for `accel` with `costs`, cut into
+    /// recordings at random points (as a pixel's rays are), each continuing the previous
+    /// one's open run: the ops, the tally and the last open run.
+    fn random_stream(
+        seed: u64,
+        accel: SimAccel,
+        costs: &'static Costs,
+    ) -> (Vec<Op>, Tally, Option<Run>) {
+        let (mut ops, mut run) = (Vec::new(), None);
+        let mut tally = Tally::new(accel, costs);
+        let (mut rng, mut cuts) = (Pcg32::new(seed, 1), Pcg32::new(seed, 2));
+        let mut left = 1 + Pcg32::new(seed, 7).below(300);
+        while left > 0 {
+            let n = (1 + cuts.below(40)).min(left);
+            left -= n;
+            let mut r = Recorder::resume(&mut tally, &mut ops, run);
+            for _ in 0..n {
+                random_event(&mut rng, &mut r);
+            }
+            run = r.finish_open();
+        }
+        (ops, tally, run)
+    }
+
     /// One random traversal or workload event.
     fn random_event(rng: &mut Pcg32, r: &mut Recorder) {
-        match rng.below(8) {
+        match rng.below(9) {
             0 => r.fetch(ByteAddr(rng.below(1 << 20) as u64), rng.below(220)),
+            8 => r.fetch_box(ByteAddr(4 * rng.below(1 << 18) as u64), 24),
             1 => {
                 let arity = [2u8, 4, 8][rng.below(3) as usize];
                 let valid = rng.below(arity as u32 + 1) as u8;
@@ -860,22 +885,7 @@ mod tests {
         for seed in 0..40u64 {
             for accel in SimAccel::ALL {
                 let costs = random_costs(seed);
-                let events = 1 + Pcg32::new(seed, 7).below(300);
-                // The stream cut into recordings at random points (as a pixel's rays are),
-                // each continuing the previous one's open run.
-                let (mut ops, mut run) = (Vec::new(), None);
-                let mut tally = Tally::new(accel, costs);
-                let (mut rng, mut cuts) = (Pcg32::new(seed, 1), Pcg32::new(seed, 2));
-                let mut left = events;
-                while left > 0 {
-                    let n = (1 + cuts.below(40)).min(left);
-                    left -= n;
-                    let mut r = Recorder::resume(&mut tally, &mut ops, run);
-                    for _ in 0..n {
-                        random_event(&mut rng, &mut r);
-                    }
-                    run = r.finish_open();
-                }
+                let (mut ops, tally, run) = random_stream(seed, accel, costs);
                 ops.extend(run.and_then(Run::op));
                 assert_eq!(tally.error(), None);
                 let fixed: u64 = (0..EVENTS)
@@ -924,19 +934,7 @@ mod tests {
             }
             let no_extra: &'static Costs = Box::leak(Box::new(Costs::from_fixed(fixed)));
             let record = |costs: &'static Costs| {
-                let (mut ops, mut run) = (Vec::new(), None);
-                let mut tally = Tally::new(accel, costs);
-                let (mut rng, mut cuts) = (Pcg32::new(seed, 1), Pcg32::new(seed, 2));
-                let mut left = 1 + Pcg32::new(seed, 7).below(300);
-                while left > 0 {
-                    let n = (1 + cuts.below(40)).min(left);
-                    left -= n;
-                    let mut r = Recorder::resume(&mut tally, &mut ops, run);
-                    for _ in 0..n {
-                        random_event(&mut rng, &mut r);
-                    }
-                    run = r.finish_open();
-                }
+                let (ops, tally, _) = random_stream(seed, accel, costs);
                 let loaded: u64 = ops
                     .iter()
                     .map(|op| match op {
