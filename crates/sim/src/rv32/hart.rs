@@ -323,6 +323,33 @@ impl Hart {
         }
     }
 
+    /// Checks that `addr` is aligned to its `bytes` and notes the one-word access in `acc`;
+    /// the offset in the local store when `addr` is the local store's.
+    #[inline(always)]
+    fn begin_access(
+        &self,
+        addr: u32,
+        bytes: u32,
+        store: bool,
+        acc: &mut MemAccess,
+    ) -> Result<Option<usize>, ExecError> {
+        if addr & (bytes - 1) != 0 {
+            return Err(ExecError::Misaligned {
+                pc: self.pc,
+                addr,
+                bytes,
+            });
+        }
+        let local = addr >= LOCAL_STORE_ADDR;
+        *acc = MemAccess {
+            addr,
+            words: 1,
+            store,
+            local,
+        };
+        Ok(local.then(|| (addr - LOCAL_STORE_ADDR) as usize))
+    }
+
     /// Loads `N` bytes at `addr` (aligned to `N`): local store, program, or global memory.
     #[inline(always)]
     fn load<const N: usize, M: Memory>(
@@ -332,22 +359,7 @@ impl Hart {
         addr: u32,
         acc: &mut MemAccess,
     ) -> Result<[u8; N], ExecError> {
-        if addr & (N as u32 - 1) != 0 {
-            return Err(ExecError::Misaligned {
-                pc: self.pc,
-                addr,
-                bytes: N as u32,
-            });
-        }
-        *acc = MemAccess {
-            addr,
-            words: 1,
-            store: false,
-            local: false,
-        };
-        if addr >= LOCAL_STORE_ADDR {
-            acc.local = true;
-            let o = (addr - LOCAL_STORE_ADDR) as usize;
+        if let Some(o) = self.begin_access(addr, N as u32, false, acc)? {
             return self
                 .local
                 .get(o..o + N)
@@ -372,22 +384,7 @@ impl Hart {
         bytes: [u8; N],
         acc: &mut MemAccess,
     ) -> Result<(), ExecError> {
-        if addr & (N as u32 - 1) != 0 {
-            return Err(ExecError::Misaligned {
-                pc: self.pc,
-                addr,
-                bytes: N as u32,
-            });
-        }
-        *acc = MemAccess {
-            addr,
-            words: 1,
-            store: true,
-            local: false,
-        };
-        if addr >= LOCAL_STORE_ADDR {
-            acc.local = true;
-            let o = (addr - LOCAL_STORE_ADDR) as usize;
+        if let Some(o) = self.begin_access(addr, N as u32, true, acc)? {
             let pc = self.pc;
             self.local
                 .get_mut(o..o + N)
