@@ -34,8 +34,6 @@ pub const FULL_SCENES: [&str; 3] = ["builtin:atrium", "builtin:forest", "builtin
 pub const FULL_FILES: [&str; 2] = ["dragon_box.ply.gz", "dragon_sponza.ply.gz"];
 /// The paper's resolution (§4.3).
 pub const FULL_RES: u32 = 1024;
-/// Default TM counts (Table 7).
-pub const DEFAULT_TMS: [u32; 3] = [32, 64, 128];
 /// Square resolution of the CPU ray sets (path workload rays).
 pub const CPU_RES: u32 = 64;
 /// Simulated rays per second of wall time on a 2-core machine, two simulations side by side,
@@ -50,11 +48,13 @@ pub const SIM_RAYS_PER_SECOND_RV32: f64 = 14_000.0;
 /// Arguments of `dualsplit report`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scenes: files (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
-    /// Default: the builtins at reduced sizes (see `DEFAULT_SCENES`).
+    /// Scenes: files (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
+    /// (hairball, forest, atrium, cornell). Without any: the atrium, forest and hairball
+    /// builtins at reduced sizes.
+    #[arg(value_parser = crate::args::parse_scene)]
     scenes: Vec<String>,
     /// Square resolution of the simulated frames (default 128, 1024 with --full).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::args::parse_positive)]
     res: Option<u32>,
     /// The paper's setup: 1024×1024, full-size scenes, 32/64/128 TMs.
     #[arg(long)]
@@ -63,7 +63,7 @@ pub struct Args {
     #[arg(long, default_value = "report")]
     out: PathBuf,
     /// TM counts of the scaling study (Table 7); Tables 4–6 use 64 when listed.
-    #[arg(long, value_delimiter = ',', default_values_t = DEFAULT_TMS)]
+    #[arg(long, value_delimiter = ',', default_value = "32,64,128", value_parser = crate::args::parse_positive)]
     tms: Vec<u32>,
     /// Thread model: rv32 (the compiled kernels instruction by instruction, the reference)
     /// or fast (the macro-op replay: about 8× faster, an uncalibrated approximation).
@@ -109,6 +109,7 @@ fn shared_scene(file: &str) -> Option<String> {
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let start = Instant::now();
+    crate::output::prepare_dir(&args.out, "--out")?;
     if args.tms.is_empty() || args.tms.contains(&0) {
         anyhow::bail!("--tms needs positive TM counts, e.g. --tms 32,64,128");
     }

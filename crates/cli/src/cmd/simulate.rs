@@ -1,4 +1,6 @@
 //! `dualsplit simulate`: one frame on the TRaX-style many-core model (Lin et al. 2020, §4).
+use crate::args::{SimAccelArg, parse_sim_accel, sim_accels};
+use crate::output::JsonOut;
 use crate::progress::Ctx;
 use anyhow::{Context, bail};
 use dualsplit_render::{RenderSettings, Workload};
@@ -9,11 +11,14 @@ use std::time::{Duration, Instant};
 /// Arguments of `dualsplit simulate`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
+    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
+    /// (hairball, forest, atrium, cornell).
+    #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
-    /// Configuration: bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst, or all (two at a time).
-    #[arg(long, default_value = "dst")]
-    accel: String,
+    /// Configurations, comma-separated: bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst,
+    /// or all (simulated two at a time).
+    #[arg(long, value_delimiter = ',', default_value = "dst", value_parser = parse_sim_accel)]
+    accel: Vec<SimAccelArg>,
     /// Workload: cast (primary + shadow ray) or path (5 diffuse bounces).
     #[arg(long, default_value = "path")]
     workload: String,
@@ -30,24 +35,15 @@ pub struct Args {
     /// or fast (the macro-op replay).
     #[arg(long, default_value = "rv32")]
     model: String,
-    /// Print JSON (an array of results) instead of a table.
-    #[arg(long)]
-    json: bool,
+    /// Print JSON instead of a table; `--json=FILE` writes it to FILE.
+    #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true, default_missing_value = "-")]
+    json: Option<std::path::PathBuf>,
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
-    let accels: Vec<SimAccel> = if args.accel == "all" {
-        SimAccel::ALL.to_vec()
-    } else {
-        match SimAccel::parse(&args.accel) {
-            Some(a) => vec![a],
-            None => bail!(
-                "unknown --accel `{}` (expected bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst or all)",
-                args.accel
-            ),
-        }
-    };
+    let accels = sim_accels(&args.accel);
+    let json = JsonOut::from_arg(args.json.as_deref())?;
     let workload = match args.workload.as_str() {
         "cast" => Workload::Cast,
         "path" => Workload::Path,
@@ -116,9 +112,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         }
     }
 
-    if args.json {
+    if let Some(out) = json {
         let results: Vec<&SimResult> = results.iter().map(|(r, _)| r).collect();
-        println!("{}", serde_json::to_string_pretty(&results)?);
+        out.emit(&serde_json::to_string_pretty(&results)?)?;
     } else {
         println!(
             "scene {} ({} triangles), {}×{} {}, {} TMs × {} TPs, {} thread model",
