@@ -239,3 +239,73 @@ fn help_texts_name_no_internal_identifier() {
         assert!(bad.is_empty(), "internal identifiers {bad:?} in:\n{help}");
     }
 }
+
+#[test]
+fn simulate_compares_configurations_and_keeps_every_number_in_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let common = ["--res", "8x4", "--model", "fast", "--workload", "cast"];
+    let mut args = vec!["simulate", "builtin:cornell", "--accel", "all"];
+    args.extend(common);
+    let o = dualsplit(&args, dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("8×4 cast"), "{out}");
+    let table = out
+        .split("comparison (")
+        .nth(1)
+        .expect("a comparison after several configurations");
+    assert!(table.starts_with("frame time, energy and DRAM lines as % of BVH2"));
+    let rows: Vec<&str> = table
+        .lines()
+        .skip(2)
+        .take_while(|l| !l.starts_with("note"))
+        .collect();
+    assert_eq!(rows.len(), 8, "{table}");
+    assert!(
+        rows[0].starts_with("BVH2 ") && rows[0].contains("100.0 %"),
+        "{table}"
+    );
+    assert!(rows[7].starts_with("DST "), "{table}");
+    // 32 pixels on 2048 threads: the chip is idle, and the output says so.
+    assert!(out.contains("note: threads sat idle"), "{out}");
+
+    // --json: settings, every result and the comparison; DST first, so BVH2 is still the
+    // baseline; the camera override is applied.
+    let mut args = vec![
+        "simulate",
+        "builtin:cornell",
+        "--accel",
+        "dst,bvh2",
+        "--eye",
+        "0,1,3.5",
+        "--json",
+    ];
+    args.extend(common);
+    let o = dualsplit(&args, dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("only JSON on stdout");
+    assert_eq!(
+        (v["width"].as_u64(), v["height"].as_u64()),
+        (Some(8), Some(4))
+    );
+    assert_eq!(v["workload"], "cast");
+    assert_eq!(v["camera"]["eye"], serde_json::json!([0.0, 1.0, 3.5]));
+    assert_eq!(v["results"].as_array().map(Vec::len), Some(2));
+    assert_eq!(v["summary"]["baseline"], "bvh2");
+    let rows = v["summary"]["rows"].as_array().unwrap();
+    assert_eq!(rows[0]["accel"], "dst");
+    assert_eq!(rows[1]["frame_vs_baseline"].as_f64(), Some(1.0));
+    let dst_ms = v["results"][0]["frame_ms"].as_f64().unwrap();
+    let bvh_ms = v["results"][1]["frame_ms"].as_f64().unwrap();
+    assert_eq!(rows[0]["frame_vs_baseline"].as_f64(), Some(dst_ms / bvh_ms));
+    assert!(rows[0]["stalls"]["idle_at_end"].as_f64().unwrap() > 0.5);
+    assert!(v["config"]["dram"]["e_read_nj"].as_f64().is_some());
+
+    // A bad camera is refused before anything is simulated.
+    let o = dualsplit(
+        &["simulate", "builtin:cornell", "--eye", "0,0", "--res", "4"],
+        dir.path(),
+    );
+    assert!(!o.status.success());
+    assert!(stdout(&o).is_empty(), "{}", stdout(&o));
+}

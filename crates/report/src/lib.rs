@@ -31,6 +31,7 @@ pub mod paper;
 pub mod produce;
 pub mod summary;
 pub mod tables;
+pub mod units;
 pub mod write;
 
 pub use cache::{Cache, CacheKey};
