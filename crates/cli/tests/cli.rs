@@ -309,3 +309,55 @@ fn simulate_compares_configurations_and_keeps_every_number_in_json() {
     assert!(!o.status.success());
     assert!(stdout(&o).is_empty(), "{}", stdout(&o));
 }
+
+#[test]
+fn report_says_which_paper_meshes_it_found_and_where() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = dir.path().join("meshes");
+    std::fs::create_dir_all(&scenes).unwrap();
+    std::fs::write(scenes.join("dragon_box.ply.gz"), "").unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "report",
+            "builtin:cornell",
+            "--res",
+            "4",
+            "--tms",
+            "1,2",
+            "--model",
+            "fast",
+            "--out",
+            "r",
+        ];
+        args.extend(extra);
+        Command::new(env!("CARGO_BIN_EXE_dualsplit"))
+            .args(&args)
+            .current_dir(dir.path())
+            .env("DUALSPLIT_SCENES", &scenes)
+            .output()
+            .unwrap()
+    };
+    let o = run(&[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = std::fs::read_to_string(dir.path().join("r/report.md")).unwrap();
+    let want = format!(
+        "Scenes folder {} (given by DUALSPLIT_SCENES). Paper meshes found: Dragon Box",
+        scenes.display()
+    );
+    assert!(md.contains(&want), "{md}");
+    assert!(md.contains("Not found: Dragon Sponza"), "{md}");
+    assert!(stderr(&o).contains(&want), "{}", stderr(&o));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r/results.json")).unwrap())
+            .unwrap();
+    assert_eq!(json["scene_files"]["source"], "env");
+
+    // --scenes wins over the variable, and must name a folder.
+    let o = run(&["--scenes", "nowhere"]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("--scenes nowhere: no such directory"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -22,6 +22,9 @@ pub struct ReportData {
     pub scenes: Vec<SceneReport>,
     /// Scenes that could not be loaded (default builtins that are not available).
     pub skipped: Vec<Skipped>,
+    /// Where the paper's meshes were looked for and which were found.
+    #[serde(default)]
+    pub scene_files: crate::scenes::SceneFiles,
     /// The paper's published values (Lin et al. 2020, Tables 3–7).
     pub paper: PaperValues,
 }

@@ -118,6 +118,11 @@ scenes marked “stand-in” are not the paper's meshes, so compare trends rathe
         },
         esc(&data.code_version)
     );
+    let _ = writeln!(
+        h,
+        "<p class=\"meta\" id=\"scene-files\">{}</p>",
+        esc(&data.scene_files.describe())
+    );
     if let Some(e) = data.sim_error() {
         let _ = writeln!(h, "<p class=\"warn\" id=\"sim-unavailable\">{}</p>", esc(e));
     }

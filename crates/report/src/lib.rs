@@ -29,6 +29,7 @@ mod error;
 pub mod html;
 pub mod paper;
 pub mod produce;
+pub mod scenes;
 pub mod summary;
 pub mod tables;
 pub mod units;

@@ -358,6 +358,7 @@ impl<'a> Producer<'a> {
             settings: self.settings.clone(),
             scenes: out,
             skipped,
+            scene_files: Default::default(),
             paper: PaperValues::published(),
         })
     }

@@ -114,6 +114,7 @@ fn synthetic_report() -> ReportData {
             synthetic_scene("atrium", "builtin:atrium", 2, &tms),
         ],
         skipped: vec![],
+        scene_files: Default::default(),
         paper: PaperValues::published(),
     }
 }
