@@ -110,6 +110,7 @@ pub struct StructureSize {
     /// The structure.
     pub kind: AccelKind,
     /// Bytes of nodes plus triangle-index lists, or why it is unknown.
+    #[serde(with = "crate::plain")]
     pub bytes: Result<u64, String>,
 }
 
@@ -123,6 +124,7 @@ pub struct Throughput {
     /// Rays in the set.
     pub rays: u64,
     /// Millions of rays per second, or why it was not timed (e.g. hits differ from BVH2).
+    #[serde(with = "crate::plain")]
     pub mrays_per_s: Result<f64, String>,
 }
 
@@ -136,6 +138,7 @@ pub struct SimRun {
     /// TM count.
     pub tms: u32,
     /// The result, or "simulator unavailable: <error>".
+    #[serde(with = "crate::plain")]
     pub result: Result<SimResult, String>,
 }
 

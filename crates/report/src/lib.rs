@@ -28,6 +28,7 @@ pub mod data;
 mod error;
 pub mod html;
 pub mod paper;
+mod plain;
 pub mod produce;
 pub mod scenes;
 pub mod summary;
