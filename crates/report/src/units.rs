@@ -53,6 +53,23 @@ pub fn count(n: f64) -> String {
     }
 }
 
+/// An axis tick: at most three decimals, trailing zeros dropped, thousands as K and
+/// millions as M (`80000` → `80K`, `0.25` → `0.25`).
+pub fn compact(v: f64) -> String {
+    let trim = |x: f64| {
+        let s = format!("{x:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    let a = v.abs();
+    if a >= 1e6 {
+        format!("{}M", trim(v / 1e6))
+    } else if a >= 1e3 {
+        format!("{}K", trim(v / 1e3))
+    } else {
+        trim(v)
+    }
+}
+
 /// The unit and scale that show every value of `values` (ms) as a number of about three
 /// digits: `("µs", 1e3)` when all are below a millisecond, `("s", 1e-3)` when all are at
 /// least a second, else `("ms", 1.0)`. For chart axes and table columns, which need one unit.
@@ -91,6 +108,16 @@ pub fn count_unit(values: &[f64]) -> (&'static str, f64) {
     }
 }
 
+/// Like [`time_unit`] for sizes given in bytes: KiB when all are below a MiB, else MiB.
+pub fn bytes_unit(values: &[f64]) -> (&'static str, f64) {
+    let max = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if max < 1024.0 * 1024.0 {
+        ("KiB", 1.0 / 1024.0)
+    } else {
+        ("MiB", 1.0 / (1024.0 * 1024.0))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -107,10 +134,16 @@ mod tests {
         assert_eq!(count(850.0), "850");
         assert_eq!(count(12_345.0), "12.3K");
         assert_eq!(count(4_560_000.0), "4.56M");
+        assert_eq!(compact(80_000.0), "80K");
+        assert_eq!(compact(1_250_000.0), "1.25M");
+        assert_eq!(compact(0.25), "0.25");
+        assert_eq!(compact(120.0), "120");
         assert_eq!(time_unit(&[0.2, 0.9]), ("µs", 1e3));
         assert_eq!(time_unit(&[0.2, 9.0]), ("ms", 1.0));
         assert_eq!(energy_unit(&[0.02, 0.5]), ("mJ", 1e3));
         assert_eq!(count_unit(&[2e6, 3e5]), ("M", 1e-6));
         assert_eq!(count_unit(&[2e4, 3e3]), ("K", 1e-3));
+        assert_eq!(bytes_unit(&[2048.0]), ("KiB", 1.0 / 1024.0));
+        assert_eq!(bytes_unit(&[3e6, 2048.0]).0, "MiB");
     }
 }

@@ -34,7 +34,7 @@ pub const FULL_SCENES: [&str; 3] = ["builtin:atrium", "builtin:forest", "builtin
 /// The paper's resolution (§4.3).
 pub const FULL_RES: u32 = 1024;
 /// Square resolution of the CPU ray sets (path workload rays).
-pub const CPU_RES: u32 = 64;
+pub const CPU_RES: u32 = 320;
 /// Simulated rays per second of wall time on a 2-core machine, two simulations side by side,
 /// with the `fast` thread model; used only for the `--full` up-front estimate. Measured:
 /// about 38K simulated rays per CPU second (release build, `lin2020` config, the default
