@@ -1,10 +1,13 @@
 //! The `dualsplit` command line. Each subcommand lives in `cmd/<name>.rs` with its own
 //! arguments; this file only parses and dispatches.
 
+mod args;
 mod cmd;
+mod lists;
+mod output;
 mod progress;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
 /// dualsplit: dual-split trees, BVHs and a TRaX-style hardware simulator.
 #[derive(Parser)]
@@ -38,6 +41,21 @@ enum Command {
 }
 
 fn main() -> std::process::ExitCode {
+    let raw: Vec<String> = std::env::args_os()
+        .skip(1)
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect();
+    if let Some(msg) = lists::space_separated(&raw) {
+        // The error shows the subcommand's usage line when there is one.
+        let mut cmd = Cli::command();
+        cmd.build();
+        let sub = raw.iter().find(|a| !a.starts_with('-')).cloned();
+        let kind = clap::error::ErrorKind::ValueValidation;
+        match sub.and_then(|s| cmd.find_subcommand_mut(&s).cloned()) {
+            Some(mut sub) => sub.error(kind, msg).exit(),
+            None => cmd.error(kind, msg).exit(),
+        }
+    }
     let cli = Cli::parse();
     let ctx = progress::Ctx::new(cli.quiet);
     let result = match cli.command {

@@ -3,6 +3,7 @@
 //!
 //! * Figures 7 and 8 (Lin et al. 2020, §4.3–4.4): bars of frame time and energy per
 //!   configuration as % of BVH2, one panel per scene; ours solid, the paper's faded beside.
+//!   The same chart of DRAM lines read (the paper gives those in Tables 4 and 5 only).
 //! * Figure 9 (§4.5): frames per second vs TM count, one line per configuration; ours on the
 //!   left, the paper's corresponding scene on the right.
 
@@ -10,6 +11,7 @@ use crate::ReportError;
 use crate::data::{ReportData, SceneReport};
 use crate::paper::{self, Metric};
 use crate::tables::metric;
+use crate::units;
 use dualsplit_render::Workload;
 use dualsplit_sim::SimAccel;
 use plotters::prelude::*;
@@ -41,12 +43,6 @@ pub fn color(a: SimAccel) -> RGBColor {
     }
 }
 
-/// An axis tick: at most three decimals, trailing zeros dropped.
-fn tick(v: f64) -> String {
-    let s = format!("{v:.3}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
-}
-
 fn chart_err(chart: &str) -> impl Fn(String) -> ReportError + '_ {
     move |message| ReportError::Chart {
         chart: chart.to_string(),
@@ -54,7 +50,8 @@ fn chart_err(chart: &str) -> impl Fn(String) -> ReportError + '_ {
     }
 }
 
-/// Figure 7 (`Cast`) or 8 (`Path`) for `metric` (frame time or energy): one panel per scene
+/// Figure 7 (`Cast`) or 8 (`Path`) for `metric` (frame time, energy or DRAM lines): one
+/// panel per scene
 /// with simulated results. `None` when no scene has results.
 pub fn fig78(
     data: &ReportData,
@@ -133,7 +130,7 @@ pub fn fig78(
                 })
                 .y_label_formatter(&|y| format!("{y:.0}%"))
                 .light_line_style(WHITE.mix(0.0))
-                .y_desc(format!("{} (% of BVH2)", metric_kind.label()))
+                .y_desc(format!("{} (% of BVH2)", metric_kind.name()))
                 .axis_desc_style(("sans-serif", 12))
                 .draw()
                 .map_err(|e| err(e.to_string()))?;
@@ -170,18 +167,24 @@ fn fps_panel(
         .flat_map(|(_, p)| p.iter().map(|q| q.1))
         .fold(0.0f64, f64::max)
         * 1.1;
-    let pad = (xmax - xmin).max(1.0) * 0.04;
+    // TM counts double from one run to the next: a log axis spaces them evenly, with a
+    // tick at each count that was run and none elsewhere.
+    let pad = (xmax / xmin).max(2.0).powf(0.06);
+    let ticks: Vec<f64> = tms.iter().map(|&t| f64::from(t)).collect();
+    let x_axis = ((xmin / pad)..(xmax * pad))
+        .log_scale()
+        .with_key_points(ticks);
     let mut chart = ChartBuilder::on(panel)
         .caption(title, ("sans-serif", 15))
         .margin(8)
         .x_label_area_size(30)
         .y_label_area_size(52)
-        .build_cartesian_2d((xmin - pad)..(xmax + pad), 0f64..ymax.max(1e-9))
+        .build_cartesian_2d(x_axis, 0f64..ymax.max(1e-9))
         .map_err(|e| err(e.to_string()))?;
     chart
         .configure_mesh()
         .x_label_formatter(&|x| format!("{x:.0}"))
-        .y_label_formatter(&|y| tick(*y))
+        .y_label_formatter(&|y| units::compact(*y))
         .light_line_style(WHITE.mix(0.0))
         .x_desc("TMs")
         .y_desc("frames per second")

@@ -22,6 +22,9 @@ pub struct ReportData {
     pub scenes: Vec<SceneReport>,
     /// Scenes that could not be loaded (default builtins that are not available).
     pub skipped: Vec<Skipped>,
+    /// Where the paper's meshes were looked for and which were found.
+    #[serde(default)]
+    pub scene_files: crate::scenes::SceneFiles,
     /// The paper's published values (Lin et al. 2020, Tables 3–7).
     pub paper: PaperValues,
 }
@@ -107,6 +110,7 @@ pub struct StructureSize {
     /// The structure.
     pub kind: AccelKind,
     /// Bytes of nodes plus triangle-index lists, or why it is unknown.
+    #[serde(with = "crate::plain")]
     pub bytes: Result<u64, String>,
 }
 
@@ -120,6 +124,7 @@ pub struct Throughput {
     /// Rays in the set.
     pub rays: u64,
     /// Millions of rays per second, or why it was not timed (e.g. hits differ from BVH2).
+    #[serde(with = "crate::plain")]
     pub mrays_per_s: Result<f64, String>,
 }
 
@@ -133,6 +138,7 @@ pub struct SimRun {
     /// TM count.
     pub tms: u32,
     /// The result, or "simulator unavailable: <error>".
+    #[serde(with = "crate::plain")]
     pub result: Result<SimResult, String>,
 }
 

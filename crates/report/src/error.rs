@@ -53,6 +53,14 @@ pub enum ReportError {
         /// What failed.
         message: String,
     },
+    /// A scenes folder named by `--scenes` or `DUALSPLIT_SCENES` is not a folder.
+    #[error("{what} {path}: no such directory")]
+    ScenesDir {
+        /// The folder.
+        path: PathBuf,
+        /// Where it was named.
+        what: String,
+    },
     /// A structure returned a different hit than BVH2 for some ray, so it is not timed.
     #[error("{structure} disagrees with BVH2 on {mismatches} of {rays} {ray_kind} rays")]
     Mismatch {

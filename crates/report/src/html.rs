@@ -118,6 +118,11 @@ scenes marked “stand-in” are not the paper's meshes, so compare trends rathe
         },
         esc(&data.code_version)
     );
+    let _ = writeln!(
+        h,
+        "<p class=\"meta\" id=\"scene-files\">{}</p>",
+        esc(&data.scene_files.describe())
+    );
     if let Some(e) = data.sim_error() {
         let _ = writeln!(h, "<p class=\"warn\" id=\"sim-unavailable\">{}</p>", esc(e));
     }
@@ -149,10 +154,14 @@ scenes marked “stand-in” are not the paper's meshes, so compare trends rathe
             for (m, what) in [
                 (Metric::FrameMs, "render times"),
                 (Metric::EnergyJ, "energy use"),
+                (
+                    Metric::DramLines,
+                    "DRAM lines read (the paper's values from its table)",
+                ),
             ] {
                 if let Some(svg) = charts::fig78(data, w, m)? {
                     v.push((
-                        format!("Figure {n}: {what}, % of BVH2 (solid: ours; faded: paper)."),
+                        format!("Figure {n}, {what}: % of BVH2 (solid: ours; faded: paper)."),
                         svg,
                     ));
                 }

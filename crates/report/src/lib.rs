@@ -28,9 +28,12 @@ pub mod data;
 mod error;
 pub mod html;
 pub mod paper;
+mod plain;
 pub mod produce;
+pub mod scenes;
 pub mod summary;
 pub mod tables;
+pub mod units;
 pub mod write;
 
 pub use cache::{Cache, CacheKey};

@@ -247,7 +247,16 @@ impl Metric {
     /// All three, in table order.
     pub const ALL: [Metric; 3] = [Metric::FrameMs, Metric::EnergyJ, Metric::DramLines];
 
-    /// Column heading.
+    /// The quantity, without a unit: `frame time`, `energy`, `DRAM lines`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::FrameMs => "frame time",
+            Metric::EnergyJ => "energy",
+            Metric::DramLines => "DRAM lines",
+        }
+    }
+
+    /// Column heading in the paper's units.
     pub fn label(self) -> &'static str {
         match self {
             Metric::FrameMs => "frame time (ms)",

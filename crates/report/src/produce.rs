@@ -35,6 +35,11 @@ pub const RENDER_RES: u32 = 192;
 pub const RENDER_SPP: u32 = 8;
 /// Minimum host time spent timing one (structure, ray kind) pair, in seconds.
 pub const MIN_TIMING_S: f64 = 0.1;
+/// Rays of each kind the CPU section times: fewer give timings dominated by warm caches
+/// and start-up, so a kind with fewer rays is left out.
+pub const CPU_RAYS: usize = 100_000;
+/// Most frames of the path workload generated to gather [`CPU_RAYS`] rays of each kind.
+pub const CPU_MAX_FRAMES: u32 = 8;
 /// Simulations run side by side.
 pub const SIM_WORKERS: usize = 2;
 
@@ -199,7 +204,7 @@ impl<'a> Producer<'a> {
                 &hashes[i],
                 "all",
                 "path",
-                &format!("cpu_res={}", self.settings.cpu_res),
+                &format!("cpu_res={};rays={CPU_RAYS}", self.settings.cpu_res),
                 (self.settings.cpu_res, self.settings.cpu_res),
             );
             // Incomplete CPU data (a structure the accel crate does not build yet) is not
@@ -358,6 +363,7 @@ impl<'a> Producer<'a> {
             settings: self.settings.clone(),
             scenes: out,
             skipped,
+            scene_files: Default::default(),
             paper: PaperValues::published(),
         })
     }
@@ -428,11 +434,13 @@ fn same_answer(a: &TraceResult, b: &TraceResult) -> bool {
     }
 }
 
-/// The rays of the path workload at `res`×`res`, 1 spp, traced on BVH2.
-fn ray_set(scene: &Scene, structures: &Structures, res: u32) -> Vec<Traced> {
-    let settings = RenderSettings::new(res, res, Workload::Path);
-    let mut out = Vec::new();
-    for y in 0..res {
+/// The rays of one frame of the path workload at `res`×`res`, 1 spp, seed `seed`, traced on
+/// BVH2, in scanline order (rows split over two threads; each pixel is deterministic).
+fn frame_rays(scene: &Scene, structures: &Structures, res: u32, seed: u32) -> Vec<Traced> {
+    let mut settings = RenderSettings::new(res, res, Workload::Path);
+    settings.seed = seed;
+    let row = |y: u32| -> Vec<Traced> {
+        let mut out = Vec::new();
         for x in 0..res {
             let mut job = PixelJob::new(scene, &settings, x, y);
             while let Some(q) = job.next_ray() {
@@ -441,8 +449,43 @@ fn ray_set(scene: &Scene, structures: &Structures, res: u32) -> Vec<Traced> {
                 job.submit(answer);
             }
         }
+        out
+    };
+    let mut rows: Vec<Vec<Traced>> = (0..res).map(|_| Vec::new()).collect();
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..2u32)
+            .map(|k| s.spawn(move || (k..res).step_by(2).map(|y| (y, row(y))).collect::<Vec<_>>()))
+            .collect();
+        for h in handles {
+            for (y, r) in h.join().unwrap_or_default() {
+                rows[y as usize] = r;
+            }
+        }
+    });
+    rows.into_iter().flatten().collect()
+}
+
+/// [`CPU_RAYS`] rays of each kind (primary, shadow, diffuse) from frames of the path
+/// workload at `res`×`res` with seeds 0, 1, … (at most [`CPU_MAX_FRAMES`]), traced on BVH2;
+/// a kind the frames yield fewer of (a camera that sees mostly sky) keeps what it has.
+fn ray_sets(scene: &Scene, structures: &Structures, res: u32) -> [Vec<Traced>; 3] {
+    let mut sets: [Vec<Traced>; 3] = Default::default();
+    for seed in 0..CPU_MAX_FRAMES {
+        if sets.iter().all(|s| s.len() >= CPU_RAYS) {
+            break;
+        }
+        for t in frame_rays(scene, structures, res, seed) {
+            let i = match t.query.kind {
+                RayKind::Primary => 0,
+                RayKind::Shadow => 1,
+                RayKind::Diffuse => 2,
+            };
+            if sets[i].len() < CPU_RAYS {
+                sets[i].push(t);
+            }
+        }
     }
-    out
+    sets
 }
 
 /// Every structure of `scene` with the report's build settings; the error as text.
@@ -475,16 +518,28 @@ pub fn cpu_data(scene: &Scene, cpu_res: u32) -> Result<CpuData, ReportError> {
             bytes: structure_bytes(&structures, kind),
         })
         .collect();
-    let rays = ray_set(scene, &structures, cpu_res);
+    let sets = ray_sets(scene, &structures, cpu_res);
     let mut throughput = Vec::new();
-    for ray_kind in [RayKind::Primary, RayKind::Shadow, RayKind::Diffuse] {
-        let set: Vec<&Traced> = rays.iter().filter(|r| r.query.kind == ray_kind).collect();
+    for (ray_kind, set) in [RayKind::Primary, RayKind::Shadow, RayKind::Diffuse]
+        .into_iter()
+        .zip(&sets)
+    {
+        let set: Vec<&Traced> = set.iter().collect();
         for kind in AccelKind::ALL {
+            let mrays_per_s = if set.len() < CPU_RAYS {
+                Err(format!(
+                    "{} {} rays from {CPU_MAX_FRAMES} frames, fewer than the {CPU_RAYS} a timing needs",
+                    set.len(),
+                    ray_kind.name()
+                ))
+            } else {
+                time_set(&structures, kind, ray_kind, &set)
+            };
             throughput.push(Throughput {
                 kind,
                 ray_kind,
                 rays: set.len() as u64,
-                mrays_per_s: time_set(&structures, kind, ray_kind, &set),
+                mrays_per_s,
             });
         }
     }

@@ -8,10 +8,12 @@
 
 use crate::data::{ReportData, SceneReport};
 use crate::paper::{self, Metric, PaperScene};
+use crate::produce::CPU_RAYS;
 use crate::summary;
+use crate::units;
 use dualsplit_accel::AccelKind;
 use dualsplit_render::{RayKind, Workload};
-use dualsplit_sim::{SimAccel, SimResult};
+use dualsplit_sim::{SimAccel, SimConfig, SimResult};
 
 /// One table cell: its text and, where it is a number, the number (written to CSV at full
 /// precision).
@@ -105,8 +107,6 @@ pub struct Section {
     pub tables: Vec<Table>,
 }
 
-const MIB: f64 = 1024.0 * 1024.0;
-
 fn slug(s: &str) -> String {
     s.chars()
         .map(|c| {
@@ -146,9 +146,16 @@ pub fn table3(data: &ReportData) -> Section {
         AccelKind::Bvh8,
         AccelKind::Dst,
     ];
+    let all: Vec<f64> = data
+        .scenes
+        .iter()
+        .flat_map(|s| kinds.iter().filter_map(|&k| s.bytes(k)))
+        .map(|b| b as f64)
+        .collect();
+    let (unit, scale) = units::bytes_unit(&all);
     let mut header = vec!["scene".to_string(), "triangles".into()];
     for k in &kinds {
-        header.push(format!("{} MiB", k.name().to_uppercase()));
+        header.push(format!("{} {unit}", k.name().to_uppercase()));
         if *k != AccelKind::Bvh2 {
             header.push(format!("{} % of BVH2", k.name().to_uppercase()));
         }
@@ -166,7 +173,7 @@ pub fn table3(data: &ReportData) -> Section {
         let b2 = s.bytes(AccelKind::Bvh2);
         for k in &kinds {
             let b = s.bytes(*k);
-            row.push(b.map_or_else(Cell::none, |b| Cell::num(b as f64 / MIB)));
+            row.push(b.map_or_else(Cell::none, |b| Cell::num(b as f64 * scale)));
             if *k != AccelKind::Bvh2 {
                 row.push(match (b, b2) {
                     (Some(b), Some(b2)) if b2 > 0 => Cell::pct(b as f64 / b2 as f64),
@@ -201,7 +208,9 @@ pub fn table3(data: &ReportData) -> Section {
         notes,
         tables: vec![Table {
             id: "table3".into(),
-            caption: "Nodes plus triangle-index lists, MiB (1 MiB = 2^20 B); % of BVH2.".into(),
+            caption: format!(
+                "Nodes plus triangle-index lists, {unit} (1 KiB = 2^10 B, 1 MiB = 2^20 B); % of BVH2."
+            ),
             paper_columns: (first_paper..first_paper + 5).collect(),
             header,
             rows,
@@ -217,6 +226,41 @@ pub fn metric(r: &SimResult, m: Metric) -> f64 {
         Metric::EnergyJ => r.energy.total(),
         Metric::DramLines => r.dram_lines as f64 / 1e6,
     }
+}
+
+/// The unit and scale that show `values` of `m` (in [`metric`]'s units: ms, J, millions of
+/// lines) readably: µs/ms/s, µJ/mJ/J, lines/K/M. The heading is `"{name} ({unit})"`.
+pub fn metric_unit(m: Metric, values: &[f64]) -> (String, f64) {
+    match m {
+        Metric::FrameMs => {
+            let (u, s) = units::time_unit(values);
+            (format!("{} ({u})", m.name()), s)
+        }
+        Metric::EnergyJ => {
+            let (u, s) = units::energy_unit(values);
+            (format!("{} ({u})", m.name()), s)
+        }
+        Metric::DramLines => {
+            let lines: Vec<f64> = values.iter().map(|v| v * 1e6).collect();
+            match units::count_unit(&lines) {
+                ("", s) => (m.name().to_string(), s * 1e6),
+                (u, s) => (format!("{} ({u})", m.name()), s * 1e6),
+            }
+        }
+    }
+}
+
+/// DRAM energy (J) of a simulated frame by cause: `[reads, row activations, background]`,
+/// from its read and activation counts and frame time with the per-event energies and
+/// background power of the hardware configuration the report simulates (`lin2020`); the
+/// three add up to the frame's DRAM energy.
+pub fn dram_split(r: &SimResult) -> [f64; 3] {
+    let d = SimConfig::lin2020().dram;
+    [
+        r.dram.reads as f64 * d.e_read_nj * 1e-9,
+        r.dram.activations as f64 * d.e_activate_nj * 1e-9,
+        d.background_w * r.frame_ms * 1e-3,
+    ]
 }
 
 /// Tables 4 (`Cast`) and 5 (`Path`): per scene, frame time, energy and DRAM lines of every
@@ -239,37 +283,53 @@ pub fn table45(data: &ReportData, workload: Workload) -> Section {
             continue;
         }
         notes.push(paper_note(s));
+        let ours = |m: Metric| -> Vec<f64> {
+            SimAccel::ALL
+                .iter()
+                .filter_map(|&a| Some(metric(s.sim(a, workload, tms)?, m)))
+                .collect()
+        };
+        let theirs = |m: Metric| -> Vec<f64> {
+            s.paper.map_or_else(Vec::new, |pm| {
+                SimAccel::ALL
+                    .iter()
+                    .map(|&a| paper::table45(workload, m, a, pm.scene))
+                    .collect()
+            })
+        };
+        let our_units: Vec<(String, f64)> = Metric::ALL
+            .iter()
+            .map(|&m| metric_unit(m, &ours(m)))
+            .collect();
+        let paper_units: Vec<(String, f64)> = Metric::ALL
+            .iter()
+            .map(|&m| metric_unit(m, &theirs(m)))
+            .collect();
         let mut header = vec!["configuration".to_string()];
-        for m in Metric::ALL {
-            let unit = if m == Metric::DramLines {
-                "DRAM lines (M)".to_string()
-            } else {
-                m.label().to_string()
-            };
-            header.push(unit);
+        for (h, _) in &our_units {
+            header.push(h.clone());
             header.push("% of BVH2".into());
         }
         let first_paper = header.len();
         if let Some(m) = &s.paper {
-            for me in Metric::ALL {
-                let unit = if me == Metric::DramLines {
-                    "DRAM lines (M)"
-                } else {
-                    me.label()
-                };
-                header.push(format!("paper {}: {unit}", m.scene.label()));
+            for (h, _) in &paper_units {
+                header.push(format!("paper {}: {h}", m.scene.label()));
                 header.push("paper %".into());
             }
         }
         let mut rows = Vec::new();
         for a in SimAccel::ALL {
             let mut row = vec![Cell::text(a.label())];
-            for m in Metric::ALL {
+            for (m, (_, scale)) in Metric::ALL.iter().copied().zip(&our_units) {
                 let base = s.sim(SimAccel::Bvh2, workload, tms).map(|r| metric(r, m));
                 match s.sim(a, workload, tms) {
                     Some(r) => {
                         let v = metric(r, m);
-                        row.push(Cell::num(v));
+                        row.push(if m == Metric::DramLines && *scale == 1e6 {
+                            Cell::int(r.dram_lines)
+                        } else {
+                            Cell::num(v * scale)
+                        });
                         row.push(
                             base.filter(|b| *b > 0.0)
                                 .map_or_else(Cell::none, |b| Cell::pct(v / b)),
@@ -279,10 +339,10 @@ pub fn table45(data: &ReportData, workload: Workload) -> Section {
                 }
             }
             if let Some(pm) = &s.paper {
-                for m in Metric::ALL {
+                for (m, (_, scale)) in Metric::ALL.iter().copied().zip(&paper_units) {
                     let v = paper::table45(workload, m, a, pm.scene);
                     let b = paper::table45(workload, m, SimAccel::Bvh2, pm.scene);
-                    row.push(Cell::num(v));
+                    row.push(Cell::num(v * scale));
                     row.push(Cell::pct(v / b));
                 }
             }
@@ -313,8 +373,9 @@ pub fn table45(data: &ReportData, workload: Workload) -> Section {
     }
 }
 
-/// Table 6: energy of path tracing split into DRAM, caches and compute (Lin et al. 2020,
-/// §4.4, Table 6).
+/// Table 6: energy of path tracing split into DRAM (itself split into reads, row
+/// activations and background power over the frame time), caches and compute (Lin et al.
+/// 2020, §4.4, Table 6; the paper does not split DRAM energy).
 pub fn table6(data: &ReportData) -> Section {
     let tms = data.settings.base_tms;
     let mut tables = Vec::new();
@@ -329,21 +390,54 @@ pub fn table6(data: &ReportData) -> Section {
             continue;
         }
         let pm = s.paper.filter(|m| m.scene.table67_index().is_some());
-        let mut header: Vec<String> = [
-            "configuration",
-            "DRAM (J)",
-            "caches (J)",
-            "compute (J)",
-            "DRAM share",
+        // Reads, activations, background, DRAM, caches, compute (J) per configuration; each
+        // column in its own unit, as the parts differ by orders of magnitude.
+        let parts = |r: &SimResult| -> [f64; 6] {
+            let [reads, acts, background] = dram_split(r);
+            let e = r.energy;
+            [reads, acts, background, e.dram_j, e.caches_j, e.compute_j]
+        };
+        let column_units: Vec<(&str, f64)> = (0..6)
+            .map(|c| {
+                let v: Vec<f64> = SimAccel::ALL
+                    .iter()
+                    .filter_map(|&a| s.sim(a, Workload::Path, tms))
+                    .map(|r| parts(r)[c])
+                    .collect();
+                units::energy_unit(&v)
+            })
+            .collect();
+        let mut header: Vec<String> = vec!["configuration".to_string()];
+        for (h, (unit, _)) in [
+            "DRAM reads",
+            "DRAM activations",
+            "DRAM background",
+            "DRAM",
+            "caches",
+            "compute",
         ]
         .iter()
-        .map(|h| h.to_string())
-        .collect();
+        .zip(&column_units)
+        {
+            header.push(format!("{h} ({unit})"));
+        }
+        header.push("DRAM share".into());
         let first_paper = header.len();
+        let paper_vals: Vec<f64> = pm
+            .map(|m| {
+                SimAccel::ALL
+                    .iter()
+                    .filter_map(|&a| paper::table6(a, m.scene))
+                    .flatten()
+                    .collect()
+            })
+            .unwrap_or_default();
+        let (paper_unit, paper_scale) = units::energy_unit(&paper_vals);
         if let Some(m) = pm {
-            for h in ["DRAM (J)", "caches (J)", "compute (J)", "DRAM share"] {
-                header.push(format!("paper {}: {h}", m.scene.label()));
+            for h in ["DRAM", "caches", "compute"] {
+                header.push(format!("paper {}: {h} ({paper_unit})", m.scene.label()));
             }
+            header.push(format!("paper {}: DRAM share", m.scene.label()));
         }
         let mut rows = Vec::new();
         for a in SimAccel::ALL {
@@ -351,11 +445,12 @@ pub fn table6(data: &ReportData) -> Section {
             match s.sim(a, Workload::Path, tms) {
                 Some(r) => {
                     let e = r.energy;
-                    row.extend([
-                        Cell::num(e.dram_j),
-                        Cell::num(e.caches_j),
-                        Cell::num(e.compute_j),
-                    ]);
+                    row.extend(
+                        parts(r)
+                            .iter()
+                            .zip(&column_units)
+                            .map(|(v, (_, scale))| Cell::num(v * scale)),
+                    );
                     let t = e.total();
                     row.push(if t > 0.0 {
                         Cell::pct(e.dram_j / t)
@@ -363,10 +458,10 @@ pub fn table6(data: &ReportData) -> Section {
                         Cell::none()
                     });
                 }
-                None => row.extend((0..4).map(|_| Cell::none())),
+                None => row.extend((0..7).map(|_| Cell::none())),
             }
             if let Some(p) = pm.and_then(|m| paper::table6(a, m.scene)) {
-                row.extend(p.iter().map(|v| Cell::num(*v)));
+                row.extend(p.iter().map(|v| Cell::num(v * paper_scale)));
                 row.push(Cell::pct(p[0] / p.iter().sum::<f64>()));
             }
             rows.push(row);
@@ -374,7 +469,10 @@ pub fn table6(data: &ReportData) -> Section {
         let ncols = header.len();
         tables.push(Table {
             id: format!("table6-{}", scene_id(i, s)),
-            caption: format!("{} — path tracing energy by category", s.label()),
+            caption: format!(
+                "{} — path tracing energy by category; DRAM energy = reads + row activations + background power × frame time",
+                s.label()
+            ),
             paper_columns: (first_paper..ncols).collect(),
             header,
             rows,
@@ -406,9 +504,28 @@ pub fn table7(data: &ReportData) -> Section {
             continue;
         }
         let pm = s.paper.filter(|m| m.scene.table67_index().is_some());
+        let ours: Vec<f64> = SimAccel::ALL
+            .iter()
+            .flat_map(|&a| tms.iter().filter_map(move |&t| s.sim(a, Workload::Path, t)))
+            .map(|r| r.frame_ms)
+            .collect();
+        let (unit, scale) = units::time_unit(&ours);
+        let theirs: Vec<f64> = pm
+            .map(|m| {
+                SimAccel::ALL
+                    .iter()
+                    .flat_map(|&a| {
+                        paper::TABLE7_TMS
+                            .iter()
+                            .filter_map(move |&t| paper::table7(a, m.scene, t))
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let (paper_unit, paper_scale) = units::time_unit(&theirs);
         let mut header = vec!["configuration".to_string()];
         for (j, t) in tms.iter().enumerate() {
-            header.push(format!("{t} TMs (ms)"));
+            header.push(format!("{t} TMs ({unit})"));
             if j > 0 {
                 header.push(format!("speedup vs {}", tms[0]));
             }
@@ -416,7 +533,7 @@ pub fn table7(data: &ReportData) -> Section {
         let first_paper = header.len();
         if let Some(m) = pm {
             for t in paper::TABLE7_TMS {
-                header.push(format!("paper {}: {t} TMs (ms)", m.scene.label()));
+                header.push(format!("paper {}: {t} TMs ({paper_unit})", m.scene.label()));
             }
         }
         let mut rows = Vec::new();
@@ -425,7 +542,7 @@ pub fn table7(data: &ReportData) -> Section {
             let first = s.sim(a, Workload::Path, tms[0]).map(|r| r.frame_ms);
             for (j, &t) in tms.iter().enumerate() {
                 let v = s.sim(a, Workload::Path, t).map(|r| r.frame_ms);
-                row.push(v.map_or_else(Cell::none, Cell::num));
+                row.push(v.map_or_else(Cell::none, |v| Cell::num(v * scale)));
                 if j > 0 {
                     row.push(match (first, v) {
                         (Some(f), Some(v)) if v > 0.0 => Cell {
@@ -438,7 +555,10 @@ pub fn table7(data: &ReportData) -> Section {
             }
             if let Some(m) = pm {
                 for t in paper::TABLE7_TMS {
-                    row.push(paper::table7(a, m.scene, t).map_or_else(Cell::none, Cell::num));
+                    row.push(
+                        paper::table7(a, m.scene, t)
+                            .map_or_else(Cell::none, |v| Cell::num(v * paper_scale)),
+                    );
                 }
             }
             rows.push(row);
@@ -492,6 +612,21 @@ pub fn cpu(data: &ReportData) -> Section {
     let mut notes = Vec::new();
     for s in &data.scenes {
         for rk in [RayKind::Primary, RayKind::Shadow, RayKind::Diffuse] {
+            // Timings on fewer rays measure warm caches and start-up more than traversal.
+            let rays = s
+                .cpu
+                .throughput
+                .iter()
+                .find(|t| t.ray_kind == rk)
+                .map_or(0, |t| t.rays);
+            if rays < CPU_RAYS as u64 {
+                notes.push(format!(
+                    "{}: {rays} {} rays, fewer than the {CPU_RAYS} a timing needs; left out.",
+                    s.name,
+                    rk.name()
+                ));
+                continue;
+            }
             let mut row = vec![
                 Cell::text(&s.name),
                 Cell::text(format!("{rk:?}").to_lowercase()),
@@ -531,42 +666,42 @@ pub fn cpu(data: &ReportData) -> Section {
     }
     notes.sort();
     notes.dedup();
+    let mut tables = vec![Table {
+        id: "cpu-build".into(),
+        caption: "Host build times (ms, wall clock; the BVH2 builder uses all cores).".into(),
+        header: [
+            "scene",
+            "triangles",
+            "BVH2 SAH build (ms)",
+            "BVH4 collapse (ms)",
+            "BVH8 collapse (ms)",
+            "DST conversion (ms)",
+            "all, incl. encoding (ms)",
+        ]
+        .iter()
+        .map(|h| h.to_string())
+        .collect(),
+        paper_columns: vec![],
+        rows: build_rows,
+    }];
+    if !rows.is_empty() {
+        tables.push(Table {
+            id: "cpu-mrays".into(),
+            caption: format!(
+                "Single-thread Mrays/s on {CPU_RAYS} rays of each kind from frames of the path workload at {0}×{0}, each structure checked ray by ray against BVH2 before timing.",
+                data.settings.cpu_res
+            ),
+            header,
+            paper_columns: vec![],
+            rows,
+        });
+    }
     Section {
         id: "cpu".into(),
         title: "CPU — build times and traversal throughput (host, this machine)".into(),
         summary: summary::cpu(data),
         notes,
-        tables: vec![
-            Table {
-                id: "cpu-build".into(),
-                caption: "Host build times (ms, wall clock; the BVH2 builder uses all cores)."
-                    .into(),
-                header: [
-                    "scene",
-                    "triangles",
-                    "BVH2 SAH build (ms)",
-                    "BVH4 collapse (ms)",
-                    "BVH8 collapse (ms)",
-                    "DST conversion (ms)",
-                    "all, incl. encoding (ms)",
-                ]
-                .iter()
-                .map(|h| h.to_string())
-                .collect(),
-                paper_columns: vec![],
-                rows: build_rows,
-            },
-            Table {
-                id: "cpu-mrays".into(),
-                caption: format!(
-                    "Single-thread Mrays/s on the rays of the path workload at {0}×{0}, each structure checked ray by ray against BVH2 before timing.",
-                    data.settings.cpu_res
-                ),
-                header,
-                paper_columns: vec![],
-                rows,
-            },
-        ],
+        tables,
     }
 }
 
@@ -598,5 +733,54 @@ mod tests {
         assert_eq!(fmt_num(1.5), "1.500");
         assert_eq!(fmt_num(0.01234), "0.0123");
         assert_eq!(Cell::pct(0.891).text, "89%");
+    }
+
+    /// The three parts of Table 6's DRAM energy add up to the simulator's DRAM energy, for
+    /// both thread models.
+    #[test]
+    fn dram_split_adds_up_to_the_simulated_dram_energy() {
+        let scene = dualsplit_scene::load("builtin:cornell").unwrap();
+        let s = dualsplit_accel::Structures::try_build(
+            &scene.triangles,
+            &dualsplit_accel::BuildConfig::default(),
+        )
+        .unwrap();
+        let settings = dualsplit_render::RenderSettings::new(8, 8, Workload::Path);
+        let mut cfg = SimConfig::lin2020();
+        cfg.tms = 2;
+        for model in dualsplit_sim::ThreadModel::ALL {
+            let r = dualsplit_sim::simulate_model(
+                model,
+                &scene,
+                &s,
+                SimAccel::Dst,
+                &settings,
+                &cfg,
+                &|_, _| {},
+            )
+            .unwrap();
+            let parts = dram_split(&r);
+            assert!(parts.iter().all(|p| *p > 0.0), "{parts:?}");
+            let sum: f64 = parts.iter().sum();
+            assert!(
+                (sum - r.energy.dram_j).abs() <= 1e-12 * r.energy.dram_j.max(1.0),
+                "{model:?}: {parts:?} sum to {sum}, DRAM energy {}",
+                r.energy.dram_j
+            );
+        }
+    }
+
+    #[test]
+    fn units_follow_the_values() {
+        assert_eq!(
+            metric_unit(Metric::FrameMs, &[0.0089, 0.5]).0,
+            "frame time (µs)"
+        );
+        assert_eq!(metric_unit(Metric::FrameMs, &[12.0]).0, "frame time (ms)");
+        assert_eq!(metric_unit(Metric::EnergyJ, &[0.02]).0, "energy (mJ)");
+        let (h, scale) = metric_unit(Metric::DramLines, &[0.0123]);
+        assert_eq!((h.as_str(), scale), ("DRAM lines (K)", 1e3));
+        assert_eq!(metric_unit(Metric::DramLines, &[0.0000390]).0, "DRAM lines");
+        assert_eq!(metric_unit(Metric::DramLines, &[3.5]).1, 1.0);
     }
 }

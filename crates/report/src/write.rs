@@ -31,6 +31,7 @@ pub fn report_md(data: &ReportData) -> String {
         "Lin et al. 2020, §4. Simulated at {}×{}, {} TMs (scaling over {:?}). Columns whose heading starts with \"paper\" are the published values; stand-in scenes are labelled.\n",
         st.width, st.height, st.base_tms, st.tms
     );
+    let _ = writeln!(m, "{}\n", data.scene_files.describe());
     if let Some(e) = data.sim_error() {
         let _ = writeln!(m, "> {e}\n");
     }

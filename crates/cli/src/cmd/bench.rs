@@ -1,7 +1,9 @@
 //! `dualsplit bench`: CPU traversal throughput per structure and ray type, and full-frame
 //! render times. Every structure's answers are checked against BVH2, ray by ray, before
 //! anything is timed (see `dualsplit_render::bench`).
-use super::render::{build_structures, load_scene, parse_accel, parse_res, parse_workload};
+use super::render::{build_structures, load_scene};
+use crate::args::{parse_accel, parse_res, parse_workload};
+use crate::output::JsonOut;
 use crate::progress::Ctx;
 use dualsplit_accel::AccelKind;
 use dualsplit_render::bench::{MeasureConfig, Throughput, measure, ray_sets};
@@ -12,7 +14,9 @@ use std::time::Instant;
 /// Arguments of `dualsplit bench`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
+    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
+    /// (hairball, forest, atrium, cornell).
+    #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
     /// Structures to measure, comma-separated (bvh2, bvh4, bvh8, dst-sw, dst); default all.
     #[arg(long, value_delimiter = ',', value_parser = parse_accel)]
@@ -32,30 +36,41 @@ pub struct Args {
     /// Skip the full-frame render timing.
     #[arg(long)]
     no_frame: bool,
-    /// Print the results as JSON lines instead of a table.
-    #[arg(long)]
-    json: bool,
+    /// Print the results as JSON lines instead of a table; `--json=FILE` writes them to FILE.
+    #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true, default_missing_value = "-")]
+    json: Option<std::path::PathBuf>,
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+    let json = JsonOut::from_arg(args.json.as_deref())?;
+    // JSON lines go out as they are measured on standard output, and all at the end to a
+    // file.
+    let mut lines: Vec<String> = Vec::new();
+    let mut json_line = |v: String| {
+        if json == Some(JsonOut::Stdout) {
+            println!("{v}");
+        } else {
+            lines.push(v);
+        }
+    };
     let accels = if args.accel.is_empty() {
         AccelKind::ALL.to_vec()
     } else {
         args.accel.clone()
     };
-    let scene = load_scene(&args.scene, ctx)?;
+    let scene = load_scene(&args.scene, ctx, json.is_some())?;
     let settings = RenderSettings {
         seed: args.seed,
         ..RenderSettings::new(args.res.0, args.res.1, args.workload)
     };
     dualsplit_render::validate(&scene, &settings)?;
-    let structures = build_structures(&scene, ctx)?;
+    let structures = build_structures(&scene, ctx, json.is_some())?;
     let sp = ctx.spinner("generating rays on bvh2");
     let t = Instant::now();
     let sets = ray_sets(&scene, &structures, &settings)?;
     sp.finish_and_clear();
-    println!(
+    let line = format!(
         "ray sets of a {}x{} {} frame: {} in {:.2} s; {} threads",
         settings.width,
         settings.height,
@@ -67,11 +82,12 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         t.elapsed().as_secs_f64(),
         rayon::current_num_threads()
     );
+    super::render::say(&line, json.is_some());
     let cfg = MeasureConfig {
         min_seconds: args.min_seconds,
         ..MeasureConfig::default()
     };
-    if !args.json {
+    if json.is_none() {
         println!(
             "{:<8} {:>16} {:>16} {:>16} {:>14}",
             "accel", "primary Mrays/s", "shadow Mrays/s", "diffuse Mrays/s", "frame s"
@@ -93,17 +109,17 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             bar.finish_and_clear();
             Some(t.elapsed().as_secs_f64())
         };
-        if args.json {
+        if json.is_some() {
             for r in &row {
-                println!("{}", serde_json::to_string(r)?);
+                json_line(serde_json::to_string(r)?);
             }
             if let Some(s) = frame_s {
-                println!(
-                    "{}",
+                json_line(
                     serde_json::json!({
                         "accel": kind, "frame_seconds": s, "width": settings.width,
                         "height": settings.height, "workload": settings.workload,
                     })
+                    .to_string(),
                 );
             }
         } else {
@@ -124,6 +140,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                     .unwrap_or_else(|| "-".into())
             );
         }
+    }
+    if let Some(out @ JsonOut::File(_)) = &json {
+        out.emit(&lines.join("\n"))?;
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -19,6 +19,9 @@ pub struct Args {
 
 /// Runs `calibrate`.
 pub fn run(a: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+    if let Some(p) = &a.out {
+        crate::output::check_file(p, "--out")?;
+    }
     let mut loaded = Vec::new();
     for (spec, w, h) in FRAMES {
         let (scene, structures) = super::load_and_build(spec, ctx)?;

@@ -13,7 +13,9 @@ use std::process::ExitCode;
 /// Arguments of `dualsplit check`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
+    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
+    /// (hairball, forest, atrium, cornell).
+    #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
     /// Rays of each kind (primary, shadow, diffuse) to compare.
     #[arg(long, default_value_t = 20_000)]

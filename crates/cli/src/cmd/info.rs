@@ -13,11 +13,13 @@ use std::process::ExitCode;
 /// Arguments of `dualsplit info`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
+    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
+    /// (hairball, forest, atrium, cornell).
+    #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
-    /// Print one JSON object instead of a table.
-    #[arg(long)]
-    json: bool,
+    /// Print one JSON object instead of a table; `--json=FILE` writes it to FILE.
+    #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true, default_missing_value = "-")]
+    json: Option<std::path::PathBuf>,
 }
 
 /// What `info` reports, also its JSON form.
@@ -37,6 +39,7 @@ struct Info<'a> {
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+    let json = crate::output::JsonOut::from_arg(args.json.as_deref())?;
     let spinner = ctx.spinner(format!("loading {}", args.scene));
     let start = std::time::Instant::now();
     let scene = dualsplit_scene::load(&args.scene);
@@ -57,8 +60,8 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         bounds: &scene.bounds,
         load_ms,
     };
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
+    if let Some(out) = json {
+        out.emit(&serde_json::to_string_pretty(&info)?)?;
     } else {
         print!("{}", table(&info));
     }
@@ -106,7 +109,7 @@ mod tests {
     fn info(scene: &str) -> anyhow::Result<std::process::ExitCode> {
         let args = Args {
             scene: scene.into(),
-            json: true,
+            json: Some("-".into()),
         };
         run(args, &Ctx::new(true))
     }

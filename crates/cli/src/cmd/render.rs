@@ -1,6 +1,8 @@
 //! `dualsplit render`: one frame of a workload on a structure, written as PNG or EXR.
 //!
-//! Also holds the argument parsers `bench` shares (resolution, structure and workload names) and the scene/structure loading steps with their spinners.
+//! Also holds the scene and structure loading steps with their spinners that `bench`
+//! shares.
+use crate::args::{View, parse_accel, parse_res, parse_scene, parse_workload};
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::{AccelKind, BuildConfig, Structures};
@@ -13,7 +15,9 @@ use std::time::Instant;
 /// Arguments of `dualsplit render`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
+    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
+    /// (hairball, forest, atrium, cornell).
+    #[arg(value_parser = parse_scene)]
     scene: String,
     /// Structure: bvh2, bvh4, bvh8, dst-sw or dst.
     #[arg(long, default_value = "bvh2", value_parser = parse_accel)]
@@ -30,80 +34,55 @@ pub struct Args {
     /// Seed of the per-pixel random numbers.
     #[arg(long, default_value_t = 0)]
     seed: u32,
-    /// Camera position x,y,z (default: the scene's camera).
-    #[arg(long, allow_hyphen_values = true)]
-    eye: Option<String>,
-    /// Point the camera looks at, x,y,z.
-    #[arg(long, allow_hyphen_values = true)]
-    target: Option<String>,
-    /// Vertical field of view in degrees, in (0, 180).
-    #[arg(long)]
-    fov: Option<f32>,
-    /// Light centre x,y,z (default: the scene's light).
-    #[arg(long, allow_hyphen_values = true)]
-    light: Option<String>,
-    /// Light radius (0 = point light, hard shadows).
-    #[arg(long)]
-    light_radius: Option<f32>,
+    /// Camera and light overrides.
+    #[command(flatten)]
+    view: View,
     /// Output image: .png (tone-mapped sRGB, 8-bit) or .exr (linear f32).
     #[arg(short, long)]
     output: PathBuf,
 }
 
-/// Parses a structure name.
-pub(crate) fn parse_accel(s: &str) -> Result<AccelKind, String> {
-    AccelKind::parse(s).ok_or_else(|| {
-        let names: Vec<_> = AccelKind::ALL.iter().map(|k| k.name()).collect();
-        format!(
-            "unknown structure `{s}` (expected one of {})",
-            names.join(", ")
-        )
-    })
-}
-
-/// Parses a workload name.
-pub(crate) fn parse_workload(s: &str) -> Result<Workload, String> {
-    Workload::parse(s).ok_or_else(|| format!("unknown workload `{s}` (expected cast or path)"))
-}
-
-/// Parses `WxH` or `N`.
-pub(crate) fn parse_res(s: &str) -> Result<(u32, u32), String> {
-    let num = |t: &str| {
-        t.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|&n| n > 0)
-            .ok_or_else(|| format!("bad resolution `{s}` (expected WIDTHxHEIGHT or N, positive)"))
-    };
-    match s.split_once(['x', 'X']) {
-        Some((w, h)) => Ok((num(w)?, num(h)?)),
-        None => num(s).map(|n| (n, n)),
-    }
-}
-
-/// Loads a scene behind a spinner.
-pub(crate) fn load_scene(spec: &str, ctx: &Ctx) -> anyhow::Result<Scene> {
+/// Loads a scene behind a spinner and says how long it took (on stderr when `stdout_is_data`,
+/// so that standard output holds only the data, e.g. JSON).
+pub(crate) fn load_scene(spec: &str, ctx: &Ctx, stdout_is_data: bool) -> anyhow::Result<Scene> {
     let sp = ctx.spinner(format!("loading {spec}"));
     let t = Instant::now();
     let scene = dualsplit_scene::load(spec).with_context(|| format!("loading {spec}"))?;
     sp.finish_and_clear();
-    println!(
+    let line = format!(
         "scene {}: {} triangles, loaded in {:.2} s",
         scene.name,
         scene.triangles.len(),
         t.elapsed().as_secs_f64()
     );
+    say(&line, stdout_is_data);
     Ok(scene)
 }
 
-/// Builds every structure behind a spinner.
-pub(crate) fn build_structures(scene: &Scene, ctx: &Ctx) -> anyhow::Result<Structures> {
+/// A progress line: on stdout, or on stderr when stdout carries data.
+pub(crate) fn say(line: &str, stdout_is_data: bool) {
+    if stdout_is_data {
+        eprintln!("{line}");
+    } else {
+        println!("{line}");
+    }
+}
+
+/// Builds every structure behind a spinner (the time line goes as in [`load_scene`]).
+pub(crate) fn build_structures(
+    scene: &Scene,
+    ctx: &Ctx,
+    stdout_is_data: bool,
+) -> anyhow::Result<Structures> {
     let sp = ctx.spinner("building structures");
     let t = Instant::now();
     let s = Structures::try_build(&scene.triangles, &BuildConfig::default())
         .context("building the acceleration structures")?;
     sp.finish_and_clear();
-    println!("structures built in {:.2} s", t.elapsed().as_secs_f64());
+    say(
+        &format!("structures built in {:.2} s", t.elapsed().as_secs_f64()),
+        stdout_is_data,
+    );
     Ok(s)
 }
 
@@ -131,21 +110,16 @@ pub(crate) fn print_counts(c: &RayCounts) {
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     dualsplit_render::ImageFormat::from_path(&args.output)?;
-    let mut scene = load_scene(&args.scene, ctx)?;
-    scene.camera =
-        scene
-            .camera
-            .with_overrides(args.eye.as_deref(), args.target.as_deref(), args.fov)?;
-    scene.light = scene
-        .light
-        .with_overrides(args.light.as_deref(), args.light_radius, None)?;
+    crate::output::check_file(&args.output, "-o")?;
+    let mut scene = load_scene(&args.scene, ctx, false)?;
+    args.view.apply(&mut scene)?;
     let settings = RenderSettings {
         spp: args.spp,
         seed: args.seed,
         ..RenderSettings::new(args.res.0, args.res.1, args.workload)
     };
     dualsplit_render::validate(&scene, &settings)?;
-    let structures = build_structures(&scene, ctx)?;
+    let structures = build_structures(&scene, ctx, false)?;
     let bar = ctx.bar(
         tile_count(&settings),
         format!("{} {}", args.accel.name(), args.workload.name()),

@@ -9,6 +9,7 @@ use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_report::data::{ReportSettings, Skipped};
 use dualsplit_report::produce::real_simulator;
+use dualsplit_report::scenes::{self, SceneFiles};
 use dualsplit_report::{Cache, Producer, Progress};
 use dualsplit_sim::ThreadModel;
 use indicatif::ProgressBar;
@@ -27,17 +28,13 @@ pub const DEFAULT_SCENES: [&str; 3] = [
 ];
 /// Default square resolution of the simulated frames.
 pub const DEFAULT_RES: u32 = 128;
-/// The paper's scenes for `--full`: full-size builtins plus the shipped Dragon Box and Dragon
-/// Sponza meshes when present.
+/// The paper's scenes for `--full`: full-size builtins, plus the shipped meshes of
+/// `dualsplit_report::scenes::PAPER_FILES` found in the scenes folder.
 pub const FULL_SCENES: [&str; 3] = ["builtin:atrium", "builtin:forest", "builtin:hairball"];
-/// Shipped meshes added by `--full` when found (paths relative to the workspace root).
-pub const FULL_FILES: [&str; 2] = ["dragon_box.ply.gz", "dragon_sponza.ply.gz"];
 /// The paper's resolution (§4.3).
 pub const FULL_RES: u32 = 1024;
-/// Default TM counts (Table 7).
-pub const DEFAULT_TMS: [u32; 3] = [32, 64, 128];
 /// Square resolution of the CPU ray sets (path workload rays).
-pub const CPU_RES: u32 = 64;
+pub const CPU_RES: u32 = 320;
 /// Simulated rays per second of wall time on a 2-core machine, two simulations side by side,
 /// with the `fast` thread model; used only for the `--full` up-front estimate. Measured:
 /// about 38K simulated rays per CPU second (release build, `lin2020` config, the default
@@ -50,11 +47,13 @@ pub const SIM_RAYS_PER_SECOND_RV32: f64 = 14_000.0;
 /// Arguments of `dualsplit report`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scenes: files (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
-    /// Default: the builtins at reduced sizes (see `DEFAULT_SCENES`).
-    scenes: Vec<String>,
+    /// Scenes: files (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
+    /// (hairball, forest, atrium, cornell). Without any: the atrium, forest and hairball
+    /// builtins at reduced sizes.
+    #[arg(value_name = "SCENES", value_parser = crate::args::parse_scene)]
+    specs: Vec<String>,
     /// Square resolution of the simulated frames (default 128, 1024 with --full).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::args::parse_positive)]
     res: Option<u32>,
     /// The paper's setup: 1024×1024, full-size scenes, 32/64/128 TMs.
     #[arg(long)]
@@ -62,8 +61,12 @@ pub struct Args {
     /// Output directory.
     #[arg(long, default_value = "report")]
     out: PathBuf,
+    /// Folder of the shipped meshes (Dragon Box, Dragon Sponza). Default: the
+    /// DUALSPLIT_SCENES environment variable, else shared/scenes beside the checkout.
+    #[arg(long = "scenes", value_name = "DIR")]
+    scenes_dir: Option<PathBuf>,
     /// TM counts of the scaling study (Table 7); Tables 4–6 use 64 when listed.
-    #[arg(long, value_delimiter = ',', default_values_t = DEFAULT_TMS)]
+    #[arg(long, value_delimiter = ',', default_value = "32,64,128", value_parser = crate::args::parse_positive)]
     tms: Vec<u32>,
     /// Thread model: rv32 (the compiled kernels instruction by instruction, the reference)
     /// or fast (the macro-op replay: about 8× faster, an uncalibrated approximation).
@@ -99,16 +102,13 @@ impl Progress for Bars<'_> {
     }
 }
 
-fn shared_scene(file: &str) -> Option<String> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/scenes")
-        .join(file);
-    p.is_file().then(|| p.display().to_string())
-}
-
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let start = Instant::now();
+    crate::output::prepare_dir(&args.out, "--out")?;
+    let dir = scenes::find_here(args.scenes_dir.as_deref())?;
+    let scene_files = SceneFiles::scan(dir.as_ref());
+    eprintln!("{}", scene_files.describe());
     if args.tms.is_empty() || args.tms.contains(&0) {
         anyhow::bail!("--tms needs positive TM counts, e.g. --tms 32,64,128");
     }
@@ -118,12 +118,12 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if res == 0 {
         anyhow::bail!("--res must be positive");
     }
-    let user_scenes = !args.scenes.is_empty();
+    let user_scenes = !args.specs.is_empty();
     let specs: Vec<String> = if user_scenes {
-        args.scenes.clone()
+        args.specs.clone()
     } else if args.full {
         let mut v: Vec<String> = FULL_SCENES.iter().map(|s| s.to_string()).collect();
-        v.extend(FULL_FILES.iter().filter_map(|f| shared_scene(f)));
+        v.extend(scene_files.files.iter().filter_map(|f| f.path.clone()));
         v
     } else {
         DEFAULT_SCENES.iter().map(|s| s.to_string()).collect()
@@ -217,7 +217,8 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         &bars,
         &*simulate,
     );
-    let data = producer.run(&scenes, skipped)?;
+    let mut data = producer.run(&scenes, skipped)?;
+    data.scene_files = scene_files;
     let written = dualsplit_report::write_report(&data, &args.out)?;
     if let Some(e) = data.sim_error() {
         eprintln!("note: {e}; simulated sections say so");

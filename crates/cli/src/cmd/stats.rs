@@ -26,11 +26,13 @@ use std::process::ExitCode;
 /// Arguments of `dualsplit stats`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
+    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
+    /// (hairball, forest, atrium, cornell).
+    #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
-    /// Print JSON instead of a table.
-    #[arg(long)]
-    json: bool,
+    /// Print JSON instead of a table; `--json=FILE` writes it to FILE.
+    #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true, default_missing_value = "-")]
+    json: Option<std::path::PathBuf>,
     /// Rays of each kind used for the per-ray comparison of DST variants.
     #[arg(long, default_value_t = 4096)]
     rays: usize,
@@ -52,6 +54,7 @@ struct Variant {
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+    let json = crate::output::JsonOut::from_arg(args.json.as_deref())?;
     let (scene, s) = super::load_and_build(&args.scene, ctx)?;
     let stats = s.stats();
     let (primary, _, diffuse) = super::rays::record(&scene, &s, args.rays, ctx);
@@ -100,7 +103,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     sp.finish_and_clear();
     let n = rays.len().max(1) as f64;
-    if args.json {
+    if let Some(out) = json {
         let mut structures = serde_json::Map::new();
         for st in &stats {
             structures.insert(st.name.clone(), serde_json::to_value(st)?);
@@ -118,7 +121,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                 "bytes": bvh.bytes as f64 / n,
             },
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        out.emit(&serde_json::to_string_pretty(&v)?)?;
         return Ok(ExitCode::SUCCESS);
     }
     println!(

@@ -1,64 +1,89 @@
-//! `dualsplit simulate`: one frame on the TRaX-style many-core model (Lin et al. 2020, §4).
+//! `dualsplit simulate`: one frame per configuration on the TRaX-style many-core model
+//! (Lin et al. 2020, §4), each printed in full, then compared side by side
+//! ([`summary`]).
+mod summary;
+
+use crate::args::{
+    SimAccelArg, View, parse_positive, parse_res, parse_sim_accel, parse_workload, sim_accels,
+};
+use crate::output::JsonOut;
 use crate::progress::Ctx;
-use anyhow::{Context, bail};
+use anyhow::Context;
+use dualsplit_accel::{BuildConfig, Structures};
 use dualsplit_render::{RenderSettings, Workload};
+use dualsplit_report::units;
 use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel, simulate_model};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
+use summary::{Summary, summarize};
 
 /// Arguments of `dualsplit simulate`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
+    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
+    /// (hairball, forest, atrium, cornell).
+    #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
-    /// Configuration: bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst, or all (two at a time).
-    #[arg(long, default_value = "dst")]
-    accel: String,
+    /// Configurations, comma-separated: bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst,
+    /// or all (simulated two at a time). With more than one, a comparison table follows,
+    /// relative to BVH2 when it is listed, else to the first.
+    #[arg(long, value_delimiter = ',', default_value = "dst", value_parser = parse_sim_accel)]
+    accel: Vec<SimAccelArg>,
     /// Workload: cast (primary + shadow ray) or path (5 diffuse bounces).
-    #[arg(long, default_value = "path")]
-    workload: String,
-    /// Image resolution (N×N pixels).
-    #[arg(long, default_value_t = 512)]
-    res: u32,
+    #[arg(long, default_value = "path", value_parser = parse_workload)]
+    workload: Workload,
+    /// Resolution, WIDTHxHEIGHT or N for N×N.
+    #[arg(long, default_value = "512", value_parser = parse_res)]
+    res: (u32, u32),
     /// Override the number of TMs.
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive)]
     tms: Option<u32>,
     /// Hardware configuration TOML (default: the built-in lin2020 = configs/lin2020.toml).
     #[arg(long)]
     config: Option<std::path::PathBuf>,
     /// Thread model: rv32 (the compiled kernels, instruction by instruction; the reference)
     /// or fast (the macro-op replay).
-    #[arg(long, default_value = "rv32")]
-    model: String,
-    /// Print JSON (an array of results) instead of a table.
-    #[arg(long)]
-    json: bool,
+    #[arg(long, default_value = "rv32", value_parser = parse_model)]
+    model: ThreadModel,
+    /// Camera and light overrides.
+    #[command(flatten)]
+    view: View,
+    /// Print JSON instead of a table; `--json=FILE` writes it to FILE.
+    #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true, default_missing_value = "-")]
+    json: Option<std::path::PathBuf>,
+}
+
+fn parse_model(s: &str) -> Result<ThreadModel, String> {
+    ThreadModel::parse(s)
+        .ok_or_else(|| format!("unknown thread model `{s}` (expected rv32 or fast)"))
+}
+
+/// Idle-at-end share of thread-cycles above which the chip is called not busy.
+const IDLE_WARN: f64 = 0.10;
+
+/// `--json`: what was simulated and every number of the tables (host timings aside: they
+/// are measurements of this machine, not results).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    scene: &'a str,
+    spec: &'a str,
+    triangles: usize,
+    width: u32,
+    height: u32,
+    workload: Workload,
+    thread_model: ThreadModel,
+    camera: &'a dualsplit_scene::Camera,
+    light: &'a dualsplit_scene::Light,
+    config: &'a SimConfig,
+    results: Vec<&'a SimResult>,
+    summary: Summary,
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
-    let accels: Vec<SimAccel> = if args.accel == "all" {
-        SimAccel::ALL.to_vec()
-    } else {
-        match SimAccel::parse(&args.accel) {
-            Some(a) => vec![a],
-            None => bail!(
-                "unknown --accel `{}` (expected bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst or all)",
-                args.accel
-            ),
-        }
-    };
-    let workload = match args.workload.as_str() {
-        "cast" => Workload::Cast,
-        "path" => Workload::Path,
-        w => bail!("unknown --workload `{w}` (expected cast or path)"),
-    };
-    let Some(model) = ThreadModel::parse(&args.model) else {
-        bail!("unknown --model `{}` (expected rv32 or fast)", args.model);
-    };
-    if args.res == 0 {
-        bail!("--res must be at least 1");
-    }
+    let accels = sim_accels(&args.accel);
+    let json = JsonOut::from_arg(args.json.as_deref())?;
+    let (workload, model) = (args.workload, args.model);
     let mut cfg = match &args.config {
         Some(p) => {
             let text =
@@ -72,8 +97,17 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     cfg.validate()?;
 
-    let (scene, structures) = super::load_and_build(&args.scene, ctx)?;
-    let settings = RenderSettings::new(args.res, args.res, workload);
+    let sp = ctx.spinner(format!("loading {}", args.scene));
+    let mut scene = dualsplit_scene::load(&args.scene)
+        .with_context(|| format!("loading scene {}", args.scene))?;
+    sp.finish_and_clear();
+    args.view.apply(&mut scene)?;
+    let settings = RenderSettings::new(args.res.0, args.res.1, workload);
+    dualsplit_render::validate(&scene, &settings)?;
+    let sp = ctx.spinner("building BVH2, BVH4, BVH8, DST");
+    let structures = Structures::try_build(&scene.triangles, &BuildConfig::default())
+        .with_context(|| format!("building the structures of {}", args.scene))?;
+    sp.finish_and_clear();
 
     // Each run's host time, for the table's `host` line only: a host measurement is never
     // part of a result (the JSON is the same on every machine).
@@ -115,17 +149,32 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             results.push(r?);
         }
     }
+    let plain: Vec<&SimResult> = results.iter().map(|(r, _)| r).collect();
+    let summary = summarize(&plain);
 
-    if args.json {
-        let results: Vec<&SimResult> = results.iter().map(|(r, _)| r).collect();
-        println!("{}", serde_json::to_string_pretty(&results)?);
+    if let Some(out) = json {
+        let report = JsonReport {
+            scene: &scene.name,
+            spec: &scene.spec,
+            triangles: scene.triangles.len(),
+            width: settings.width,
+            height: settings.height,
+            workload,
+            thread_model: model,
+            camera: &scene.camera,
+            light: &scene.light,
+            config: &cfg,
+            results: plain,
+            summary,
+        };
+        out.emit(&serde_json::to_string_pretty(&report)?)?;
     } else {
         println!(
             "scene {} ({} triangles), {}×{} {}, {} TMs × {} TPs, {} thread model",
             scene.name,
             scene.triangles.len(),
-            args.res,
-            args.res,
+            settings.width,
+            settings.height,
             workload.name(),
             cfg.tms,
             cfg.tps_per_tm,
@@ -133,6 +182,25 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         );
         for (r, host) in &results {
             print_result(r, *host);
+        }
+        if results.len() > 1 {
+            println!(
+                "\ncomparison (frame time, energy and DRAM lines as % of {}; stalls and idle as shares of all thread-cycles)",
+                summary.baseline.map_or("?", |a| a.label())
+            );
+            print!("{}", summary::table(&summary));
+        }
+        let idle = summary
+            .rows
+            .iter()
+            .map(|r| r.stalls.idle_at_end)
+            .fold(0.0f64, f64::max);
+        if idle > IDLE_WARN {
+            println!(
+                "note: threads sat idle at the end of the frame for up to {:.0} % of their cycles: the frame has too few pixels for {} threads, so the chip is not busy; a larger --res compares the structures on a busy chip",
+                100.0 * idle,
+                cfg.tms * cfg.tps_per_tm
+            );
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -149,19 +217,19 @@ fn print_result(r: &SimResult, host: Duration) {
     let u = &r.utilisation;
     println!("== {label}");
     println!(
-        "  frame time     {:.3} ms ({} cycles), {} rays, {:.0} instructions and {:.0} thread-cycles per ray",
-        r.frame_ms,
+        "  frame time     {} ({} cycles), {} rays, {:.0} instructions and {:.0} thread-cycles per ray",
+        units::time_ms(r.frame_ms),
         r.cycles,
         r.rays,
         r.instructions.total() as f64 / r.rays.max(1) as f64,
         r.cycles as f64 * r.threads as f64 / r.rays.max(1) as f64
     );
     println!(
-        "  energy         {:.4} J total: DRAM {:.4} J, caches {:.4} J, compute {:.4} J",
-        e.total(),
-        e.dram_j,
-        e.caches_j,
-        e.compute_j
+        "  energy         {} total: DRAM {}, caches {}, compute {}",
+        units::energy_j(e.total()),
+        units::energy_j(e.dram_j),
+        units::energy_j(e.caches_j),
+        units::energy_j(e.compute_j)
     );
     println!(
         "  DRAM           {} lines read, {} activations, row-hit rate {:.1} %",

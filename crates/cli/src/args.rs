@@ -1,0 +1,201 @@
+//! Argument parsers and argument groups shared by the subcommands: structure, workload and
+//! resolution names, scene specs (checked before any work starts), and the camera and light
+//! overrides of `render` and `simulate`.
+use anyhow::Context;
+use dualsplit_accel::AccelKind;
+use dualsplit_render::Workload;
+use dualsplit_scene::Scene;
+use dualsplit_sim::SimAccel;
+use std::path::Path;
+
+/// Parses a structure name.
+pub fn parse_accel(s: &str) -> Result<AccelKind, String> {
+    AccelKind::parse(s).ok_or_else(|| {
+        let names: Vec<_> = AccelKind::ALL.iter().map(|k| k.name()).collect();
+        format!(
+            "unknown structure `{s}` (expected one of {})",
+            names.join(", ")
+        )
+    })
+}
+
+/// One item of `simulate --accel`: a configuration, or `all` of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SimAccelArg {
+    /// Every configuration, in the paper's order.
+    All,
+    /// One configuration.
+    One(SimAccel),
+}
+
+/// Parses a simulated configuration name or `all`.
+pub fn parse_sim_accel(s: &str) -> Result<SimAccelArg, String> {
+    if s == "all" {
+        return Ok(SimAccelArg::All);
+    }
+    SimAccel::parse(s).map(SimAccelArg::One).ok_or_else(|| {
+        let names: Vec<_> = SimAccel::ALL.iter().map(|k| k.name()).collect();
+        format!(
+            "unknown configuration `{s}` (expected one of {} or all)",
+            names.join(", ")
+        )
+    })
+}
+
+/// The configurations a `--accel` list names, in the order given, each once (`all` expands
+/// to every configuration in the paper's order).
+pub fn sim_accels(items: &[SimAccelArg]) -> Vec<SimAccel> {
+    let mut out = Vec::new();
+    for item in items {
+        let add: &[SimAccel] = match item {
+            SimAccelArg::All => &SimAccel::ALL,
+            SimAccelArg::One(a) => std::slice::from_ref(a),
+        };
+        for a in add {
+            if !out.contains(a) {
+                out.push(*a);
+            }
+        }
+    }
+    out
+}
+
+/// Parses a workload name.
+pub fn parse_workload(s: &str) -> Result<Workload, String> {
+    Workload::parse(s).ok_or_else(|| format!("unknown workload `{s}` (expected cast or path)"))
+}
+
+/// Parses `WxH` or `N` (for N×N), both positive.
+pub fn parse_res(s: &str) -> Result<(u32, u32), String> {
+    let num = |t: &str| {
+        t.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| n > 0)
+            .ok_or_else(|| format!("bad resolution `{s}` (expected WIDTHxHEIGHT or N, positive)"))
+    };
+    match s.split_once(['x', 'X']) {
+        Some((w, h)) => Ok((num(w)?, num(h)?)),
+        None => num(s).map(|n| (n, n)),
+    }
+}
+
+/// Parses a positive count (TMs, resolution side).
+pub fn parse_positive(s: &str) -> Result<u32, String> {
+    s.trim()
+        .parse::<u32>()
+        .ok()
+        .filter(|&n| n > 0)
+        .ok_or_else(|| format!("`{s}` is not a positive whole number"))
+}
+
+/// What a scene argument is, for the help texts.
+pub const SCENE_HELP: &str = "a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params (hairball, forest, atrium, cornell)";
+
+/// Checks a scene spec before anything is loaded: a `builtin:` spec passes (its name and
+/// parameters are checked when it is generated); a file must exist and not be a directory.
+/// The message for a missing file says so and names the builtins, suggesting `builtin:NAME`
+/// when the spec is a builtin's bare name.
+pub fn parse_scene(spec: &str) -> Result<String, String> {
+    if spec.starts_with("builtin:") {
+        return Ok(spec.to_string());
+    }
+    let path = Path::new(spec);
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => Err(format!("`{spec}` is a directory; a scene is {SCENE_HELP}")),
+        Ok(_) => Ok(spec.to_string()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            let names = dualsplit_scene::builtin::NAMES;
+            let name = spec.split('?').next().unwrap_or(spec);
+            let hint = if names.contains(&name) {
+                format!(" (did you mean builtin:{spec}?)")
+            } else {
+                String::new()
+            };
+            Err(format!(
+                "no such file: `{spec}`{hint}; a scene is a file (.obj, .ply, .gltf, .glb, optionally .gz) or a generated builtin: {}",
+                names
+                    .iter()
+                    .map(|n| format!("builtin:{n}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        }
+        Err(e) => Err(format!("`{spec}`: {e}")),
+    }
+}
+
+/// Checks an `x,y,z` vector's syntax; the value is kept as text for the scene's
+/// `with_overrides`.
+fn parse_vec3_text(s: &str) -> Result<String, String> {
+    dualsplit_scene::parse_vec3("value", s)
+        .map(|_| s.to_string())
+        .map_err(|e| e.to_string())
+}
+
+/// Camera and light overrides, as `render` and `simulate` take them.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct View {
+    /// Camera position x,y,z (default: the scene's camera).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_vec3_text)]
+    pub eye: Option<String>,
+    /// Point the camera looks at, x,y,z.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_vec3_text)]
+    pub target: Option<String>,
+    /// Vertical field of view in degrees, in (0, 180).
+    #[arg(long)]
+    pub fov: Option<f32>,
+    /// Light centre x,y,z (default: the scene's light).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_vec3_text)]
+    pub light: Option<String>,
+    /// Light radius (0 = point light, hard shadows).
+    #[arg(long)]
+    pub light_radius: Option<f32>,
+}
+
+impl View {
+    /// Applies the overrides to `scene`'s camera and light.
+    pub fn apply(&self, scene: &mut Scene) -> anyhow::Result<()> {
+        scene.camera = scene
+            .camera
+            .with_overrides(self.eye.as_deref(), self.target.as_deref(), self.fov)
+            .context("camera options")?;
+        scene.light = scene
+            .light
+            .with_overrides(self.light.as_deref(), self.light_radius, None)
+            .context("light options")?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolutions() {
+        assert_eq!(parse_res("64"), Ok((64, 64)));
+        assert_eq!(parse_res("64x32"), Ok((64, 32)));
+        assert!(parse_res("0").is_err());
+        assert!(parse_res("64x").is_err());
+    }
+
+    #[test]
+    fn sim_accel_lists_keep_order_and_drop_repeats() {
+        let items = ["dst", "bvh2", "all"].map(|s| parse_sim_accel(s).unwrap());
+        let got = sim_accels(&items);
+        assert_eq!(got.len(), SimAccel::ALL.len());
+        assert_eq!(&got[..2], &[SimAccel::Dst, SimAccel::Bvh2]);
+        assert!(parse_sim_accel("bvh3").is_err());
+    }
+
+    #[test]
+    fn missing_scene_files_are_named() {
+        let e = parse_scene("no/such/scene.obj").unwrap_err();
+        assert!(e.contains("no such file"), "{e}");
+        assert!(e.contains("builtin:hairball"), "{e}");
+        let e = parse_scene("forest").unwrap_err();
+        assert!(e.contains("did you mean builtin:forest?"), "{e}");
+        assert!(parse_scene("builtin:anything").is_ok());
+    }
+}

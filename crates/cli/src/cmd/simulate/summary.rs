@@ -1,0 +1,237 @@
+//! The comparison of several simulated configurations: frame time, energy and DRAM lines,
+//! each also as a fraction of a baseline (BVH2 when it was simulated, else the first
+//! configuration), per-ray work, and where the threads' cycles went (stall shares, idle at
+//! the end of the frame).
+use dualsplit_report::units;
+use dualsplit_sim::{SimAccel, SimResult};
+use serde::Serialize;
+
+/// Shares of all thread-cycles (cycles × threads) by what a thread waited for.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct StallShares {
+    /// Waiting for load data.
+    pub memory: f64,
+    /// Waiting for a pipeline result.
+    pub pipeline_latency: f64,
+    /// Waiting for a free pipeline.
+    pub pipeline_busy: f64,
+    /// Waiting for a functional unit's result (compiled kernels).
+    pub dependency: f64,
+    /// Waiting for a free shared unit (compiled kernels).
+    pub fu_busy: f64,
+    /// Waiting for the reciprocal unit.
+    pub fpinv: f64,
+    /// L1 bank conflicts.
+    pub l1_bank: f64,
+    /// Waiting for the global atomic unit.
+    pub atomic: f64,
+    /// Finished while other threads still ran (the frame's tail).
+    pub idle_at_end: f64,
+}
+
+impl StallShares {
+    /// The shares of `r`'s thread-cycles.
+    pub fn of(r: &SimResult) -> Self {
+        let total = r.cycles as f64 * f64::from(r.threads);
+        let f = |x: u64| if total > 0.0 { x as f64 / total } else { 0.0 };
+        let s = &r.stalls;
+        Self {
+            memory: f(s.memory),
+            pipeline_latency: f(s.pipeline_latency),
+            pipeline_busy: f(s.pipeline_busy),
+            dependency: f(s.dependency),
+            fu_busy: f(s.fu_busy),
+            fpinv: f(s.fpinv),
+            l1_bank: f(s.l1_bank),
+            atomic: f(s.atomic),
+            idle_at_end: f(s.idle),
+        }
+    }
+
+    /// Stalls on units and pipelines: everything but memory and the idle tail.
+    pub fn units(&self) -> f64 {
+        self.pipeline_latency
+            + self.pipeline_busy
+            + self.dependency
+            + self.fu_busy
+            + self.fpinv
+            + self.l1_bank
+            + self.atomic
+    }
+}
+
+/// One configuration's row of the comparison (every number of the printed tables except
+/// host timings).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Row {
+    /// The configuration.
+    pub accel: Option<SimAccel>,
+    /// Frame time (ms).
+    pub frame_ms: f64,
+    /// Frame time / the baseline's.
+    pub frame_vs_baseline: Option<f64>,
+    /// Total energy (J).
+    pub energy_j: f64,
+    /// Energy / the baseline's.
+    pub energy_vs_baseline: Option<f64>,
+    /// 64-byte DRAM lines read.
+    pub dram_lines: u64,
+    /// DRAM lines / the baseline's.
+    pub dram_lines_vs_baseline: Option<f64>,
+    /// Instructions per ray.
+    pub instructions_per_ray: f64,
+    /// Thread-cycles (cycles × threads) per ray.
+    pub thread_cycles_per_ray: f64,
+    /// Where the thread-cycles went.
+    pub stalls: StallShares,
+}
+
+/// The comparison: the baseline and one row per configuration, in the order simulated.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    /// The configuration the ratios divide by.
+    pub baseline: Option<SimAccel>,
+    /// One row per configuration.
+    pub rows: Vec<Row>,
+}
+
+fn ratio(v: f64, base: f64) -> Option<f64> {
+    (base > 0.0).then(|| v / base)
+}
+
+/// The comparison of `results`: BVH2 is the baseline when present, else the first result.
+pub fn summarize(results: &[&SimResult]) -> Summary {
+    let base = results
+        .iter()
+        .find(|r| r.accel == Some(SimAccel::Bvh2))
+        .or_else(|| results.first())
+        .copied();
+    let rows = results
+        .iter()
+        .map(|r| {
+            let rays = r.rays.max(1) as f64;
+            let rel = |f: fn(&SimResult) -> f64| base.and_then(|b| ratio(f(r), f(b)));
+            Row {
+                accel: r.accel,
+                frame_ms: r.frame_ms,
+                frame_vs_baseline: rel(|x| x.frame_ms),
+                energy_j: r.energy.total(),
+                energy_vs_baseline: rel(|x| x.energy.total()),
+                dram_lines: r.dram_lines,
+                dram_lines_vs_baseline: rel(|x| x.dram_lines as f64),
+                instructions_per_ray: r.instructions.total() as f64 / rays,
+                thread_cycles_per_ray: r.cycles as f64 * f64::from(r.threads) / rays,
+                stalls: StallShares::of(r),
+            }
+        })
+        .collect();
+    Summary {
+        baseline: base.and_then(|b| b.accel),
+        rows,
+    }
+}
+
+fn pct(v: Option<f64>) -> String {
+    v.map_or_else(|| "—".into(), |v| format!("{:.1} %", 100.0 * v))
+}
+
+/// The comparison as a text table.
+pub fn table(s: &Summary) -> String {
+    let base = s.baseline.map_or("?", |a| a.label());
+    let header = [
+        "config".to_string(),
+        "frame time".into(),
+        format!("% {base}"),
+        "energy".into(),
+        format!("% {base}"),
+        "DRAM lines".into(),
+        format!("% {base}"),
+        "memory stall".into(),
+        "unit stall".into(),
+        "idle at end".into(),
+    ];
+    let mut rows = vec![header.to_vec()];
+    for r in &s.rows {
+        rows.push(vec![
+            r.accel.map_or("?", |a| a.label()).to_string(),
+            units::time_ms(r.frame_ms),
+            pct(r.frame_vs_baseline),
+            units::energy_j(r.energy_j),
+            pct(r.energy_vs_baseline),
+            units::count(r.dram_lines as f64),
+            pct(r.dram_lines_vs_baseline),
+            pct(Some(r.stalls.memory)),
+            pct(Some(r.stalls.units())),
+            pct(Some(r.stalls.idle_at_end)),
+        ]);
+    }
+    let widths: Vec<usize> = (0..rows[0].len())
+        .map(|c| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0))
+        .collect();
+    let mut out = String::new();
+    for row in &rows {
+        let cells: Vec<String> = row
+            .iter()
+            .zip(&widths)
+            .enumerate()
+            .map(|(c, (cell, w))| {
+                let pad = w - cell.chars().count();
+                if c == 0 {
+                    format!("{cell}{}", " ".repeat(pad))
+                } else {
+                    format!("{}{cell}", " ".repeat(pad))
+                }
+            })
+            .collect();
+        out.push_str(cells.join("  ").trim_end());
+        out.push('\n');
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dualsplit_sim::EnergySplit;
+
+    fn result(accel: SimAccel, frame_ms: f64, lines: u64) -> SimResult {
+        let mut r = SimResult {
+            accel: Some(accel),
+            threads: 4,
+            cycles: 100,
+            frame_ms,
+            energy: EnergySplit {
+                dram_j: frame_ms / 10.0,
+                caches_j: 0.0,
+                compute_j: 0.0,
+            },
+            dram_lines: lines,
+            rays: 10,
+            ..Default::default()
+        };
+        r.stalls.memory = 100;
+        r.stalls.idle = 40;
+        r
+    }
+
+    #[test]
+    fn bvh2_is_the_baseline_when_present() {
+        let d = result(SimAccel::Dst, 3.0, 600);
+        let b = result(SimAccel::Bvh2, 4.0, 800);
+        let s = summarize(&[&d, &b]);
+        assert_eq!(s.baseline, Some(SimAccel::Bvh2));
+        assert_eq!(s.rows[0].frame_vs_baseline, Some(0.75));
+        assert_eq!(s.rows[0].dram_lines_vs_baseline, Some(0.75));
+        assert_eq!(s.rows[1].energy_vs_baseline, Some(1.0));
+        assert_eq!(s.rows[0].stalls.memory, 0.25);
+        assert_eq!(s.rows[0].stalls.idle_at_end, 0.1);
+        assert_eq!(s.rows[0].thread_cycles_per_ray, 40.0);
+        let t = table(&s);
+        assert!(t.contains("% BVH2"), "{t}");
+        assert!(t.contains("75.0 %"), "{t}");
+
+        let s = summarize(&[&d, &result(SimAccel::Bvh8, 6.0, 900)]);
+        assert_eq!(s.baseline, Some(SimAccel::Dst));
+        assert_eq!(s.rows[1].frame_vs_baseline, Some(2.0));
+    }
+}
