@@ -363,3 +363,36 @@ fn report_says_which_paper_meshes_it_found_and_where() {
         stderr(&o)
     );
 }
+
+/// `report --dry-run` prints the plan and its time estimate without loading a scene: the
+/// default plan names Dragon Box when a scenes folder holds it, `--full` the paper's setup.
+#[test]
+fn report_dry_run_prints_the_plan_without_loading() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = dir.path().join("scenes");
+    std::fs::create_dir(&scenes).unwrap();
+    // An empty file under the mesh's name: a dry run must not read it.
+    std::fs::write(scenes.join("dragon_box.ply.gz"), b"").unwrap();
+    let s = scenes.to_str().unwrap();
+    let o = dualsplit(&["report", "--dry-run", "--scenes", s], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("plan: 4 scenes") && e.contains("dragon_box.ply.gz"),
+        "{e}"
+    );
+    assert!(
+        e.contains("fast thread model") && e.contains("roughly"),
+        "{e}"
+    );
+    let o = dualsplit(
+        &["report", "--dry-run", "--full", "--scenes", s],
+        dir.path(),
+    );
+    let e = stderr(&o);
+    assert!(o.status.success(), "{e}");
+    assert!(
+        e.contains("1024×1024") && e.contains("rv32 thread model"),
+        "{e}"
+    );
+}

@@ -49,6 +49,18 @@ pub struct ReportSettings {
     pub thread_model: dualsplit_sim::ThreadModel,
 }
 
+impl ReportSettings {
+    /// The TM counts of the scaling study as prose: "32, 64 and 128".
+    pub fn tms_list(&self) -> String {
+        let v: Vec<String> = self.tms.iter().map(u32::to_string).collect();
+        match v.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            Some((last, _)) => last.clone(),
+            None => String::new(),
+        }
+    }
+}
+
 /// A scene that was asked for but could not be loaded.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Skipped {

@@ -99,12 +99,12 @@ pub fn index_html(data: &ReportData) -> Result<String, ReportError> {
     let _ = writeln!(
         h,
         "<p class=\"meta\">Reproduces the results section of Lin, Vasiou, Yuksel, Kopta and Brunvand, HPG 2020 (§4, Tables 3–7, Figures 7–9). \
-Simulated at {}×{}, 1 spp, {} TMs for Tables 4–6, TM scaling over {:?}{}; the threads {}. Code version {}. Grey columns and faded bars are the paper's published values; \
+Simulated at {}×{}, 1 spp, {} TMs for Tables 4–6, TM scaling over {} TMs{}; the threads {}. Code version {}. Grey columns and faded bars are the paper's published values; \
 scenes marked “stand-in” are not the paper's meshes, so compare trends rather than values.</p>",
         st.width,
         st.height,
         st.base_tms,
-        st.tms,
+        st.tms_list(),
         if st.full {
             " (the paper's full setup)"
         } else {

@@ -150,10 +150,19 @@ impl<'a> Producer<'a> {
     /// The scenes that get the TM-scaling study: those standing for the paper's Crytek
     /// Sponza and Hairball (Table 7), or the first scene when none does.
     pub fn scaling_scenes(scenes: &[Scene]) -> Vec<bool> {
-        let wanted: Vec<bool> = scenes
+        let names: Vec<String> = scenes
             .iter()
-            .map(|s| {
-                PaperMatch::for_scene(&s.name, &s.spec).is_some_and(|m| {
+            .map(|s| format!("{} {}", s.name, s.spec))
+            .collect();
+        Self::scaling_specs(&names)
+    }
+
+    /// [`Producer::scaling_scenes`] from the scenes' specs alone (before loading them).
+    pub fn scaling_specs(specs: &[String]) -> Vec<bool> {
+        let wanted: Vec<bool> = specs
+            .iter()
+            .map(|spec| {
+                PaperMatch::for_scene("", spec).is_some_and(|m| {
                     matches!(m.scene, PaperScene::CrytekSponza | PaperScene::Hairball)
                 })
             })
@@ -161,7 +170,7 @@ impl<'a> Producer<'a> {
         if wanted.iter().any(|&w| w) {
             wanted
         } else {
-            (0..scenes.len()).map(|i| i == 0).collect()
+            (0..specs.len()).map(|i| i == 0).collect()
         }
     }
 

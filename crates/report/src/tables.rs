@@ -310,6 +310,7 @@ pub fn table45(data: &ReportData, workload: Workload) -> Section {
             header.push(h.clone());
             header.push("% of BVH2".into());
         }
+        header.push("idle at end".into());
         let first_paper = header.len();
         if let Some(m) = &s.paper {
             for (h, _) in &paper_units {
@@ -338,6 +339,10 @@ pub fn table45(data: &ReportData, workload: Workload) -> Section {
                     None => row.extend([Cell::none(), Cell::none()]),
                 }
             }
+            // Threads out of work before the frame ends (a frame too small for the chip).
+            row.push(s.sim(a, workload, tms).map_or_else(Cell::none, |r| {
+                Cell::pct(dualsplit_sim::StallShares::of(r).idle_at_end)
+            }));
             if let Some(pm) = &s.paper {
                 for (m, (_, scale)) in Metric::ALL.iter().copied().zip(&paper_units) {
                     let v = paper::table45(workload, m, a, pm.scene);
@@ -364,6 +369,11 @@ pub fn table45(data: &ReportData, workload: Workload) -> Section {
             rows,
         });
     }
+    notes.extend(
+        summary::idle_warnings(data, Some(workload))
+            .into_iter()
+            .map(|w| format!("Warning: {w}.")),
+    );
     Section {
         id: format!("table{num}"),
         title: format!("Table {num} — {what}"),

@@ -28,8 +28,11 @@ pub fn report_md(data: &ReportData) -> String {
     let st = &data.settings;
     let _ = writeln!(
         m,
-        "Lin et al. 2020, §4. Simulated at {}×{}, {} TMs (scaling over {:?}). Columns whose heading starts with \"paper\" are the published values; stand-in scenes are labelled.\n",
-        st.width, st.height, st.base_tms, st.tms
+        "Lin et al. 2020, §4. Simulated at {}×{}, {} TMs (scaling over {} TMs). Columns whose heading starts with \"paper\" are the published values; stand-in scenes are labelled.\n",
+        st.width,
+        st.height,
+        st.base_tms,
+        st.tms_list()
     );
     let _ = writeln!(m, "{}\n", data.scene_files.describe());
     if let Some(e) = data.sim_error() {

@@ -48,6 +48,7 @@ pub mod kernels;
 pub mod memory;
 pub mod rv32;
 mod scheduler;
+mod shares;
 pub mod slots;
 pub mod thread;
 pub mod tm;
@@ -64,6 +65,7 @@ pub use config::{CacheConfig, ConfigError, DramConfig, EnergyConfig, SimConfig, 
 pub use cycle::{Cycle, Tick};
 pub use kernel::{InstrCounts, Mix};
 pub use memory::{CacheStats, DramStats};
+pub use shares::StallShares;
 pub use thread::{Stalls, Thread};
 pub use tm::{Issued, Tm, UnitStats, WordAddr};
 

@@ -8,6 +8,7 @@
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_report::data::{ReportSettings, Skipped};
+use dualsplit_report::paper::PaperScene;
 use dualsplit_report::produce::real_simulator;
 use dualsplit_report::scenes::{self, SceneFiles};
 use dualsplit_report::{Cache, Producer, Progress};
@@ -18,16 +19,20 @@ use std::process::ExitCode;
 use std::sync::Mutex;
 use std::time::Instant;
 
-/// Default scenes: the builtins at reduced sizes, so the whole default report finishes in
-/// about 5 minutes on a 2-core machine while keeping the paper's scene characters
-/// (hairball ↔ Hairball, forest ↔ Vegetation, atrium ↔ Crytek Sponza).
+/// Default stand-ins: the builtins at reduced sizes, keeping the paper's scene characters
+/// (hairball ↔ Hairball, forest ↔ Vegetation, atrium ↔ Crytek Sponza). The default report
+/// also takes the paper's own Dragon Box from the scenes folder when it is there.
 pub const DEFAULT_SCENES: [&str; 3] = [
     "builtin:atrium?triangles=30000",
     "builtin:forest?triangles=40000",
     "builtin:hairball?triangles=60000",
 ];
-/// Default square resolution of the simulated frames.
-pub const DEFAULT_RES: u32 = 128;
+/// Default square resolution of the simulated frames. Threads run out of pixels before the
+/// frame ends (scanline hand-out, the last pixels' paths the longest): measured on the
+/// default scenes with 64 TMs, path tracing left up to 27 % of the thread-cycles idle at
+/// 128², up to 18 % at 256² and 1 % at 512² (Dragon Box); 384² keeps the 64-TM tables
+/// near or under the 10 % the report warns at, in a few minutes on 2 cores.
+pub const DEFAULT_RES: u32 = 384;
 /// The paper's scenes for `--full`: full-size builtins, plus the shipped meshes of
 /// `dualsplit_report::scenes::PAPER_FILES` found in the scenes folder.
 pub const FULL_SCENES: [&str; 3] = ["builtin:atrium", "builtin:forest", "builtin:hairball"];
@@ -36,13 +41,13 @@ pub const FULL_RES: u32 = 1024;
 /// Square resolution of the CPU ray sets (path workload rays).
 pub const CPU_RES: u32 = 320;
 /// Simulated rays per second of wall time on a 2-core machine, two simulations side by side,
-/// with the `fast` thread model; used only for the `--full` up-front estimate. Measured:
-/// about 38K simulated rays per CPU second (release build, `lin2020` config, the default
-/// builtins at 64×64).
-pub const SIM_RAYS_PER_SECOND: f64 = 40_000.0;
-/// The same with the compiled kernels (`rv32`). Measured: dragon_box 256² path, all eight
-/// configurations two at a time, 3.82 M rays in about 260 s of wall time.
-pub const SIM_RAYS_PER_SECOND_RV32: f64 = 14_000.0;
+/// with the `fast` thread model; used only for the up-front estimate. Measured with model
+/// 7: dragon_box 256² path, BVH2, 477,571 rays in 3.3 s on one core (145K per second), two
+/// at a time on 2 cores; other configurations and scenes run up to 2× slower.
+pub const SIM_RAYS_PER_SECOND: f64 = 200_000.0;
+/// The same with the compiled kernels (`rv32`). Measured with model 7: the same frame in
+/// 16.1–16.6 s on one core (29K rays per second), two at a time.
+pub const SIM_RAYS_PER_SECOND_RV32: f64 = 45_000.0;
 
 /// Arguments of `dualsplit report`.
 #[derive(clap::Args)]
@@ -69,9 +74,14 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', default_value = "32,64,128", value_parser = crate::args::parse_positive)]
     tms: Vec<u32>,
     /// Thread model: rv32 (the compiled kernels instruction by instruction, the reference)
-    /// or fast (the macro-op replay: about 8× faster, an uncalibrated approximation).
-    #[arg(long, default_value = "rv32")]
-    model: String,
+    /// or fast (the replay calibrated against them: about 5× faster, within 10 %). Default:
+    /// fast, rv32 with --full.
+    #[arg(long)]
+    model: Option<String>,
+    /// Print the plan (scenes, frames, configurations) and the time estimate, then stop
+    /// without loading anything.
+    #[arg(long)]
+    dry_run: bool,
 }
 
 /// indicatif bars behind the report's `Progress` trait.
@@ -121,12 +131,22 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let user_scenes = !args.specs.is_empty();
     let specs: Vec<String> = if user_scenes {
         args.specs.clone()
-    } else if args.full {
-        let mut v: Vec<String> = FULL_SCENES.iter().map(|s| s.to_string()).collect();
-        v.extend(scene_files.files.iter().filter_map(|f| f.path.clone()));
-        v
     } else {
-        DEFAULT_SCENES.iter().map(|s| s.to_string()).collect()
+        // The paper's meshes found in the scenes folder (all with --full; Dragon Box, the
+        // paper's own, by default), then the builtins.
+        let files = scene_files
+            .files
+            .iter()
+            .filter(|f| args.full || f.scene == PaperScene::DragonBox)
+            .filter_map(|f| f.path.clone());
+        let builtins: &[&str] = if args.full {
+            &FULL_SCENES
+        } else {
+            &DEFAULT_SCENES
+        };
+        files
+            .chain(builtins.iter().map(|s| s.to_string()))
+            .collect()
     };
     let mut tms = args.tms.clone();
     tms.sort_unstable();
@@ -136,6 +156,23 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     } else {
         tms[tms.len() / 2]
     };
+    let model = args
+        .model
+        .as_deref()
+        .unwrap_or(if args.full { "rv32" } else { "fast" });
+    let thread_model = ThreadModel::parse(model)
+        .ok_or_else(|| anyhow::anyhow!("unknown --model `{model}` (expected rv32 or fast)"))?;
+    let plan = Plan {
+        specs: &specs,
+        res,
+        tms: &tms,
+        base_tms,
+        thread_model,
+    };
+    eprintln!("{}", plan.describe());
+    if args.dry_run {
+        return Ok(ExitCode::SUCCESS);
+    }
 
     let mut scenes = Vec::new();
     let mut skipped = Vec::new();
@@ -156,9 +193,6 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         }
     }
 
-    let thread_model = ThreadModel::parse(&args.model).ok_or_else(|| {
-        anyhow::anyhow!("unknown --model `{}` (expected rv32 or fast)", args.model)
-    })?;
     if scenes.is_empty() {
         anyhow::bail!(
             "no scene could be loaded: {}",
@@ -169,34 +203,6 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                 .join("; ")
         );
     }
-    if args.full {
-        let pixels = f64::from(res) * f64::from(res);
-        let scaling = Producer::scaling_scenes(&scenes)
-            .iter()
-            .filter(|&&b| b)
-            .count();
-        let extra_tms = tms.iter().filter(|&&t| t != base_tms).count();
-        // 8 configurations; up to 2 rays per pixel for casting and 12 for path tracing (see
-        // dualsplit-render), about 1.5 and 6 on average.
-        let frames = scenes.len() * 16 + scaling * extra_tms * 8;
-        let rays = 8.0 * pixels * (1.5 + 6.0) * scenes.len() as f64
-            + (scaling * extra_tms * 8) as f64 * pixels * 6.0;
-        let secs = rays
-            / match thread_model {
-                ThreadModel::Rv32 => SIM_RAYS_PER_SECOND_RV32,
-                ThreadModel::Fast => SIM_RAYS_PER_SECOND,
-            };
-        let when = if secs >= 3600.0 {
-            format!("{:.1} hours", secs / 3600.0)
-        } else {
-            format!("{:.0} minutes", (secs / 60.0).ceil())
-        };
-        eprintln!(
-            "--full: {} scenes at {res}×{res}, {frames} simulated frames; roughly {when} on a 2-core machine (cached pieces are skipped)",
-            scenes.len()
-        );
-    }
-
     let settings = ReportSettings {
         width: res,
         height: res,
@@ -223,6 +229,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if let Some(e) = data.sim_error() {
         eprintln!("note: {e}; simulated sections say so");
     }
+    for w in dualsplit_report::summary::idle_warnings(&data, None) {
+        eprintln!("warning: {w}");
+    }
     println!(
         "wrote {} ({} files; {} pieces computed, the rest from {}) in {:.1} s",
         args.out.join("index.html").display(),
@@ -232,4 +241,63 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         start.elapsed().as_secs_f64()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// What a report will simulate, known before any scene is loaded.
+struct Plan<'a> {
+    specs: &'a [String],
+    res: u32,
+    tms: &'a [u32],
+    base_tms: u32,
+    thread_model: ThreadModel,
+}
+
+impl Plan<'_> {
+    /// Simulated frames: every configuration, cast and path, per scene at the base TM
+    /// count, and path at the other TM counts on the scaling scenes (Table 7).
+    fn frames(&self) -> (usize, usize) {
+        let scaling = Producer::scaling_specs(self.specs)
+            .iter()
+            .filter(|&&b| b)
+            .count();
+        let extra_tms = self.tms.iter().filter(|&&t| t != self.base_tms).count();
+        let n = dualsplit_sim::SimAccel::ALL.len();
+        (self.specs.len() * 2 * n, scaling * extra_tms * n)
+    }
+
+    /// Wall seconds the simulations take on a 2-core machine, from the rays of the frames
+    /// (about 1.5 per pixel cast, 6 path, as `dualsplit-render` traces them on the paper's
+    /// scenes) and the measured simulation speed.
+    fn seconds(&self) -> f64 {
+        let pixels = f64::from(self.res) * f64::from(self.res);
+        let (base, scaling) = self.frames();
+        let rays = base as f64 / 2.0 * pixels * (1.5 + 6.0) + scaling as f64 * pixels * 6.0;
+        rays / match self.thread_model {
+            ThreadModel::Rv32 => SIM_RAYS_PER_SECOND_RV32,
+            ThreadModel::Fast => SIM_RAYS_PER_SECOND,
+        }
+    }
+
+    fn describe(&self) -> String {
+        let (base, scaling) = self.frames();
+        let secs = self.seconds();
+        let when = if secs >= 3600.0 {
+            format!("{:.1} hours", secs / 3600.0)
+        } else if secs >= 120.0 {
+            format!("{:.0} minutes", (secs / 60.0).ceil())
+        } else {
+            format!("{:.0} seconds", secs.ceil())
+        };
+        format!(
+            "plan: {} scenes ({}) at {r}×{r}, {} thread model; {base} frames at {} TMs \
+             (8 configurations, cast and path) and {scaling} TM-scaling frames at {:?} TMs; \
+             simulations roughly {when} on a 2-core machine (cached frames are skipped)",
+            self.specs.len(),
+            self.specs.join(", "),
+            self.thread_model.name(),
+            self.base_tms,
+            self.tms,
+            r = self.res,
+        )
+    }
 }

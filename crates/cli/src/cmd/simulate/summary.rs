@@ -3,62 +3,8 @@
 //! configuration), per-ray work, and where the threads' cycles went (stall shares, idle at
 //! the end of the frame).
 use dualsplit_report::units;
-use dualsplit_sim::{SimAccel, SimResult};
+use dualsplit_sim::{SimAccel, SimResult, StallShares};
 use serde::Serialize;
-
-/// Shares of all thread-cycles (cycles × threads) by what a thread waited for.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct StallShares {
-    /// Waiting for load data.
-    pub memory: f64,
-    /// Waiting for a pipeline result.
-    pub pipeline_latency: f64,
-    /// Waiting for a free pipeline.
-    pub pipeline_busy: f64,
-    /// Waiting for a functional unit's result (compiled kernels).
-    pub dependency: f64,
-    /// Waiting for a free shared unit (compiled kernels).
-    pub fu_busy: f64,
-    /// Waiting for the reciprocal unit.
-    pub fpinv: f64,
-    /// L1 bank conflicts.
-    pub l1_bank: f64,
-    /// Waiting for the global atomic unit.
-    pub atomic: f64,
-    /// Finished while other threads still ran (the frame's tail).
-    pub idle_at_end: f64,
-}
-
-impl StallShares {
-    /// The shares of `r`'s thread-cycles.
-    pub fn of(r: &SimResult) -> Self {
-        let total = r.cycles as f64 * f64::from(r.threads);
-        let f = |x: u64| if total > 0.0 { x as f64 / total } else { 0.0 };
-        let s = &r.stalls;
-        Self {
-            memory: f(s.memory),
-            pipeline_latency: f(s.pipeline_latency),
-            pipeline_busy: f(s.pipeline_busy),
-            dependency: f(s.dependency),
-            fu_busy: f(s.fu_busy),
-            fpinv: f(s.fpinv),
-            l1_bank: f(s.l1_bank),
-            atomic: f(s.atomic),
-            idle_at_end: f(s.idle),
-        }
-    }
-
-    /// Stalls on units and pipelines: everything but memory and the idle tail.
-    pub fn units(&self) -> f64 {
-        self.pipeline_latency
-            + self.pipeline_busy
-            + self.dependency
-            + self.fu_busy
-            + self.fpinv
-            + self.l1_bank
-            + self.atomic
-    }
-}
 
 /// One configuration's row of the comparison (every number of the printed tables except
 /// host timings).
