@@ -2,7 +2,8 @@
 //!
 //! [`EmbreeScene`] puts a scene's triangles into one Embree triangle mesh and traces single
 //! rays with `rtcIntersect1` / `rtcOccluded1`. [`agree`] compares its answers with ours and
-//! explains the differences (ties, grazing rays, interval ends).
+//! explains the differences (ties, grazing rays, interval ends); [`agree_closest`] and
+//! [`agree_occluded`] do so for whole ray sets.
 //!
 //! The library is optional. `build.rs` looks for Debian's `libembree3.so` (package
 //! `libembree-dev`, Embree 3.13); without it the crate still builds, [`available`] is
@@ -12,6 +13,7 @@
 //! with its SAFETY note, behind a safe API.
 
 pub mod agree;
+mod check;
 mod error;
 #[cfg(dualsplit_embree)]
 mod ffi;
@@ -23,6 +25,7 @@ mod options;
 mod scene;
 
 pub use agree::{Agreement, Differences, Verdict, classify};
+pub use check::{agree_closest, agree_occluded};
 pub use error::{EmbreeError, ErrorCode};
 pub use options::EmbreeOptions;
 pub use scene::EmbreeScene;

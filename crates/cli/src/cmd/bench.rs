@@ -1,13 +1,33 @@
 //! `dualsplit bench`: CPU traversal throughput per structure and ray type, and full-frame
 //! render times. Every structure's answers are checked against BVH2, ray by ray, before
 //! anything is timed (see `dualsplit_render::bench`).
+//!
+//! With `--peer embree` the same ray sets are also traced on Intel Embree 3 (single-ray
+//! `rtcIntersect1` / `rtcOccluded1`): its answers are compared with ours first (differences
+//! must be explained as ties, grazing or interval-boundary hits, see `dualsplit_embree::agree`),
+//! then ours and Embree's are timed interleaved, pass after pass, in one run.
 use super::render::{build_structures, load_scene, parse_accel, parse_res, parse_workload};
 use crate::progress::Ctx;
-use dualsplit_accel::AccelKind;
-use dualsplit_render::bench::{MeasureConfig, Throughput, measure, ray_sets};
-use dualsplit_render::{RenderSettings, Workload, render, tile_count};
+use anyhow::Context;
+use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_embree::{Agreement, EmbreeScene, agree_closest, agree_occluded};
+use dualsplit_geometry::Ray;
+use dualsplit_render::bench::{
+    Contender, MeasureConfig, RaySet, Throughput, Timing, measure, measure_interleaved, ray_sets,
+    trace_fn, verify,
+};
+use dualsplit_render::{RayKind, RenderSettings, TraceResult, Workload, render, tile_count};
+use dualsplit_scene::Scene;
+use std::collections::BTreeMap;
 use std::process::ExitCode;
 use std::time::Instant;
+
+/// A tracer to compare ours with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Peer {
+    /// Intel Embree 3 (Debian's libembree-dev), single rays.
+    Embree,
+}
 
 /// Arguments of `dualsplit bench`.
 #[derive(clap::Args)]
@@ -32,6 +52,14 @@ pub struct Args {
     /// Skip the full-frame render timing.
     #[arg(long)]
     no_frame: bool,
+    /// Also trace the rays on a peer (embree), check that it agrees with ours, and time ours
+    /// and the peer interleaved in one run.
+    #[arg(long, value_enum)]
+    peer: Option<Peer>,
+    /// Threads the timed traversals run on (default: every core). Loading, building and
+    /// the checks use every core whatever this says.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    threads: Option<u32>,
     /// Print the results as JSON lines instead of a table.
     #[arg(long)]
     json: bool,
@@ -39,10 +67,29 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+    if args.peer == Some(Peer::Embree) && !dualsplit_embree::available() {
+        anyhow::bail!(
+            "--peer embree: the Embree peer is missing: {}",
+            dualsplit_embree::STATUS
+        );
+    }
     let accels = if args.accel.is_empty() {
         AccelKind::ALL.to_vec()
     } else {
         args.accel.clone()
+    };
+    let pool = match args.threads {
+        Some(n) => Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n as usize)
+                .build()
+                .context("starting the timing threads")?,
+        ),
+        None => None,
+    };
+    let in_pool = |f: &mut (dyn FnMut() -> anyhow::Result<()> + Send)| match &pool {
+        Some(p) => p.install(f),
+        None => f(),
     };
     let scene = load_scene(&args.scene, ctx)?;
     let settings = RenderSettings {
@@ -55,8 +102,11 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let t = Instant::now();
     let sets = ray_sets(&scene, &structures, &settings)?;
     sp.finish_and_clear();
+    let threads = pool
+        .as_ref()
+        .map_or_else(rayon::current_num_threads, |p| p.current_num_threads());
     println!(
-        "ray sets of a {}x{} {} frame: {} in {:.2} s; {} threads",
+        "ray sets of a {}x{} {} frame: {} in {:.2} s; timing on {} threads",
         settings.width,
         settings.height,
         settings.workload.name(),
@@ -65,13 +115,27 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             .collect::<Vec<_>>()
             .join(", "),
         t.elapsed().as_secs_f64(),
-        rayon::current_num_threads()
+        threads
     );
     let cfg = MeasureConfig {
         min_seconds: args.min_seconds,
         ..MeasureConfig::default()
     };
-    if !args.json {
+    let peer_run = PeerRun {
+        scene: &scene,
+        structures: &structures,
+        sets: &sets,
+        accels: &accels,
+        cfg: &cfg,
+        json: args.json,
+        ctx,
+        pool: pool.as_ref(),
+    };
+    if args.peer == Some(Peer::Embree) {
+        peer_run.run_embree()?;
+    }
+    let show_rays = args.peer.is_none();
+    if !args.json && (show_rays || !args.no_frame) {
         println!(
             "{:<8} {:>16} {:>16} {:>16} {:>14}",
             "accel", "primary Mrays/s", "shadow Mrays/s", "diffuse Mrays/s", "frame s"
@@ -79,20 +143,31 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     for &kind in &accels {
         let mut row: Vec<Throughput> = Vec::new();
-        for set in sets.iter().filter(|s| !s.rays.is_empty()) {
-            let sp = ctx.spinner(format!("{} {} rays", kind.name(), set.kind.name()));
-            row.push(measure(&structures, kind, set, &cfg)?);
-            sp.finish_and_clear();
+        if show_rays {
+            for set in sets.iter().filter(|s| !s.rays.is_empty()) {
+                let sp = ctx.spinner(format!("{} {} rays", kind.name(), set.kind.name()));
+                in_pool(&mut || {
+                    row.push(measure(&structures, kind, set, &cfg)?);
+                    Ok(())
+                })?;
+                sp.finish_and_clear();
+            }
         }
         let frame_s = if args.no_frame {
             None
         } else {
             let bar = ctx.bar(tile_count(&settings), format!("{} frame", kind.name()));
             let t = Instant::now();
-            render(&scene, &structures, kind, &settings, &|| bar.inc(1))?;
+            in_pool(&mut || {
+                render(&scene, &structures, kind, &settings, &|| bar.inc(1))?;
+                Ok(())
+            })?;
             bar.finish_and_clear();
             Some(t.elapsed().as_secs_f64())
         };
+        if row.is_empty() && frame_s.is_none() {
+            continue;
+        }
         if args.json {
             for r in &row {
                 println!("{}", serde_json::to_string(r)?);
@@ -107,7 +182,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                 );
             }
         } else {
-            let cell = |k: dualsplit_render::RayKind| {
+            let cell = |k: RayKind| {
                 row.iter()
                     .find(|r| r.ray_kind == k)
                     .map(|r| format!("{:.2}", r.mrays_per_s))
@@ -116,9 +191,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             println!(
                 "{:<8} {:>16} {:>16} {:>16} {:>14}",
                 kind.name(),
-                cell(dualsplit_render::RayKind::Primary),
-                cell(dualsplit_render::RayKind::Shadow),
-                cell(dualsplit_render::RayKind::Diffuse),
+                cell(RayKind::Primary),
+                cell(RayKind::Shadow),
+                cell(RayKind::Diffuse),
                 frame_s
                     .map(|s| format!("{s:.3}"))
                     .unwrap_or_else(|| "-".into())
@@ -126,4 +201,251 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Everything the peer comparison needs.
+struct PeerRun<'a> {
+    scene: &'a Scene,
+    structures: &'a Structures,
+    sets: &'a [RaySet; 3],
+    accels: &'a [AccelKind],
+    cfg: &'a MeasureConfig,
+    json: bool,
+    ctx: &'a Ctx,
+    /// The timing threads (`--threads`), or none for rayon's global pool.
+    pool: Option<&'a rayon::ThreadPool>,
+}
+
+/// The name of the peer in the results.
+const EMBREE: &str = "embree";
+
+impl PeerRun<'_> {
+    /// Builds Embree's scene, checks agreement on every set, then times ours and Embree's
+    /// interleaved on the current rayon pool and prints both with the ratios.
+    fn run_embree(&self) -> anyhow::Result<()> {
+        let sp = self.ctx.spinner("building the Embree scene");
+        let t = Instant::now();
+        let peer = EmbreeScene::new(&self.scene.triangles).context("--peer embree")?;
+        sp.finish_and_clear();
+        let build_s = t.elapsed().as_secs_f64();
+        let sets: Vec<&RaySet> = self.sets.iter().filter(|s| !s.rays.is_empty()).collect();
+
+        // 1. Our structures against BVH2 (bit for bit), then BVH2 against Embree.
+        let mut agreement: BTreeMap<&str, Agreement> = BTreeMap::new();
+        for set in &sets {
+            let sp = self
+                .ctx
+                .spinner(format!("checking {} rays", set.kind.name()));
+            for &kind in self.accels {
+                verify(self.structures, kind, set)?;
+            }
+            agreement.insert(set.kind.name(), self.agree(&peer, set));
+            sp.finish_and_clear();
+        }
+        if !self.json {
+            println!(
+                "embree {}: scene built in {build_s:.2} s; agreement with bvh2 (every structure \
+                 above equals it bit for bit):",
+                peer.version()
+            );
+            for set in &sets {
+                print_agreement(set.kind.name(), &agreement[set.kind.name()]);
+            }
+        }
+        if let Some((kind, a)) = agreement.iter().find(|(_, a)| !a.is_explained()) {
+            if self.json {
+                println!(
+                    "{}",
+                    serde_json::json!({"peer": EMBREE, "agreement": agreement})
+                );
+            }
+            anyhow::bail!(
+                "embree and bvh2 disagree on {} {kind} rays that no tie, grazing or \
+                 boundary hit explains ({} hit against miss, {} other triangle); refusing \
+                 to time them",
+                a.hit_miss.unexplained + a.triangle.unexplained,
+                a.hit_miss.unexplained,
+                a.triangle.unexplained
+            );
+        }
+
+        // 2. Timing, interleaved.
+        let mut timings: Vec<Timing> = Vec::new();
+        for set in &sets {
+            let sp = self.ctx.spinner(format!(
+                "timing {} rays on {} and embree, interleaved",
+                set.kind.name(),
+                self.accels
+                    .iter()
+                    .map(|a| a.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+            let ours: Vec<_> = self
+                .accels
+                .iter()
+                .map(|&a| trace_fn(self.structures, a, set.kind))
+                .collect();
+            let ray_kind = set.kind;
+            let peer_trace = |rays: &[Ray]| -> u64 {
+                match ray_kind {
+                    RayKind::Shadow => rays.iter().filter(|r| peer.occluded(r)).count() as u64,
+                    RayKind::Primary | RayKind::Diffuse => {
+                        rays.iter().filter(|r| peer.intersect(r).is_some()).count() as u64
+                    }
+                }
+            };
+            let mut contenders: Vec<Contender<'_>> = self
+                .accels
+                .iter()
+                .zip(&ours)
+                .map(|(a, f)| Contender {
+                    name: a.name(),
+                    trace: f,
+                })
+                .collect();
+            contenders.push(Contender {
+                name: EMBREE,
+                trace: &peer_trace,
+            });
+            let timed = || measure_interleaved(set, &contenders, self.cfg);
+            timings.extend(match self.pool {
+                Some(p) => p.install(timed),
+                None => timed(),
+            });
+            sp.finish_and_clear();
+        }
+
+        // 3. Ratios: our fastest structure over Embree, per ray kind.
+        let mut ratio = BTreeMap::new();
+        let mut best = BTreeMap::new();
+        for set in &sets {
+            let of_kind = || timings.iter().filter(|t| t.ray_kind == set.kind);
+            let peer_t = of_kind().find(|t| t.accel == EMBREE);
+            let ours = of_kind()
+                .filter(|t| t.accel != EMBREE)
+                .max_by(|a, b| a.mrays_per_s.total_cmp(&b.mrays_per_s));
+            if let (Some(p), Some(o)) = (peer_t, ours) {
+                ratio.insert(set.kind.name(), o.mrays_per_s / p.mrays_per_s);
+                best.insert(set.kind.name(), o.accel.clone());
+            }
+        }
+        let threads = timings.first().map_or(0, |t| t.threads);
+        if self.json {
+            for t in &timings {
+                println!("{}", serde_json::to_string(t)?);
+            }
+            println!(
+                "{}",
+                serde_json::json!({
+                    "scene": self.scene.name, "peer": EMBREE, "peer_version": peer.version(),
+                    "peer_build_seconds": build_s,
+                    "threads": threads, "method": "interleaved",
+                    "agreement": agreement, "best": best, "ratio_best_to_peer": ratio,
+                })
+            );
+        } else {
+            print_timings(&timings, &best, &ratio, threads);
+        }
+        Ok(())
+    }
+
+    /// Agreement of Embree with BVH2's answers on `set`.
+    fn agree(&self, peer: &EmbreeScene, set: &RaySet) -> Agreement {
+        let tris = &self.scene.triangles;
+        match set.kind {
+            RayKind::Shadow => {
+                let ours: Vec<bool> = set.expected.iter().map(TraceResult::is_hit).collect();
+                let closest = |r: &Ray| {
+                    self.structures
+                        .closest_hit(AccelKind::Bvh2, r, &mut NoObserver)
+                };
+                agree_occluded(peer, tris, &set.rays, &ours, &closest)
+            }
+            RayKind::Primary | RayKind::Diffuse => {
+                let ours: Vec<_> = set
+                    .expected
+                    .iter()
+                    .map(|r| match r {
+                        TraceResult::Closest(h) => *h,
+                        TraceResult::Occluded(_) => None,
+                    })
+                    .collect();
+                agree_closest(peer, tris, &set.rays, &ours)
+            }
+        }
+    }
+}
+
+fn print_agreement(kind: &str, a: &Agreement) {
+    let d = |x: &dualsplit_embree::Differences| match x.total() {
+        0 => "0".to_string(),
+        n => format!(
+            "{n} (tie {}, grazing {}, boundary {}, unexplained {})",
+            x.tie, x.grazing, x.boundary, x.unexplained
+        ),
+    };
+    println!(
+        "  {kind:<8} {:>8} rays, {:>8} same; hit/miss differs {}; triangle differs {}{}",
+        a.rays,
+        a.same,
+        d(&a.hit_miss),
+        d(&a.triangle),
+        if kind == "shadow" {
+            String::new()
+        } else {
+            format!("; same triangle, largest |Δt|/t {:.1e}", a.max_t_rel_diff)
+        }
+    );
+}
+
+fn print_timings(
+    timings: &[Timing],
+    best: &BTreeMap<&str, String>,
+    ratio: &BTreeMap<&str, f64>,
+    threads: usize,
+) {
+    let repeats = timings.first().map_or(0, |t| t.repeats);
+    println!(
+        "interleaved, {threads} thread(s), Mrays/s over all passes (fastest pass); \
+         {repeats} passes per set"
+    );
+    println!(
+        "{:<12} {:>18} {:>18} {:>18}",
+        "accel", "primary", "shadow", "diffuse"
+    );
+    let mut names: Vec<&str> = Vec::new();
+    for t in timings {
+        if !names.contains(&t.accel.as_str()) {
+            names.push(&t.accel);
+        }
+    }
+    for name in names {
+        let cell = |k: RayKind| {
+            timings
+                .iter()
+                .find(|t| t.accel == name && t.ray_kind == k)
+                .map(|t| format!("{:.2} ({:.2})", t.mrays_per_s, t.best_pass_mrays_per_s))
+                .unwrap_or_else(|| "-".into())
+        };
+        println!(
+            "{name:<12} {:>18} {:>18} {:>18}",
+            cell(RayKind::Primary),
+            cell(RayKind::Shadow),
+            cell(RayKind::Diffuse)
+        );
+    }
+    let cell = |k: RayKind| {
+        ratio
+            .get(k.name())
+            .map(|r| format!("{r:.2} ({})", best[k.name()]))
+            .unwrap_or_else(|| "-".into())
+    };
+    println!(
+        "{:<12} {:>18} {:>18} {:>18}",
+        "best/embree",
+        cell(RayKind::Primary),
+        cell(RayKind::Shadow),
+        cell(RayKind::Diffuse)
+    );
 }
