@@ -5,25 +5,26 @@
 //! * **Tie**: both triangles are hit at the same `t` (a ray through a shared edge or vertex,
 //!   duplicated coplanar faces). dualsplit's rule gives such a ray to the smaller triangle
 //!   id; Embree gives it to whichever triangle its traversal meets first.
-//! * **Grazing**: the ray passes within a hair of a triangle's edge, or nearly in its plane
-//!   (thin triangles seen edge-on). There the two ray–triangle tests round differently:
-//!   dualsplit's is watertight (Woop et al. 2013), Embree's default is not.
+//! * **Grazing**: the ray passes within a few f32 roundings of a triangle's edge (thin
+//!   triangles, rays nearly in a triangle's plane). There the two ray–triangle tests round
+//!   differently: dualsplit's is watertight (Woop et al. 2013), Embree's default is not.
 //! * **Boundary**: the hit lies at an end of the ray's `[t_min, t_max]` interval, where the
 //!   two tests' roundings of `t` decide whether it counts.
 //!
 //! [`classify`] decides, from the triangles' geometry in f64, which of these explains a
-//! difference; a difference none of them explains is [`Verdict::Unexplained`].
+//! difference; a difference none of them explains (a hit on a triangle the ray does not
+//! pass through, a triangle squarely hit but missed) is [`Verdict::Unexplained`].
 
 use dualsplit_geometry::{Hit, Ray, Triangle};
 
 /// Relative difference in `t` under which two hits count as a tie (both triangles meet
 /// the ray at the same point, up to the peer's f32 rounding).
 pub const TIE_REL: f64 = 1e-5;
-/// A hit whose smallest f64 barycentric is below this is on an edge.
-pub const EDGE_BARY: f64 = 1e-4;
-/// A ray whose direction makes a cosine below this with the triangle's normal is grazing
-/// its plane.
-pub const PLANE_COS: f64 = 1e-3;
+/// A ray passing within this many f32 epsilons of the scene's coordinate magnitude
+/// (`max |coordinate|` of the ray origin and the triangle) from a triangle's edge grazes
+/// it: an f32 ray–triangle test rounds each vertex relative to the origin to about one
+/// epsilon of that magnitude, and its edge functions compound a few such errors.
+pub const GRAZE_EPS: f64 = 16.0;
 /// Relative distance of a hit's `t` to `t_min` or `t_max` under which it is at the boundary.
 pub const BOUNDARY_REL: f64 = 1e-4;
 
@@ -42,105 +43,166 @@ pub enum Verdict {
     Unexplained,
 }
 
-/// The ray's intersection with a triangle's plane, in f64: `t`, the barycentrics
-/// `(w, u, v)` (weights of `v0`, `v1`, `v2`) and the cosine between the ray and the normal.
+/// Where a ray passes a triangle, in f64.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PlaneHit {
-    /// Ray parameter.
+pub struct Crossing {
+    /// Ray parameter where the ray meets the triangle's plane (NaN when it is parallel).
     pub t: f64,
-    /// Smallest of the three barycentrics (negative outside the triangle).
-    pub min_bary: f64,
-    /// `|cos|` of the angle between the ray direction and the triangle's normal.
-    pub cos: f64,
+    /// Signed distance from the ray to the nearest edge line of the triangle, measured in
+    /// the plane perpendicular to the ray (where the watertight test evaluates its edge
+    /// functions): positive inside the triangle, negative outside. Thin triangles and rays
+    /// nearly in a triangle's plane give small distances.
+    pub edge_distance: f64,
+    /// The distance under which the ray grazes the triangle: [`GRAZE_EPS`] f32 epsilons of
+    /// the largest coordinate magnitude of the ray origin and the triangle.
+    pub tolerance: f64,
 }
 
-/// The ray's intersection with `tri`'s plane in f64 (Möller–Trumbore without the inside
-/// test), or `None` when the ray is parallel to the plane or the triangle is degenerate.
-pub fn plane_hit(tri: &Triangle, ray: &Ray) -> Option<PlaneHit> {
+/// Where `ray` passes `tri` ([`Crossing`]), or `None` for a zero direction or a triangle
+/// with a non-finite coordinate.
+pub fn crossing(tri: &Triangle, ray: &Ray) -> Option<Crossing> {
     let f = |v: dualsplit_geometry::Vec3| [v.x as f64, v.y as f64, v.z as f64];
     let (o, d) = (f(ray.origin), f(ray.dir));
-    let [v0, v1, v2] = tri.v.map(f);
-    let e1 = sub(v1, v0);
-    let e2 = sub(v2, v0);
-    let p = cross(d, e2);
-    let det = dot(e1, p);
-    let n = cross(e1, e2);
-    let scale = norm(d) * norm(n);
-    if det == 0.0 || scale == 0.0 || !det.is_finite() {
+    let vs = tri.v.map(f);
+    let len = norm(d);
+    if len == 0.0 || !len.is_finite() || !vs.iter().flatten().all(|c| c.is_finite()) {
         return None;
     }
-    let s = sub(o, v0);
-    let u = dot(s, p) / det;
-    let q = cross(s, e1);
-    let v = dot(d, q) / det;
-    let t = dot(e2, q) / det;
-    Some(PlaneHit {
+    let d = d.map(|c| c / len);
+    // An orthonormal basis (b1, b2) of the plane perpendicular to the ray.
+    let a = d.map(f64::abs);
+    let axis = if a[0] <= a[1] && a[0] <= a[2] {
+        [1.0, 0.0, 0.0]
+    } else if a[1] <= a[2] {
+        [0.0, 1.0, 0.0]
+    } else {
+        [0.0, 0.0, 1.0]
+    };
+    let b1 = cross(d, axis);
+    let b1 = b1.map(|c| c / norm(b1));
+    let b2 = cross(d, b1);
+    let q = vs.map(|v| {
+        let r = sub(v, o);
+        [dot(r, b1), dot(r, b2)]
+    });
+    let edges = [(0, 1), (1, 2), (2, 0)];
+    let e = edges.map(|(i, j)| q[i][0] * q[j][1] - q[i][1] * q[j][0]);
+    let area2 = e[0] + e[1] + e[2];
+    let edge_distance = if area2 == 0.0 {
+        // The triangle projects onto a segment: the ray lies in its plane (or the triangle is
+        // degenerate). It touches it at best, so the distance is never positive.
+        -edges
+            .iter()
+            .map(|&(i, j)| segment_distance(q[i], q[j]))
+            .fold(f64::INFINITY, f64::min)
+    } else {
+        let sign = area2.signum();
+        edges
+            .iter()
+            .zip(e)
+            .map(|(&(i, j), e)| {
+                let l = (q[j][0] - q[i][0]).hypot(q[j][1] - q[i][1]);
+                if l == 0.0 {
+                    f64::INFINITY
+                } else {
+                    sign * e / l
+                }
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let n = cross(sub(vs[1], vs[0]), sub(vs[2], vs[0]));
+    let t = dot(n, sub(vs[0], o)) / dot(n, d) / len;
+    let scale = vs
+        .iter()
+        .chain([&o])
+        .flatten()
+        .fold(0.0f64, |m, c| m.max(c.abs()));
+    Some(Crossing {
         t,
-        min_bary: u.min(v).min(1.0 - u - v),
-        cos: (det / scale).abs(),
+        edge_distance,
+        tolerance: GRAZE_EPS * f32::EPSILON as f64 * scale,
     })
 }
 
-/// Whether a hit on `tri` is grazing ([`EDGE_BARY`], [`PLANE_COS`]).
-fn grazing(tri: &Triangle, ray: &Ray) -> bool {
-    match plane_hit(tri, ray) {
-        None => true,
-        Some(h) => h.min_bary < EDGE_BARY || h.cos < PLANE_COS,
+/// Distance from the origin to the segment `a b` in 2D.
+fn segment_distance(a: [f64; 2], b: [f64; 2]) -> f64 {
+    let ab = [b[0] - a[0], b[1] - a[1]];
+    let l2 = ab[0] * ab[0] + ab[1] * ab[1];
+    let s = if l2 == 0.0 {
+        0.0
+    } else {
+        (-(a[0] * ab[0] + a[1] * ab[1]) / l2).clamp(0.0, 1.0)
+    };
+    (a[0] + s * ab[0]).hypot(a[1] + s * ab[1])
+}
+
+/// What a claimed hit on a triangle looks like from the triangle's geometry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Claim {
+    /// The ray passes farther than the tolerance outside the triangle, or the triangle does
+    /// not exist: the hit is false.
+    Off,
+    /// The ray passes through the triangle at plane distance `t` (the claimed `t` when the
+    /// ray is parallel to the plane); `edge`: within the tolerance of an edge.
+    On { t: f64, edge: bool },
+}
+
+fn claim(tris: &[Triangle], ray: &Ray, h: &Hit) -> Claim {
+    let Some(c) = tris.get(h.prim.index()).and_then(|tri| crossing(tri, ray)) else {
+        return Claim::Off;
+    };
+    if c.edge_distance < -c.tolerance {
+        Claim::Off
+    } else {
+        Claim::On {
+            t: if c.t.is_finite() { c.t } else { h.t as f64 },
+            edge: c.edge_distance < c.tolerance,
+        }
     }
 }
 
-fn boundary(t: f32, ray: &Ray) -> bool {
-    let near = |a: f32, b: f32| {
-        let (a, b) = (a as f64, b as f64);
-        b.is_finite() && (a - b).abs() <= BOUNDARY_REL * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
+fn boundary(t: f64, ray: &Ray) -> bool {
+    let near = |b: f32| {
+        let b = b as f64;
+        b.is_finite() && (t - b).abs() <= BOUNDARY_REL * t.abs().max(b.abs())
     };
-    near(t, ray.t_min) || near(t, ray.t_max)
+    near(ray.t_min) || near(ray.t_max)
 }
 
 /// Compares our closest hit with the peer's for `ray` over `tris` (the triangles both
 /// were built from). For shadow rays, pass each side's closest hit on the segment when
 /// their occlusion answers differ.
 ///
-/// Hits with the same triangle are [`Verdict::Same`] whatever their `t`. Otherwise, in
-/// order: [`Verdict::Tie`] when both hit and their f64 plane distances agree to
-/// [`TIE_REL`]; [`Verdict::Grazing`] when either hit is grazing; [`Verdict::Boundary`] when
-/// either hit is at an end of the ray's interval; else [`Verdict::Unexplained`]. A hit
-/// naming a triangle outside `tris` is unexplained.
+/// Hits with the same triangle are [`Verdict::Same`] whatever their `t`. A hit on a
+/// triangle the ray passes outside of by more than the tolerance ([`Crossing`]) is false
+/// and the difference [`Verdict::Unexplained`]. Otherwise, with "the nearer hit" the one
+/// with the smaller f64 plane distance (the other tracer missed it, or found it wrongly):
+/// [`Verdict::Tie`] when both hit at f64 plane distances equal to [`TIE_REL`];
+/// [`Verdict::Grazing`] when the ray passes the nearer hit's triangle within the tolerance
+/// of an edge; [`Verdict::Boundary`] when the nearer hit lies at an end of the ray's
+/// interval; else [`Verdict::Unexplained`].
 pub fn classify(tris: &[Triangle], ray: &Ray, ours: Option<Hit>, peer: Option<Hit>) -> Verdict {
-    let tri = |h: &Hit| tris.get(h.prim.index());
-    match (ours, peer) {
-        (None, None) => Verdict::Same,
-        (Some(a), Some(b)) if a.prim == b.prim => Verdict::Same,
-        (Some(a), Some(b)) => {
-            let (Some(ta), Some(tb)) = (tri(&a), tri(&b)) else {
-                return Verdict::Unexplained;
-            };
-            let tie = match (plane_hit(ta, ray), plane_hit(tb, ray)) {
-                (Some(pa), Some(pb)) => (pa.t - pb.t).abs() <= TIE_REL * pa.t.abs().max(pb.t.abs()),
-                _ => false,
-            };
-            if tie {
-                Verdict::Tie
-            } else if grazing(ta, ray) || grazing(tb, ray) {
-                Verdict::Grazing
-            } else if boundary(a.t, ray) || boundary(b.t, ray) {
-                Verdict::Boundary
-            } else {
-                Verdict::Unexplained
+    let nearer = match (ours, peer) {
+        (None, None) => return Verdict::Same,
+        (Some(a), Some(b)) if a.prim == b.prim => return Verdict::Same,
+        (Some(a), Some(b)) => match (claim(tris, ray, &a), claim(tris, ray, &b)) {
+            (Claim::On { t: ta, edge: ea }, Claim::On { t: tb, edge: eb }) => {
+                if (ta - tb).abs() <= TIE_REL * ta.abs().max(tb.abs()) {
+                    return Verdict::Tie;
+                }
+                if ta < tb { (ta, ea) } else { (tb, eb) }
             }
-        }
-        (Some(h), None) | (None, Some(h)) => {
-            let Some(t) = tri(&h) else {
-                return Verdict::Unexplained;
-            };
-            if grazing(t, ray) {
-                Verdict::Grazing
-            } else if boundary(h.t, ray) {
-                Verdict::Boundary
-            } else {
-                Verdict::Unexplained
-            }
-        }
+            _ => return Verdict::Unexplained,
+        },
+        (Some(h), None) | (None, Some(h)) => match claim(tris, ray, &h) {
+            Claim::On { t, edge } => (t, edge),
+            Claim::Off => return Verdict::Unexplained,
+        },
+    };
+    match nearer {
+        (_, true) => Verdict::Grazing,
+        (t, false) if boundary(t, ray) => Verdict::Boundary,
+        _ => Verdict::Unexplained,
     }
 }
 
@@ -182,7 +244,7 @@ impl Differences {
 }
 
 /// The agreement of a set of rays.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Agreement {
     /// Rays compared.
     pub rays: u64,
@@ -196,6 +258,9 @@ pub struct Agreement {
     /// Largest relative difference of `t` among hits on the same triangle (closest-hit
     /// rays only).
     pub max_t_rel_diff: f64,
+    /// The first unexplained difference: the ray and both answers.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_unexplained: Option<String>,
 }
 
 impl Agreement {
@@ -217,6 +282,9 @@ impl Agreement {
                 }
             }
             _ => {}
+        }
+        if v == Verdict::Unexplained && self.first_unexplained.is_none() {
+            self.first_unexplained = Some(format!("{ray:?}: ours {ours:?}, peer {peer:?}"));
         }
         match (ours.is_some(), peer.is_some(), v) {
             (_, _, Verdict::Same) => self.same += 1,
@@ -262,6 +330,9 @@ impl Agreement {
         self.hit_miss.merge(&o.hit_miss);
         self.triangle.merge(&o.triangle);
         self.max_t_rel_diff = self.max_t_rel_diff.max(o.max_t_rel_diff);
+        if self.first_unexplained.is_none() {
+            self.first_unexplained.clone_from(&o.first_unexplained);
+        }
     }
 
     /// True when every difference is explained.

@@ -261,11 +261,12 @@ impl PeerRun<'_> {
             }
             anyhow::bail!(
                 "embree and bvh2 disagree on {} {kind} rays that no tie, grazing or \
-                 boundary hit explains ({} hit against miss, {} other triangle); refusing \
-                 to time them",
+                 boundary hit explains ({} hit against miss, {} other triangle; the first: \
+                 {}); refusing to time them",
                 a.hit_miss.unexplained + a.triangle.unexplained,
                 a.hit_miss.unexplained,
-                a.triangle.unexplained
+                a.triangle.unexplained,
+                a.first_unexplained.as_deref().unwrap_or("-")
             );
         }
 
