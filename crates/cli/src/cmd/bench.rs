@@ -319,6 +319,7 @@ impl PeerRun<'_> {
 
         // 3. Ratios: our fastest structure over Embree, per ray kind.
         let mut ratio = BTreeMap::new();
+        let mut ratio_fastest = BTreeMap::new();
         let mut best = BTreeMap::new();
         for set in &sets {
             let of_kind = || timings.iter().filter(|t| t.ray_kind == set.kind);
@@ -329,6 +330,13 @@ impl PeerRun<'_> {
             if let (Some(p), Some(o)) = (peer_t, ours) {
                 ratio.insert(set.kind.name(), o.mrays_per_s / p.mrays_per_s);
                 best.insert(set.kind.name(), o.accel.clone());
+            }
+            let ours_fastest = of_kind()
+                .filter(|t| t.accel != EMBREE)
+                .map(|t| t.best_pass_mrays_per_s)
+                .max_by(f64::total_cmp);
+            if let (Some(p), Some(o)) = (peer_t, ours_fastest) {
+                ratio_fastest.insert(set.kind.name(), o / p.best_pass_mrays_per_s);
             }
         }
         let threads = timings.first().map_or(0, |t| t.threads);
@@ -343,10 +351,11 @@ impl PeerRun<'_> {
                     "peer_build_seconds": build_s,
                     "threads": threads, "method": "interleaved",
                     "agreement": agreement, "best": best, "ratio_best_to_peer": ratio,
+                    "ratio_best_to_peer_fastest_pass": ratio_fastest,
                 })
             );
         } else {
-            print_timings(&timings, &best, &ratio, threads);
+            print_timings(&timings, &best, &[&ratio, &ratio_fastest], threads);
         }
         Ok(())
     }
@@ -403,13 +412,19 @@ fn print_agreement(kind: &str, a: &Agreement) {
 fn print_timings(
     timings: &[Timing],
     best: &BTreeMap<&str, String>,
-    ratio: &BTreeMap<&str, f64>,
+    ratios: &[&BTreeMap<&str, f64>; 2],
     threads: usize,
 ) {
-    let repeats = timings.first().map_or(0, |t| t.repeats);
+    let mut passes: Vec<String> = Vec::new();
+    for t in timings {
+        let p = format!("{} {}", t.repeats, t.ray_kind.name());
+        if !passes.contains(&p) {
+            passes.push(p);
+        }
+    }
     println!(
-        "interleaved, {threads} thread(s), Mrays/s over all passes (fastest pass); \
-         {repeats} passes per set"
+        "interleaved on {threads} thread(s), passes: {}; Mrays/s over all passes (fastest pass)",
+        passes.join(", ")
     );
     println!(
         "{:<12} {:>18} {:>18} {:>18}",
@@ -436,11 +451,9 @@ fn print_timings(
             cell(RayKind::Diffuse)
         );
     }
-    let cell = |k: RayKind| {
-        ratio
-            .get(k.name())
-            .map(|r| format!("{r:.2} ({})", best[k.name()]))
-            .unwrap_or_else(|| "-".into())
+    let cell = |k: RayKind| match (ratios[0].get(k.name()), ratios[1].get(k.name())) {
+        (Some(r), Some(f)) => format!("{r:.2} ({f:.2}) {}", best[k.name()]),
+        _ => "-".into(),
     };
     println!(
         "{:<12} {:>18} {:>18} {:>18}",
