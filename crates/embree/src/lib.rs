@@ -25,7 +25,7 @@ mod options;
 mod scene;
 
 pub use agree::{Agreement, Differences, Verdict, classify};
-pub use check::{agree_closest, agree_occluded};
+pub use check::{TErrors, agree_closest, agree_occluded, t_errors};
 pub use error::{EmbreeError, ErrorCode};
 pub use options::EmbreeOptions;
 pub use scene::EmbreeScene;

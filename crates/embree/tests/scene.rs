@@ -1,7 +1,7 @@
 //! The Embree wrapper on small hand-made scenes, and the classification of differences.
 //! Tests that need the library print a note and pass when the crate was built without it.
 
-use dualsplit_embree::{EmbreeError, EmbreeScene, Verdict, available, classify};
+use dualsplit_embree::{EmbreeError, EmbreeScene, Verdict, available, classify, t_errors};
 use dualsplit_geometry::{Hit, PrimId, Ray, Triangle, Vec3};
 
 fn quad_at(z: f32) -> [Triangle; 2] {
@@ -147,6 +147,24 @@ fn a_far_triangle_against_a_near_one_is_unexplained() {
         classify(&tris, &ray, hit(2, 2.0), hit(9, 2.0)),
         Verdict::Unexplained
     );
+}
+
+#[test]
+fn t_errors_measure_against_the_plane_in_f64() {
+    let tris = quad_at(2.0);
+    let rays: Vec<Ray> = (0..100)
+        .map(|i| Ray::new(Vec3::new(-0.9 + 0.018 * i as f32, 0.5, 0.0), Vec3::Z))
+        .collect();
+    // Exact hits: no error. One hit 1e-3 too far: the largest error, above the 99th
+    // percentile of 100 hits only when it is the last.
+    let mut hits: Vec<Option<Hit>> = rays.iter().map(|_| hit(1, 2.0)).collect();
+    assert_eq!(t_errors(&tris, &rays, &hits).max, 0.0);
+    hits[7] = hit(1, 2.002);
+    hits[8] = None;
+    let e = t_errors(&tris, &rays, &hits);
+    assert_eq!(e.hits, 99);
+    assert!((e.max - 1e-3).abs() < 1e-6, "{e:?}");
+    assert_eq!((e.p50, e.p99), (0.0, 0.0));
 }
 
 /// Without the library the test passes with a note, except under CI (`CI` set), where

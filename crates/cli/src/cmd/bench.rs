@@ -10,7 +10,7 @@ use super::render::{build_structures, load_scene, parse_accel, parse_res, parse_
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::{AccelKind, NoObserver, Structures};
-use dualsplit_embree::{Agreement, EmbreeScene, agree_closest, agree_occluded};
+use dualsplit_embree::{Agreement, EmbreeScene, TErrors, agree_closest, agree_occluded, t_errors};
 use dualsplit_geometry::Ray;
 use dualsplit_render::bench::{
     Contender, MeasureConfig, RaySet, Throughput, Timing, measure, measure_interleaved, ray_sets,
@@ -18,6 +18,7 @@ use dualsplit_render::bench::{
 };
 use dualsplit_render::{RayKind, RenderSettings, TraceResult, Workload, render, tile_count};
 use dualsplit_scene::Scene;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -232,6 +233,7 @@ impl PeerRun<'_> {
 
         // 1. Our structures against BVH2 (bit for bit), then BVH2 against Embree.
         let mut agreement: BTreeMap<&str, Agreement> = BTreeMap::new();
+        let mut t_error: BTreeMap<&str, BTreeMap<&str, TErrors>> = BTreeMap::new();
         for set in &sets {
             let sp = self
                 .ctx
@@ -240,6 +242,9 @@ impl PeerRun<'_> {
                 verify(self.structures, kind, set)?;
             }
             agreement.insert(set.kind.name(), self.agree(&peer, set));
+            if set.kind != RayKind::Shadow {
+                t_error.insert(set.kind.name(), self.t_errors(&peer, set));
+            }
             sp.finish_and_clear();
         }
         if !self.json {
@@ -250,6 +255,16 @@ impl PeerRun<'_> {
             );
             for set in &sets {
                 print_agreement(set.kind.name(), &agreement[set.kind.name()]);
+            }
+            println!("hit distance t against f64 (relative error, p99.9 / max):");
+            for (kind, e) in sets
+                .iter()
+                .filter_map(|s| t_error.get_key_value(s.kind.name()))
+            {
+                println!(
+                    "  {kind:<8} ours {:.1e} / {:.1e}; embree {:.1e} / {:.1e}",
+                    e["ours"].p999, e["ours"].max, e[EMBREE].p999, e[EMBREE].max
+                );
             }
         }
         if let Some((kind, a)) = agreement.iter().find(|(_, a)| !a.is_explained()) {
@@ -350,7 +365,8 @@ impl PeerRun<'_> {
                     "scene": self.scene.name, "peer": EMBREE, "peer_version": peer.version(),
                     "peer_build_seconds": build_s,
                     "threads": threads, "method": "interleaved",
-                    "agreement": agreement, "best": best, "ratio_best_to_peer": ratio,
+                    "agreement": agreement, "t_error": t_error,
+                    "best": best, "ratio_best_to_peer": ratio,
                     "ratio_best_to_peer_fastest_pass": ratio_fastest,
                 })
             );
@@ -358,6 +374,17 @@ impl PeerRun<'_> {
             print_timings(&timings, &best, &[&ratio, &ratio_fastest], threads);
         }
         Ok(())
+    }
+
+    /// Relative errors of our and Embree's hit distances on `set` against f64.
+    fn t_errors(&self, peer: &EmbreeScene, set: &RaySet) -> BTreeMap<&'static str, TErrors> {
+        let tris = &self.scene.triangles;
+        let ours = closest_hits(set);
+        let theirs: Vec<_> = set.rays.par_iter().map(|r| peer.intersect(r)).collect();
+        BTreeMap::from([
+            ("ours", t_errors(tris, &set.rays, &ours)),
+            (EMBREE, t_errors(tris, &set.rays, &theirs)),
+        ])
     }
 
     /// Agreement of Embree with BVH2's answers on `set`.
@@ -373,18 +400,21 @@ impl PeerRun<'_> {
                 agree_occluded(peer, tris, &set.rays, &ours, &closest)
             }
             RayKind::Primary | RayKind::Diffuse => {
-                let ours: Vec<_> = set
-                    .expected
-                    .iter()
-                    .map(|r| match r {
-                        TraceResult::Closest(h) => *h,
-                        TraceResult::Occluded(_) => None,
-                    })
-                    .collect();
-                agree_closest(peer, tris, &set.rays, &ours)
+                agree_closest(peer, tris, &set.rays, &closest_hits(set))
             }
         }
     }
+}
+
+/// BVH2's closest hits of a closest-hit set (`None` for shadow answers).
+fn closest_hits(set: &RaySet) -> Vec<Option<dualsplit_geometry::Hit>> {
+    set.expected
+        .iter()
+        .map(|r| match r {
+            TraceResult::Closest(h) => *h,
+            TraceResult::Occluded(_) => None,
+        })
+        .collect()
 }
 
 fn print_agreement(kind: &str, a: &Agreement) {
