@@ -12,6 +12,10 @@
 //!    (rayon), until [`MeasureConfig::min_seconds`] and [`MeasureConfig::min_repeats`] are
 //!    both reached, and reports rays per second over all repeats.
 //!
+//! [`measure_interleaved`] times several tracers (our structures and a peer such as Embree)
+//! on one set in turn, pass after pass, so that all of them see the same host noise; each
+//! tracer is checked by its caller before.
+//!
 //! This is the one place the library reads the wall clock: a throughput is a measurement of
 //! the machine, not a result of the algorithm. Nothing else depends on it.
 
@@ -205,5 +209,117 @@ pub fn measure(
                 threads,
             });
         }
+    }
+}
+
+/// A tracer in an interleaved timing: a name and a function that traces every ray of a
+/// slice (of one [`RayKind`]) and returns how many hit, so the result cannot be optimised
+/// away. The per-ray loop lives inside the function, so each tracer's inner loop is
+/// compiled for it alone.
+pub struct Contender<'a> {
+    /// Name in the results (`"bvh2"`, `"embree"`, …).
+    pub name: &'a str,
+    /// Traces a slice of rays; returns the number of hits.
+    pub trace: &'a (dyn Fn(&[Ray]) -> u64 + Sync),
+}
+
+/// The timing of one tracer on one set, from [`measure_interleaved`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Timing {
+    /// The contender's name.
+    pub accel: String,
+    /// Ray kind.
+    pub ray_kind: RayKind,
+    /// Rays in the set.
+    pub rays: u64,
+    /// Times the whole set was traced (the same for every contender of a run).
+    pub repeats: u32,
+    /// Wall-clock seconds of all its passes.
+    pub seconds: f64,
+    /// Millions of rays per second over all passes: `rays · repeats / seconds / 10⁶`.
+    pub mrays_per_s: f64,
+    /// Millions of rays per second of its fastest pass (the least disturbed).
+    pub best_pass_mrays_per_s: f64,
+    /// Threads the passes ran on.
+    pub threads: usize,
+    /// Hits in one pass.
+    pub hits: u64,
+}
+
+/// Times `contenders` on `set`, interleaved: each round traces the whole set once with every
+/// contender, starting with a different one each round, until every contender has run
+/// [`MeasureConfig::min_seconds`] and [`MeasureConfig::min_repeats`] passes. A pass runs on
+/// the current rayon pool: in one sequential loop when it has one thread, otherwise in
+/// parallel over chunks of [`CHUNK`] rays.
+///
+/// The contenders are not checked here; the caller verifies them first ([`verify`], or a
+/// peer's agreement check). An empty set or no contenders give no timings.
+pub fn measure_interleaved(
+    set: &RaySet,
+    contenders: &[Contender<'_>],
+    cfg: &MeasureConfig,
+) -> Vec<Timing> {
+    let threads = rayon::current_num_threads();
+    if set.rays.is_empty() || contenders.is_empty() {
+        return Vec::new();
+    }
+    let pass = |c: &Contender<'_>| -> (f64, u64) {
+        let start = Instant::now();
+        let hits = if threads == 1 {
+            (c.trace)(&set.rays)
+        } else {
+            set.rays.par_chunks(CHUNK).map(|ch| (c.trace)(ch)).sum()
+        };
+        (start.elapsed().as_secs_f64(), hits)
+    };
+    let n = contenders.len();
+    let mut seconds = vec![0.0f64; n];
+    let mut best = vec![f64::INFINITY; n];
+    let mut hits = vec![0u64; n];
+    let mut repeats = 0u32;
+    while repeats < cfg.min_repeats || seconds.iter().any(|&s| s < cfg.min_seconds) {
+        for k in 0..n {
+            let i = (repeats as usize + k) % n;
+            let (s, h) = pass(&contenders[i]);
+            seconds[i] += s;
+            best[i] = best[i].min(s);
+            hits[i] = std::hint::black_box(h);
+        }
+        repeats += 1;
+    }
+    let rays = set.rays.len() as u64;
+    contenders
+        .iter()
+        .enumerate()
+        .map(|(i, c)| Timing {
+            accel: c.name.to_string(),
+            ray_kind: set.kind,
+            rays,
+            repeats,
+            seconds: seconds[i],
+            mrays_per_s: rays as f64 * repeats as f64 / seconds[i] / 1e6,
+            best_pass_mrays_per_s: rays as f64 / best[i] / 1e6,
+            threads,
+            hits: hits[i],
+        })
+        .collect()
+}
+
+/// The [`Contender`] trace function of structure `kind` for rays of kind `ray_kind`.
+pub fn trace_fn(
+    structures: &Structures,
+    kind: AccelKind,
+    ray_kind: RayKind,
+) -> impl Fn(&[Ray]) -> u64 + Sync + '_ {
+    move |rays: &[Ray]| {
+        rays.iter()
+            .map(|ray| {
+                let q = RayQuery {
+                    ray: *ray,
+                    kind: ray_kind,
+                };
+                trace_query(structures, kind, &q, &mut NoObserver).is_hit() as u64
+            })
+            .sum()
     }
 }

@@ -1,15 +1,36 @@
 //! `dualsplit bench`: CPU traversal throughput per structure and ray type, and full-frame
 //! render times. Every structure's answers are checked against BVH2, ray by ray, before
 //! anything is timed (see `dualsplit_render::bench`).
+//!
+//! With `--peer embree` the same ray sets are also traced on Intel Embree 3 (single-ray
+//! `rtcIntersect1` / `rtcOccluded1`): its answers are compared with ours first (differences
+//! must be explained as ties, grazing or interval-boundary hits, see `dualsplit_embree::agree`),
+//! then ours and Embree's are timed interleaved, pass after pass, in one run.
 use super::render::{build_structures, load_scene};
 use crate::args::{parse_accel, parse_res, parse_workload};
 use crate::output::JsonOut;
 use crate::progress::Ctx;
-use dualsplit_accel::AccelKind;
-use dualsplit_render::bench::{MeasureConfig, Throughput, measure, ray_sets};
-use dualsplit_render::{RenderSettings, Workload, render, tile_count};
+use anyhow::Context;
+use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_embree::{Agreement, EmbreeScene, TErrors, agree_closest, agree_occluded, t_errors};
+use dualsplit_geometry::Ray;
+use dualsplit_render::bench::{
+    Contender, MeasureConfig, RaySet, Throughput, Timing, measure, measure_interleaved, ray_sets,
+    trace_fn, verify,
+};
+use dualsplit_render::{RayKind, RenderSettings, TraceResult, Workload, render, tile_count};
+use dualsplit_scene::Scene;
+use rayon::prelude::*;
+use std::collections::BTreeMap;
 use std::process::ExitCode;
 use std::time::Instant;
+
+/// A tracer to compare ours with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Peer {
+    /// Intel Embree 3 (Debian's libembree-dev), single rays.
+    Embree,
+}
 
 /// Arguments of `dualsplit bench`.
 #[derive(clap::Args)]
@@ -36,6 +57,14 @@ pub struct Args {
     /// Skip the full-frame render timing.
     #[arg(long)]
     no_frame: bool,
+    /// Also trace the rays on a peer (embree), check that it agrees with ours, and time ours
+    /// and the peer interleaved in one run.
+    #[arg(long, value_enum)]
+    peer: Option<Peer>,
+    /// Threads the timed traversals run on (default: every core). Loading, building and
+    /// the checks use every core whatever this says.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    threads: Option<u32>,
     /// Print the results as JSON lines instead of a table; `--json=FILE` writes them to FILE.
     #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true, default_missing_value = "-")]
     json: Option<std::path::PathBuf>,
@@ -43,6 +72,12 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+    if args.peer == Some(Peer::Embree) && !dualsplit_embree::available() {
+        anyhow::bail!(
+            "--peer embree: the Embree peer is missing: {}",
+            dualsplit_embree::STATUS
+        );
+    }
     let json = JsonOut::from_arg(args.json.as_deref())?;
     // JSON lines go out as they are measured on standard output, and all at the end to a
     // file.
@@ -59,6 +94,19 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     } else {
         args.accel.clone()
     };
+    let pool = match args.threads {
+        Some(n) => Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n as usize)
+                .build()
+                .context("starting the timing threads")?,
+        ),
+        None => None,
+    };
+    let in_pool = |f: &mut (dyn FnMut() -> anyhow::Result<()> + Send)| match &pool {
+        Some(p) => p.install(f),
+        None => f(),
+    };
     let scene = load_scene(&args.scene, ctx, json.is_some())?;
     let settings = RenderSettings {
         seed: args.seed,
@@ -70,8 +118,11 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let t = Instant::now();
     let sets = ray_sets(&scene, &structures, &settings)?;
     sp.finish_and_clear();
+    let threads = pool
+        .as_ref()
+        .map_or_else(rayon::current_num_threads, |p| p.current_num_threads());
     let line = format!(
-        "ray sets of a {}x{} {} frame: {} in {:.2} s; {} threads",
+        "ray sets of a {}x{} {} frame: {} in {:.2} s; timing on {} threads",
         settings.width,
         settings.height,
         settings.workload.name(),
@@ -80,14 +131,30 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             .collect::<Vec<_>>()
             .join(", "),
         t.elapsed().as_secs_f64(),
-        rayon::current_num_threads()
+        threads
     );
     super::render::say(&line, json.is_some());
     let cfg = MeasureConfig {
         min_seconds: args.min_seconds,
         ..MeasureConfig::default()
     };
-    if json.is_none() {
+    let peer_run = PeerRun {
+        scene: &scene,
+        structures: &structures,
+        sets: &sets,
+        accels: &accels,
+        cfg: &cfg,
+        json: json.is_some(),
+        ctx,
+        pool: pool.as_ref(),
+    };
+    if args.peer == Some(Peer::Embree) {
+        for l in peer_run.run_embree()? {
+            json_line(l);
+        }
+    }
+    let show_rays = args.peer.is_none();
+    if json.is_none() && (show_rays || !args.no_frame) {
         println!(
             "{:<8} {:>16} {:>16} {:>16} {:>14}",
             "accel", "primary Mrays/s", "shadow Mrays/s", "diffuse Mrays/s", "frame s"
@@ -95,20 +162,31 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     for &kind in &accels {
         let mut row: Vec<Throughput> = Vec::new();
-        for set in sets.iter().filter(|s| !s.rays.is_empty()) {
-            let sp = ctx.spinner(format!("{} {} rays", kind.name(), set.kind.name()));
-            row.push(measure(&structures, kind, set, &cfg)?);
-            sp.finish_and_clear();
+        if show_rays {
+            for set in sets.iter().filter(|s| !s.rays.is_empty()) {
+                let sp = ctx.spinner(format!("{} {} rays", kind.name(), set.kind.name()));
+                in_pool(&mut || {
+                    row.push(measure(&structures, kind, set, &cfg)?);
+                    Ok(())
+                })?;
+                sp.finish_and_clear();
+            }
         }
         let frame_s = if args.no_frame {
             None
         } else {
             let bar = ctx.bar(tile_count(&settings), format!("{} frame", kind.name()));
             let t = Instant::now();
-            render(&scene, &structures, kind, &settings, &|| bar.inc(1))?;
+            in_pool(&mut || {
+                render(&scene, &structures, kind, &settings, &|| bar.inc(1))?;
+                Ok(())
+            })?;
             bar.finish_and_clear();
             Some(t.elapsed().as_secs_f64())
         };
+        if row.is_empty() && frame_s.is_none() {
+            continue;
+        }
         if json.is_some() {
             for r in &row {
                 json_line(serde_json::to_string(r)?);
@@ -123,7 +201,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                 );
             }
         } else {
-            let cell = |k: dualsplit_render::RayKind| {
+            let cell = |k: RayKind| {
                 row.iter()
                     .find(|r| r.ray_kind == k)
                     .map(|r| format!("{:.2}", r.mrays_per_s))
@@ -132,9 +210,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             println!(
                 "{:<8} {:>16} {:>16} {:>16} {:>14}",
                 kind.name(),
-                cell(dualsplit_render::RayKind::Primary),
-                cell(dualsplit_render::RayKind::Shadow),
-                cell(dualsplit_render::RayKind::Diffuse),
+                cell(RayKind::Primary),
+                cell(RayKind::Shadow),
+                cell(RayKind::Diffuse),
                 frame_s
                     .map(|s| format!("{s:.3}"))
                     .unwrap_or_else(|| "-".into())
@@ -145,4 +223,296 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         out.emit(&lines.join("\n"))?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Everything the peer comparison needs.
+struct PeerRun<'a> {
+    scene: &'a Scene,
+    structures: &'a Structures,
+    sets: &'a [RaySet; 3],
+    accels: &'a [AccelKind],
+    cfg: &'a MeasureConfig,
+    json: bool,
+    ctx: &'a Ctx,
+    /// The timing threads (`--threads`), or none for rayon's global pool.
+    pool: Option<&'a rayon::ThreadPool>,
+}
+
+/// The name of the peer in the results.
+const EMBREE: &str = "embree";
+
+impl PeerRun<'_> {
+    /// Builds Embree's scene, checks agreement on every set, then times ours and Embree's
+    /// interleaved on the current rayon pool and prints both with the ratios (as a table),
+    /// or returns them as JSON lines.
+    fn run_embree(&self) -> anyhow::Result<Vec<String>> {
+        let mut lines = Vec::new();
+        let sp = self.ctx.spinner("building the Embree scene");
+        let t = Instant::now();
+        let peer = EmbreeScene::new(&self.scene.triangles).context("--peer embree")?;
+        sp.finish_and_clear();
+        let build_s = t.elapsed().as_secs_f64();
+        let sets: Vec<&RaySet> = self.sets.iter().filter(|s| !s.rays.is_empty()).collect();
+
+        // 1. Our structures against BVH2 (bit for bit), then BVH2 against Embree.
+        let mut agreement: BTreeMap<&str, Agreement> = BTreeMap::new();
+        let mut t_error: BTreeMap<&str, BTreeMap<&str, TErrors>> = BTreeMap::new();
+        for set in &sets {
+            let sp = self
+                .ctx
+                .spinner(format!("checking {} rays", set.kind.name()));
+            for &kind in self.accels {
+                verify(self.structures, kind, set)?;
+            }
+            agreement.insert(set.kind.name(), self.agree(&peer, set));
+            if set.kind != RayKind::Shadow {
+                t_error.insert(set.kind.name(), self.t_errors(&peer, set));
+            }
+            sp.finish_and_clear();
+        }
+        if !self.json {
+            println!(
+                "embree {}: scene built in {build_s:.2} s; agreement with bvh2 (every structure \
+                 above equals it bit for bit):",
+                peer.version()
+            );
+            for set in &sets {
+                print_agreement(set.kind.name(), &agreement[set.kind.name()]);
+            }
+            println!("hit distance t against f64 (relative error, p99.9 / max):");
+            for (kind, e) in sets
+                .iter()
+                .filter_map(|s| t_error.get_key_value(s.kind.name()))
+            {
+                println!(
+                    "  {kind:<8} ours {:.1e} / {:.1e}; embree {:.1e} / {:.1e}",
+                    e["ours"].p999, e["ours"].max, e[EMBREE].p999, e[EMBREE].max
+                );
+            }
+        }
+        if let Some((kind, a)) = agreement.iter().find(|(_, a)| !a.is_explained()) {
+            if self.json {
+                println!(
+                    "{}",
+                    serde_json::json!({"peer": EMBREE, "agreement": agreement})
+                );
+            }
+            anyhow::bail!(
+                "embree and bvh2 disagree on {} {kind} rays that no tie, grazing or \
+                 boundary hit explains ({} hit against miss, {} other triangle; the first: \
+                 {}); refusing to time them",
+                a.hit_miss.unexplained + a.triangle.unexplained,
+                a.hit_miss.unexplained,
+                a.triangle.unexplained,
+                a.first_unexplained.as_deref().unwrap_or("-")
+            );
+        }
+
+        // 2. Timing, interleaved.
+        let mut timings: Vec<Timing> = Vec::new();
+        for set in &sets {
+            let sp = self.ctx.spinner(format!(
+                "timing {} rays on {} and embree, interleaved",
+                set.kind.name(),
+                self.accels
+                    .iter()
+                    .map(|a| a.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+            let ours: Vec<_> = self
+                .accels
+                .iter()
+                .map(|&a| trace_fn(self.structures, a, set.kind))
+                .collect();
+            let ray_kind = set.kind;
+            let peer_trace = |rays: &[Ray]| -> u64 {
+                match ray_kind {
+                    RayKind::Shadow => rays.iter().filter(|r| peer.occluded(r)).count() as u64,
+                    RayKind::Primary | RayKind::Diffuse => {
+                        rays.iter().filter(|r| peer.intersect(r).is_some()).count() as u64
+                    }
+                }
+            };
+            let mut contenders: Vec<Contender<'_>> = self
+                .accels
+                .iter()
+                .zip(&ours)
+                .map(|(a, f)| Contender {
+                    name: a.name(),
+                    trace: f,
+                })
+                .collect();
+            contenders.push(Contender {
+                name: EMBREE,
+                trace: &peer_trace,
+            });
+            let timed = || measure_interleaved(set, &contenders, self.cfg);
+            timings.extend(match self.pool {
+                Some(p) => p.install(timed),
+                None => timed(),
+            });
+            sp.finish_and_clear();
+        }
+
+        // 3. Ratios: our fastest structure over Embree, per ray kind.
+        let mut ratio = BTreeMap::new();
+        let mut ratio_fastest = BTreeMap::new();
+        let mut best = BTreeMap::new();
+        for set in &sets {
+            let of_kind = || timings.iter().filter(|t| t.ray_kind == set.kind);
+            let peer_t = of_kind().find(|t| t.accel == EMBREE);
+            let ours = of_kind()
+                .filter(|t| t.accel != EMBREE)
+                .max_by(|a, b| a.mrays_per_s.total_cmp(&b.mrays_per_s));
+            if let (Some(p), Some(o)) = (peer_t, ours) {
+                ratio.insert(set.kind.name(), o.mrays_per_s / p.mrays_per_s);
+                best.insert(set.kind.name(), o.accel.clone());
+            }
+            let ours_fastest = of_kind()
+                .filter(|t| t.accel != EMBREE)
+                .map(|t| t.best_pass_mrays_per_s)
+                .max_by(f64::total_cmp);
+            if let (Some(p), Some(o)) = (peer_t, ours_fastest) {
+                ratio_fastest.insert(set.kind.name(), o / p.best_pass_mrays_per_s);
+            }
+        }
+        let threads = timings.first().map_or(0, |t| t.threads);
+        if self.json {
+            for t in &timings {
+                lines.push(serde_json::to_string(t)?);
+            }
+            lines.push(
+                serde_json::json!({
+                    "scene": self.scene.name, "peer": EMBREE, "peer_version": peer.version(),
+                    "peer_build_seconds": build_s,
+                    "threads": threads, "method": "interleaved",
+                    "agreement": agreement, "t_error": t_error,
+                    "best": best, "ratio_best_to_peer": ratio,
+                    "ratio_best_to_peer_fastest_pass": ratio_fastest,
+                })
+                .to_string(),
+            );
+        } else {
+            print_timings(&timings, &best, &[&ratio, &ratio_fastest], threads);
+        }
+        Ok(lines)
+    }
+
+    /// Relative errors of our and Embree's hit distances on `set` against f64.
+    fn t_errors(&self, peer: &EmbreeScene, set: &RaySet) -> BTreeMap<&'static str, TErrors> {
+        let tris = &self.scene.triangles;
+        let ours = closest_hits(set);
+        let theirs: Vec<_> = set.rays.par_iter().map(|r| peer.intersect(r)).collect();
+        BTreeMap::from([
+            ("ours", t_errors(tris, &set.rays, &ours)),
+            (EMBREE, t_errors(tris, &set.rays, &theirs)),
+        ])
+    }
+
+    /// Agreement of Embree with BVH2's answers on `set`.
+    fn agree(&self, peer: &EmbreeScene, set: &RaySet) -> Agreement {
+        let tris = &self.scene.triangles;
+        match set.kind {
+            RayKind::Shadow => {
+                let ours: Vec<bool> = set.expected.iter().map(TraceResult::is_hit).collect();
+                let closest = |r: &Ray| {
+                    self.structures
+                        .closest_hit(AccelKind::Bvh2, r, &mut NoObserver)
+                };
+                agree_occluded(peer, tris, &set.rays, &ours, &closest)
+            }
+            RayKind::Primary | RayKind::Diffuse => {
+                agree_closest(peer, tris, &set.rays, &closest_hits(set))
+            }
+        }
+    }
+}
+
+/// BVH2's closest hits of a closest-hit set (`None` for shadow answers).
+fn closest_hits(set: &RaySet) -> Vec<Option<dualsplit_geometry::Hit>> {
+    set.expected
+        .iter()
+        .map(|r| match r {
+            TraceResult::Closest(h) => *h,
+            TraceResult::Occluded(_) => None,
+        })
+        .collect()
+}
+
+fn print_agreement(kind: &str, a: &Agreement) {
+    let d = |x: &dualsplit_embree::Differences| match x.total() {
+        0 => "0".to_string(),
+        n => format!(
+            "{n} (tie {}, grazing {}, boundary {}, unexplained {})",
+            x.tie, x.grazing, x.boundary, x.unexplained
+        ),
+    };
+    println!(
+        "  {kind:<8} {:>8} rays, {:>8} same; hit/miss differs {}; triangle differs {}{}",
+        a.rays,
+        a.same,
+        d(&a.hit_miss),
+        d(&a.triangle),
+        if kind == "shadow" {
+            String::new()
+        } else {
+            format!("; same triangle, largest |Δt|/t {:.1e}", a.max_t_rel_diff)
+        }
+    );
+}
+
+fn print_timings(
+    timings: &[Timing],
+    best: &BTreeMap<&str, String>,
+    ratios: &[&BTreeMap<&str, f64>; 2],
+    threads: usize,
+) {
+    let mut passes: Vec<String> = Vec::new();
+    for t in timings {
+        let p = format!("{} {}", t.repeats, t.ray_kind.name());
+        if !passes.contains(&p) {
+            passes.push(p);
+        }
+    }
+    println!(
+        "interleaved on {threads} thread(s), passes: {}; Mrays/s over all passes (fastest pass)",
+        passes.join(", ")
+    );
+    println!(
+        "{:<12} {:>18} {:>18} {:>18}",
+        "accel", "primary", "shadow", "diffuse"
+    );
+    let mut names: Vec<&str> = Vec::new();
+    for t in timings {
+        if !names.contains(&t.accel.as_str()) {
+            names.push(&t.accel);
+        }
+    }
+    for name in names {
+        let cell = |k: RayKind| {
+            timings
+                .iter()
+                .find(|t| t.accel == name && t.ray_kind == k)
+                .map(|t| format!("{:.2} ({:.2})", t.mrays_per_s, t.best_pass_mrays_per_s))
+                .unwrap_or_else(|| "-".into())
+        };
+        println!(
+            "{name:<12} {:>18} {:>18} {:>18}",
+            cell(RayKind::Primary),
+            cell(RayKind::Shadow),
+            cell(RayKind::Diffuse)
+        );
+    }
+    let cell = |k: RayKind| match (ratios[0].get(k.name()), ratios[1].get(k.name())) {
+        (Some(r), Some(f)) => format!("{r:.2} ({f:.2}) {}", best[k.name()]),
+        _ => "-".into(),
+    };
+    println!(
+        "{:<12} {:>18} {:>18} {:>18}",
+        "best/embree",
+        cell(RayKind::Primary),
+        cell(RayKind::Shadow),
+        cell(RayKind::Diffuse)
+    );
 }
