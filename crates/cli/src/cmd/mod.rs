@@ -3,9 +3,11 @@ pub mod bench;
 pub mod calibrate;
 pub mod check;
 pub mod info;
+pub mod plan;
 pub mod rays;
 pub mod render;
 pub mod report;
+pub mod run_job;
 pub mod simulate;
 pub mod stats;
 

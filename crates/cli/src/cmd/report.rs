@@ -129,25 +129,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--res must be positive");
     }
     let user_scenes = !args.specs.is_empty();
-    let specs: Vec<String> = if user_scenes {
-        args.specs.clone()
-    } else {
-        // The paper's meshes found in the scenes folder (all with --full; Dragon Box, the
-        // paper's own, by default), then the builtins.
-        let files = scene_files
-            .files
-            .iter()
-            .filter(|f| args.full || f.scene == PaperScene::DragonBox)
-            .filter_map(|f| f.path.clone());
-        let builtins: &[&str] = if args.full {
-            &FULL_SCENES
-        } else {
-            &DEFAULT_SCENES
-        };
-        files
-            .chain(builtins.iter().map(|s| s.to_string()))
-            .collect()
-    };
+    let specs = resolve_specs(&args.specs, args.full, &scene_files);
     let mut tms = args.tms.clone();
     tms.sort_unstable();
     tms.dedup();
@@ -241,6 +223,24 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         start.elapsed().as_secs_f64()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// The scenes of a report or study: those given, else the paper's meshes found in the
+/// scenes folder (all with `full`; Dragon Box, the paper's own, by default), then the
+/// builtins.
+pub fn resolve_specs(given: &[String], full: bool, scene_files: &SceneFiles) -> Vec<String> {
+    if !given.is_empty() {
+        return given.to_vec();
+    }
+    let files = scene_files
+        .files
+        .iter()
+        .filter(|f| full || f.scene == PaperScene::DragonBox)
+        .filter_map(|f| f.path.clone());
+    let builtins: &[&str] = if full { &FULL_SCENES } else { &DEFAULT_SCENES };
+    files
+        .chain(builtins.iter().map(|s| s.to_string()))
+        .collect()
 }
 
 /// What a report will simulate, known before any scene is loaded.
