@@ -10,6 +10,7 @@ pub mod report;
 pub mod run_job;
 pub mod simulate;
 pub mod stats;
+pub mod study_report;
 
 use crate::progress::Ctx;
 use anyhow::Context;

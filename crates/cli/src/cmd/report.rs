@@ -64,8 +64,8 @@ pub struct Args {
     #[arg(long)]
     full: bool,
     /// Output directory.
-    #[arg(long, default_value = "report")]
-    out: PathBuf,
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Folder of the shipped meshes (Dragon Box, Dragon Sponza). Default: the
     /// DUALSPLIT_SCENES environment variable, else shared/scenes beside the checkout.
     #[arg(long = "scenes", value_name = "DIR")]
@@ -82,6 +82,11 @@ pub struct Args {
     /// without loading anything.
     #[arg(long)]
     dry_run: bool,
+    /// Assemble the study in DIR (made by `dualsplit plan`, filled by `run-job`) from the
+    /// results in DIR/cache/ into DIR/report/ (or --out when given); missing entries are
+    /// listed, not run.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["specs", "full", "dry_run", "tms", "model", "res", "scenes_dir"])]
+    from: Option<PathBuf>,
 }
 
 /// indicatif bars behind the report's `Progress` trait.
@@ -113,9 +118,13 @@ impl Progress for Bars<'_> {
 }
 
 /// Runs the subcommand.
-pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+    if let Some(dir) = &args.from {
+        return super::study_report::run(dir, args.out.as_deref());
+    }
     let start = Instant::now();
-    crate::output::prepare_dir(&args.out, "--out")?;
+    let out = args.out.take().unwrap_or_else(|| PathBuf::from("report"));
+    crate::output::prepare_dir(&out, "--out")?;
     let dir = scenes::find_here(args.scenes_dir.as_deref())?;
     let scene_files = SceneFiles::scan(dir.as_ref());
     eprintln!("{}", scene_files.describe());
@@ -199,15 +208,10 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         ctx,
         bar: Mutex::new(None),
     };
-    let producer = Producer::new(
-        Cache::new(args.out.join("cache")),
-        settings,
-        &bars,
-        &*simulate,
-    );
+    let producer = Producer::new(Cache::new(out.join("cache")), settings, &bars, &*simulate);
     let mut data = producer.run(&scenes, skipped)?;
     data.scene_files = scene_files;
-    let written = dualsplit_report::write_report(&data, &args.out)?;
+    let written = dualsplit_report::write_report(&data, &out)?;
     if let Some(e) = data.sim_error() {
         eprintln!("note: {e}; simulated sections say so");
     }
@@ -216,10 +220,10 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     println!(
         "wrote {} ({} files; {} pieces computed, the rest from {}) in {:.1} s",
-        args.out.join("index.html").display(),
+        out.join("index.html").display(),
         written.len(),
         producer.computed(),
-        args.out.join("cache").display(),
+        out.join("cache").display(),
         start.elapsed().as_secs_f64()
     );
     Ok(ExitCode::SUCCESS)
