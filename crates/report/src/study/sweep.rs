@@ -24,8 +24,11 @@ pub struct SweepChart {
 const W: u32 = 1050;
 const H: u32 = 330;
 
+/// A metric's value in a row.
+type MetricOf = fn(&StudyRow) -> f64;
+
 /// The metrics, their axis names and their values in a row.
-const METRICS: [(&str, fn(&StudyRow) -> f64); 3] = [
+const METRICS: [(&str, MetricOf); 3] = [
     ("frame time (ms)", |r| r.frame_ms),
     ("energy (J)", |r| r.energy_j),
     ("DRAM lines", |r| r.dram_lines as f64),
