@@ -36,6 +36,10 @@ enum Command {
     Simulate(cmd::simulate::Args),
     /// Regenerate the paper's tables and figures.
     Report(cmd::report::Args),
+    /// Write a study's plan: one independent simulation per entry, with sweeps.
+    Plan(cmd::plan::Args),
+    /// Run one entry of a study's plan into its result cache.
+    RunJob(cmd::run_job::Args),
     /// Measure the fast thread model's per-event costs from the compiled kernels.
     Calibrate(cmd::calibrate::Args),
 }
@@ -66,6 +70,8 @@ fn main() -> std::process::ExitCode {
         Command::Bench(a) => cmd::bench::run(a, &ctx),
         Command::Simulate(a) => cmd::simulate::run(a, &ctx),
         Command::Report(a) => cmd::report::run(a, &ctx),
+        Command::Plan(a) => cmd::plan::run(a, &ctx),
+        Command::RunJob(a) => cmd::run_job::run(a, &ctx),
         Command::Calibrate(a) => cmd::calibrate::run(a, &ctx),
     };
     match result {

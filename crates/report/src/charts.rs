@@ -21,7 +21,7 @@ use std::sync::Once;
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
 
-fn register_font() {
+pub(crate) fn register_font() {
     REGISTER.call_once(|| {
         // The font is embedded and valid; a failure would only lose text metrics.
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);

@@ -3,11 +3,14 @@ pub mod bench;
 pub mod calibrate;
 pub mod check;
 pub mod info;
+pub mod plan;
 pub mod rays;
 pub mod render;
 pub mod report;
+pub mod run_job;
 pub mod simulate;
 pub mod stats;
+pub mod study_report;
 
 use crate::progress::Ctx;
 use anyhow::Context;

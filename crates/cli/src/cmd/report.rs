@@ -64,8 +64,8 @@ pub struct Args {
     #[arg(long)]
     full: bool,
     /// Output directory.
-    #[arg(long, default_value = "report")]
-    out: PathBuf,
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Folder of the shipped meshes (Dragon Box, Dragon Sponza). Default: the
     /// DUALSPLIT_SCENES environment variable, else shared/scenes beside the checkout.
     #[arg(long = "scenes", value_name = "DIR")]
@@ -82,6 +82,11 @@ pub struct Args {
     /// without loading anything.
     #[arg(long)]
     dry_run: bool,
+    /// Assemble the study in DIR (made by `dualsplit plan`, filled by `run-job`) from the
+    /// results in DIR/cache/ into DIR/report/ (or --out when given); missing entries are
+    /// listed, not run.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["specs", "full", "dry_run", "tms", "model", "res", "scenes_dir"])]
+    from: Option<PathBuf>,
 }
 
 /// indicatif bars behind the report's `Progress` trait.
@@ -113,9 +118,13 @@ impl Progress for Bars<'_> {
 }
 
 /// Runs the subcommand.
-pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+    if let Some(dir) = &args.from {
+        return super::study_report::run(dir, args.out.as_deref());
+    }
     let start = Instant::now();
-    crate::output::prepare_dir(&args.out, "--out")?;
+    let out = args.out.take().unwrap_or_else(|| PathBuf::from("report"));
+    crate::output::prepare_dir(&out, "--out")?;
     let dir = scenes::find_here(args.scenes_dir.as_deref())?;
     let scene_files = SceneFiles::scan(dir.as_ref());
     eprintln!("{}", scene_files.describe());
@@ -129,25 +138,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--res must be positive");
     }
     let user_scenes = !args.specs.is_empty();
-    let specs: Vec<String> = if user_scenes {
-        args.specs.clone()
-    } else {
-        // The paper's meshes found in the scenes folder (all with --full; Dragon Box, the
-        // paper's own, by default), then the builtins.
-        let files = scene_files
-            .files
-            .iter()
-            .filter(|f| args.full || f.scene == PaperScene::DragonBox)
-            .filter_map(|f| f.path.clone());
-        let builtins: &[&str] = if args.full {
-            &FULL_SCENES
-        } else {
-            &DEFAULT_SCENES
-        };
-        files
-            .chain(builtins.iter().map(|s| s.to_string()))
-            .collect()
-    };
+    let specs = resolve_specs(&args.specs, args.full, &scene_files);
     let mut tms = args.tms.clone();
     tms.sort_unstable();
     tms.dedup();
@@ -217,15 +208,10 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         ctx,
         bar: Mutex::new(None),
     };
-    let producer = Producer::new(
-        Cache::new(args.out.join("cache")),
-        settings,
-        &bars,
-        &*simulate,
-    );
+    let producer = Producer::new(Cache::new(out.join("cache")), settings, &bars, &*simulate);
     let mut data = producer.run(&scenes, skipped)?;
     data.scene_files = scene_files;
-    let written = dualsplit_report::write_report(&data, &args.out)?;
+    let written = dualsplit_report::write_report(&data, &out)?;
     if let Some(e) = data.sim_error() {
         eprintln!("note: {e}; simulated sections say so");
     }
@@ -234,13 +220,31 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     println!(
         "wrote {} ({} files; {} pieces computed, the rest from {}) in {:.1} s",
-        args.out.join("index.html").display(),
+        out.join("index.html").display(),
         written.len(),
         producer.computed(),
-        args.out.join("cache").display(),
+        out.join("cache").display(),
         start.elapsed().as_secs_f64()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// The scenes of a report or study: those given, else the paper's meshes found in the
+/// scenes folder (all with `full`; Dragon Box, the paper's own, by default), then the
+/// builtins.
+pub fn resolve_specs(given: &[String], full: bool, scene_files: &SceneFiles) -> Vec<String> {
+    if !given.is_empty() {
+        return given.to_vec();
+    }
+    let files = scene_files
+        .files
+        .iter()
+        .filter(|f| full || f.scene == PaperScene::DragonBox)
+        .filter_map(|f| f.path.clone());
+    let builtins: &[&str] = if full { &FULL_SCENES } else { &DEFAULT_SCENES };
+    files
+        .chain(builtins.iter().map(|s| s.to_string()))
+        .collect()
 }
 
 /// What a report will simulate, known before any scene is loaded.
