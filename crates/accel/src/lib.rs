@@ -46,6 +46,7 @@ pub mod dst;
 pub mod image;
 pub mod observer;
 pub mod query;
+pub mod saved;
 pub mod stats;
 pub mod tree;
 pub mod validate;

@@ -141,7 +141,7 @@ pub struct BuildStats {
 }
 
 impl BuildStats {
-    fn of_bvh(kind: TreeKind, b: &BvhImage, build_ms: f64) -> Self {
+    pub(crate) fn of_bvh(kind: TreeKind, b: &BvhImage, build_ms: f64) -> Self {
         Self {
             kind: Some(kind),
             build_ms,
