@@ -9,15 +9,56 @@
 //! Every traversal is generic over an [`Observer`] (the one-traversal contract: README,
 //! "What is where").
 //! [`Structures`] builds all of them from one scene and dispatches by [`AccelKind`].
+//!
+//! ## Using the library
+//!
+//! Build exactly the structure you need, query it through [`RayQuery`], and save it to a
+//! file to skip the build next time ([`saved`]):
+//!
+//! ```
+//! use dualsplit_accel::math::{Ray, Triangle, Vec3};
+//! use dualsplit_accel::{BuildConfig, Bvh2Tree, DstConfig, DstTree, RayQuery};
+//! let tris = vec![Triangle::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0))];
+//! let bvh2 = Bvh2Tree::build(tris, &BuildConfig::default())?;
+//! let dst = DstTree::from_bvh2(&bvh2, &DstConfig::hardware())?;
+//! let hits = dst.intersect_batch(&[Ray::new(Vec3::ZERO, Vec3::Z)]);
+//! assert_eq!(hits[0].map(|h| h.t), Some(2.0));
+//! # Ok::<(), dualsplit_accel::AccelError>(())
+//! ```
+//!
+//! * Structures: [`Bvh2Tree::build`]; [`BvhTree::bvh4_from`], [`BvhTree::bvh8_from`] and
+//!   [`DstTree::from_bvh2`] derive the others from a BVH2, each with its [`BuildStats`]
+//!   (times in milliseconds).
+//! * Queries: [`RayQuery`] (`intersect`, `occluded`, batch forms, and the `_observed` forms
+//!   the simulator uses).
+//! * DST traversals: [`DstDecoding::Software`] ([`AccelKind::DstSw`], `dst-sw`: the paper's
+//!   DST\*, the fast one on a CPU) and [`DstDecoding::Pipeline`] ([`AccelKind::Dst`], `dst`:
+//!   the hardware pipeline model). [`AccelKind::DST_SOFTWARE`] and
+//!   [`AccelKind::DST_PIPELINE`] name them too.
+//! * Math types: [`math`] re-exports the vector, ray, triangle and hit types (glam's `Vec3`
+//!   included), so callers need not depend on glam.
+//! * Threads: builds and batch queries run on the current rayon pool; use
+//!   [`rayon::ThreadPool::install`] or [`Bvh2Tree::build_in`] to pick one.
 
 pub mod build;
 pub mod bvh2;
 pub mod dst;
 pub mod image;
 pub mod observer;
+pub mod query;
+pub mod saved;
 pub mod stats;
+pub mod tree;
 pub mod validate;
 pub mod wide;
+
+/// The geometry types of the public API, re-exported so that callers need not depend on
+/// `dualsplit-geometry` or match its glam version.
+pub mod math {
+    pub use dualsplit_geometry::{Aabb, Hit, PrimId, Ray, Triangle, Vec3};
+    /// The vector library `Vec3` comes from.
+    pub use glam;
+}
 
 pub use build::{BuildConfig, Bvh2, Bvh2Node};
 pub use image::{ByteAddr, ImageError, MemoryImage, SharedTriangles};
@@ -25,6 +66,12 @@ pub use observer::{CountingObserver, DstNodeKind, NoObserver, NodeStep, Observer
 pub use stats::StructureStats;
 pub use validate::ValidationReport;
 pub use wide::{BvhImage, CollapseConfig, WideBvh};
+
+pub use dst::{Dst, DstConfig};
+pub use query::{DstPipeline, RayQuery};
+/// The rayon crate builds and batch queries run on (for [`rayon::ThreadPool`]).
+pub use rayon;
+pub use tree::{AnyTree, BuildStats, Bvh2Tree, BvhTree, DstDecoding, DstTree, TreeKind};
 
 use dualsplit_geometry::{Aabb, Hit, Ray, Triangle};
 use serde::{Deserialize, Serialize};
@@ -40,13 +87,25 @@ pub enum AccelKind {
     Bvh4,
     /// 8-wide BVH (Ylitie collapse), 200-byte nodes.
     Bvh8,
-    /// Dual-split tree, software decoder (the paper's DST*).
+    /// Dual-split tree, software decoder (the paper's DST*): the fast CPU traversal
+    /// ([`AccelKind::DST_SOFTWARE`], [`DstDecoding::Software`]; command line `dst-sw`).
+    #[doc(alias = "DstSoftware")]
     DstSw,
-    /// Dual-split tree traversed by the hardware pipeline's step function.
+    /// Dual-split tree traversed by the hardware pipeline's step function: the model of the
+    /// paper's hardware, slower on a CPU ([`AccelKind::DST_PIPELINE`],
+    /// [`DstDecoding::Pipeline`]; command line `dst`).
+    #[doc(alias = "DstPipeline")]
     Dst,
 }
 
 impl AccelKind {
+    /// The DST's software decoder (the paper's DST\*), the fast CPU traversal: an
+    /// unambiguous name for [`AccelKind::DstSw`].
+    pub const DST_SOFTWARE: AccelKind = AccelKind::DstSw;
+    /// The DST traversed by the hardware pipeline model: an unambiguous name for
+    /// [`AccelKind::Dst`].
+    pub const DST_PIPELINE: AccelKind = AccelKind::Dst;
+
     /// All kinds, in report order.
     pub const ALL: [AccelKind; 5] = [
         AccelKind::Bvh2,

@@ -24,6 +24,8 @@ struct Cli {
 enum Command {
     /// Load a scene and print its triangles, bounds and load statistics.
     Info(cmd::info::Args),
+    /// Build one structure and save it to a tree file.
+    Build(cmd::build::Args),
     /// Build every structure and print sizes, node counts and build times (Table 3).
     Stats(cmd::stats::Args),
     /// Validate every structure and check per-ray equivalence against BVH2.
@@ -64,6 +66,7 @@ fn main() -> std::process::ExitCode {
     let ctx = progress::Ctx::new(cli.quiet);
     let result = match cli.command {
         Command::Info(a) => cmd::info::run(a, &ctx),
+        Command::Build(a) => cmd::build::run(a, &ctx),
         Command::Stats(a) => cmd::stats::run(a, &ctx),
         Command::Check(a) => cmd::check::run(a, &ctx),
         Command::Render(a) => cmd::render::run(a, &ctx),

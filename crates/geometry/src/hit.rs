@@ -1,6 +1,9 @@
 /// A triangle id: the triangle's index in the scene's triangle array, which every
 /// structure's leaves and the hit it returns name it by.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, bytemuck::Pod, bytemuck::Zeroable,
+)]
+#[repr(transparent)]
 pub struct PrimId(pub u32);
 
 impl PrimId {
@@ -19,7 +22,11 @@ impl std::fmt::Display for PrimId {
 
 /// A closest-hit result: the ray parameter and the triangle id (index into the scene's
 /// triangle array), plus the barycentric coordinates of the hit.
-#[derive(Clone, Copy, Debug, PartialEq)]
+///
+/// Plain data (`repr(C)`, [`bytemuck::Pod`]): 16 bytes in the order `t`, `prim`, `u`, `v`,
+/// so hits can be written and read in bulk.
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub struct Hit {
     /// Ray parameter of the hit point.
     pub t: f32,
@@ -30,6 +37,8 @@ pub struct Hit {
     /// Barycentric v (weight of vertex 2).
     pub v: f32,
 }
+
+const _: () = assert!(std::mem::size_of::<Hit>() == 16);
 
 impl Hit {
     /// The total order used by every closest-hit traversal: smaller `t` wins, equal `t` goes

@@ -35,7 +35,12 @@ pub fn widen_exit(t: f32) -> f32 {
 }
 
 /// A ray `origin + t * dir` valid for `t` in `[t_min, t_max]`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+///
+/// Plain data (`repr(C)`, [`bytemuck::Pod`]): 32 bytes, eight little-endian `f32` on the
+/// usual targets in the order origin.xyz, dir.xyz, t_min, t_max, so a file of rays can be
+/// read in bulk with [`bytemuck::cast_slice`] (or [`bytemuck::pod_read_unaligned`] per ray when the bytes are not 4-aligned).
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub struct Ray {
     /// Origin.
     pub origin: Vec3,
@@ -46,6 +51,8 @@ pub struct Ray {
     /// Upper end of the valid interval.
     pub t_max: f32,
 }
+
+const _: () = assert!(std::mem::size_of::<Ray>() == 32);
 
 impl Ray {
     /// A ray valid on `[0, ∞)`.

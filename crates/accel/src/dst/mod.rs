@@ -273,4 +273,19 @@ impl Dst {
     pub fn triangles(&self) -> &[Triangle] {
         self.image.triangle_slice()
     }
+
+    /// A tree from its parts, as a saved tree file stores them ([`crate::saved`]).
+    pub(crate) fn from_parts(
+        image: MemoryImage,
+        scene_box: Aabb,
+        config: DstConfig,
+        stats: DstStats,
+    ) -> Self {
+        Self {
+            image,
+            scene_box,
+            config,
+            stats,
+        }
+    }
 }

@@ -1,0 +1,76 @@
+//! Loading a saved Dragon Box DST against building it: `build_dst` is the whole build
+//! (BVH2 + conversion), `load_dst` reads and checks the saved file (page cache warm).
+//!
+//! `cargo bench -p dualsplit-accel --bench saved_tree`
+//! (under `cargo test --benches` the small `dragon_res4` is used).
+
+use dualsplit_accel::{AnyTree, BuildConfig, Bvh2Tree, DstConfig, DstTree, SharedTriangles};
+use dualsplit_testkit::scenes::load_shipped;
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+struct Input {
+    tris: SharedTriangles,
+    file: PathBuf,
+    _dir: tempfile::TempDir,
+}
+
+fn scene_name() -> String {
+    std::env::var("DST_BENCH_SCENE").unwrap_or_else(|_| {
+        if !std::env::args().any(|a| a == "--bench") {
+            "dragon_res4.ply.gz".into()
+        } else {
+            "dragon_box.ply.gz".into()
+        }
+    })
+}
+
+fn build(tris: &SharedTriangles) -> DstTree {
+    let bvh2 = Bvh2Tree::build(tris.clone(), &BuildConfig::default()).expect("bvh2");
+    DstTree::from_bvh2(&bvh2, &DstConfig::hardware()).expect("dst")
+}
+
+fn input() -> &'static Input {
+    static INPUT: OnceLock<Input> = OnceLock::new();
+    INPUT.get_or_init(|| {
+        let tris: SharedTriangles = load_shipped(&scene_name()).into();
+        let dir = tempfile::tempdir().expect("tempdir");
+        let file = dir.path().join("dst.dstree");
+        AnyTree::from(build(&tris)).save(&file).expect("save");
+        Input {
+            tris,
+            file,
+            _dir: dir,
+        }
+    })
+}
+
+fn main() {
+    let i = input();
+    // The loaded tree is the built one.
+    let loaded = AnyTree::load(&i.file, Some(&i.tris)).expect("load");
+    assert_eq!(loaded.image().words, build(&i.tris).image().words);
+    eprintln!(
+        "{}: {} triangles, tree file {} bytes",
+        scene_name(),
+        i.tris.len(),
+        std::fs::metadata(&i.file).expect("file").len()
+    );
+    divan::main();
+}
+
+#[divan::bench(sample_count = 5, sample_size = 1)]
+fn build_dst() -> DstTree {
+    build(&input().tris)
+}
+
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn load_dst() -> AnyTree {
+    let i = input();
+    AnyTree::load(&i.file, Some(&i.tris)).expect("load")
+}
+
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn load_dst_unchecked_scene() -> AnyTree {
+    AnyTree::load(&input().file, None).expect("load")
+}

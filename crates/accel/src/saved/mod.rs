@@ -1,0 +1,415 @@
+//! Saved trees: one structure's memory image and the triangles it references, in a
+//! versioned, checksummed file (`docs/tree-format.md`).
+//!
+//! ```text
+//!   0     header (512 B): magic, format version, kind, sizes, triangle hash, build config,
+//!         the structure's own fields; zero-padded to byte 4096
+//!   4096  node words, index words (little-endian u32)
+//!   ...   triangles (9 × f32 each, id order)
+//!   end   SHA-256 of every byte before it
+//! ```
+//!
+//! Loading checks, in order: the magic, the version, that the sizes in the header add up
+//! to the file's length (before anything is allocated), the checksum, and, when the caller
+//! names the scene, the triangle hash. Each failure is a [`SavedError`]; nothing panics.
+//!
+//! Loading reads the file into memory rather than mapping it: a file mapping is `unsafe`
+//! (another process may change or truncate the file under it), which this workspace
+//! forbids. The node and index words are read straight into their final buffer
+//! ([`crate::image::Words`], an anonymous huge-page mapping for large images), with no
+//! intermediate copy; the triangles take one extra copy into their shared allocation.
+//!
+//! ```
+//! use dualsplit_accel::math::{Ray, Triangle, Vec3};
+//! use dualsplit_accel::{AnyTree, BuildConfig, Bvh2Tree, DstConfig, DstTree, RayQuery};
+//! let tris = vec![Triangle::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0))];
+//! let bvh2 = Bvh2Tree::build(&tris[..], &BuildConfig::default()).unwrap();
+//! let dst = AnyTree::from(DstTree::from_bvh2(&bvh2, &DstConfig::hardware()).unwrap());
+//! let bytes = dst.to_bytes();
+//! let back = AnyTree::from_bytes(&bytes, Some(&tris)).unwrap();
+//! let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+//! assert_eq!(back.intersect(&ray), dst.intersect(&ray));
+//! let mut bad = bytes.clone();
+//! bad[5000] ^= 1;
+//! assert!(AnyTree::from_bytes(&bad, None).is_err());
+//! ```
+
+mod header;
+
+pub use header::{CHECKSUM_BYTES, FORMAT_VERSION, HEADER_BYTES, MAGIC, WORDS_OFFSET};
+
+use crate::dst::Dst;
+use crate::image::{MemoryImage, SharedTriangles, Words};
+use crate::tree::{AnyTree, BuildStats, BvhTree, DstTree, TreeKind};
+use crate::wide::BvhImage;
+use dualsplit_geometry::Triangle;
+use header::{Extra, Header};
+use sha2::{Digest, Sha256};
+use std::io::{self, Read, Write};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// Why a saved tree could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum SavedError {
+    /// Reading or writing the file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: io::Error,
+    },
+    /// A load error, with the file it came from.
+    #[error("{}: {source}", path.display())]
+    At {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        source: Box<SavedError>,
+    },
+    /// The file does not start with [`MAGIC`].
+    #[error("not a dualsplit tree file (bad magic)")]
+    NotATree,
+    /// A format version this crate does not read.
+    #[error("tree file format version {found}, this build reads version {supported}")]
+    UnsupportedVersion {
+        /// The file's version.
+        found: u32,
+        /// The version this crate reads.
+        supported: u32,
+    },
+    /// The file is shorter (truncated) or longer than its header says.
+    #[error("tree file is {found} bytes, its header says {expected} (truncated or damaged)")]
+    Length {
+        /// Bytes the header says.
+        expected: u64,
+        /// Bytes there are.
+        found: u64,
+    },
+    /// The data ended before the length it was said to have.
+    #[error("tree file ended early (truncated while reading)")]
+    EndedEarly,
+    /// The header's fields contradict each other.
+    #[error("malformed tree file: {0}")]
+    Malformed(String),
+    /// The checksum does not match the contents.
+    #[error("tree file is corrupt: checksum mismatch")]
+    Checksum,
+    /// The tree was built from other triangles than the scene it is used with.
+    #[error(
+        "tree file was built from another scene (triangle hash {found}, the scene's is {expected})"
+    )]
+    WrongScene {
+        /// The scene's triangle hash (hex).
+        expected: String,
+        /// The file's triangle hash (hex).
+        found: String,
+    },
+}
+
+impl SavedError {
+    fn malformed(s: String) -> Self {
+        SavedError::Malformed(s)
+    }
+
+    /// The error without its file context ([`SavedError::At`] unwrapped).
+    pub fn cause(&self) -> &SavedError {
+        match self {
+            SavedError::At { source, .. } => source.cause(),
+            e => e,
+        }
+    }
+
+    fn at(self, path: &Path) -> Self {
+        match self {
+            e @ (SavedError::Io { .. } | SavedError::At { .. }) => e,
+            e => SavedError::At {
+                path: path.to_owned(),
+                source: Box::new(e),
+            },
+        }
+    }
+}
+
+/// SHA-256 of triangles as stored (36 little-endian bytes each, id order): what a saved
+/// tree records to recognise its scene.
+pub fn triangle_hash(triangles: &[Triangle]) -> [u8; 32] {
+    let mut h = Sha256::new();
+    hash_triangles(&mut h, triangles);
+    h.finalize().into()
+}
+
+fn hash_triangles(h: &mut Sha256, triangles: &[Triangle]) {
+    if cfg!(target_endian = "little") {
+        h.update(bytemuck::cast_slice::<Triangle, u8>(triangles));
+    } else {
+        for t in triangles {
+            for v in t.v {
+                for c in v.to_array() {
+                    h.update(c.to_le_bytes());
+                }
+            }
+        }
+    }
+}
+
+fn hex(h: &[u8; 32]) -> String {
+    h.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Writes `words` as little-endian bytes into `out` and the hash.
+fn put_words<W: Write>(out: &mut HashingWriter<W>, words: &[u32]) -> io::Result<()> {
+    if cfg!(target_endian = "little") {
+        out.write_all(bytemuck::cast_slice(words))
+    } else {
+        for w in words {
+            out.write_all(&w.to_le_bytes())?;
+        }
+        Ok(())
+    }
+}
+
+struct HashingWriter<W> {
+    inner: W,
+    hash: Sha256,
+}
+
+impl<W: Write> HashingWriter<W> {
+    fn write_all(&mut self, b: &[u8]) -> io::Result<()> {
+        self.hash.update(b);
+        self.inner.write_all(b)
+    }
+}
+
+impl AnyTree {
+    /// The file header of this tree.
+    fn header(&self) -> Header {
+        let img = self.image();
+        let extra = match self {
+            AnyTree::Bvh(b) => Extra::Bvh {
+                internal_nodes: b.encoded.internal_nodes as u64,
+                leaves: b.encoded.leaves as u64,
+                sah_cost: b.encoded.sah_cost,
+            },
+            AnyTree::Dst(d) => Extra::Dst {
+                config: *d.dst.config(),
+                scene_box: d.dst.scene_box(),
+                stats: d.dst.stats(),
+            },
+        };
+        let (n, i, t) = (
+            img.nodes.len() as u64,
+            img.indices.len() as u64,
+            img.triangle_slice().len() as u64,
+        );
+        Header {
+            kind: self.kind(),
+            node_words: n,
+            index_words: i,
+            triangles: t,
+            file_bytes: header::implied_bytes(n, i, t).unwrap_or(u64::MAX),
+            triangle_hash: triangle_hash(img.triangle_slice()),
+            build: *self.config(),
+            extra,
+        }
+    }
+
+    /// Writes the tree in the saved-tree format to `w`. The same tree always gives the
+    /// same bytes (no time stamps; build times are not stored).
+    pub fn write_to<W: Write>(&self, w: W) -> io::Result<()> {
+        let mut out = HashingWriter {
+            inner: w,
+            hash: Sha256::new(),
+        };
+        let mut head = self.header().encode();
+        head.resize(WORDS_OFFSET as usize, 0);
+        out.write_all(&head)?;
+        let img = self.image();
+        put_words(&mut out, &img.words[img.nodes.start..img.indices.end])?;
+        let tris = img.triangle_slice();
+        if cfg!(target_endian = "little") {
+            out.write_all(bytemuck::cast_slice(tris))?;
+        } else {
+            put_words(&mut out, bytemuck::cast_slice(tris))?;
+        }
+        let sum: [u8; 32] = out.hash.finalize().into();
+        out.inner.write_all(&sum)?;
+        out.inner.flush()
+    }
+
+    /// The saved-tree file as bytes.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut v = Vec::new();
+        // Writing to a Vec cannot fail.
+        let _ = self.write_to(&mut v);
+        v
+    }
+
+    /// Saves the tree to `path` (created or replaced).
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), SavedError> {
+        let path = path.as_ref();
+        let io = |source| SavedError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let f = std::fs::File::create(path).map_err(io)?;
+        self.write_to(io::BufWriter::with_capacity(1 << 20, f))
+            .map_err(io)
+    }
+
+    /// Reads a saved tree of `len` bytes from `r`. With `scene`, the tree must have been
+    /// built from exactly these triangles ([`SavedError::WrongScene`] otherwise).
+    pub fn read_from<R: Read>(
+        mut r: R,
+        len: u64,
+        scene: Option<&[Triangle]>,
+    ) -> Result<AnyTree, SavedError> {
+        let short = |e: io::Error| match e.kind() {
+            io::ErrorKind::UnexpectedEof => SavedError::EndedEarly,
+            _ => SavedError::Io {
+                path: PathBuf::new(),
+                source: e,
+            },
+        };
+        let mut hash = Sha256::new();
+        let mut head = [0u8; HEADER_BYTES];
+        if len < WORDS_OFFSET + CHECKSUM_BYTES {
+            r.read_exact(&mut head[..len.min(HEADER_BYTES as u64) as usize])
+                .map_err(short)?;
+            if head[..8.min(len as usize)] != MAGIC[..8.min(len as usize)] {
+                return Err(SavedError::NotATree);
+            }
+            return Err(SavedError::Length {
+                expected: WORDS_OFFSET + CHECKSUM_BYTES,
+                found: len,
+            });
+        }
+        r.read_exact(&mut head).map_err(short)?;
+        let h = Header::decode(&head, len)?;
+        hash.update(head);
+        let mut pad = vec![0u8; WORDS_OFFSET as usize - HEADER_BYTES];
+        r.read_exact(&mut pad).map_err(short)?;
+        hash.update(&pad);
+
+        // The sizes add up to `len` (checked by `decode`), so these fit in memory as the
+        // file did.
+        let n_words = (h.node_words + h.index_words) as usize;
+        let mut words = Words::zeroed(n_words);
+        {
+            let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut words[..]);
+            r.read_exact(bytes).map_err(short)?;
+            hash.update(&*bytes);
+        }
+        if cfg!(target_endian = "big") {
+            for w in words.iter_mut() {
+                *w = u32::from_le(*w);
+            }
+        }
+        let mut tris = vec![Triangle::default(); h.triangles as usize];
+        {
+            let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut tris[..]);
+            r.read_exact(bytes).map_err(short)?;
+            hash.update(&*bytes);
+        }
+        if cfg!(target_endian = "big") {
+            let f: &mut [u32] = bytemuck::cast_slice_mut(&mut tris[..]);
+            for w in f {
+                *w = u32::from_le(*w);
+            }
+        }
+        let mut sum = [0u8; 32];
+        r.read_exact(&mut sum).map_err(short)?;
+        let mut extra = [0u8; 1];
+        if r.read(&mut extra).map_err(short)? != 0 {
+            return Err(SavedError::Length {
+                expected: len,
+                found: len + 1,
+            });
+        }
+        if <[u8; 32]>::from(hash.finalize()) != sum {
+            return Err(SavedError::Checksum);
+        }
+        if let Some(scene) = scene {
+            let want = triangle_hash(scene);
+            if want != h.triangle_hash {
+                return Err(SavedError::WrongScene {
+                    expected: hex(&want),
+                    found: hex(&h.triangle_hash),
+                });
+            }
+        }
+        Ok(assemble(&h, words, SharedTriangles::from(tris)))
+    }
+
+    /// Reads a saved tree from bytes (see [`AnyTree::read_from`]).
+    pub fn from_bytes(bytes: &[u8], scene: Option<&[Triangle]>) -> Result<AnyTree, SavedError> {
+        Self::read_from(bytes, bytes.len() as u64, scene)
+    }
+
+    /// Loads the saved tree at `path`. With `scene`, the tree must have been built from
+    /// exactly these triangles. Errors name the file.
+    pub fn load(path: impl AsRef<Path>, scene: Option<&[Triangle]>) -> Result<AnyTree, SavedError> {
+        let path = path.as_ref();
+        let io = |source| SavedError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let f = std::fs::File::open(path).map_err(io)?;
+        let len = f.metadata().map_err(io)?.len();
+        Self::read_from(io::BufReader::with_capacity(1 << 16, f), len, scene).map_err(|e| match e {
+            SavedError::Io { source, .. } => io(source),
+            e => e.at(path),
+        })
+    }
+}
+
+/// The tree a checked header and its regions describe.
+fn assemble(h: &Header, words: Words, tris: SharedTriangles) -> AnyTree {
+    let nodes = h.node_words as usize;
+    let tri_start = nodes + h.index_words as usize;
+    let image = MemoryImage {
+        words,
+        nodes: 0..nodes,
+        indices: nodes..tri_start,
+        triangles: tri_start..tri_start + 9 * tris.len(),
+        triangle_data: tris,
+    };
+    match h.extra {
+        Extra::Bvh {
+            internal_nodes,
+            leaves,
+            sah_cost,
+        } => {
+            let encoded = BvhImage {
+                arity: match h.kind {
+                    TreeKind::Bvh2 => 2,
+                    TreeKind::Bvh4 => 4,
+                    _ => 8,
+                },
+                image,
+                internal_nodes: internal_nodes as usize,
+                leaves: leaves as usize,
+                sah_cost,
+                time: Duration::ZERO,
+            };
+            AnyTree::Bvh(BvhTree {
+                stats: BuildStats::of_bvh(h.kind, &encoded, 0.0),
+                encoded,
+                config: h.build,
+            })
+        }
+        Extra::Dst {
+            config,
+            scene_box,
+            stats,
+        } => {
+            let dst = Dst::from_parts(image, scene_box, config, stats);
+            AnyTree::Dst(DstTree {
+                stats: BuildStats::of_dst(&dst, 0.0),
+                dst,
+                config: h.build,
+            })
+        }
+    }
+}

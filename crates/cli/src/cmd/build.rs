@@ -1,0 +1,116 @@
+//! `dualsplit build SCENE --accel dst|bvh2|bvh4|bvh8 -o FILE [--json]`: builds exactly one
+//! structure (a DST, BVH4 or BVH8 is derived from the scene's BVH2) and saves it in the
+//! saved-tree format (`docs/tree-format.md`), so later runs can load it instead of
+//! building.
+//!
+//! JSON schema (`--json`), one object: `{"scene", "spec", "triangles", "accel", "file",
+//! "file_bytes", "bvh2_ms", "build_ms", "save_ms", "stats"}`: `build_ms` is the wall time of
+//! every step that makes the structure (the BVH2 build, plus the collapse or conversion),
+//! `bvh2_ms` the BVH2 build alone, `save_ms` the write, and `stats` the structure's
+//! [`dualsplit_accel::BuildStats`] (its own `build_ms` is the last step alone). Times are
+//! host measurements.
+use crate::progress::Ctx;
+use anyhow::Context;
+use dualsplit_accel::{
+    AnyTree, BuildConfig, BuildStats, Bvh2Tree, BvhTree, DstConfig, DstTree, TreeKind,
+};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Arguments of `dualsplit build`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
+    #[arg(value_parser = crate::args::parse_scene)]
+    scene: String,
+    /// The structure to build: dst (hardware preset), bvh2, bvh4 or bvh8.
+    #[arg(long, value_parser = parse_tree_kind)]
+    accel: TreeKind,
+    /// The tree file to write.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Print one JSON object instead of a table; `--json=FILE` writes it to FILE.
+    #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true, default_missing_value = "-")]
+    json: Option<PathBuf>,
+}
+
+/// Parses `dst`, `bvh2`, `bvh4` or `bvh8`.
+pub fn parse_tree_kind(s: &str) -> Result<TreeKind, String> {
+    TreeKind::parse(s).ok_or_else(|| format!("unknown structure `{s}` (dst, bvh2, bvh4, bvh8)"))
+}
+
+/// What `build` reports, also its JSON form.
+#[derive(serde::Serialize)]
+struct Built<'a> {
+    scene: &'a str,
+    spec: &'a str,
+    triangles: u64,
+    accel: TreeKind,
+    file: String,
+    file_bytes: u64,
+    bvh2_ms: f64,
+    build_ms: f64,
+    save_ms: f64,
+    stats: BuildStats,
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
+    let json = crate::output::JsonOut::from_arg(args.json.as_deref())?;
+    crate::output::check_file(&args.output, "-o")?;
+    let sp = ctx.spinner(format!("loading {}", args.scene));
+    let scene = dualsplit_scene::load(&args.scene)
+        .with_context(|| format!("loading scene {}", args.scene))?;
+    sp.set_message(format!("building {}", args.accel));
+    let t0 = Instant::now();
+    let bvh2 = Bvh2Tree::build(&scene.triangles[..], &BuildConfig::default())
+        .with_context(|| format!("building the BVH2 of {}", args.scene))?;
+    let bvh2_ms = bvh2.stats().build_ms;
+    let tree: AnyTree = match args.accel {
+        TreeKind::Dst => DstTree::from_bvh2(&bvh2, &DstConfig::hardware())?.into(),
+        TreeKind::Bvh2 => bvh2.into_tree().into(),
+        TreeKind::Bvh4 => BvhTree::bvh4_from(&bvh2)?.into(),
+        TreeKind::Bvh8 => BvhTree::bvh8_from(&bvh2)?.into(),
+    };
+    let build_ms = t0.elapsed().as_secs_f64() * 1e3;
+    sp.set_message(format!("saving {}", args.output.display()));
+    let t0 = Instant::now();
+    tree.save(&args.output)?;
+    let save_ms = t0.elapsed().as_secs_f64() * 1e3;
+    sp.finish_and_clear();
+    let file_bytes = std::fs::metadata(&args.output)
+        .with_context(|| format!("reading back {}", args.output.display()))?
+        .len();
+    let out = Built {
+        scene: &scene.name,
+        spec: &scene.spec,
+        triangles: scene.triangles.len() as u64,
+        accel: args.accel,
+        file: args.output.display().to_string(),
+        file_bytes,
+        bvh2_ms,
+        build_ms,
+        save_ms,
+        stats: *tree.stats(),
+    };
+    if let Some(j) = json {
+        j.emit(&serde_json::to_string_pretty(&out)?)?;
+    } else {
+        println!(
+            "{} {}: {} triangles, {} node + {} index bytes, built in {:.1} ms (BVH2 {:.1} ms), \
+             saved {} bytes to {} in {:.1} ms",
+            out.scene,
+            out.accel,
+            out.triangles,
+            out.stats.node_bytes,
+            out.stats.index_bytes,
+            out.build_ms,
+            out.bvh2_ms,
+            out.file_bytes,
+            out.file,
+            out.save_ms
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
