@@ -85,7 +85,8 @@ pub(crate) fn parse_res(s: &str) -> Result<(u32, u32), String> {
 pub(crate) fn load_scene(spec: &str, ctx: &Ctx) -> anyhow::Result<Scene> {
     let sp = ctx.spinner(format!("loading {spec}"));
     let t = Instant::now();
-    let scene = dualsplit_scene::load(spec).with_context(|| format!("loading {spec}"))?;
+    let scene =
+        dualsplit_scene::load_with(spec, &ctx.limits).with_context(|| format!("loading {spec}"))?;
     sp.finish_and_clear();
     println!(
         "scene {}: {} triangles, loaded in {:.2} s",

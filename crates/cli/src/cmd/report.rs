@@ -141,7 +141,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let mut skipped = Vec::new();
     for spec in &specs {
         let sp = ctx.spinner(format!("loading {spec}"));
-        let loaded = dualsplit_scene::load(spec);
+        let loaded = dualsplit_scene::load_with(spec, &ctx.limits);
         sp.finish_and_clear();
         match loaded {
             Ok(s) => scenes.push(s),

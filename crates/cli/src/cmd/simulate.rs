@@ -72,8 +72,12 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     cfg.validate()?;
 
-    let (scene, structures) = super::load_and_build(&args.scene, ctx)?;
+    let scene = super::load(&args.scene, ctx)?;
     let settings = RenderSettings::new(args.res, args.res, workload);
+    // The frame and the camera obey the renderer's limits (the simulator renders the same
+    // image), checked before the structures are built.
+    dualsplit_render::validate(&scene, &settings)?;
+    let structures = super::build(&scene, ctx)?;
 
     // Each run's host time, for the table's `host` line only: a host measurement is never
     // part of a result (the JSON is the same on every machine).
