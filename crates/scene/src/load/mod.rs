@@ -208,6 +208,15 @@ pub fn maybe_gunzip(path: &Path, raw: Vec<u8>) -> Result<Vec<u8>, SceneError> {
     gunzip_within(path, raw, &ByteBudget::new(&Limits::default()))
 }
 
+/// [`maybe_gunzip`] with the output bounded by `limits.max_bytes`.
+pub fn maybe_gunzip_with(
+    path: &Path,
+    raw: Vec<u8>,
+    limits: &Limits,
+) -> Result<Vec<u8>, SceneError> {
+    gunzip_within(path, raw, &ByteBudget::new(limits))
+}
+
 /// [`maybe_gunzip`] with the output bounded by what is left of `budget` (not charged here).
 /// Inflating streams into the output and stops one byte past the budget, so a gzip bomb
 /// costs at most the budget before it is refused.
