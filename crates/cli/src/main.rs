@@ -2,6 +2,7 @@
 //! arguments; this file only parses and dispatches.
 
 mod cmd;
+mod input;
 mod progress;
 
 use clap::{Parser, Subcommand};

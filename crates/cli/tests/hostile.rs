@@ -125,3 +125,36 @@ fn render_states_the_real_limits() {
     );
     fails_with(&out, "at most 65536 samples per pixel");
 }
+
+#[test]
+fn configurations_are_read_only_from_small_regular_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = |config: &str| {
+        dualsplit(
+            &[
+                "simulate",
+                "builtin:cornell",
+                "--res",
+                "4",
+                "--model",
+                "fast",
+                "--config",
+                config,
+            ],
+            dir.path(),
+        )
+    };
+    fails_with(&sim("/dev/zero"), "not a regular file");
+    std::fs::write(dir.path().join("big.toml"), vec![b'#'; 2 << 20]).unwrap();
+    fails_with(&sim("big.toml"), "larger than 1048576 bytes");
+    #[cfg(unix)]
+    {
+        let ok = Command::new("mkfifo")
+            .arg(dir.path().join("pipe.toml"))
+            .status()
+            .unwrap()
+            .success();
+        assert!(ok);
+        fails_with(&sim("pipe.toml"), "not a regular file");
+    }
+}

@@ -61,8 +61,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     let mut cfg = match &args.config {
         Some(p) => {
-            let text =
-                std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            let text = crate::input::read_text(p, crate::input::MAX_CONFIG_BYTES)?;
             SimConfig::from_toml(&text).with_context(|| format!("in {}", p.display()))?
         }
         None => SimConfig::lin2020(),
