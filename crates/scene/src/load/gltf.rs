@@ -307,14 +307,23 @@ fn emit(
             pos.dimensions()
         )));
     }
-    let positions: Vec<Vec3> = read_accessor(&pos, buffers)
-        .map_err(err)?
-        .map(|b| {
-            let f = |i: usize| f32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
-            world.transform_point3(Vec3::new(f(0), f(4), f(8)))
-        })
-        .collect();
-    let indices: Vec<usize> = match prim.indices() {
+    // Positions are read and transformed per index, not all at once: the work of one
+    // instance is its triangle count, however large the accessor it draws from.
+    let positions = read_accessor(&pos, buffers).map_err(err)?;
+    let point = |i: usize| {
+        let b = positions.get(i).ok_or_else(|| {
+            err(format!(
+                "vertex index {i} out of range ({} vertices)",
+                positions.count
+            ))
+        })?;
+        let f = |k: usize| f32::from_le_bytes([b[k], b[k + 1], b[k + 2], b[k + 3]]);
+        Ok(world.transform_point3(Vec3::new(f(0), f(4), f(8))))
+    };
+    let triangle = |t: [usize; 3]| -> Result<Triangle, SceneError> {
+        Ok(Triangle::new(point(t[0])?, point(t[1])?, point(t[2])?))
+    };
+    match prim.indices() {
         Some(acc) => {
             let t = acc.data_type();
             if acc.dimensions() != Dimensions::Scalar
@@ -322,43 +331,67 @@ fn emit(
             {
                 return Err(err(format!("indices must be unsigned SCALAR, found {t:?}")));
             }
-            read_accessor(&acc, buffers)
-                .map_err(err)?
-                .map(|b| match t {
-                    DataType::U8 => b[0] as usize,
-                    DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as usize,
-                    _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
-                })
-                .collect()
+            let indices = read_accessor(&acc, buffers).map_err(err)?;
+            check_multiple_of_3(indices.count).map_err(err)?;
+            let index = |b: &[u8]| match t {
+                DataType::U8 => b[0] as usize,
+                DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as usize,
+                _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
+            };
+            let mut it = indices.iter().map(index);
+            while let (Some(a), Some(b), Some(c)) = (it.next(), it.next(), it.next()) {
+                out.push(triangle([a, b, c])?);
+            }
         }
-        None => (0..positions.len()).collect(),
-    };
-    if !indices.len().is_multiple_of(3) {
-        return Err(err(format!(
-            "{} indices, not a multiple of 3",
-            indices.len()
-        )));
-    }
-    for t in indices.chunks_exact(3) {
-        let get = |i: usize| {
-            positions.get(i).copied().ok_or_else(|| {
-                err(format!(
-                    "vertex index {i} out of range ({} vertices)",
-                    positions.len()
-                ))
-            })
-        };
-        out.push(Triangle::new(get(t[0])?, get(t[1])?, get(t[2])?));
+        None => {
+            check_multiple_of_3(positions.count).map_err(err)?;
+            for k in (0..positions.count).step_by(3) {
+                out.push(triangle([k, k + 1, k + 2])?);
+            }
+        }
     }
     Ok(())
 }
 
-/// The elements of an accessor as byte slices of the element size, bounds-checked against
-/// its buffer view and buffer. Sparse accessors and accessors without a view are rejected.
+/// An error unless `n` vertex indices make whole triangles.
+fn check_multiple_of_3(n: usize) -> Result<(), String> {
+    if n.is_multiple_of(3) {
+        Ok(())
+    } else {
+        Err(format!("{n} indices, not a multiple of 3"))
+    }
+}
+
+/// The elements of an accessor: `count` slices of `size` bytes, `stride` apart in `data`.
+struct Elements<'b> {
+    data: &'b [u8],
+    stride: usize,
+    size: usize,
+    count: usize,
+}
+
+impl<'b> Elements<'b> {
+    /// Element `i`, or `None` past the end.
+    fn get(&self, i: usize) -> Option<&'b [u8]> {
+        if i >= self.count {
+            return None;
+        }
+        self.data.get(i * self.stride..i * self.stride + self.size)
+    }
+
+    /// Every element in order.
+    fn iter(&self) -> impl Iterator<Item = &'b [u8]> + '_ {
+        (0..self.count).filter_map(|i| self.get(i))
+    }
+}
+
+/// The elements of an accessor, bounds-checked against its buffer view and buffer (so every
+/// `get` below `count` succeeds). Sparse accessors and accessors without a view are
+/// rejected.
 fn read_accessor<'b>(
     acc: &gltf::Accessor<'_>,
     buffers: &'b [Cow<'_, [u8]>],
-) -> Result<impl Iterator<Item = &'b [u8]>, String> {
+) -> Result<Elements<'b>, String> {
     if acc.sparse().is_some() {
         return Err(format!(
             "accessor {}: sparse accessors are not supported",
@@ -404,7 +437,12 @@ fn read_accessor<'b>(
                 view_bytes.len()
             )
         })?;
-    Ok((0..count).map(move |i| &data[i * stride..i * stride + size]))
+    Ok(Elements {
+        data,
+        stride,
+        size,
+        count,
+    })
 }
 
 /// The POSITION accessor's element count, 0 without one.
