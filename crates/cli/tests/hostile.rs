@@ -158,3 +158,17 @@ fn configurations_are_read_only_from_small_regular_files() {
         fails_with(&sim("pipe.toml"), "not a regular file");
     }
 }
+
+#[test]
+fn ray_counts_are_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    for cmd in ["check", "stats"] {
+        let out = dualsplit(
+            &[cmd, "builtin:cornell", "--rays", "100000000000"],
+            dir.path(),
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{cmd}: {err}");
+        assert!(err.contains("from 1 to 4194304"), "{cmd}: {err}");
+    }
+}

@@ -16,7 +16,7 @@ pub struct Args {
     /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
     scene: String,
     /// Rays of each kind (primary, shadow, diffuse) to compare.
-    #[arg(long, default_value_t = 20_000)]
+    #[arg(long, default_value_t = 20_000, value_parser = super::rays::parse_count)]
     rays: usize,
 }
 

@@ -32,7 +32,7 @@ pub struct Args {
     #[arg(long)]
     json: bool,
     /// Rays of each kind used for the per-ray comparison of DST variants.
-    #[arg(long, default_value_t = 4096)]
+    #[arg(long, default_value_t = 4096, value_parser = super::rays::parse_count)]
     rays: usize,
 }
 
