@@ -118,6 +118,13 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if res == 0 {
         anyhow::bail!("--res must be positive");
     }
+    // The simulated frames obey the renderer's frame limit.
+    if u64::from(res) * u64::from(res) > dualsplit_render::MAX_PIXELS {
+        anyhow::bail!(
+            "--res {res}: at most {} pixels in a frame (--res 16384)",
+            dualsplit_render::MAX_PIXELS
+        );
+    }
     let user_scenes = !args.scenes.is_empty();
     let specs: Vec<String> = if user_scenes {
         args.scenes.clone()
