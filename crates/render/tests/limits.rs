@@ -39,7 +39,7 @@ fn frames_at_the_limits_pass() {
 
 #[test]
 fn frames_past_the_limits_are_refused_with_the_limit() {
-    // 65535 × 65535 passed the old per-side check and needed about 34 GB.
+    // 65535 × 65535 is within the per-side limit but would need about 34 GB.
     refused(check(65535, 65535, 1, 5), &MAX_PIXELS.to_string());
     // 65536 × 65536 is within the per-side limit: the pixel count refuses it.
     refused(check(65536, 65536, 1, 5), &MAX_PIXELS.to_string());

@@ -14,7 +14,7 @@
 //! bytes, so it covers both. [`Cache::get`] returns a value
 //! only when the header's key equals the key asked for (not only its hash in the file
 //! name) and the checksum matches; anything else (a hand edit, a truncated or corrupt
-//! file, an old layout, a file that is not a regular file or is larger than
+//! file, a value without a header, a file that is not a regular file or is larger than
 //! [`MAX_ENTRY_BYTES`]) counts as missing, so the piece is recomputed, never shown.
 //!
 //! Floats are written in their shortest round-trip form and read back exactly (serde_json's
@@ -221,14 +221,14 @@ mod tests {
         let mut other = key.clone();
         other.config = "{\"tms\":1}".into();
         assert_eq!(decode::<Vec<f64>>(&other, &good), None);
-        // A header whose key was edited, with the old checksum: the checksum covers the key.
+        // A header whose key was edited, keeping its checksum: the checksum covers the key.
         let forged = text.replace("\"dst\"", "\"bvh2\"");
         assert_ne!(forged, text);
         let mut bvh2 = key.clone();
         bvh2.structure = "bvh2".into();
         assert_eq!(decode::<Vec<f64>>(&bvh2, forged.as_bytes()), None);
         assert_eq!(decode::<Vec<f64>>(&key, forged.as_bytes()), None);
-        // Truncations and the old layout (bare JSON).
+        // Truncations, and a bare JSON value without a header.
         for n in 0..good.len() {
             assert_eq!(decode::<Vec<f64>>(&key, &good[..n]), None);
         }
