@@ -3,6 +3,7 @@
 
 mod args;
 mod cmd;
+mod input;
 mod lists;
 mod output;
 mod progress;
@@ -16,6 +17,16 @@ struct Cli {
     /// Hide progress bars.
     #[arg(long, short, global = true)]
     quiet: bool,
+    /// Most triangles a scene may have, after triangulating polygons and instancing glTF
+    /// meshes (see docs/robustness.md).
+    #[arg(long, global = true, value_name = "N",
+          default_value_t = dualsplit_scene::Limits::DEFAULT_MAX_TRIANGLES)]
+    max_triangles: u64,
+    /// Most bytes of scene file content a load may hold: the file after inflating it, plus
+    /// its glTF buffers (see docs/robustness.md).
+    #[arg(long, global = true, value_name = "BYTES",
+          default_value_t = dualsplit_scene::Limits::DEFAULT_MAX_BYTES)]
+    max_scene_bytes: u64,
     #[command(subcommand)]
     command: Command,
 }
@@ -63,7 +74,11 @@ fn main() -> std::process::ExitCode {
         }
     }
     let cli = Cli::parse();
-    let ctx = progress::Ctx::new(cli.quiet);
+    let mut ctx = progress::Ctx::new(cli.quiet);
+    ctx.limits = dualsplit_scene::Limits {
+        max_triangles: cli.max_triangles,
+        max_bytes: cli.max_scene_bytes,
+    };
     let result = match cli.command {
         Command::Info(a) => cmd::info::run(a, &ctx),
         Command::Build(a) => cmd::build::run(a, &ctx),

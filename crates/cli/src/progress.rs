@@ -3,17 +3,20 @@
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 
-/// Output policy shared by every subcommand.
+/// Output policy and scene budgets shared by every subcommand.
 pub struct Ctx {
     /// Draw progress bars.
     pub show_progress: bool,
+    /// The budgets every scene is loaded within (`--max-triangles`, `--max-scene-bytes`).
+    pub limits: dualsplit_scene::Limits,
 }
 
 impl Ctx {
-    /// Progress is shown unless `quiet` or stderr is not a terminal.
+    /// Progress is shown unless `quiet` or stderr is not a terminal; default scene budgets.
     pub fn new(quiet: bool) -> Self {
         Self {
             show_progress: !quiet && std::io::stderr().is_terminal(),
+            limits: dualsplit_scene::Limits::default(),
         }
     }
 

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 /// Everything that can go wrong while rendering, writing an image or measuring throughput.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
-    /// Width, height or samples per pixel is zero, or the frame is too large.
+    /// Width, height or samples per pixel is zero, or the frame breaks a limit of
+    /// [`validate`](crate::validate).
     #[error("invalid render settings: {width}x{height} at {spp} spp ({reason})")]
     Settings {
         /// Width in pixels.
@@ -14,8 +15,8 @@ pub enum RenderError {
         height: u32,
         /// Samples per pixel.
         spp: u32,
-        /// What is wrong.
-        reason: &'static str,
+        /// What is wrong, with the limit it breaks.
+        reason: String,
     },
     /// The camera cannot form a view basis (eye on target, view parallel to up, bad field of
     /// view, non-finite values).

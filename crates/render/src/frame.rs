@@ -28,25 +28,65 @@ pub fn tile_count(settings: &RenderSettings) -> u64 {
     settings.width.div_ceil(TILE) as u64 * settings.height.div_ceil(TILE) as u64
 }
 
-/// Checks the settings, the scene's camera and its light; every renderer entry point calls it.
+/// Most pixels per side of a frame.
+pub const MAX_SIDE: u32 = 1 << 16;
+
+/// Most pixels in a frame: 2^28 (16384 × 16384). [`render`] holds about 9 bytes per pixel
+/// at once (the tiles' values, the image, its 8-bit encoding), so a frame at the limit needs
+/// about 2.4 GB.
+pub const MAX_PIXELS: u64 = 1 << 28;
+
+/// Most samples per pixel.
+pub const MAX_SPP: u32 = 1 << 16;
+
+/// Most samples in a frame (pixels × samples per pixel): 2^36, a 1024 × 1024 frame at
+/// [`MAX_SPP`]. Beyond it a frame takes days; the bound also keeps every per-frame counter
+/// far from overflowing.
+pub const MAX_SAMPLES: u64 = 1 << 36;
+
+/// Most diffuse bounces of the path workload.
+pub const MAX_BOUNCES: u32 = 1 << 10;
+
+/// Checks the settings, the scene's camera and its light; every renderer entry point calls
+/// it. The limits are [`MAX_SIDE`], [`MAX_PIXELS`], [`MAX_SPP`], [`MAX_SAMPLES`] and
+/// [`MAX_BOUNCES`]; an error says which one and its value.
 pub fn validate(scene: &Scene, settings: &RenderSettings) -> Result<(), RenderError> {
-    let bad = |reason| RenderError::Settings {
+    let bad = |reason: String| RenderError::Settings {
         width: settings.width,
         height: settings.height,
         spp: settings.spp,
         reason,
     };
     if settings.width == 0 || settings.height == 0 {
-        return Err(bad("the image has no pixel"));
+        return Err(bad("the image has no pixel".into()));
     }
     if settings.spp == 0 {
-        return Err(bad("at least one sample per pixel is needed"));
+        return Err(bad("at least one sample per pixel is needed".into()));
     }
-    if settings.width.checked_mul(settings.height).is_none()
-        || settings.width > 1 << 16
-        || settings.height > 1 << 16
-    {
-        return Err(bad("at most 65536 pixels per side"));
+    if settings.width > MAX_SIDE || settings.height > MAX_SIDE {
+        return Err(bad(format!("at most {MAX_SIDE} pixels per side")));
+    }
+    let pixels = u64::from(settings.width) * u64::from(settings.height);
+    if pixels > MAX_PIXELS {
+        return Err(bad(format!(
+            "{pixels} pixels; at most {MAX_PIXELS} (16384x16384) in a frame, \
+             whose buffers take about 2.4 GB"
+        )));
+    }
+    if settings.spp > MAX_SPP {
+        return Err(bad(format!("at most {MAX_SPP} samples per pixel")));
+    }
+    if pixels * u64::from(settings.spp) > MAX_SAMPLES {
+        return Err(bad(format!(
+            "{} samples; at most {MAX_SAMPLES} (pixels x samples per pixel) in a frame",
+            pixels * u64::from(settings.spp)
+        )));
+    }
+    if settings.bounces > MAX_BOUNCES {
+        return Err(bad(format!(
+            "{} bounces; at most {MAX_BOUNCES}",
+            settings.bounces
+        )));
     }
     let c = &scene.camera;
     let cam_err = |reason| RenderError::Camera {

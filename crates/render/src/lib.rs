@@ -59,7 +59,10 @@ mod trace;
 pub use counts::{KindCounts, RayCounts};
 pub use dualsplit_accel::AccelKind;
 pub use error::RenderError;
-pub use frame::{Frame, TILE, render, render_records, tile_count, validate};
+pub use frame::{
+    Frame, MAX_BOUNCES, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, MAX_SPP, TILE, render, render_records,
+    tile_count, validate,
+};
 pub use image::{Image, ImageFormat, srgb_encode};
 pub use job::{
     ALBEDO, AMBIENT, FrameConstants, PixelJob, RayKind, RayQuery, RenderSettings, SKY, TraceResult,

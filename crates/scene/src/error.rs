@@ -34,6 +34,37 @@ pub enum SceneError {
         /// The spec.
         spec: String,
     },
+    /// A budget of [`Limits`](crate::Limits) would be exceeded.
+    #[error("{path}: more than {limit} {} (the limit; raise it with {})", what.unit(), what.flag())]
+    Limit {
+        /// The file or spec.
+        path: String,
+        /// Which budget.
+        what: crate::limits::Budget,
+        /// The budget.
+        limit: u64,
+    },
+    /// The path names something other than a regular file (a directory, a device, a pipe,
+    /// a socket), which is never read: it could block or never end.
+    #[error("{path}: not a regular file ({kind}); only regular files are read")]
+    NotAFile {
+        /// The file.
+        path: PathBuf,
+        /// What it is instead.
+        kind: &'static str,
+    },
+    /// A glTF buffer URI that is not a relative path inside the scene file's folder.
+    #[error("{path}: buffer {buffer} URI `{uri}`: {reason}")]
+    ExternalUri {
+        /// The glTF file.
+        path: PathBuf,
+        /// The buffer's index.
+        buffer: usize,
+        /// The URI as written in the file.
+        uri: String,
+        /// Why it is refused.
+        reason: String,
+    },
     /// A builtin name or parameter is wrong.
     #[error("builtin scene `{spec}`: {message}")]
     Builtin {

@@ -10,6 +10,12 @@
 //! assert!(scene.triangles.len() > 0);
 //! ```
 //!
+//! ## Budgets
+//!
+//! Scene files are untrusted: every load works within a [`Limits`] (a triangle budget and
+//! a byte budget, see [`limits`]), and only regular files are read. [`load`] uses the
+//! defaults; [`load_with`] takes others.
+//!
 //! ## Degenerate and non-finite triangles
 //!
 //! One rule everywhere: triangles with a non-finite coordinate (NaN or ±∞) are **dropped**
@@ -26,10 +32,12 @@
 pub mod builtin;
 mod camera;
 mod error;
+pub mod limits;
 pub mod load;
 
 pub use camera::{Camera, CameraError, Light, parse_vec3};
 pub use error::SceneError;
+pub use limits::Limits;
 
 use dualsplit_geometry::{Aabb, Triangle};
 
@@ -143,13 +151,19 @@ impl Scene {
     }
 }
 
-/// Loads a scene from a spec: a file path or `builtin:NAME?params`.
+/// Loads a scene from a spec: a file path or `builtin:NAME?params`, within the default
+/// [`Limits`].
 pub fn load(spec: &str) -> Result<Scene, SceneError> {
+    load_with(spec, &Limits::default())
+}
+
+/// [`load`] within `limits` (see [`limits`]).
+pub fn load_with(spec: &str, limits: &Limits) -> Result<Scene, SceneError> {
     if let Some(rest) = spec.strip_prefix("builtin:") {
-        builtin::generate(rest)
+        builtin::generate_with(rest, limits)
     } else {
         let path = std::path::Path::new(spec);
-        let mut scene = load::load_file(path)?;
+        let mut scene = load::load_file_with(path, limits)?;
         let stem = file_stem(path);
         scene.camera = Camera::preset_for(stem, &scene.bounds);
         scene.light = Light::preset_for(stem, &scene.bounds);

@@ -221,9 +221,18 @@ fn ply_garbage_after_header() {
 
 #[test]
 fn non_finite_vertices_are_dropped_and_counted() {
-    // ASCII PLY has no spelling for NaN: ply-rs-bw rejects the token, with its line.
-    let text = format!("{PLY_HEAD}0 0 0\n1 0 0\nnan 0 0\n3 0 1 2\n");
-    expect_parse(&fail("nan.ply", text.as_bytes()), Some(12), "nan");
+    // ASCII PLY: `nan`, `inf` and `-Infinity` are read and follow the same rule.
+    let head = PLY_HEAD
+        .replace("vertex 3", "vertex 6")
+        .replace("face 1", "face 4");
+    let text = format!(
+        "{head}0 0 0\n1 0 0\n0 1 0\nnan 0 0\n0 inf 0\n0 0 -Infinity\n\
+         3 0 1 2\n3 0 3 2\n3 4 1 2\n3 5 1 0\n"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let s = load::load_file(&write(dir.path(), "nan.ply", text.as_bytes())).unwrap();
+    assert_eq!(s.stats.source_triangles, 4);
+    assert_eq!((s.stats.non_finite, s.triangles.len()), (3, 1));
     // Binary PLY: vertices 3 (NaN) and 4 (inf); faces 1 and 2 use them.
     let mut b = bin_header("5", "4").into_bytes();
     for c in [
@@ -251,7 +260,6 @@ fn non_finite_vertices_are_dropped_and_counted() {
             b.extend_from_slice(&i.to_le_bytes());
         }
     }
-    let dir = tempfile::tempdir().unwrap();
     let s = load::load_file(&write(dir.path(), "nan.ply", &b)).unwrap();
     assert_eq!(s.stats.source_triangles, 4);
     assert_eq!(s.stats.non_finite, 2);

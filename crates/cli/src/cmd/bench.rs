@@ -70,6 +70,11 @@ pub struct Args {
     json: Option<std::path::PathBuf>,
 }
 
+/// Most pixels in a benchmark frame: 2^24 (4096 × 4096). The ray sets hold every ray of the
+/// frame with BVH2's answer, about 450 bytes per pixel on the path workload (peak RSS of
+/// `bench builtin:cornell --res 1024 --accel bvh2`: 459 MB), so about 7.5 GB at the limit.
+pub const MAX_BENCH_PIXELS: u64 = 1 << 24;
+
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if args.peer == Some(Peer::Embree) && !dualsplit_embree::available() {
@@ -113,6 +118,15 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         ..RenderSettings::new(args.res.0, args.res.1, args.workload)
     };
     dualsplit_render::validate(&scene, &settings)?;
+    let pixels = u64::from(settings.width) * u64::from(settings.height);
+    if pixels > MAX_BENCH_PIXELS {
+        anyhow::bail!(
+            "--res {}x{}: {pixels} pixels; bench holds every ray of its frame (about 450 bytes \
+             per pixel), so at most {MAX_BENCH_PIXELS} (4096x4096)",
+            settings.width,
+            settings.height
+        );
+    }
     let structures = build_structures(&scene, ctx, json.is_some())?;
     let sp = ctx.spinner("generating rays on bvh2");
     let t = Instant::now();

@@ -18,7 +18,7 @@ pub struct Args {
     #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
     /// Rays of each kind (primary, shadow, diffuse) to compare.
-    #[arg(long, default_value_t = 20_000)]
+    #[arg(long, default_value_t = 20_000, value_parser = super::rays::parse_count)]
     rays: usize,
 }
 

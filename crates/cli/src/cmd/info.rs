@@ -42,7 +42,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let json = crate::output::JsonOut::from_arg(args.json.as_deref())?;
     let spinner = ctx.spinner(format!("loading {}", args.scene));
     let start = std::time::Instant::now();
-    let scene = dualsplit_scene::load(&args.scene);
+    let scene = dualsplit_scene::load_with(&args.scene, &ctx.limits);
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     spinner.finish_and_clear();
     // The error names the file (and line) or the builtin spec already.

@@ -5,6 +5,21 @@ use dualsplit_geometry::Ray;
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
 use rayon::prelude::*;
 
+/// Most rays of each kind `--rays` may ask for: 2^22. Recording holds each pass's rays of
+/// every pixel, then the three sets: peak RSS of `stats builtin:cornell --rays 1000000` is
+/// 657 MB, so about 2.7 GB at the limit.
+pub const MAX_RAYS: usize = 1 << 22;
+
+/// Parses a `--rays` count: 1 to [`MAX_RAYS`].
+pub fn parse_count(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if (1..=MAX_RAYS).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "`{s}` is not a ray count from 1 to {MAX_RAYS} (the limit of recorded rays)"
+        )),
+    }
+}
+
 /// Records `n` rays of each kind (primary, shadow, diffuse) from path-traced pixel jobs
 /// (5 bounces), driven by the BVH2's answers; more passes with new seeds until each kind has
 /// `n` rays (at most 64 passes: a scene the camera barely sees yields fewer).

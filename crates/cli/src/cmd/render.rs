@@ -47,7 +47,8 @@ pub struct Args {
 pub(crate) fn load_scene(spec: &str, ctx: &Ctx, stdout_is_data: bool) -> anyhow::Result<Scene> {
     let sp = ctx.spinner(format!("loading {spec}"));
     let t = Instant::now();
-    let scene = dualsplit_scene::load(spec).with_context(|| format!("loading {spec}"))?;
+    let scene =
+        dualsplit_scene::load_with(spec, &ctx.limits).with_context(|| format!("loading {spec}"))?;
     sp.finish_and_clear();
     let line = format!(
         "scene {}: {} triangles, loaded in {:.2} s",

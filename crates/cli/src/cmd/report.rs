@@ -137,6 +137,13 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if res == 0 {
         anyhow::bail!("--res must be positive");
     }
+    // The simulated frames obey the renderer's frame limit.
+    if u64::from(res) * u64::from(res) > dualsplit_render::MAX_PIXELS {
+        anyhow::bail!(
+            "--res {res}: at most {} pixels in a frame (--res 16384)",
+            dualsplit_render::MAX_PIXELS
+        );
+    }
     let user_scenes = !args.specs.is_empty();
     let specs = resolve_specs(&args.specs, args.full, &scene_files);
     let mut tms = args.tms.clone();
@@ -169,7 +176,7 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let mut skipped = Vec::new();
     for spec in &specs {
         let sp = ctx.spinner(format!("loading {spec}"));
-        let loaded = dualsplit_scene::load(spec);
+        let loaded = dualsplit_scene::load_with(spec, &ctx.limits);
         sp.finish_and_clear();
         match loaded {
             Ok(s) => scenes.push(s),

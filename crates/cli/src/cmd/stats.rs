@@ -34,7 +34,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true, default_missing_value = "-")]
     json: Option<std::path::PathBuf>,
     /// Rays of each kind used for the per-ray comparison of DST variants.
-    #[arg(long, default_value_t = 4096)]
+    #[arg(long, default_value_t = 4096, value_parser = super::rays::parse_count)]
     rays: usize,
 }
 

@@ -39,7 +39,7 @@ pub use cornell::CornellParams;
 pub use forest::ForestParams;
 pub use hairball::HairballParams;
 
-use crate::{LoadStats, Scene, SceneError};
+use crate::{Limits, LoadStats, Scene, SceneError};
 use std::str::FromStr;
 
 /// Names of the builtin scenes, in documentation order.
@@ -54,22 +54,33 @@ pub const NAMES: [&str; 4] = ["hairball", "forest", "atrium", "cornell"];
 /// assert!(dualsplit_scene::builtin::generate("teapot").is_err());
 /// ```
 pub fn generate(spec: &str) -> Result<Scene, SceneError> {
+    generate_with(spec, &Limits::default())
+}
+
+/// [`generate`] within `limits`: a `triangles=N` target above
+/// [`Limits::max_triangles`] is refused before anything is generated, and so is a result
+/// that lands above it.
+pub fn generate_with(spec: &str, limits: &Limits) -> Result<Scene, SceneError> {
     let mut p = Params::parse(spec)?;
     let name = p.name.clone();
+    let what = format!("builtin:{spec}");
     let (triangles, camera, light) = match name.as_str() {
         "hairball" => {
             let s = HairballParams::from_params(&mut p)?;
             p.finish()?;
+            limits.check_triangles(&what, u64::from(s.triangles))?;
             (s.triangles(), s.camera(), s.light())
         }
         "forest" => {
             let s = ForestParams::from_params(&mut p)?;
             p.finish()?;
+            limits.check_triangles(&what, u64::from(s.triangles))?;
             (s.triangles(), s.camera(), s.light())
         }
         "atrium" => {
             let s = AtriumParams::from_params(&mut p)?;
             p.finish()?;
+            limits.check_triangles(&what, u64::from(s.triangles))?;
             (s.triangles(), s.camera(), s.light())
         }
         "cornell" => {
@@ -84,12 +95,8 @@ pub fn generate(spec: &str) -> Result<Scene, SceneError> {
             )));
         }
     };
-    let mut scene = Scene::from_triangles(
-        name,
-        format!("builtin:{spec}"),
-        triangles,
-        LoadStats::default(),
-    )?;
+    limits.check_triangles(&what, triangles.len() as u64)?;
+    let mut scene = Scene::from_triangles(name, what, triangles, LoadStats::default())?;
     scene.camera = camera;
     scene.light = light;
     Ok(scene)

@@ -7,7 +7,7 @@
 //! an object ends, so its line is found by a second, light scan ([`locate_bad_index`]).
 
 use super::{Mesh, fan, gather, parse_error};
-use crate::{LoadStats, SceneError};
+use crate::{Limits, LoadStats, SceneError};
 use dualsplit_geometry::Vec3;
 use std::io::BufRead;
 use std::path::Path;
@@ -44,7 +44,7 @@ impl BufRead for LineCounter<'_> {
 }
 
 /// Parses a whole OBJ file (already inflated).
-pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, SceneError> {
+pub(super) fn parse(path: &Path, bytes: &[u8], limits: &Limits) -> Result<Mesh, SceneError> {
     let mut reader = LineCounter {
         inner: bytes,
         newlines: 0,
@@ -104,6 +104,10 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, SceneError> {
             }
         };
         if mesh.face_arities.is_empty() {
+            limits.check_triangles(
+                &path.display(),
+                (faces.len() + mesh.indices.len() / 3) as u64,
+            )?;
             for t in mesh.indices.chunks_exact(3) {
                 faces.push([to_global(t[0])?, to_global(t[1])?, to_global(t[2])?]);
             }
@@ -117,7 +121,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, SceneError> {
                     poly.push(to_global(i)?);
                 }
                 if poly.len() >= 3 {
-                    fan(&poly, &mut faces, &mut stats);
+                    fan(path, limits, &poly, &mut faces, &mut stats)?;
                 }
                 start = end;
             }

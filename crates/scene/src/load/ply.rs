@@ -1,5 +1,7 @@
-//! PLY: header and ASCII body through `ply-rs-bw`, binary bodies (either endianness) through
-//! a small decoder of our own (the speed bar; see `docs/performance.md`).
+//! PLY: the header through `ply-rs-bw`; the ASCII body ([`ascii`]) and binary bodies (either
+//! endianness) through small readers of our own (the binary one for the speed bar, see
+//! `docs/performance.md`; the ASCII one to read `nan` and `inf`, which ply-rs-bw's grammar
+//! refuses).
 //!
 //! What is read: element `vertex` with scalar properties `x`, `y`, `z` (any scalar type, any
 //! position among other properties) and element `face` with a list property
@@ -7,13 +9,13 @@
 //! fan-triangulated in file order. Every other element and property is skipped, wherever it
 //! appears.
 
+mod ascii;
+
 use super::{Mesh, fan, gather, parse_error};
-use crate::{LoadStats, SceneError};
+use crate::{Limits, LoadStats, SceneError};
 use dualsplit_geometry::{Triangle, Vec3};
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
-use ply_rs_bw::ply::{
-    DefaultElement, ElementDef, Encoding, Header, Property, PropertyType, ScalarType,
-};
+use ply_rs_bw::ply::{DefaultElement, ElementDef, Encoding, Header, PropertyType, ScalarType};
 use std::path::Path;
 
 /// Where the loader finds its data in the header.
@@ -27,7 +29,7 @@ struct Schema {
 }
 
 /// Parses a whole PLY file (already inflated).
-pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, SceneError> {
+pub(super) fn parse(path: &Path, bytes: &[u8], limits: &Limits) -> Result<Mesh, SceneError> {
     let parser = Parser::<DefaultElement>::new();
     let mut reader = Reader::new(bytes);
     let header = parser
@@ -36,14 +38,11 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, SceneError> {
     // ply-rs-bw's reader is now on the first body line (1-based).
     let first_body_line = reader.line() as u64;
     let schema = schema(path, &header)?;
+    let body = reader.into_inner();
     match header.encoding {
-        Encoding::Ascii => parse_ascii(path, &parser, reader, &header, &schema, first_body_line),
-        Encoding::BinaryLittleEndian => {
-            parse_binary(path, reader.into_inner(), &header, &schema, false)
-        }
-        Encoding::BinaryBigEndian => {
-            parse_binary(path, reader.into_inner(), &header, &schema, true)
-        }
+        Encoding::Ascii => ascii::parse(path, body, &header, &schema, first_body_line, limits),
+        Encoding::BinaryLittleEndian => parse_binary(path, body, &header, &schema, false, limits),
+        Encoding::BinaryBigEndian => parse_binary(path, body, &header, &schema, true, limits),
     }
 }
 
@@ -166,101 +165,6 @@ fn short_face(path: &Path, line: Option<u64>, face: usize, n: usize) -> SceneErr
         line,
         format!("face {face} has {n} vertices; a polygon needs at least 3"),
     )
-}
-
-// ---------------------------------------------------------------------------------------
-// ASCII
-// ---------------------------------------------------------------------------------------
-
-/// The ASCII body through ply-rs-bw's `DefaultElement`.
-fn parse_ascii(
-    path: &Path,
-    parser: &Parser<DefaultElement>,
-    mut reader: Reader<&[u8]>,
-    header: &Header,
-    schema: &Schema,
-    first_body_line: u64,
-) -> Result<Mesh, SceneError> {
-    let mut positions = Vec::new();
-    let mut faces = Vec::new();
-    let mut stats = LoadStats::default();
-    // Each element record takes one line.
-    let mut first_line = first_body_line;
-    for (name, def) in &header.elements {
-        let elems = parser
-            .read_payload_for_element(&mut reader, def, header)
-            .map_err(|e| ply_error(path, &e))?;
-        if name == "vertex" {
-            positions.reserve(elems.len());
-            for (i, e) in elems.iter().enumerate() {
-                let mut p = [0.0f32; 3];
-                for (c, &k) in p.iter_mut().zip(&schema.xyz) {
-                    *c = e.get_index(k).and_then(|(_, v)| scalar(v)).ok_or_else(|| {
-                        parse_error(
-                            path,
-                            Some(first_line + i as u64),
-                            "missing vertex coordinate",
-                        )
-                    })? as f32;
-                }
-                positions.push(Vec3::from_array(p));
-            }
-        } else if name == "face" {
-            faces.reserve(elems.len());
-            let mut poly = Vec::new();
-            for (i, e) in elems.iter().enumerate() {
-                let line = Some(first_line + i as u64);
-                let list = e.get_index(schema.face_list).map(|(_, v)| v);
-                poly.clear();
-                for x in list.map(list_values).unwrap_or_default() {
-                    poly.push(check_index(path, line, i, x, schema.vertex_count)?);
-                }
-                if poly.len() < 3 {
-                    return Err(short_face(path, line, i, poly.len()));
-                }
-                fan(&poly, &mut faces, &mut stats);
-            }
-        }
-        first_line += def.count as u64;
-    }
-    stats.source_triangles = faces.len() as u64;
-    Ok(Mesh {
-        triangles: gather(&positions, &faces),
-        stats,
-    })
-}
-
-/// A scalar property as `f64`.
-fn scalar(p: &Property) -> Option<f64> {
-    Some(match *p {
-        Property::Char(v) => v.into(),
-        Property::UChar(v) => v.into(),
-        Property::Short(v) => v.into(),
-        Property::UShort(v) => v.into(),
-        Property::Int(v) => v.into(),
-        Property::UInt(v) => v.into(),
-        Property::Float(v) => v.into(),
-        Property::Double(v) => v,
-        _ => return None,
-    })
-}
-
-/// The values of a list property as `f64`.
-fn list_values(p: &Property) -> Vec<f64> {
-    fn conv<T: Copy + Into<f64>>(v: &[T]) -> Vec<f64> {
-        v.iter().map(|&x| x.into()).collect()
-    }
-    match p {
-        Property::ListChar(v) => conv(v),
-        Property::ListUChar(v) => conv(v),
-        Property::ListShort(v) => conv(v),
-        Property::ListUShort(v) => conv(v),
-        Property::ListInt(v) => conv(v),
-        Property::ListUInt(v) => conv(v),
-        Property::ListFloat(v) => conv(v),
-        Property::ListDouble(v) => v.clone(),
-        _ => Vec::new(),
-    }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -402,6 +306,7 @@ fn parse_binary(
     header: &Header,
     schema: &Schema,
     big_endian: bool,
+    limits: &Limits,
 ) -> Result<Mesh, SceneError> {
     let mut cur = Cursor {
         bytes: body,
@@ -421,6 +326,8 @@ fn parse_binary(
         if name == "vertex" {
             positions = read_vertices(path, &mut cur, def, schema)?;
         } else if name == "face" {
+            // Every record is a polygon of at least one triangle, or an error.
+            limits.check_triangles(&path.display(), def.count as u64)?;
             // The fast path builds triangles straight from the records, so it needs the
             // positions first (the usual order: vertices before faces).
             let fast = match props(def)[..] {
@@ -433,7 +340,7 @@ fn parse_binary(
             };
             match fast {
                 Some(t) => triangles = t,
-                None => read_faces(path, &mut cur, def, schema, &mut faces, &mut stats)?,
+                None => read_faces(path, &mut cur, def, schema, limits, &mut faces, &mut stats)?,
             }
         } else if fixed {
             cur.pos += need;
@@ -580,13 +487,14 @@ fn read_faces(
     cur: &mut Cursor<'_>,
     def: &ElementDef,
     schema: &Schema,
+    limits: &Limits,
     faces: &mut Vec<[u32; 3]>,
     stats: &mut LoadStats,
 ) -> Result<(), SceneError> {
     let props = props(def);
     // Most files have triangles only, so one triangle per record is a good guess (the count
     // was checked against the bytes present).
-    faces.reserve(def.count);
+    faces.reserve(def.count.min(limits.max_triangles as usize));
     let mut poly: Vec<u32> = Vec::with_capacity(16);
     for i in 0..def.count {
         for (k, &t) in props.iter().enumerate() {
@@ -598,13 +506,10 @@ fn read_faces(
                         let x = cur.scalar(it).ok_or_else(|| cut(path, def, i))?;
                         poly.push(check_index(path, None, i, x, schema.vertex_count)?);
                     }
-                    if n == 3 {
-                        faces.push([poly[0], poly[1], poly[2]]);
-                    } else if n < 3 {
+                    if n < 3 {
                         return Err(short_face(path, None, i, n));
-                    } else {
-                        fan(&poly, faces, stats);
                     }
+                    fan(path, limits, &poly, faces, stats)?;
                 }
                 _ => skip_property(path, cur, def, i, t)?,
             }

@@ -86,8 +86,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let (workload, model) = (args.workload, args.model);
     let mut cfg = match &args.config {
         Some(p) => {
-            let text =
-                std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            let text = crate::input::read_text(p, crate::input::MAX_CONFIG_BYTES)?;
             SimConfig::from_toml(&text).with_context(|| format!("in {}", p.display()))?
         }
         None => SimConfig::lin2020(),
@@ -97,12 +96,11 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     cfg.validate()?;
 
-    let sp = ctx.spinner(format!("loading {}", args.scene));
-    let mut scene = dualsplit_scene::load(&args.scene)
-        .with_context(|| format!("loading scene {}", args.scene))?;
-    sp.finish_and_clear();
+    let mut scene = super::load(&args.scene, ctx)?;
     args.view.apply(&mut scene)?;
     let settings = RenderSettings::new(args.res.0, args.res.1, workload);
+    // The frame and the camera obey the renderer's limits (the simulator renders the same
+    // image), checked before the structures are built.
     dualsplit_render::validate(&scene, &settings)?;
     let sp = ctx.spinner("building BVH2, BVH4, BVH8, DST");
     let structures = Structures::try_build(&scene.triangles, &BuildConfig::default())

@@ -1,0 +1,174 @@
+//! Hostile input through the command line: each reproducer ends in a clear error (exit 1,
+//! a message naming what is wrong and the limit) instead of a read outside the scene's
+//! folder, an abort or a hang.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn dualsplit(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_dualsplit"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the binary runs")
+}
+
+/// Expects exit status 1 and `needle` in stderr.
+fn fails_with(out: &Output, needle: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "stderr: {err}");
+    assert!(err.contains(needle), "`{err}` lacks `{needle}`");
+}
+
+#[test]
+fn gltf_buffers_outside_the_folder_are_not_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = r#"{"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+      "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+      "buffers":[{"uri":"../../../../etc/passwd","byteLength":36}],
+      "bufferViews":[{"buffer":0,"byteLength":36}],
+      "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+        "min":[0,0,0],"max":[1,1,0]}]}"#;
+    std::fs::write(dir.path().join("p.gltf"), json).unwrap();
+    let out = dualsplit(&["info", "--json", "p.gltf"], dir.path());
+    fails_with(&out, "../../../../etc/passwd");
+    assert!(out.stdout.is_empty());
+    let zero = json.replace("../../../../etc/passwd", "/dev/zero");
+    std::fs::write(dir.path().join("z.gltf"), zero).unwrap();
+    fails_with(&dualsplit(&["info", "z.gltf"], dir.path()), "/dev/zero");
+}
+
+#[test]
+fn scene_budgets_are_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = "builtin:hairball?triangles=5000";
+    let out = dualsplit(&["info", spec, "--max-triangles", "1000"], dir.path());
+    fails_with(&out, "more than 1000 triangles");
+    fails_with(&out, "--max-triangles");
+    let out = dualsplit(&["info", spec, "--max-triangles", "10000"], dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::write(
+        dir.path().join("t.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let out = dualsplit(&["info", "t.obj", "--max-scene-bytes", "10"], dir.path());
+    fails_with(&out, "--max-scene-bytes");
+}
+
+#[test]
+fn simulate_obeys_the_renderer_limits() {
+    let dir = tempfile::tempdir().unwrap();
+    // Coordinates near 1e38 put the fitted camera at infinity: render refuses it, and so
+    // must simulate.
+    std::fs::write(
+        dir.path().join("big.obj"),
+        "v 1e38 1e38 1e38\nv -1e38 -1e38 -1e38\nv 1e38 -1e38 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let args = ["big.obj", "--res", "8", "--workload", "cast"];
+    let render = [&["render"][..], &args, &["-o", "x.png"]].concat();
+    fails_with(&dualsplit(&render, dir.path()), "invalid camera");
+    let simulate = [&["simulate"][..], &args, &["--model", "fast"]].concat();
+    fails_with(&dualsplit(&simulate, dir.path()), "invalid camera");
+    // A frame far beyond the pixel limit is refused before anything is built or allocated.
+    let out = dualsplit(
+        &[
+            "simulate",
+            "builtin:cornell",
+            "--res",
+            "100000",
+            "--model",
+            "fast",
+        ],
+        dir.path(),
+    );
+    fails_with(&out, "pixels per side");
+    let out = dualsplit(
+        &[
+            "simulate",
+            "builtin:cornell",
+            "--res",
+            "20000",
+            "--model",
+            "fast",
+        ],
+        dir.path(),
+    );
+    fails_with(&out, "268435456");
+}
+
+#[test]
+fn render_states_the_real_limits() {
+    let dir = tempfile::tempdir().unwrap();
+    for res in ["65535x65535", "65536x65536"] {
+        let out = dualsplit(
+            &["render", "builtin:cornell", "--res", res, "-o", "x.png"],
+            dir.path(),
+        );
+        fails_with(&out, "at most 268435456 (16384x16384) in a frame");
+    }
+    let out = dualsplit(
+        &[
+            "render",
+            "builtin:cornell",
+            "--spp",
+            "4000000000",
+            "-o",
+            "x.png",
+        ],
+        dir.path(),
+    );
+    fails_with(&out, "at most 65536 samples per pixel");
+}
+
+#[test]
+fn configurations_are_read_only_from_small_regular_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = |config: &str| {
+        dualsplit(
+            &[
+                "simulate",
+                "builtin:cornell",
+                "--res",
+                "4",
+                "--model",
+                "fast",
+                "--config",
+                config,
+            ],
+            dir.path(),
+        )
+    };
+    fails_with(&sim("/dev/zero"), "not a regular file");
+    std::fs::write(dir.path().join("big.toml"), vec![b'#'; 2 << 20]).unwrap();
+    fails_with(&sim("big.toml"), "larger than 1048576 bytes");
+    #[cfg(unix)]
+    {
+        let ok = Command::new("mkfifo")
+            .arg(dir.path().join("pipe.toml"))
+            .status()
+            .unwrap()
+            .success();
+        assert!(ok);
+        fails_with(&sim("pipe.toml"), "not a regular file");
+    }
+}
+
+#[test]
+fn ray_counts_are_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    for cmd in ["check", "stats"] {
+        let out = dualsplit(
+            &[cmd, "builtin:cornell", "--rays", "100000000000"],
+            dir.path(),
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{cmd}: {err}");
+        assert!(err.contains("from 1 to 4194304"), "{cmd}: {err}");
+    }
+}
