@@ -53,11 +53,11 @@ pub const SIM_RAYS_PER_SECOND_RV32: f64 = 45_000.0;
 #[derive(clap::Args)]
 pub struct Args {
     /// Scenes: files (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
-    /// (hairball, forest, atrium, cornell). Without any: the atrium, forest and hairball
-    /// builtins at reduced sizes.
+    /// (hairball, forest, atrium, cornell). Without any: Dragon Box when the scenes folder
+    /// holds it, and the atrium, forest and hairball builtins at reduced sizes.
     #[arg(value_name = "SCENES", value_parser = crate::args::parse_scene)]
     specs: Vec<String>,
-    /// Square resolution of the simulated frames (default 128, 1024 with --full).
+    /// Square resolution of the simulated frames (default 384, 1024 with --full).
     #[arg(long, value_parser = crate::args::parse_positive)]
     res: Option<u32>,
     /// The paper's setup: 1024×1024, full-size scenes, 32/64/128 TMs.
