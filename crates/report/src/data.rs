@@ -149,7 +149,7 @@ pub struct SimRun {
     pub workload: Workload,
     /// TM count.
     pub tms: u32,
-    /// The result, or "simulator unavailable: <error>".
+    /// The result, or "simulator unavailable: `<error>`".
     #[serde(with = "crate::plain")]
     pub result: Result<SimResult, String>,
 }

@@ -9,7 +9,7 @@
 //!
 //! Structures are built only when some piece of their scene is missing. Simulations run two
 //! at a time (the machine has two cores). A simulator error is recorded in the data as
-//! "simulator unavailable: <error>" and never cached, so it is retried next time.
+//! "simulator unavailable: `<error>`" and never cached, so it is retried next time.
 
 use crate::ReportError;
 use crate::cache::{CODE_VERSION, Cache, CacheKey, SCHEMA};

@@ -13,7 +13,7 @@
 //! ## Budgets
 //!
 //! Scene files are untrusted: every load works within a [`Limits`] (a triangle budget and
-//! a byte budget, see [`limits`]), and only regular files are read. [`load`] uses the
+//! a byte budget, see [`limits`]), and only regular files are read. [`load()`] uses the
 //! defaults; [`load_with`] takes others.
 //!
 //! ## Degenerate and non-finite triangles
@@ -157,7 +157,7 @@ pub fn load(spec: &str) -> Result<Scene, SceneError> {
     load_with(spec, &Limits::default())
 }
 
-/// [`load`] within `limits` (see [`limits`]).
+/// [`load()`] within `limits` (see [`limits`]).
 pub fn load_with(spec: &str, limits: &Limits) -> Result<Scene, SceneError> {
     if let Some(rest) = spec.strip_prefix("builtin:") {
         builtin::generate_with(rest, limits)

@@ -4,7 +4,7 @@
 //! instance one mesh many times or name `/dev/zero` as a buffer. Every loader therefore
 //! works against a [`Limits`]: a maximum number of triangles and a maximum number of bytes
 //! of file content held in memory. Exceeding either is a typed
-//! [`SceneError::Limit`](crate::SceneError::Limit), raised as soon as the loader knows,
+//! [`SceneError::Limit`], raised as soon as the loader knows,
 //! before the memory is spent.
 //!
 //! The defaults are sized for a 24 GiB machine: the largest shipped scene

@@ -93,7 +93,7 @@ pub struct Units<'a> {
     pub placement: &'a Placement,
 }
 
-/// Instructions retired, by [`FuClass`] (indexed by [`crate::rv32::fu_index`]).
+/// Instructions retired, by [`FuClass`] (indexed by [`crate::rv32::run::fu_index`]).
 pub type ClassCounts = [u64; crate::rv32::run::FU_CLASSES];
 
 /// One thread processor.

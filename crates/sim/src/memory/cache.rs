@@ -294,7 +294,7 @@ impl Cache {
     /// a line in flight is `Present` with its future fill cycle (the caller merges).
     ///
     /// A line a direct-mapped cache holds in its way is answered inline
-    /// ([`Cache::find_direct`]); the rest goes through `Cache::lookup_general`.
+    /// (`Cache::find_direct`); the rest goes through `Cache::lookup_general`.
     #[inline]
     pub fn lookup(&mut self, line: u64, now: Cycle) -> Lookup {
         if let Some(fill) = self.find_direct(line) {
