@@ -199,3 +199,32 @@ mod tests {
         assert!(parse_scene("builtin:anything").is_ok());
     }
 }
+
+/// The scope of a study, shared by `report` and `plan`: scenes, frame size, TM counts and
+/// thread model.
+#[derive(clap::Args, Clone, Debug)]
+pub struct Scope {
+    /// Scenes: files (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
+    /// (hairball, forest, atrium, cornell). Without any: Dragon Box when the scenes folder
+    /// holds it, and the atrium, forest and hairball builtins at reduced sizes.
+    #[arg(value_name = "SCENES", value_parser = crate::args::parse_scene)]
+    pub specs: Vec<String>,
+    /// Square resolution of the simulated frames (default 384, 1024 with --full).
+    #[arg(long, value_parser = crate::args::parse_positive)]
+    pub res: Option<u32>,
+    /// The paper's setup: 1024×1024, full-size scenes, 32/64/128 TMs.
+    #[arg(long)]
+    pub full: bool,
+    /// Folder of the shipped meshes (Dragon Box, Dragon Sponza). Default: the
+    /// DUALSPLIT_SCENES environment variable, else shared/scenes beside the checkout.
+    #[arg(long = "scenes", value_name = "DIR")]
+    pub scenes_dir: Option<std::path::PathBuf>,
+    /// TM counts of the scaling study (Table 7); Tables 4–6 use 64 when listed.
+    #[arg(long, value_delimiter = ',', default_value = "32,64,128", value_parser = crate::args::parse_positive)]
+    pub tms: Vec<u32>,
+    /// Thread model: rv32 (the compiled kernels instruction by instruction, the reference)
+    /// or fast (the replay calibrated against them: about 5× faster, within 10 %). Default:
+    /// fast, rv32 with --full.
+    #[arg(long)]
+    pub model: Option<String>,
+}

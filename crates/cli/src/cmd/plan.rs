@@ -21,27 +21,12 @@ use std::process::ExitCode;
 /// Arguments of `dualsplit plan`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scenes, as for `report` (default: the report's default scenes).
-    #[arg(value_name = "SCENES", value_parser = crate::args::parse_scene)]
-    specs: Vec<String>,
-    /// Square resolution of the simulated frames (default as `report`, 1024 with --full).
-    #[arg(long, value_parser = crate::args::parse_positive)]
-    res: Option<u32>,
-    /// The paper's setup: 1024×1024, full-size scenes, 32/64/128 TMs, rv32.
-    #[arg(long)]
-    full: bool,
+    /// What to simulate, as for `report`.
+    #[command(flatten)]
+    scope: crate::args::Scope,
     /// The study's directory: plan.json goes there, results into its cache/.
     #[arg(long)]
     out: PathBuf,
-    /// Folder of the shipped meshes, as for `report`.
-    #[arg(long = "scenes", value_name = "DIR")]
-    scenes_dir: Option<PathBuf>,
-    /// TM counts of the scaling study; the comparison uses 64 when listed.
-    #[arg(long, value_delimiter = ',', default_value = "32,64,128", value_parser = crate::args::parse_positive)]
-    tms: Vec<u32>,
-    /// Thread model: rv32 or fast (default: fast, rv32 with --full).
-    #[arg(long)]
-    model: Option<String>,
     /// Configurations to simulate (default: all eight).
     #[arg(long, value_delimiter = ',', value_parser = parse_sim_accel)]
     accel: Vec<SimAccelArg>,
@@ -78,10 +63,12 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if keys.windows(2).any(|w| w[0] == w[1]) {
         anyhow::bail!("a key is swept by two --vary options; list its values in one");
     }
-    let res = args
-        .res
-        .unwrap_or(if args.full { FULL_RES } else { DEFAULT_RES });
-    let mut tms = args.tms.clone();
+    let res = args.scope.res.unwrap_or(if args.scope.full {
+        FULL_RES
+    } else {
+        DEFAULT_RES
+    });
+    let mut tms = args.scope.tms.clone();
     tms.sort_unstable();
     tms.dedup();
     if tms.is_empty() {
@@ -92,10 +79,11 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     } else {
         tms[tms.len() / 2]
     };
-    let model = args
-        .model
-        .as_deref()
-        .unwrap_or(if args.full { "rv32" } else { "fast" });
+    let model =
+        args.scope
+            .model
+            .as_deref()
+            .unwrap_or(if args.scope.full { "rv32" } else { "fast" });
     let thread_model = ThreadModel::parse(model)
         .ok_or_else(|| anyhow::anyhow!("unknown --model `{model}` (expected rv32 or fast)"))?;
     let accels = if args.accel.is_empty() {
@@ -109,9 +97,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         args.workload.clone()
     };
 
-    let dir = scenes::find_here(args.scenes_dir.as_deref())?;
+    let dir = scenes::find_here(args.scope.scenes_dir.as_deref())?;
     let scene_files = SceneFiles::scan(dir.as_ref());
-    let specs = resolve_specs(&args.specs, args.full, &scene_files);
+    let specs = resolve_specs(&args.scope.specs, args.scope.full, &scene_files);
     let mut plan_scenes = Vec::new();
     for spec in &specs {
         let sp = ctx.spinner(format!("loading {spec}"));

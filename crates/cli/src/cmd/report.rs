@@ -52,32 +52,12 @@ pub const SIM_RAYS_PER_SECOND_RV32: f64 = 45_000.0;
 /// Arguments of `dualsplit report`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scenes: files (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
-    /// (hairball, forest, atrium, cornell). Without any: Dragon Box when the scenes folder
-    /// holds it, and the atrium, forest and hairball builtins at reduced sizes.
-    #[arg(value_name = "SCENES", value_parser = crate::args::parse_scene)]
-    specs: Vec<String>,
-    /// Square resolution of the simulated frames (default 384, 1024 with --full).
-    #[arg(long, value_parser = crate::args::parse_positive)]
-    res: Option<u32>,
-    /// The paper's setup: 1024×1024, full-size scenes, 32/64/128 TMs.
-    #[arg(long)]
-    full: bool,
+    /// What to simulate: scenes, frame size, TM counts, thread model.
+    #[command(flatten)]
+    scope: crate::args::Scope,
     /// Output directory.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Folder of the shipped meshes (Dragon Box, Dragon Sponza). Default: the
-    /// DUALSPLIT_SCENES environment variable, else shared/scenes beside the checkout.
-    #[arg(long = "scenes", value_name = "DIR")]
-    scenes_dir: Option<PathBuf>,
-    /// TM counts of the scaling study (Table 7); Tables 4–6 use 64 when listed.
-    #[arg(long, value_delimiter = ',', default_value = "32,64,128", value_parser = crate::args::parse_positive)]
-    tms: Vec<u32>,
-    /// Thread model: rv32 (the compiled kernels instruction by instruction, the reference)
-    /// or fast (the replay calibrated against them: about 5× faster, within 10 %). Default:
-    /// fast, rv32 with --full.
-    #[arg(long)]
-    model: Option<String>,
     /// Print the plan (scenes, frames, configurations) and the time estimate, then stop
     /// without loading anything.
     #[arg(long)]
@@ -125,15 +105,17 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let start = Instant::now();
     let out = args.out.take().unwrap_or_else(|| PathBuf::from("report"));
     crate::output::prepare_dir(&out, "--out")?;
-    let dir = scenes::find_here(args.scenes_dir.as_deref())?;
+    let dir = scenes::find_here(args.scope.scenes_dir.as_deref())?;
     let scene_files = SceneFiles::scan(dir.as_ref());
     eprintln!("{}", scene_files.describe());
-    if args.tms.is_empty() || args.tms.contains(&0) {
+    if args.scope.tms.is_empty() || args.scope.tms.contains(&0) {
         anyhow::bail!("--tms needs positive TM counts, e.g. --tms 32,64,128");
     }
-    let res = args
-        .res
-        .unwrap_or(if args.full { FULL_RES } else { DEFAULT_RES });
+    let res = args.scope.res.unwrap_or(if args.scope.full {
+        FULL_RES
+    } else {
+        DEFAULT_RES
+    });
     if res == 0 {
         anyhow::bail!("--res must be positive");
     }
@@ -144,9 +126,9 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             dualsplit_render::MAX_PIXELS
         );
     }
-    let user_scenes = !args.specs.is_empty();
-    let specs = resolve_specs(&args.specs, args.full, &scene_files);
-    let mut tms = args.tms.clone();
+    let user_scenes = !args.scope.specs.is_empty();
+    let specs = resolve_specs(&args.scope.specs, args.scope.full, &scene_files);
+    let mut tms = args.scope.tms.clone();
     tms.sort_unstable();
     tms.dedup();
     let base_tms = if tms.contains(&64) {
@@ -154,10 +136,11 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     } else {
         tms[tms.len() / 2]
     };
-    let model = args
-        .model
-        .as_deref()
-        .unwrap_or(if args.full { "rv32" } else { "fast" });
+    let model =
+        args.scope
+            .model
+            .as_deref()
+            .unwrap_or(if args.scope.full { "rv32" } else { "fast" });
     let thread_model = ThreadModel::parse(model)
         .ok_or_else(|| anyhow::anyhow!("unknown --model `{model}` (expected rv32 or fast)"))?;
     let plan = Plan {
@@ -207,7 +190,7 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         tms,
         base_tms,
         cpu_res: CPU_RES,
-        full: args.full,
+        full: args.scope.full,
         thread_model,
     };
     let simulate = real_simulator(thread_model);
