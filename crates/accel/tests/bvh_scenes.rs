@@ -1,12 +1,14 @@
 //! BVH2, BVH4 and BVH8 on the shipped scenes: identical leaves, clean validation, and
 //! per-ray identical answers for primary, shadow and diffuse-bounce rays recorded from
-//! path-traced pixel jobs on each scene's default camera.
+//! path-traced pixel jobs on each scene's default camera: every BVH's plain query (its
+//! CPU-side copy, [`dualsplit_accel::wide::cpu`]) and its image traversal (what the
+//! simulator reads) against the BVH2's image traversal, hit for hit and bit for bit.
 //!
 //! Release builds (`cargo test --release`, what CI runs) compare at least 100K rays of each
 //! kind per scene; debug builds compare 3K of each so that `cargo test` stays quick.
 
 use dualsplit_accel::{AccelKind, BuildConfig, CollapseConfig, NoObserver, Structures, WideBvh};
-use dualsplit_testkit::oracle::key;
+use dualsplit_testkit::oracle::{hit_bits, key};
 use dualsplit_testkit::rays::record_rays;
 use dualsplit_testkit::scenes::load_scene;
 use rayon::prelude::*;
@@ -43,18 +45,36 @@ fn equivalence(name: &str) {
     );
     for (what, set) in [("primary", &rays.primary), ("diffuse", &rays.diffuse)] {
         set.par_iter().enumerate().for_each(|(i, ray)| {
-            let want = key(s.closest_hit(AccelKind::Bvh2, ray, &mut NoObserver));
-            for kind in [AccelKind::Bvh4, AccelKind::Bvh8] {
-                let got = key(s.closest_hit(kind, ray, &mut NoObserver));
-                assert_eq!(got, want, "{name}: {what} ray {i} {ray:?} on {kind:?}");
+            let want = hit_bits(s.bvh2_image.closest_hit_image(ray, &mut NoObserver));
+            for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+                let b = s.encoded(kind).unwrap();
+                let image = hit_bits(b.closest_hit_image(ray, &mut NoObserver));
+                assert_eq!(
+                    image, want,
+                    "{name}: {what} ray {i} {ray:?} on {kind:?}'s image"
+                );
+                let got = s.closest_hit(kind, ray, &mut NoObserver);
+                assert_eq!(
+                    hit_bits(got),
+                    want,
+                    "{name}: {what} ray {i} {ray:?} on {kind:?}"
+                );
+                assert_eq!(key(got).is_some(), want.is_some());
             }
         });
     }
     rays.shadow.par_iter().enumerate().for_each(|(i, ray)| {
         let want = s
-            .closest_hit(AccelKind::Bvh2, ray, &mut NoObserver)
+            .bvh2_image
+            .closest_hit_image(ray, &mut NoObserver)
             .is_some();
         for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+            let b = s.encoded(kind).unwrap();
+            let image = b.any_hit_image(ray, &mut NoObserver);
+            assert_eq!(
+                image, want,
+                "{name}: shadow ray {i} {ray:?} on {kind:?}'s image"
+            );
             let got = s.any_hit(kind, ray, &mut NoObserver);
             assert_eq!(got, want, "{name}: shadow ray {i} {ray:?} on {kind:?}");
         }

@@ -2,8 +2,9 @@
 //!
 //! Method (tinybvh's habit: check, then time):
 //!
-//! 1. [`ray_sets`] runs every pixel's [`PixelJob`] of a frame on BVH2 and keeps each ray with
-//!    BVH2's answer, split by [`RayKind`] (primary, shadow, diffuse), in pixel order. The rays
+//! 1. [`ray_sets`] runs every pixel's [`PixelJob`] of a frame on BVH2's memory image (its
+//!    observed traversal, not the CPU-side copy that plain queries use) and keeps each ray
+//!    with BVH2's answer, split by [`RayKind`] (primary, shadow, diffuse), in pixel order. The rays
 //!    are exactly those the renderer traces, so shadow and diffuse rays start on surfaces.
 //! 2. [`measure`] first traces every ray of a set on the structure under test and compares
 //!    the answer with BVH2's bit for bit ([`TraceResult::bit_eq`]); the first mismatch is a
@@ -21,7 +22,7 @@
 
 use crate::trace::{run_job, trace_query};
 use crate::{PixelJob, RayCounts, RayKind, RayQuery, RenderError, RenderSettings, TraceResult};
-use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_accel::{AccelKind, NoObserver, Observer, Structures};
 use dualsplit_geometry::Ray;
 use dualsplit_scene::Scene;
 use rayon::prelude::*;
@@ -41,8 +42,15 @@ pub struct RaySet {
     pub expected: Vec<TraceResult>,
 }
 
+/// An observer that ignores every report but is not [`NoObserver`], so a BVH answers by
+/// traversing its byte-exact image ([`Observer::OBSERVES_NOTHING`] is false): the reference
+/// the timed structures, which answer from their CPU-side copies, are checked against.
+struct ImageReference;
+
+impl Observer for ImageReference {}
+
 /// Builds the three ray sets (primary, shadow, diffuse; the *cast* workload's diffuse set is
-/// empty) of a frame of `settings` by running every pixel's job on BVH2.
+/// empty) of a frame of `settings` by running every pixel's job on BVH2's image.
 pub fn ray_sets(
     scene: &Scene,
     structures: &Structures,
@@ -60,7 +68,7 @@ pub fn ray_sets(
                     job,
                     structures,
                     AccelKind::Bvh2,
-                    &mut NoObserver,
+                    &mut ImageReference,
                     &mut counts,
                     |q, r| v.push((*q, *r)),
                 );

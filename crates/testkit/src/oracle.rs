@@ -67,7 +67,29 @@ pub fn check_ray(s: &Structures, tris: &[Triangle], ray: &Ray, what: &str) {
             "{what}: {} any hit vs oracle, ray {ray:?}",
             kind.name()
         );
+        // A BVH answers plain queries from its CPU-side copy; its image traversal (what the
+        // simulator and every counting observer read) must give the same hit, bit for bit.
+        if let Some(b) = s.encoded(kind) {
+            let image = b.closest_hit_image(ray, &mut NoObserver);
+            assert_eq!(
+                hit_bits(image),
+                hit_bits(got),
+                "{what}: {} image traversal vs CPU copy, ray {ray:?}",
+                kind.name()
+            );
+            assert_eq!(
+                b.any_hit_image(ray, &mut NoObserver),
+                want_any,
+                "{what}: {} image any hit vs oracle, ray {ray:?}",
+                kind.name()
+            );
+        }
     }
+}
+
+/// Every bit of a hit: `t`, triangle id, `u`, `v`.
+pub fn hit_bits(h: Option<Hit>) -> Option<[u32; 4]> {
+    h.map(|h| [h.t.to_bits(), h.prim.0, h.u.to_bits(), h.v.to_bits()])
 }
 
 /// [`check_ray`] for each of `rays`, named by its index.

@@ -1,0 +1,458 @@
+//! The CPU-side copy of a BVH image that the plain queries traverse: child boxes of each
+//! node stored lane by lane (structure of arrays, 4 children per [`Chunk`]) so that one
+//! SIMD slab test covers 4 children, and triangles copied in leaf order, four to a packet
+//! lane by lane, so that the first stage of the watertight test runs on a leaf at once.
+//!
+//! It is made from the byte-exact image (so from the same BVH2 and collapse: the same
+//! children, the same box words, the same leaves) when a plain query first needs it, and is
+//! used only when the caller observes nothing ([`crate::Observer::OBSERVES_NOTHING`]); the
+//! simulator and every counting observer still read the image through
+//! [`super::traverse`]. The answers are the image traversal's, ray for ray and bit for bit:
+//!
+//! * the box test is [`super::traverse`]'s arithmetic lane by lane: `(p - o) * inv`, far
+//!   planes multiplied by [`EXIT_WIDEN`], the interval clipped by compare-and-select (x86's
+//!   `maxps`/`minps` keep the running bound when a plane distance is NaN, exactly as the
+//!   scalar `if tn > entry`); rays whose interval ends are NaN take the image traversal;
+//! * the triangle test is the same [`dualsplit_geometry::Triangle::intersect`] on the same triangle words (a SIMD
+//!   first stage only drops triangles that it would reject at that stage), and hits are kept by [`Hit::closer_than`]'s `(t, prim)` order, which makes the closest hit
+//!   independent of the order in which leaves are visited;
+//! * nodes are culled against the same [`cull_limit`] of the best `t`, which keeps every
+//!   leaf that can hold an equally near hit with a smaller id.
+//!
+//! Only the visiting order of a node's hit children differs (nearest first, the rest pushed
+//! by a rank computed from their entry distances, ties in either order), which changes no
+//! answer.
+
+use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
+use dualsplit_geometry::{EXIT_WIDEN, Hit, PrimId, Ray, RayPre, cull_limit};
+use std::cell::Cell;
+use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
+
+/// Children per chunk: one SSE register of `f32`.
+pub const LANES: usize = 4;
+
+/// Child word of a leaf: bit 31 set, bits 0–30 the index of its first triangle in
+/// [`CpuBvh::tris`].
+const LEAF: u32 = 1 << 31;
+
+/// Child word of an empty lane.
+const EMPTY: u32 = u32::MAX;
+
+/// Four children of a node: their boxes plane by plane, then their child words.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub struct Chunk {
+    /// `planes[p][lane]`: plane `p` of the lane's box, in the image's box-word order
+    /// (min.x, min.y, min.z, max.x, max.y, max.z). Empty lanes hold the degenerate box.
+    pub planes: [[f32; LANES]; 6],
+    /// Per lane: a node (index of its first chunk), a leaf ([`LEAF`] | first triangle) or
+    /// [`EMPTY`].
+    pub child: [u32; LANES],
+}
+
+const EMPTY_CHUNK: Chunk = Chunk {
+    planes: [
+        [f32::INFINITY; LANES],
+        [f32::INFINITY; LANES],
+        [f32::INFINITY; LANES],
+        [f32::NEG_INFINITY; LANES],
+        [f32::NEG_INFINITY; LANES],
+        [f32::NEG_INFINITY; LANES],
+    ],
+    child: [EMPTY; LANES],
+};
+
+/// Up to four triangles of one leaf, vertex coordinates lane by lane, with their ids. A leaf
+/// takes one packet per four triangles, consecutive; its last packet is the one whose lane 3
+/// has bit 31 set ([`RUN_END`] on the leaf's last id, or [`EMPTY`] padding).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub struct TriPacket {
+    /// `v[3 * vertex + axis][lane]`.
+    pub v: [[f32; LANES]; 9],
+    /// Triangle ids; [`RUN_END`] on the leaf's last one, [`EMPTY`] on unused lanes.
+    pub prim: [u32; LANES],
+}
+
+const EMPTY_PACKET: TriPacket = TriPacket {
+    v: [[0.0; LANES]; 9],
+    prim: [EMPTY; LANES],
+};
+
+/// The CPU-side copy of one BVH image (see the module docs).
+#[derive(Clone, Debug, Default)]
+pub struct CpuBvh {
+    /// Chunks per node: 1 for BVH2 and BVH4, 2 for BVH8.
+    pub chunks_per_node: usize,
+    /// The nodes, each `chunks_per_node` consecutive chunks, the root first.
+    pub chunks: Vec<Chunk>,
+    /// The leaves' triangles in leaf order, four to a packet.
+    pub packets: Vec<TriPacket>,
+    /// The scene's triangles by id (shared with the image).
+    pub triangles: crate::image::SharedTriangles,
+}
+
+impl CpuBvh {
+    /// Copies the image of node layout `L` (depth-first, children of a node next to one
+    /// another).
+    pub fn from_image<L: NodeLayout>(img: &MemoryImage) -> Self {
+        let cpn = L::ARITY.div_ceil(LANES);
+        let words = &img.words[..];
+        let triangles = img.triangle_slice();
+        let mut out = CpuBvh {
+            chunks_per_node: cpn,
+            chunks: Vec::new(),
+            packets: Vec::new(),
+            triangles: img.triangle_data.clone(),
+        };
+        // (image word of a node, chunk index it is copied to)
+        let mut todo: Vec<(usize, usize)> = vec![(0, 0)];
+        out.chunks.extend(std::iter::repeat_n(EMPTY_CHUNK, cpn));
+        while let Some((w, at)) = todo.pop() {
+            let node = L::read(words, w);
+            let mut addr = node.offset() as usize;
+            let mut lane = 0;
+            let mut internal = Vec::new();
+            for k in 0..L::ARITY {
+                let kind = node.kind(k);
+                if kind == ChildKind::Empty {
+                    continue;
+                }
+                let ch = &mut out.chunks[at + lane / LANES];
+                let l = lane % LANES;
+                for (p, &v) in node.box_words(k).iter().enumerate() {
+                    ch.planes[p][l] = v;
+                }
+                match kind {
+                    ChildKind::Leaf => {
+                        let run = words[addr] as usize;
+                        let first = out.packets.len() as u32;
+                        assert!(first < LEAF, "too many triangle packets");
+                        let mut i = run;
+                        let mut t = 0;
+                        loop {
+                            if t % LANES == 0 {
+                                out.packets.push(EMPTY_PACKET);
+                            }
+                            let e = words[i];
+                            let pk = out.packets.last_mut().expect("pushed");
+                            let tri = &triangles[(e & !RUN_END) as usize];
+                            for (r, row) in pk.v.iter_mut().enumerate() {
+                                row[t % LANES] = tri.v[r / 3][r % 3];
+                            }
+                            pk.prim[t % LANES] = e;
+                            if e & RUN_END != 0 {
+                                break;
+                            }
+                            i += 1;
+                            t += 1;
+                        }
+                        ch.child[l] = LEAF | first;
+                    }
+                    _ => internal.push((addr, at + lane / LANES, l)),
+                }
+                addr += L::child_words(kind) as usize;
+                lane += 1;
+            }
+            // Children of one node next to one another, then their subtrees depth-first.
+            let mut subtrees = Vec::with_capacity(internal.len());
+            for (cw, chunk, l) in internal {
+                let idx = out.chunks.len();
+                out.chunks.extend(std::iter::repeat_n(EMPTY_CHUNK, cpn));
+                out.chunks[chunk].child[l] = idx as u32;
+                subtrees.push((cw, idx));
+            }
+            todo.extend(subtrees.into_iter().rev());
+        }
+        out
+    }
+
+    /// Bytes of the copy (chunks and leaf-ordered triangles).
+    pub fn bytes(&self) -> usize {
+        self.chunks.len() * size_of::<Chunk>() + self.packets.len() * size_of::<TriPacket>()
+    }
+
+    /// Closest hit (`ANY = false`) or some hit (`ANY = true`) of `ray`; `None` when the ray
+    /// must take the image traversal instead (its `t_min` or cull limit is NaN).
+    #[inline]
+    pub fn traverse<const ANY: bool>(&self, ray: &Ray) -> Option<Option<Hit>> {
+        if (ray.t_min - cull_limit(ray.t_max)).is_nan() {
+            return None;
+        }
+        let mut stack = STACK.take();
+        stack.clear();
+        let hit = match self.chunks_per_node {
+            1 => self.run::<1, ANY>(ray, &mut stack),
+            _ => self.run::<2, ANY>(ray, &mut stack),
+        };
+        STACK.set(stack);
+        Some(hit)
+    }
+
+    #[inline(always)]
+    fn run<const C: usize, const ANY: bool>(
+        &self,
+        ray: &Ray,
+        stack: &mut Vec<Entry>,
+    ) -> Option<Hit> {
+        let r = ray.precompute();
+        let rs = RaySimd::new(&r);
+        let chunks = &self.chunks[..];
+        let packets = &self.packets[..];
+        let triangles = &self.triangles[..];
+        let mut best: Option<Hit> = None;
+        let mut best_t = ray.t_max;
+        let mut limit = cull_limit(best_t);
+        let t_lo = f32x4::splat(ray.t_min);
+        let mut cur = 0u32;
+        loop {
+            if cur & LEAF == 0 {
+                let n = cur as usize;
+                let t_hi = f32x4::splat(limit);
+                let mut dist = [[0f32; LANES]; C];
+                let mut mask = 0u32;
+                for c in 0..C {
+                    let (entry, m) = rs.test(&chunks[n + c], t_lo, t_hi);
+                    dist[c] = entry.to_array();
+                    mask |= m << (LANES * c);
+                }
+                let child = |i: usize| chunks[n + i / LANES].child[i % LANES];
+                let d = |i: usize| dist[i / LANES][i % LANES];
+                if mask != 0 {
+                    let first = mask.trailing_zeros() as usize;
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        cur = child(first);
+                        continue;
+                    }
+                    let second = rest.trailing_zeros() as usize;
+                    if rest & (rest - 1) == 0 {
+                        // Two hits: the nearer next, the other on the stack.
+                        let (near, far) = if d(second) < d(first) {
+                            (second, first)
+                        } else {
+                            (first, second)
+                        };
+                        stack.push(Entry {
+                            t: d(far),
+                            child: child(far),
+                        });
+                        cur = child(near);
+                        continue;
+                    }
+                    // Three or more: each goes to the stack slot of its rank (the number of
+                    // hit children before it by entry distance, ties by slot), nearest on
+                    // top; then the nearest is taken.
+                    let count = mask.count_ones() as usize;
+                    let base = stack.len();
+                    stack.resize(
+                        base + count,
+                        Entry {
+                            t: 0.0,
+                            child: EMPTY,
+                        },
+                    );
+                    let mut m = mask;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let di = d(i);
+                        let mut rank = 0;
+                        let mut o = mask;
+                        while o != 0 {
+                            let j = o.trailing_zeros() as usize;
+                            o &= o - 1;
+                            let dj = d(j);
+                            rank += (dj < di || (dj == di && j < i)) as usize;
+                        }
+                        stack[base + count - 1 - rank] = Entry {
+                            t: di,
+                            child: child(i),
+                        };
+                    }
+                    cur = stack.pop().map_or(EMPTY, |e| e.child);
+                    continue;
+                }
+            } else {
+                let mut i = (cur & !LEAF) as usize;
+                loop {
+                    let pk = &packets[i];
+                    // Lanes the scalar test could accept; it decides each of them.
+                    let mut m = rs.triangle_candidates(pk);
+                    while m != 0 {
+                        let l = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let p = PrimId(pk.prim[l] & !RUN_END);
+                        if let Some(h) = triangles[p.index()].intersect(&r, ray.t_min, best_t)
+                            && best.is_none_or(|b| !b.closer_than(h.t, p))
+                        {
+                            best = Some(Hit {
+                                t: h.t,
+                                prim: p,
+                                u: h.u,
+                                v: h.v,
+                            });
+                            if ANY {
+                                return best;
+                            }
+                            best_t = h.t;
+                            limit = cull_limit(best_t);
+                        }
+                    }
+                    if pk.prim[LANES - 1] & RUN_END != 0 {
+                        break;
+                    }
+                    i += 1;
+                }
+            }
+            // Next: the nearest stacked entry not beyond the limit.
+            loop {
+                let Some(e) = stack.pop() else {
+                    return best;
+                };
+                if e.t <= limit {
+                    cur = e.child;
+                    break;
+                }
+            }
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Entry {
+    t: f32,
+    child: u32,
+}
+
+thread_local! {
+    /// The traversal stack's buffer, one per thread, reused from ray to ray.
+    static STACK: Cell<Vec<Entry>> = const { Cell::new(Vec::new()) };
+}
+
+/// The ray's constants broadcast to all lanes, the plane rows its signs pick, and the
+/// watertight test's axes and shear.
+struct RaySimd {
+    o: [f32x4; 3],
+    inv: [f32x4; 3],
+    near: [usize; 3],
+    far: [usize; 3],
+    k: [usize; 3],
+    sx: f32x4,
+    sy: f32x4,
+}
+
+impl RaySimd {
+    fn new(r: &RayPre) -> Self {
+        let o = r.ray.origin;
+        let inv = r.inv_dir;
+        let s = |a: usize| 3 * r.neg[a] as usize;
+        Self {
+            o: [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)],
+            inv: [
+                f32x4::splat(inv.x),
+                f32x4::splat(inv.y),
+                f32x4::splat(inv.z),
+            ],
+            near: [s(0), 1 + s(1), 2 + s(2)],
+            far: [3 - s(0), 4 - s(1), 5 - s(2)],
+            k: r.k,
+            sx: f32x4::splat(r.shear.x),
+            sy: f32x4::splat(r.shear.y),
+        }
+    }
+
+    /// The lanes of `pk` that [`dualsplit_geometry::Triangle::intersect`] might accept: the first stage of that
+    /// test (shear, edge functions `u`, `v`, `w`, same IEEE operations in the same order)
+    /// on four triangles at once, dropping a lane only where the scalar test returns `None`
+    /// at that stage: no edge function is zero (so no f64 recomputation) and their signs
+    /// differ. Every other lane is left to the scalar test, so answers are its answers.
+    #[inline(always)]
+    fn triangle_candidates(&self, pk: &TriPacket) -> u32 {
+        let [kx, ky, kz] = self.k;
+        let rel = |vertex: usize, axis: usize| f32x4::new(pk.v[3 * vertex + axis]) - self.o[axis];
+        let (ax, ay, az) = (rel(0, kx), rel(0, ky), rel(0, kz));
+        let (bx, by, bz) = (rel(1, kx), rel(1, ky), rel(1, kz));
+        let (cx, cy, cz) = (rel(2, kx), rel(2, ky), rel(2, kz));
+        let ax = ax - self.sx * az;
+        let ay = ay - self.sy * az;
+        let bx = bx - self.sx * bz;
+        let by = by - self.sy * bz;
+        let cx = cx - self.sx * cz;
+        let cy = cy - self.sy * cz;
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let zero = f32x4::splat(0.0);
+        let any_zero = u.cmp_eq(zero) | v.cmp_eq(zero) | w.cmp_eq(zero);
+        let neg = u.cmp_lt(zero) | v.cmp_lt(zero) | w.cmp_lt(zero);
+        let pos = u.cmp_gt(zero) | v.cmp_gt(zero) | w.cmp_gt(zero);
+        let reject = (neg & pos).move_mask() as u32 & !(any_zero.move_mask() as u32);
+        let unused = i32x4::new(bytemuck::cast::<[u32; LANES], [i32; LANES]>(pk.prim))
+            .cmp_eq(i32x4::splat(-1))
+            .move_mask() as u32;
+        0b1111 & !reject & !unused
+    }
+
+    /// Entry distances of the chunk's four boxes clipped to `[t_lo, t_hi]`, and the mask of
+    /// the non-empty lanes the ray meets (`entry <= exit`).
+    #[inline(always)]
+    fn test(&self, ch: &Chunk, t_lo: f32x4, t_hi: f32x4) -> (f32x4, u32) {
+        let mut entry = t_lo;
+        let mut exit = t_hi;
+        let widen = f32x4::splat(EXIT_WIDEN);
+        for a in 0..3 {
+            let tn = (f32x4::new(ch.planes[self.near[a]]) - self.o[a]) * self.inv[a];
+            let tf = (f32x4::new(ch.planes[self.far[a]]) - self.o[a]) * self.inv[a] * widen;
+            entry = keep_max(tn, entry);
+            exit = keep_min(tf, exit);
+        }
+        let hit = entry.cmp_le(exit).move_mask() as u32;
+        let empty = i32x4::new(bytemuck::cast::<[u32; LANES], [i32; LANES]>(ch.child))
+            .cmp_eq(i32x4::splat(-1))
+            .move_mask() as u32;
+        (entry, hit & !empty)
+    }
+}
+
+/// `if x > bound { x } else { bound }` per lane: a NaN `x` keeps the bound.
+#[inline(always)]
+fn keep_max(x: f32x4, bound: f32x4) -> f32x4 {
+    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    {
+        // `maxps x, bound` is `x > bound ? x : bound`.
+        x.fast_max(bound)
+    }
+    #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
+    {
+        x.cmp_gt(bound).blend(x, bound)
+    }
+}
+
+/// `if x < bound { x } else { bound }` per lane: a NaN `x` keeps the bound.
+#[inline(always)]
+fn keep_min(x: f32x4, bound: f32x4) -> f32x4 {
+    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    {
+        // `minps x, bound` is `x < bound ? x : bound`.
+        x.fast_min(bound)
+    }
+    #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
+    {
+        x.cmp_lt(bound).blend(x, bound)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `keep_max`/`keep_min` keep the bound for a NaN lane, as the scalar compare does.
+    #[test]
+    fn keep_ignores_nan() {
+        let x = f32x4::new([f32::NAN, 2.0, -1.0, f32::INFINITY]);
+        let b = f32x4::new([1.0, 1.0, 1.0, 1.0]);
+        assert_eq!(keep_max(x, b).to_array(), [1.0, 2.0, 1.0, f32::INFINITY]);
+        assert_eq!(keep_min(x, b).to_array(), [1.0, 1.0, -1.0, 1.0]);
+    }
+}
