@@ -13,7 +13,7 @@
 //!   planes multiplied by [`EXIT_WIDEN`], the interval clipped by compare-and-select (x86's
 //!   `maxps`/`minps` keep the running bound when a plane distance is NaN, exactly as the
 //!   scalar `if tn > entry`); rays whose interval ends are NaN take the image traversal;
-//! * the triangle test is the same [`dualsplit_geometry::Triangle::intersect`] on the same triangle words (a SIMD
+//! * the triangle test is the same [`Triangle::intersect`] on the same triangle words (a SIMD
 //!   first stage only drops triangles that it would reject at that stage), and hits are kept by [`Hit::closer_than`]'s `(t, prim)` order, which makes the closest hit
 //!   independent of the order in which leaves are visited;
 //! * nodes are culled against the same [`cull_limit`] of the best `t`, which keeps every
@@ -24,7 +24,7 @@
 //! answer.
 
 use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
-use dualsplit_geometry::{EXIT_WIDEN, Hit, PrimId, Ray, RayPre, cull_limit};
+use dualsplit_geometry::{EXIT_WIDEN, Hit, PrimId, Ray, RayPre, Triangle, Vec3, cull_limit};
 use std::cell::Cell;
 use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
 
@@ -62,15 +62,16 @@ const EMPTY_CHUNK: Chunk = Chunk {
     child: [EMPTY; LANES],
 };
 
-/// Up to four triangles of one leaf, vertex coordinates lane by lane, with their ids. A leaf
-/// takes one packet per four triangles, consecutive; its last packet is the one whose lane 3
-/// has bit 31 set ([`RUN_END`] on the leaf's last id, or [`EMPTY`] padding).
+/// Four consecutive triangles of the leaf-ordered triangle list, vertex coordinates lane by
+/// lane, with their ids. Leaves follow one another without padding: a leaf starts at any
+/// lane (its child word names the slot `4 · packet + lane`) and ends at the first lane from
+/// there whose id has [`RUN_END`] set; the last packet is padded with [`EMPTY`] lanes.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
 pub struct TriPacket {
     /// `v[3 * vertex + axis][lane]`.
     pub v: [[f32; LANES]; 9],
-    /// Triangle ids; [`RUN_END`] on the leaf's last one, [`EMPTY`] on unused lanes.
+    /// Triangle ids; [`RUN_END`] on a leaf's last one, [`EMPTY`] on padding lanes.
     pub prim: [u32; LANES],
 }
 
@@ -88,8 +89,6 @@ pub struct CpuBvh {
     pub chunks: Vec<Chunk>,
     /// The leaves' triangles in leaf order, four to a packet.
     pub packets: Vec<TriPacket>,
-    /// The scene's triangles by id (shared with the image).
-    pub triangles: crate::image::SharedTriangles,
 }
 
 impl CpuBvh {
@@ -103,10 +102,11 @@ impl CpuBvh {
             chunks_per_node: cpn,
             chunks: Vec::new(),
             packets: Vec::new(),
-            triangles: img.triangle_data.clone(),
         };
         // (image word of a node, chunk index it is copied to)
         let mut todo: Vec<(usize, usize)> = vec![(0, 0)];
+        // Triangle slots used (4 per packet).
+        let mut slots = 0usize;
         out.chunks.extend(std::iter::repeat_n(EMPTY_CHUNK, cpn));
         while let Some((w, at)) = todo.pop() {
             let node = L::read(words, w);
@@ -126,26 +126,25 @@ impl CpuBvh {
                 match kind {
                     ChildKind::Leaf => {
                         let run = words[addr] as usize;
-                        let first = out.packets.len() as u32;
-                        assert!(first < LEAF, "too many triangle packets");
+                        let first = slots as u32;
+                        assert!(first < LEAF, "too many triangle references");
                         let mut i = run;
-                        let mut t = 0;
                         loop {
-                            if t % LANES == 0 {
+                            if slots & (LANES - 1) == 0 {
                                 out.packets.push(EMPTY_PACKET);
                             }
                             let e = words[i];
                             let pk = out.packets.last_mut().expect("pushed");
                             let tri = &triangles[(e & !RUN_END) as usize];
                             for (r, row) in pk.v.iter_mut().enumerate() {
-                                row[t % LANES] = tri.v[r / 3][r % 3];
+                                row[slots % LANES] = tri.v[r / 3][r % 3];
                             }
-                            pk.prim[t % LANES] = e;
+                            pk.prim[slots % LANES] = e;
+                            slots += 1;
                             if e & RUN_END != 0 {
                                 break;
                             }
                             i += 1;
-                            t += 1;
                         }
                         ch.child[l] = LEAF | first;
                     }
@@ -199,7 +198,6 @@ impl CpuBvh {
         let rs = RaySimd::new(&r);
         let chunks = &self.chunks[..];
         let packets = &self.packets[..];
-        let triangles = &self.triangles[..];
         let mut best: Option<Hit> = None;
         let mut best_t = ray.t_max;
         let mut limit = cull_limit(best_t);
@@ -233,9 +231,15 @@ impl CpuBvh {
                         } else {
                             (first, second)
                         };
+                        let c = child(far);
+                        if c & LEAF == 0 {
+                            super::simd::prefetch(&chunks[c as usize]);
+                        } else {
+                            super::simd::prefetch(&packets[(c & !LEAF) as usize / LANES]);
+                        }
                         stack.push(Entry {
                             t: d(far),
-                            child: child(far),
+                            child: c,
                         });
                         cur = child(near);
                         continue;
@@ -244,6 +248,17 @@ impl CpuBvh {
                     // hit children before it by entry distance, ties by slot), nearest on
                     // top; then the nearest is taken.
                     let count = mask.count_ones() as usize;
+                    let mut m = mask;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let c = child(i);
+                        if c & LEAF == 0 {
+                            super::simd::prefetch(&chunks[c as usize]);
+                        } else {
+                            super::simd::prefetch(&packets[(c & !LEAF) as usize / LANES]);
+                        }
+                    }
                     let base = stack.len();
                     stack.resize(
                         base + count,
@@ -274,16 +289,32 @@ impl CpuBvh {
                     continue;
                 }
             } else {
-                let mut i = (cur & !LEAF) as usize;
+                let slot = (cur & !LEAF) as usize;
+                let mut i = slot / LANES;
+                // Lanes at or after the leaf's first.
+                let mut from = (0b1111 << (slot % LANES)) & 0b1111;
                 loop {
                     let pk = &packets[i];
                     // Lanes the scalar test could accept; it decides each of them.
-                    let mut m = rs.triangle_candidates(pk);
+                    // Lanes up to the leaf's last (the first id from `from` on with
+                    // bit 31 set: RUN_END or padding).
+                    let ends = f32x4::new(bytemuck::cast(pk.prim)).move_mask() as u32 & from;
+                    let lanes = if ends == 0 {
+                        from
+                    } else {
+                        from & ((ends & ends.wrapping_neg()) << 1).wrapping_sub(1)
+                    };
+                    let mut m = rs.triangle_candidates(pk) & lanes;
                     while m != 0 {
                         let l = m.trailing_zeros() as usize;
                         m &= m - 1;
                         let p = PrimId(pk.prim[l] & !RUN_END);
-                        if let Some(h) = triangles[p.index()].intersect(&r, ray.t_min, best_t)
+                        // The triangle's own words, from the packet (already in cache).
+                        let vertex = |k: usize| {
+                            Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l])
+                        };
+                        let tri = Triangle::new(vertex(0), vertex(1), vertex(2));
+                        if let Some(h) = tri.intersect(&r, ray.t_min, best_t)
                             && best.is_none_or(|b| !b.closer_than(h.t, p))
                         {
                             best = Some(Hit {
@@ -299,10 +330,11 @@ impl CpuBvh {
                             limit = cull_limit(best_t);
                         }
                     }
-                    if pk.prim[LANES - 1] & RUN_END != 0 {
+                    if ends != 0 {
                         break;
                     }
                     i += 1;
+                    from = 0b1111;
                 }
             }
             // Next: the nearest stacked entry not beyond the limit.
@@ -362,7 +394,7 @@ impl RaySimd {
         }
     }
 
-    /// The lanes of `pk` that [`dualsplit_geometry::Triangle::intersect`] might accept: the first stage of that
+    /// The lanes of `pk` that [`Triangle::intersect`] might accept: the first stage of that
     /// test (shear, edge functions `u`, `v`, `w`, same IEEE operations in the same order)
     /// on four triangles at once, dropping a lane only where the scalar test returns `None`
     /// at that stage: no edge function is zero (so no f64 recomputation) and their signs
@@ -388,10 +420,7 @@ impl RaySimd {
         let neg = u.cmp_lt(zero) | v.cmp_lt(zero) | w.cmp_lt(zero);
         let pos = u.cmp_gt(zero) | v.cmp_gt(zero) | w.cmp_gt(zero);
         let reject = (neg & pos).move_mask() as u32 & !(any_zero.move_mask() as u32);
-        let unused = i32x4::new(bytemuck::cast::<[u32; LANES], [i32; LANES]>(pk.prim))
-            .cmp_eq(i32x4::splat(-1))
-            .move_mask() as u32;
-        0b1111 & !reject & !unused
+        0b1111 & !reject
     }
 
     /// Entry distances of the chunk's four boxes clipped to `[t_lo, t_hi]`, and the mask of
