@@ -207,19 +207,34 @@ impl CpuBvh {
             if cur & LEAF == 0 {
                 let n = cur as usize;
                 let t_hi = f32x4::splat(limit);
-                let mut dist = [[0f32; LANES]; C];
+                let mut dv = [f32x4::splat(0.0); C];
                 let mut mask = 0u32;
                 for c in 0..C {
                     let (entry, m) = rs.test(&chunks[n + c], t_lo, t_hi);
-                    dist[c] = entry.to_array();
+                    dv[c] = entry;
                     mask |= m << (LANES * c);
                 }
+                let dist = dv.map(|v| v.to_array());
                 let child = |i: usize| chunks[n + i / LANES].child[i % LANES];
                 let d = |i: usize| dist[i / LANES][i % LANES];
                 if mask != 0 {
                     let first = mask.trailing_zeros() as usize;
                     let rest = mask & (mask - 1);
                     if rest == 0 {
+                        cur = child(first);
+                        continue;
+                    }
+                    if ANY {
+                        // Any hit ends the ray: no order is better than another, so the
+                        // first hit child is next and the others are pushed unsorted.
+                        let mut m = rest;
+                        while m != 0 {
+                            let i = m.trailing_zeros() as usize;
+                            m &= m - 1;
+                            let c = child(i);
+                            prefetch_child(chunks, packets, c);
+                            stack.push(Entry { t: d(i), child: c });
+                        }
                         cur = child(first);
                         continue;
                     }
@@ -232,11 +247,7 @@ impl CpuBvh {
                             (first, second)
                         };
                         let c = child(far);
-                        if c & LEAF == 0 {
-                            super::simd::prefetch(&chunks[c as usize]);
-                        } else {
-                            super::simd::prefetch(&packets[(c & !LEAF) as usize / LANES]);
-                        }
+                        prefetch_child(chunks, packets, c);
                         stack.push(Entry {
                             t: d(far),
                             child: c,
@@ -253,11 +264,7 @@ impl CpuBvh {
                         let i = m.trailing_zeros() as usize;
                         m &= m - 1;
                         let c = child(i);
-                        if c & LEAF == 0 {
-                            super::simd::prefetch(&chunks[c as usize]);
-                        } else {
-                            super::simd::prefetch(&packets[(c & !LEAF) as usize / LANES]);
-                        }
+                        prefetch_child(chunks, packets, c);
                     }
                     let base = stack.len();
                     stack.resize(
@@ -272,14 +279,17 @@ impl CpuBvh {
                         let i = m.trailing_zeros() as usize;
                         m &= m - 1;
                         let di = d(i);
-                        let mut rank = 0;
-                        let mut o = mask;
-                        while o != 0 {
-                            let j = o.trailing_zeros() as usize;
-                            o &= o - 1;
-                            let dj = d(j);
-                            rank += (dj < di || (dj == di && j < i)) as usize;
+                        // The hit lanes nearer than `i`, or as near and in an earlier slot,
+                        // from one comparison per chunk.
+                        let splat = f32x4::splat(di);
+                        let mut before = 0u32;
+                        for (c, v) in dv.iter().enumerate() {
+                            let lt = v.cmp_lt(splat).move_mask() as u32;
+                            let eq = v.cmp_eq(splat).move_mask() as u32;
+                            let earlier = ((1u32 << i) - 1) >> (LANES * c);
+                            before |= (lt | (eq & earlier)) << (LANES * c);
                         }
+                        let rank = (before & mask).count_ones() as usize;
                         stack[base + count - 1 - rank] = Entry {
                             t: di,
                             child: child(i),
@@ -348,6 +358,16 @@ impl CpuBvh {
                 }
             }
         }
+    }
+}
+
+/// Prefetches the first chunk of child word `c`'s node or the first packet of its leaf.
+#[inline(always)]
+fn prefetch_child(chunks: &[Chunk], packets: &[TriPacket], c: u32) {
+    if c & LEAF == 0 {
+        super::simd::prefetch(&chunks[c as usize]);
+    } else {
+        super::simd::prefetch(&packets[(c & !LEAF) as usize / LANES]);
     }
 }
 
