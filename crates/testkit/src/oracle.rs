@@ -1,7 +1,7 @@
 //! The brute-force reference: every triangle tested against the ray, the closest hit chosen
 //! in `(t, triangle id)` order. Every structure must match it bit for bit, ray by ray.
 
-use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_accel::{AccelKind, CountingObserver, NoObserver, Structures};
 use dualsplit_geometry::{Hit, PrimId, Ray, Triangle};
 
 /// Closest hit over all triangles on `[t_min, t_max]`, ordered by `(t, triangle id)`: equal
@@ -65,6 +65,21 @@ pub fn check_ray(s: &Structures, tris: &[Triangle], ray: &Ray, what: &str) {
             s.any_hit(kind, ray, &mut NoObserver),
             want_any,
             "{what}: {} any hit vs oracle, ray {ray:?}",
+            kind.name()
+        );
+        // Observed traversals (what the simulator runs) read the image; plain queries may
+        // not (a BVH's CPU-side copy, the DST's plain decoder). Every bit agrees.
+        let observed = s.closest_hit(kind, ray, &mut CountingObserver::default());
+        assert_eq!(
+            hit_bits(observed),
+            hit_bits(got),
+            "{what}: {} observed vs plain closest hit, ray {ray:?}",
+            kind.name()
+        );
+        assert_eq!(
+            s.any_hit(kind, ray, &mut CountingObserver::default()),
+            want_any,
+            "{what}: {} observed any hit vs oracle, ray {ray:?}",
             kind.name()
         );
         // A BVH answers plain queries from its CPU-side copy; its image traversal (what the

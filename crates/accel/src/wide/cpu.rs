@@ -75,7 +75,7 @@ pub struct TriPacket {
     pub prim: [u32; LANES],
 }
 
-const EMPTY_PACKET: TriPacket = TriPacket {
+pub(crate) const EMPTY_PACKET: TriPacket = TriPacket {
     v: [[0.0; LANES]; 9],
     prim: [EMPTY; LANES],
 };
@@ -128,24 +128,16 @@ impl CpuBvh {
                         let run = words[addr] as usize;
                         let first = slots as u32;
                         assert!(first < LEAF, "too many triangle references");
-                        let mut i = run;
-                        loop {
-                            if slots & (LANES - 1) == 0 {
-                                out.packets.push(EMPTY_PACKET);
-                            }
-                            let e = words[i];
-                            let pk = out.packets.last_mut().expect("pushed");
-                            let tri = &triangles[(e & !RUN_END) as usize];
-                            for (r, row) in pk.v.iter_mut().enumerate() {
-                                row[slots % LANES] = tri.v[r / 3][r % 3];
-                            }
-                            pk.prim[slots % LANES] = e;
-                            slots += 1;
-                            if e & RUN_END != 0 {
-                                break;
-                            }
-                            i += 1;
-                        }
+                        let len = words[run..]
+                            .iter()
+                            .position(|&e| e & RUN_END != 0)
+                            .map_or(0, |p| p + 1);
+                        pack_entries(
+                            &mut out.packets,
+                            &mut slots,
+                            words[run..run + len].iter().copied(),
+                            triangles,
+                        );
                         ch.child[l] = LEAF | first;
                     }
                     _ => internal.push((addr, at + lane / LANES, l)),
@@ -300,52 +292,10 @@ impl CpuBvh {
                 }
             } else {
                 let slot = (cur & !LEAF) as usize;
-                let mut i = slot / LANES;
-                // Lanes at or after the leaf's first.
-                let mut from = (0b1111 << (slot % LANES)) & 0b1111;
-                loop {
-                    let pk = &packets[i];
-                    // Lanes the scalar test could accept; it decides each of them.
-                    // Lanes up to the leaf's last (the first id from `from` on with
-                    // bit 31 set: RUN_END or padding).
-                    let ends = f32x4::new(bytemuck::cast(pk.prim)).move_mask() as u32 & from;
-                    let lanes = if ends == 0 {
-                        from
-                    } else {
-                        from & ((ends & ends.wrapping_neg()) << 1).wrapping_sub(1)
-                    };
-                    let mut m = rs.triangle_candidates(pk) & lanes;
-                    while m != 0 {
-                        let l = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        let p = PrimId(pk.prim[l] & !RUN_END);
-                        // The triangle's own words, from the packet (already in cache).
-                        let vertex = |k: usize| {
-                            Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l])
-                        };
-                        let tri = Triangle::new(vertex(0), vertex(1), vertex(2));
-                        if let Some(h) = tri.intersect(&r, ray.t_min, best_t)
-                            && best.is_none_or(|b| !b.closer_than(h.t, p))
-                        {
-                            best = Some(Hit {
-                                t: h.t,
-                                prim: p,
-                                u: h.u,
-                                v: h.v,
-                            });
-                            if ANY {
-                                return best;
-                            }
-                            best_t = h.t;
-                            limit = cull_limit(best_t);
-                        }
-                    }
-                    if ends != 0 {
-                        break;
-                    }
-                    i += 1;
-                    from = 0b1111;
+                if test_leaf::<ANY>(packets, slot, &rs, &r, &mut best, &mut best_t) {
+                    return best;
                 }
+                limit = cull_limit(best_t);
             }
             // Next: the nearest stacked entry not beyond the limit.
             loop {
@@ -371,6 +321,89 @@ fn prefetch_child(chunks: &[Chunk], packets: &[TriPacket], c: u32) {
     }
 }
 
+/// Tests the leaf whose first triangle is at `slot` of `packets` (it ends at the first id
+/// from there with [`RUN_END`]) on `[ray.t_min, best_t]`, keeping the closest hit by
+/// [`Hit::closer_than`] in `best` and `best_t`. Returns true when `ANY` and a hit was
+/// accepted.
+#[inline(always)]
+pub(crate) fn test_leaf<const ANY: bool>(
+    packets: &[TriPacket],
+    slot: usize,
+    rs: &RaySimd,
+    r: &RayPre,
+    best: &mut Option<Hit>,
+    best_t: &mut f32,
+) -> bool {
+    let mut i = slot / LANES;
+    // Lanes at or after the leaf's first.
+    let mut from = (0b1111 << (slot % LANES)) & 0b1111;
+    loop {
+        let pk = &packets[i];
+        // Lanes up to the leaf's last (the first id from `from` on with bit 31 set:
+        // RUN_END or padding).
+        let ends = f32x4::new(bytemuck::cast(pk.prim)).move_mask() as u32 & from;
+        let lanes = if ends == 0 {
+            from
+        } else {
+            from & ((ends & ends.wrapping_neg()) << 1).wrapping_sub(1)
+        };
+        // Lanes the scalar test could accept; it decides each of them.
+        let mut m = rs.triangle_candidates(pk) & lanes;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let p = PrimId(pk.prim[l] & !RUN_END);
+            // The triangle's own words, from the packet (already in cache).
+            let vertex =
+                |k: usize| Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l]);
+            let tri = Triangle::new(vertex(0), vertex(1), vertex(2));
+            if let Some(h) = tri.intersect(r, r.ray.t_min, *best_t)
+                && best.is_none_or(|b| !b.closer_than(h.t, p))
+            {
+                *best = Some(Hit {
+                    t: h.t,
+                    prim: p,
+                    u: h.u,
+                    v: h.v,
+                });
+                if ANY {
+                    return true;
+                }
+                *best_t = h.t;
+            }
+        }
+        if ends != 0 {
+            return false;
+        }
+        i += 1;
+        from = 0b1111;
+    }
+}
+
+/// Appends the triangles of the index-run entries `entries` (ids with [`RUN_END`] on each
+/// run's last) to `packets`, slot after slot from `*slots`, padding nothing: the caller
+/// pads the last packet by starting from [`EMPTY_PACKET`]s.
+pub(crate) fn pack_entries(
+    packets: &mut Vec<TriPacket>,
+    slots: &mut usize,
+    entries: impl IntoIterator<Item = u32>,
+    triangles: &[Triangle],
+) {
+    for e in entries {
+        if *slots & (LANES - 1) == 0 {
+            packets.push(EMPTY_PACKET);
+        }
+        let pk = packets.last_mut().expect("pushed");
+        let tri = &triangles[(e & !RUN_END) as usize];
+        let l = *slots % LANES;
+        for (r, row) in pk.v.iter_mut().enumerate() {
+            row[l] = tri.v[r / 3][r % 3];
+        }
+        pk.prim[l] = e;
+        *slots += 1;
+    }
+}
+
 #[derive(Clone, Copy)]
 struct Entry {
     t: f32,
@@ -384,7 +417,7 @@ thread_local! {
 
 /// The ray's constants broadcast to all lanes, the plane rows its signs pick, and the
 /// watertight test's axes and shear.
-struct RaySimd {
+pub(crate) struct RaySimd {
     o: [f32x4; 3],
     inv: [f32x4; 3],
     near: [usize; 3],
@@ -395,7 +428,9 @@ struct RaySimd {
 }
 
 impl RaySimd {
-    fn new(r: &RayPre) -> Self {
+    /// The constants of the precomputed ray `r`.
+    #[inline(always)]
+    pub(crate) fn new(r: &RayPre) -> Self {
         let o = r.ray.origin;
         let inv = r.inv_dir;
         let s = |a: usize| 3 * r.neg[a] as usize;
