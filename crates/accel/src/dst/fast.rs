@@ -13,6 +13,7 @@ use super::Dst;
 use super::header::HeaderOffset;
 use super::pipeline::le_or_nan;
 use super::traverse::{Entry, Stack};
+use crate::image::Pages;
 use crate::wide::cpu::{RaySimd, TriPacket, pack_entries, test_leaf};
 use dualsplit_geometry::{Hit, Ray, cull_limit, widen_exit};
 use std::sync::Arc;
@@ -31,7 +32,7 @@ impl Dst {
                 img.words[img.indices.clone()].iter().copied(),
                 img.triangle_slice(),
             );
-            Arc::new(packets)
+            Arc::new(Pages::from_slice(&packets))
         })
     }
 

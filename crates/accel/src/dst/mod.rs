@@ -243,7 +243,7 @@ pub struct Dst {
     stats: DstStats,
     /// The triangles of the index region in its order, four to a packet, for the plain
     /// queries' decoder (`fast.rs`); made on first use.
-    packets: std::sync::OnceLock<std::sync::Arc<Vec<crate::wide::cpu::TriPacket>>>,
+    packets: std::sync::OnceLock<std::sync::Arc<crate::image::Pages<crate::wide::cpu::TriPacket>>>,
 }
 
 impl Dst {

@@ -23,7 +23,7 @@
 //! by a rank computed from their entry distances, ties in either order), which changes no
 //! answer.
 
-use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
+use crate::image::{ChildKind, MemoryImage, NodeLayout, Pages, RUN_END};
 use dualsplit_geometry::{EXIT_WIDEN, Hit, PrimId, Ray, RayPre, Triangle, Vec3, cull_limit};
 use std::cell::Cell;
 use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
@@ -39,7 +39,7 @@ const LEAF: u32 = 1 << 31;
 const EMPTY: u32 = u32::MAX;
 
 /// Four children of a node: their boxes plane by plane, then their child words.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(16))]
 pub struct Chunk {
     /// `planes[p][lane]`: plane `p` of the lane's box, in the image's box-word order
@@ -66,7 +66,7 @@ const EMPTY_CHUNK: Chunk = Chunk {
 /// lane, with their ids. Leaves follow one another without padding: a leaf starts at any
 /// lane (its child word names the slot `4 · packet + lane`) and ends at the first lane from
 /// there whose id has [`RUN_END`] set; the last packet is padded with [`EMPTY`] lanes.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(16))]
 pub struct TriPacket {
     /// `v[3 * vertex + axis][lane]`.
@@ -86,9 +86,9 @@ pub struct CpuBvh {
     /// Chunks per node: 1 for BVH2 and BVH4, 2 for BVH8.
     pub chunks_per_node: usize,
     /// The nodes, each `chunks_per_node` consecutive chunks, the root first.
-    pub chunks: Vec<Chunk>,
+    pub chunks: Pages<Chunk>,
     /// The leaves' triangles in leaf order, four to a packet.
-    pub packets: Vec<TriPacket>,
+    pub packets: Pages<TriPacket>,
 }
 
 impl CpuBvh {
@@ -98,8 +98,11 @@ impl CpuBvh {
         let cpn = L::ARITY.div_ceil(LANES);
         let words = &img.words[..];
         let triangles = img.triangle_slice();
-        let mut out = CpuBvh {
-            chunks_per_node: cpn,
+        struct Out {
+            chunks: Vec<Chunk>,
+            packets: Vec<TriPacket>,
+        }
+        let mut out = Out {
             chunks: Vec::new(),
             packets: Vec::new(),
         };
@@ -155,7 +158,11 @@ impl CpuBvh {
             }
             todo.extend(subtrees.into_iter().rev());
         }
-        out
+        CpuBvh {
+            chunks_per_node: cpn,
+            chunks: Pages::from_slice(&out.chunks),
+            packets: Pages::from_slice(&out.packets),
+        }
     }
 
     /// Bytes of the copy (chunks and leaf-ordered triangles).
