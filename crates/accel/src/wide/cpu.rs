@@ -257,7 +257,7 @@ impl CpuBvh {
                     // Three or more: each goes to the stack slot of its rank (the number of
                     // hit children before it by entry distance, ties by slot), nearest on
                     // top; then the nearest is taken.
-                    let count = mask.count_ones() as usize;
+                    let count = ones(mask);
                     let mut m = mask;
                     while m != 0 {
                         let i = m.trailing_zeros() as usize;
@@ -288,7 +288,7 @@ impl CpuBvh {
                             let earlier = ((1u32 << i) - 1) >> (LANES * c);
                             before |= (lt | (eq & earlier)) << (LANES * c);
                         }
-                        let rank = (before & mask).count_ones() as usize;
+                        let rank = ones(before & mask);
                         stack[base + count - 1 - rank] = Entry {
                             t: di,
                             child: child(i),
@@ -316,6 +316,22 @@ impl CpuBvh {
             }
         }
     }
+}
+
+/// Set bits of an 8-bit mask: the x86-64 baseline has no `popcnt`, and `count_ones` becomes
+/// a dozen instructions there; a 256-byte table is one load.
+#[inline(always)]
+fn ones(mask: u32) -> usize {
+    const TABLE: [u8; 256] = {
+        let mut t = [0u8; 256];
+        let mut i = 0;
+        while i < 256 {
+            t[i] = (i as u32).count_ones() as u8;
+            i += 1;
+        }
+        t
+    };
+    TABLE[(mask & 0xff) as usize] as usize
 }
 
 /// Prefetches the first chunk of child word `c`'s node or the first packet of its leaf.
