@@ -14,14 +14,19 @@
 //!   `maxps`/`minps` keep the running bound when a plane distance is NaN, exactly as the
 //!   scalar `if tn > entry`); rays whose interval ends are NaN take the image traversal;
 //! * the triangle test is the same [`Triangle::intersect`] on the same triangle words (a SIMD
-//!   first stage only drops triangles that it would reject at that stage), and hits are kept by [`Hit::closer_than`]'s `(t, prim)` order, which makes the closest hit
-//!   independent of the order in which leaves are visited;
+//!   first stage only drops triangles that it would reject at that stage), and hits are kept
+//!   by [`Hit::closer_than`]'s `(t, prim)` order, which makes the closest hit independent of
+//!   the order in which leaves are visited;
 //! * nodes are culled against the same [`cull_limit`] of the best `t`, which keeps every
 //!   leaf that can hold an equally near hit with a smaller id.
 //!
 //! Only the visiting order of a node's hit children differs (nearest first, the rest pushed
-//! by a rank computed from their entry distances, ties in either order), which changes no
-//! answer.
+//! by a rank computed from their entry distances, ties in either order; for shadow rays the
+//! first hit child first and the rest as they come), which changes no answer.
+//!
+//! Hit children about to be pushed are prefetched (`simd.rs`), and the chunks and packets
+//! live in transparent huge pages ([`Pages`]). Figures: `docs/performance.md`, "CPU
+//! traversal".
 
 use crate::image::{ChildKind, MemoryImage, NodeLayout, Pages, RUN_END};
 use dualsplit_geometry::{EXIT_WIDEN, Hit, PrimId, Ray, RayPre, Triangle, Vec3, cull_limit};
@@ -31,12 +36,12 @@ use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
 /// Children per chunk: one SSE register of `f32`.
 pub const LANES: usize = 4;
 
-/// Child word of a leaf: bit 31 set, bits 0–30 the index of its first triangle in
-/// [`CpuBvh::tris`].
-const LEAF: u32 = 1 << 31;
+/// Child word of a leaf: bit 31 set, bits 0–30 the slot of its first triangle in
+/// [`CpuBvh::packets`] (`4 · packet + lane`).
+pub const LEAF: u32 = 1 << 31;
 
 /// Child word of an empty lane.
-const EMPTY: u32 = u32::MAX;
+pub const EMPTY: u32 = u32::MAX;
 
 /// Four children of a node: their boxes plane by plane, then their child words.
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
