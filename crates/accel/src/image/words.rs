@@ -205,6 +205,20 @@ mod tests {
     }
 
     #[test]
+    fn pages_copy_small_and_large_slices() {
+        let small: Vec<[u32; 4]> = (0..10).map(|i| [i, i + 1, i + 2, i + 3]).collect();
+        assert_eq!(&Pages::from_slice(&small)[..], &small[..]);
+        let n = MAPPED_MIN_BYTES / 16 + 5;
+        let big: Vec<[u32; 4]> = (0..n as u32).map(|i| [i, !i, i ^ 7, 3]).collect();
+        let pages = Pages::from_slice(&big);
+        assert_eq!(&pages[..], &big[..]);
+        #[cfg(unix)]
+        assert!(format!("{pages:?}").contains("mapped: true"));
+        assert_eq!(&pages.clone()[..], &big[..]);
+        assert!(Pages::<u32>::default().is_empty());
+    }
+
+    #[test]
     fn vectors_convert_both_ways() {
         let w = Words::from(vec![1, 2, 3]);
         assert_eq!(&w[..], &[1, 2, 3]);

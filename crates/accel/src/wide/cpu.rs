@@ -530,34 +530,152 @@ impl RaySimd {
 /// `if x > bound { x } else { bound }` per lane: a NaN `x` keeps the bound.
 #[inline(always)]
 fn keep_max(x: f32x4, bound: f32x4) -> f32x4 {
-    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    #[cfg(all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    ))]
     {
-        // `maxps x, bound` is `x > bound ? x : bound`.
+        // `maxps x, bound` is `x > bound ? x : bound` (`wide` uses it where SSE is on).
         x.fast_max(bound)
     }
-    #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
+    #[cfg(not(all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    )))]
     {
-        x.cmp_gt(bound).blend(x, bound)
+        keep_max_portable(x, bound)
     }
+}
+
+/// [`keep_max`] by compare and blend, for targets without SSE's `maxps`.
+#[inline(always)]
+#[cfg_attr(
+    all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    ),
+    allow(dead_code)
+)]
+fn keep_max_portable(x: f32x4, bound: f32x4) -> f32x4 {
+    x.cmp_gt(bound).blend(x, bound)
 }
 
 /// `if x < bound { x } else { bound }` per lane: a NaN `x` keeps the bound.
 #[inline(always)]
 fn keep_min(x: f32x4, bound: f32x4) -> f32x4 {
-    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    #[cfg(all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    ))]
     {
-        // `minps x, bound` is `x < bound ? x : bound`.
+        // `minps x, bound` is `x < bound ? x : bound` (`wide` uses it where SSE is on).
         x.fast_min(bound)
     }
-    #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
+    #[cfg(not(all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    )))]
     {
-        x.cmp_lt(bound).blend(x, bound)
+        keep_min_portable(x, bound)
     }
+}
+
+/// [`keep_min`] by compare and blend, for targets without SSE's `minps`.
+#[inline(always)]
+#[cfg_attr(
+    all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    ),
+    allow(dead_code)
+)]
+fn keep_min_portable(x: f32x4, bound: f32x4) -> f32x4 {
+    x.cmp_lt(bound).blend(x, bound)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use dualsplit_geometry::Pcg32;
+
+    /// A coordinate from a small set (box planes through the ray's origin, zero direction
+    /// components, so NaN plane distances) or random.
+    fn coord(rng: &mut Pcg32) -> f32 {
+        match rng.below(6) {
+            0 => 0.0,
+            1 => -0.0,
+            2 => 1.0,
+            3 => -1.0,
+            _ => rng.range_f32(-4.0, 4.0),
+        }
+    }
+
+    /// The chunk test gives, lane by lane, `RayPre::slab`'s hit or miss and entry distance
+    /// (up to the sign of a zero) for every non-NaN interval, with empty lanes never hit.
+    #[test]
+    fn chunk_test_matches_ray_slab() {
+        let mut rng = Pcg32::new(11, 5);
+        let ends = [0.0, -0.0, 0.5, 1e-3, f32::INFINITY, f32::NEG_INFINITY, 3.0];
+        for case in 0..50_000 {
+            let v = |rng: &mut Pcg32| Vec3::new(coord(rng), coord(rng), coord(rng));
+            let r = Ray::new(v(&mut rng), v(&mut rng)).precompute();
+            let mut ch = EMPTY_CHUNK;
+            let mut boxes = Vec::new();
+            for l in 0..LANES {
+                if rng.below(5) == 0 {
+                    continue;
+                }
+                let (p, q) = (v(&mut rng), v(&mut rng));
+                let (lo, hi) = (p.min(q), p.max(q));
+                let w = [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z];
+                for (k, &x) in w.iter().enumerate() {
+                    ch.planes[k][l] = x;
+                }
+                ch.child[l] = l as u32;
+                boxes.push((l, lo, hi));
+            }
+            let t_lo = ends[rng.below(ends.len() as u32) as usize];
+            let t_hi = ends[rng.below(ends.len() as u32) as usize];
+            let (entry, mask) = RaySimd::new(&r).test(&ch, f32x4::splat(t_lo), f32x4::splat(t_hi));
+            let entry = entry.to_array();
+            let mut want = 0;
+            for (l, lo, hi) in boxes {
+                let (e, x) = r.slab(lo, hi, t_lo, t_hi);
+                if e <= x {
+                    want |= 1 << l;
+                    assert_eq!(entry[l], e, "case {case} lane {l}");
+                }
+            }
+            assert_eq!(mask, want, "case {case}: {r:?}");
+        }
+    }
+
+    /// The packet's first stage drops a lane only where `Triangle::intersect` misses: on
+    /// triangles and rays with coordinates from a small set (edges through the ray, zero
+    /// edge functions, degenerate triangles) and random ones.
+    #[test]
+    fn triangle_candidates_keep_every_hit() {
+        let mut rng = Pcg32::new(3, 9);
+        let mut hits = 0;
+        for case in 0..50_000 {
+            let v = |rng: &mut Pcg32| Vec3::new(coord(rng), coord(rng), coord(rng));
+            let r = Ray::new(v(&mut rng), v(&mut rng)).precompute();
+            let tris: Vec<Triangle> = (0..LANES)
+                .map(|_| Triangle::new(v(&mut rng), v(&mut rng), v(&mut rng)))
+                .collect();
+            let mut packets = Vec::new();
+            let mut slots = 0;
+            pack_entries(&mut packets, &mut slots, [0, 1, 2, 3 | RUN_END], &tris);
+            let m = RaySimd::new(&r).triangle_candidates(&packets[0]);
+            for (l, t) in tris.iter().enumerate() {
+                if t.intersect(&r, f32::NEG_INFINITY, f32::INFINITY).is_some() {
+                    hits += 1;
+                    assert!(m & (1 << l) != 0, "case {case} lane {l}: {t:?} {r:?}");
+                }
+            }
+        }
+        assert!(hits > 1000, "{hits} hits");
+    }
 
     /// `keep_max`/`keep_min` keep the bound for a NaN lane, as the scalar compare does.
     #[test]
@@ -566,5 +684,14 @@ mod tests {
         let b = f32x4::new([1.0, 1.0, 1.0, 1.0]);
         assert_eq!(keep_max(x, b).to_array(), [1.0, 2.0, 1.0, f32::INFINITY]);
         assert_eq!(keep_min(x, b).to_array(), [1.0, 1.0, -1.0, 1.0]);
+        // The compare-and-blend forms other targets use agree.
+        assert_eq!(
+            keep_max_portable(x, b).to_array(),
+            keep_max(x, b).to_array()
+        );
+        assert_eq!(
+            keep_min_portable(x, b).to_array(),
+            keep_min(x, b).to_array()
+        );
     }
 }
