@@ -160,6 +160,64 @@ fn configurations_are_read_only_from_small_regular_files() {
 }
 
 #[test]
+fn configuration_values_outside_their_ranges_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = |toml: &str, model: &str| {
+        std::fs::write(dir.path().join("c.toml"), toml).unwrap();
+        dualsplit(
+            &[
+                "simulate",
+                "builtin:cornell",
+                "--res",
+                "4",
+                "--model",
+                model,
+                "--config",
+                "c.toml",
+            ],
+            dir.path(),
+        )
+    };
+    // Each once aborted with "memory allocation of N bytes failed", wrapped, or printed
+    // "0 rays" or "NaN J".
+    for (toml, says) in [
+        (
+            "tms = 4294967295",
+            "`tms` = 4294967295 is invalid: must be an integer from 1 to 1024 TMs",
+        ),
+        ("tps_per_tm = 1000000", "`tps_per_tm` = 1000000"),
+        (
+            "[l2]\nsize_bytes = 68719476736",
+            "`l2.size_bytes` = 68719476736",
+        ),
+        (
+            "[units]\nbox_pipes = 4000000000",
+            "`units.box_pipes` = 4000000000",
+        ),
+        (
+            "[dram]\nchannels = 1073741824",
+            "`dram.channels` = 1073741824",
+        ),
+        (
+            "[l1]\nhit_latency = 1000000000000",
+            "`l1.hit_latency` = 1000000000000",
+        ),
+        ("[dram]\nt_cas = 9223372036854775807", "`dram.t_cas`"),
+        ("tms = 65536\ntps_per_tm = 65536", "`tms` = 65536"),
+        ("[energy]\nl1_nj = nan", "`energy.l1_nj` = NaN"),
+    ] {
+        fails_with(&sim(toml, "fast"), says);
+    }
+    fails_with(
+        &sim(
+            "tms = 1024\ntps_per_tm = 1024\n[units]\nlocal_store_bytes = 1048576",
+            "rv32",
+        ),
+        "at most 8192 MiB",
+    );
+}
+
+#[test]
 fn ray_counts_are_bounded() {
     let dir = tempfile::tempdir().unwrap();
     for cmd in ["check", "stats"] {

@@ -42,10 +42,12 @@ mod compiled;
 pub mod config;
 mod cycle;
 pub mod energy;
+pub mod footprint;
 pub mod fu;
 pub mod kernel;
 pub mod kernels;
 pub mod memory;
+pub mod ranges;
 pub mod rv32;
 mod scheduler;
 mod shares;
@@ -316,9 +318,25 @@ pub enum SimError {
     /// instruction).
     #[error("kernel: {0}")]
     Exec(#[from] rv32::ExecError),
+    /// The simulation would take more host memory than [`footprint::MAX_SIM_BYTES`].
+    #[error(
+        "the simulation would need about {} MiB of memory (threads {} MiB, caches and units {} MiB, DRAM model {} MiB, frame {} MiB, fixed {} MiB); at most {} MiB: lower tms, tps_per_tm, units.local_store_bytes, the cache sizes or the resolution",
+        mib(need.total()), mib(need.threads), mib(need.caches), mib(need.dram), mib(need.frame), mib(need.fixed), mib(*limit)
+    )]
+    Memory {
+        /// The estimate, by term.
+        need: footprint::Footprint,
+        /// The limit.
+        limit: u64,
+    },
     /// The `fast` model's measured costs are missing or unreadable.
     #[error("fast model: {0}")]
     Calibration(#[from] calibrate::CalibrationError),
+}
+
+/// Bytes in MiB, rounded up.
+fn mib(bytes: u64) -> u64 {
+    bytes.div_ceil(1 << 20)
 }
 
 /// Simulates one frame of `settings` on `scene` with configuration `accel`, the threads
@@ -360,6 +378,8 @@ pub fn simulate_model(
             height: settings.height,
         });
     }
+    let pixels = settings.width as u64 * settings.height as u64;
+    footprint::check(cfg, accel, model, pixels)?;
     match model {
         ThreadModel::Rv32 => compiled::run(scene, structures, accel, settings, cfg, progress),
         ThreadModel::Fast => workload::run(scene, structures, accel, settings, cfg, progress),

@@ -95,6 +95,10 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         cfg.tms = t;
     }
     cfg.validate()?;
+    for &accel in &accels {
+        let pixels = args.res.0 as u64 * args.res.1 as u64;
+        dualsplit_sim::footprint::check(&cfg, accel, model, pixels)?;
+    }
 
     let mut scene = super::load(&args.scene, ctx)?;
     args.view.apply(&mut scene)?;
