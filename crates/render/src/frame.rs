@@ -51,6 +51,49 @@ pub const MAX_BOUNCES: u32 = 1 << 10;
 /// it. The limits are [`MAX_SIDE`], [`MAX_PIXELS`], [`MAX_SPP`], [`MAX_SAMPLES`] and
 /// [`MAX_BOUNCES`]; an error says which one and its value.
 pub fn validate(scene: &Scene, settings: &RenderSettings) -> Result<(), RenderError> {
+    validate_frame(settings)?;
+    let c = &scene.camera;
+    let cam_err = |reason| RenderError::Camera {
+        eye: c.eye.to_array(),
+        target: c.target.to_array(),
+        up: c.up.to_array(),
+        fov_y_deg: c.fov_y_deg,
+        reason,
+    };
+    if !(c.eye.is_finite() && c.target.is_finite() && c.up.is_finite() && c.fov_y_deg.is_finite()) {
+        return Err(cam_err("non-finite value"));
+    }
+    if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
+        return Err(cam_err(
+            "the field of view must lie strictly between 0° and 180°",
+        ));
+    }
+    let fwd = (c.target - c.eye).normalize_or_zero();
+    if fwd == glam::Vec3::ZERO {
+        return Err(cam_err("eye and target coincide"));
+    }
+    if fwd.cross(c.up).normalize_or_zero() == glam::Vec3::ZERO {
+        return Err(cam_err("the view direction is parallel to the up vector"));
+    }
+    let l = &scene.light;
+    if !(l.position.is_finite()
+        && l.radius.is_finite()
+        && l.radius >= 0.0
+        && l.intensity.is_finite()
+        && l.intensity >= 0.0)
+    {
+        return Err(RenderError::Light {
+            position: l.position.to_array(),
+            radius: l.radius,
+            intensity: l.intensity,
+        });
+    }
+    Ok(())
+}
+
+/// The scene-independent part of [`validate`]: frame size, samples and bounces, so a caller
+/// can refuse a frame before it loads the scene.
+pub fn validate_frame(settings: &RenderSettings) -> Result<(), RenderError> {
     let bad = |reason: String| RenderError::Settings {
         width: settings.width,
         height: settings.height,
@@ -87,42 +130,6 @@ pub fn validate(scene: &Scene, settings: &RenderSettings) -> Result<(), RenderEr
             "{} bounces; at most {MAX_BOUNCES}",
             settings.bounces
         )));
-    }
-    let c = &scene.camera;
-    let cam_err = |reason| RenderError::Camera {
-        eye: c.eye.to_array(),
-        target: c.target.to_array(),
-        up: c.up.to_array(),
-        fov_y_deg: c.fov_y_deg,
-        reason,
-    };
-    if !(c.eye.is_finite() && c.target.is_finite() && c.up.is_finite() && c.fov_y_deg.is_finite()) {
-        return Err(cam_err("non-finite value"));
-    }
-    if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
-        return Err(cam_err(
-            "the field of view must lie strictly between 0° and 180°",
-        ));
-    }
-    let fwd = (c.target - c.eye).normalize_or_zero();
-    if fwd == glam::Vec3::ZERO {
-        return Err(cam_err("eye and target coincide"));
-    }
-    if fwd.cross(c.up).normalize_or_zero() == glam::Vec3::ZERO {
-        return Err(cam_err("the view direction is parallel to the up vector"));
-    }
-    let l = &scene.light;
-    if !(l.position.is_finite()
-        && l.radius.is_finite()
-        && l.radius >= 0.0
-        && l.intensity.is_finite()
-        && l.intensity >= 0.0)
-    {
-        return Err(RenderError::Light {
-            position: l.position.to_array(),
-            radius: l.radius,
-            intensity: l.intensity,
-        });
     }
     Ok(())
 }

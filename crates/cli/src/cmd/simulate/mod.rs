@@ -95,6 +95,10 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         cfg.tms = t;
     }
     cfg.validate()?;
+    // The frame obeys the renderer's limits, and the chip and frame fit the simulator's
+    // memory bound, before the scene is loaded.
+    let settings = RenderSettings::new(args.res.0, args.res.1, workload);
+    dualsplit_render::validate_frame(&settings)?;
     for &accel in &accels {
         let pixels = args.res.0 as u64 * args.res.1 as u64;
         dualsplit_sim::footprint::check(&cfg, accel, model, pixels)?;
@@ -102,7 +106,6 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
 
     let mut scene = super::load(&args.scene, ctx)?;
     args.view.apply(&mut scene)?;
-    let settings = RenderSettings::new(args.res.0, args.res.1, workload);
     // The frame and the camera obey the renderer's limits (the simulator renders the same
     // image), checked before the structures are built.
     dualsplit_render::validate(&scene, &settings)?;
