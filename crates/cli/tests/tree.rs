@@ -270,3 +270,24 @@ fn a_structure_the_tree_does_not_hold_is_refused() {
     }
     assert!(!d.join("x.png").exists());
 }
+
+#[test]
+fn build_loads_its_scene_within_the_budgets() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let e = refused(
+        &[
+            "--max-triangles",
+            "10",
+            "build",
+            SCENE,
+            "--accel",
+            "dst",
+            "-o",
+            "c.dst",
+        ],
+        d,
+    );
+    assert!(e.contains("10"), "{e}");
+    assert!(!d.join("c.dst").exists());
+}
