@@ -14,6 +14,7 @@
 //! let dst = AnyTree::from(DstTree::from_bvh2(&bvh2, &DstConfig::hardware())?);
 //! assert_eq!(dst.kinds(), [AccelKind::DstSw, AccelKind::Dst]);
 //! assert!(!dst.supports(AccelKind::Bvh2));
+//! assert_eq!(dst.kind_names(), "dst-sw, dst");
 //! let ray = Ray::new(Vec3::ZERO, Vec3::Z);
 //! fn t(s: &impl TraversalSet, kind: AccelKind, ray: &Ray) -> Option<f32> {
 //!     TraversalSet::closest_hit(s, kind, ray, &mut NoObserver).map(|h| h.t)
@@ -43,6 +44,13 @@ pub trait TraversalSet: Sync {
     /// True when `kind` is one of [`TraversalSet::kinds`].
     fn supports(&self, kind: AccelKind) -> bool {
         self.kinds().contains(&kind)
+    }
+
+    /// The command-line names of [`TraversalSet::kinds`], comma-separated (`dst-sw, dst`),
+    /// for messages.
+    fn kind_names(&self) -> String {
+        let names: Vec<&str> = self.kinds().iter().map(|k| k.name()).collect();
+        names.join(", ")
     }
 
     /// The reference traversal: the first of [`TraversalSet::kinds`].

@@ -5,8 +5,8 @@
 //! A saved tree answers the traversals of its structure only: `dst-sw` and `dst` for a DST,
 //! its own kind for a BVH2, BVH4 or BVH8 ([`dualsplit_accel::TreeKind::accel_kinds`]).
 //! Asking `--accel` for another is an error that names the file and what it holds. The
-//! tree must come from the scene given: its triangle hash is checked against the scene's
-//! triangles when it is loaded.
+//! tree must come from the scene given: its triangles are checked against the scene's when
+//! it is loaded.
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::{
@@ -93,13 +93,12 @@ impl Loaded {
     pub fn require(&self, value: &str, kind: AccelKind) -> anyhow::Result<()> {
         match self {
             Loaded::Saved { tree, file, .. } if !tree.supports(kind) => {
-                let names: Vec<_> = tree.kinds().iter().map(|k| k.name()).collect();
                 anyhow::bail!(
                     "--accel {value}: tree file {} holds a {}, whose traversals are {}; \
                      save a {} tree with `dualsplit build SCENE --accel {}`, or leave out --tree",
                     file.display(),
                     tree.kind(),
-                    names.join(", "),
+                    tree.kind_names(),
                     dualsplit_accel::TreeKind::of_accel(kind),
                     dualsplit_accel::TreeKind::of_accel(kind)
                 )

@@ -221,12 +221,7 @@ pub fn supported<S: TraversalSet>(structures: &S, kind: AccelKind) -> Result<(),
     } else {
         Err(RenderError::Unsupported {
             accel: kind.name(),
-            available: structures
-                .kinds()
-                .iter()
-                .map(|k| k.name())
-                .collect::<Vec<_>>()
-                .join(", "),
+            available: structures.kind_names(),
         })
     }
 }

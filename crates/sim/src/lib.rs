@@ -366,12 +366,7 @@ pub fn simulate_model<S: TraversalSet>(
     if !structures.supports(accel.kind()) {
         return Err(SimError::Unsupported {
             accel: accel.label(),
-            available: structures
-                .kinds()
-                .iter()
-                .map(|k| k.name())
-                .collect::<Vec<_>>()
-                .join(", "),
+            available: structures.kind_names(),
         });
     }
     if settings.width == 0 || settings.height == 0 {

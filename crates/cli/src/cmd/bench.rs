@@ -49,7 +49,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', value_parser = parse_accel)]
     accel: Vec<AccelKind>,
     /// Measure the tree saved in FILE by `dualsplit build` instead of building; it must come
-    /// from SCENE (its triangles' hash is checked). Only its traversals exist (dst-sw and dst
+    /// from SCENE (its triangles are checked). Only its traversals exist (dst-sw and dst
     /// for a DST, its own kind for a BVH); the rays and their expected answers come from its
     /// first one (`check --tree` compares a saved tree with a fresh BVH2).
     #[arg(long, value_name = "FILE")]

@@ -31,7 +31,7 @@ pub struct Args {
     #[arg(long, default_value_t = 20_000, value_parser = super::rays::parse_count)]
     rays: usize,
     /// Check the tree saved in FILE by `dualsplit build` instead of every structure: it must
-    /// come from SCENE (its triangles' hash is checked); it is validated and each of its
+    /// come from SCENE (its triangles are checked); it is validated and each of its
     /// traversals is compared ray by ray with a BVH2 built afresh from SCENE.
     #[arg(long, value_name = "FILE")]
     tree: Option<std::path::PathBuf>,

@@ -28,7 +28,7 @@ pub struct Args {
     #[arg(long, value_parser = parse_accel)]
     accel: Option<AccelKind>,
     /// Render with the tree saved in FILE by `dualsplit build` instead of building; it must
-    /// come from SCENE (its triangles' hash is checked). Only its traversals exist: dst-sw
+    /// come from SCENE (its triangles are checked). Only its traversals exist: dst-sw
     /// and dst for a DST, its own kind for a BVH.
     #[arg(long, value_name = "FILE")]
     tree: Option<PathBuf>,

@@ -37,7 +37,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', value_parser = parse_sim_accel)]
     accel: Vec<SimAccelArg>,
     /// Simulate the tree saved in FILE by `dualsplit build` instead of building; it must
-    /// come from SCENE (its triangles' hash is checked). Only its configurations exist:
+    /// come from SCENE (its triangles are checked). Only its configurations exist:
     /// dst-sw and dst for a DST, bvh4 and bvh4+ for a BVH4, and so on.
     #[arg(long, value_name = "FILE")]
     tree: Option<std::path::PathBuf>,
