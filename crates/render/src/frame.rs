@@ -6,7 +6,7 @@
 
 use crate::trace::run_job;
 use crate::{Image, PixelJob, PixelRecord, RayCounts, RenderError, RenderSettings, trace_pixel};
-use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_accel::{AccelKind, NoObserver, TraversalSet};
 use dualsplit_scene::Scene;
 use rayon::prelude::*;
 
@@ -155,14 +155,17 @@ fn tiles(settings: &RenderSettings) -> Vec<(u32, u32, u32, u32)> {
 ///
 /// Every [`AccelKind`] returns a bit-identical [`Frame`]: the structures return bit-identical
 /// hits (the geometry crate's robustness rules), and the jobs depend on nothing else.
-pub fn render(
+/// `structures` is every structure of the scene or one tree ([`TraversalSet`]); a `kind` it
+/// lacks is a [`RenderError::Unsupported`].
+pub fn render<S: TraversalSet>(
     scene: &Scene,
-    structures: &Structures,
+    structures: &S,
     kind: AccelKind,
     settings: &RenderSettings,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Frame, RenderError> {
     validate(scene, settings)?;
+    supported(structures, kind)?;
     let done: Vec<(Vec<f32>, RayCounts)> = tiles(settings)
         .into_par_iter()
         .map(|(x0, y0, x1, y1)| {
@@ -201,13 +204,14 @@ pub fn render(
 /// Traces every pixel of the frame with [`trace_pixel`] (in parallel over rows) and returns
 /// the records in row-major order. Memory grows with the ray count: meant for tests, the
 /// simulator's reference streams and small frames.
-pub fn render_records(
+pub fn render_records<S: TraversalSet>(
     scene: &Scene,
-    structures: &Structures,
+    structures: &S,
     kind: AccelKind,
     settings: &RenderSettings,
 ) -> Result<Vec<PixelRecord>, RenderError> {
     validate(scene, settings)?;
+    supported(structures, kind)?;
     Ok((0..settings.height)
         .into_par_iter()
         .flat_map_iter(|y| {
@@ -215,4 +219,16 @@ pub fn render_records(
                 .map(move |x| trace_pixel(structures, kind, scene, settings, x, y, &mut NoObserver))
         })
         .collect())
+}
+
+/// Ok when `structures` has traversal `kind`, else [`RenderError::Unsupported`].
+pub fn supported<S: TraversalSet>(structures: &S, kind: AccelKind) -> Result<(), RenderError> {
+    if structures.supports(kind) {
+        Ok(())
+    } else {
+        Err(RenderError::Unsupported {
+            accel: kind.name(),
+            available: structures.kind_names(),
+        })
+    }
 }

@@ -71,7 +71,7 @@ pub use shares::StallShares;
 pub use thread::{Stalls, Thread};
 pub use tm::{Issued, Tm, UnitStats, WordAddr};
 
-use dualsplit_accel::{AccelKind, Structures};
+use dualsplit_accel::{AccelKind, TraversalSet};
 use dualsplit_render::RenderSettings;
 use dualsplit_scene::Scene;
 use serde::{Deserialize, Serialize};
@@ -329,6 +329,15 @@ pub enum SimError {
         /// The limit.
         limit: u64,
     },
+    /// The structures given have no traversal for this configuration (one saved tree holds
+    /// one structure).
+    #[error("no {accel} traversal here: the structures given have {available}")]
+    Unsupported {
+        /// The configuration asked for.
+        accel: &'static str,
+        /// The traversals there are, comma-separated.
+        available: String,
+    },
     /// The `fast` model's measured costs are missing or unreadable.
     #[error("fast model: {0}")]
     Calibration(#[from] calibrate::CalibrationError),
@@ -342,9 +351,9 @@ fn mib(bytes: u64) -> u64 {
 /// Simulates one frame of `settings` on `scene` with configuration `accel`, the threads
 /// executing the compiled kernels ([`ThreadModel::Rv32`]); `progress` is called with
 /// (pixels done, pixels total).
-pub fn simulate(
+pub fn simulate<S: TraversalSet>(
     scene: &Scene,
-    structures: &Structures,
+    structures: &S,
     accel: SimAccel,
     settings: &RenderSettings,
     cfg: &SimConfig,
@@ -362,16 +371,22 @@ pub fn simulate(
 }
 
 /// [`simulate`] with the threads' execution model `model`.
-pub fn simulate_model(
+pub fn simulate_model<S: TraversalSet>(
     model: ThreadModel,
     scene: &Scene,
-    structures: &Structures,
+    structures: &S,
     accel: SimAccel,
     settings: &RenderSettings,
     cfg: &SimConfig,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<SimResult, SimError> {
     cfg.validate()?;
+    if !structures.supports(accel.kind()) {
+        return Err(SimError::Unsupported {
+            accel: accel.label(),
+            available: structures.kind_names(),
+        });
+    }
     if settings.width == 0 || settings.height == 0 {
         return Err(SimError::EmptyFrame {
             width: settings.width,
