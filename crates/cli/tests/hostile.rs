@@ -126,24 +126,23 @@ fn render_states_the_real_limits() {
     fails_with(&out, "at most 65536 samples per pixel");
 }
 
+/// `simulate builtin:cornell` at 4² on thread model `model` with `--config config`.
+fn simulate_with_config(config: &str, model: &str, dir: &Path) -> Output {
+    let args = [
+        "simulate",
+        "builtin:cornell",
+        "--res",
+        "4",
+        "--model",
+        model,
+    ];
+    dualsplit(&[&args[..], &["--config", config]].concat(), dir)
+}
+
 #[test]
 fn configurations_are_read_only_from_small_regular_files() {
     let dir = tempfile::tempdir().unwrap();
-    let sim = |config: &str| {
-        dualsplit(
-            &[
-                "simulate",
-                "builtin:cornell",
-                "--res",
-                "4",
-                "--model",
-                "fast",
-                "--config",
-                config,
-            ],
-            dir.path(),
-        )
-    };
+    let sim = |config: &str| simulate_with_config(config, "fast", dir.path());
     fails_with(&sim("/dev/zero"), "not a regular file");
     std::fs::write(dir.path().join("big.toml"), vec![b'#'; 2 << 20]).unwrap();
     fails_with(&sim("big.toml"), "larger than 1048576 bytes");
@@ -164,19 +163,7 @@ fn configuration_values_outside_their_ranges_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let sim = |toml: &str, model: &str| {
         std::fs::write(dir.path().join("c.toml"), toml).unwrap();
-        dualsplit(
-            &[
-                "simulate",
-                "builtin:cornell",
-                "--res",
-                "4",
-                "--model",
-                model,
-                "--config",
-                "c.toml",
-            ],
-            dir.path(),
-        )
+        simulate_with_config("c.toml", model, dir.path())
     };
     // Each once aborted with "memory allocation of N bytes failed", wrapped, or printed
     // "0 rays" or "NaN J".
