@@ -8,7 +8,9 @@
 //!
 //! Every traversal is generic over an [`Observer`] (the one-traversal contract: README,
 //! "What is where").
-//! [`Structures`] builds all of them from one scene and dispatches by [`AccelKind`].
+//! [`Structures`] builds all of them from one scene and dispatches by [`AccelKind`];
+//! [`TraversalSet`] is what the renderer and the simulator run on: [`Structures`], or one
+//! [`AnyTree`] (built alone or loaded from a saved file).
 //!
 //! ## Using the library
 //!
@@ -50,6 +52,7 @@ pub mod image;
 pub mod observer;
 pub mod query;
 pub mod saved;
+pub mod set;
 pub mod stats;
 pub mod tree;
 pub mod validate;
@@ -74,6 +77,7 @@ pub use dst::{Dst, DstConfig};
 pub use query::{DstPipeline, RayQuery};
 /// The rayon crate builds and batch queries run on (for [`rayon::ThreadPool`]).
 pub use rayon;
+pub use set::TraversalSet;
 pub use tree::{AnyTree, BuildStats, Bvh2Tree, BvhTree, DstDecoding, DstTree, TreeKind};
 
 use dualsplit_geometry::{Aabb, Hit, Ray, Triangle};

@@ -216,3 +216,32 @@ fn both_dst_decodings_read_a_loaded_dst() {
         );
     }
 }
+
+/// The seeds of the `tree` fuzz target (`fuzz/seeds/tree`) are the files this code writes
+/// for 12 triangles of the Cornell box, one of each kind (both DST presets), so they stay
+/// valid when the format changes: `DUALSPLIT_WRITE_SEEDS=1 cargo test -p dualsplit-accel
+/// --test saved_tree fuzz_seeds` rewrites them.
+#[test]
+fn fuzz_seeds_are_the_files_this_code_writes() {
+    let tris = &scene("builtin:cornell")[..12];
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds/tree");
+    let write = std::env::var_os("DUALSPLIT_WRITE_SEEDS").is_some();
+    let names = ["bvh2", "bvh4", "bvh8", "dst", "dst_software"];
+    for (tree, name) in trees(tris).iter().zip(names) {
+        let bytes = tree.to_bytes();
+        let path = dir.join(name);
+        if write {
+            std::fs::create_dir_all(&dir).expect("seed folder");
+            std::fs::write(&path, &bytes).expect("write seed");
+        }
+        let seed = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(
+            seed == bytes,
+            "{} is not the file this code writes; rerun with DUALSPLIT_WRITE_SEEDS=1",
+            path.display()
+        );
+        assert!(seed.len() < 8 << 10, "{name}: {} bytes", seed.len());
+        let back = AnyTree::from_bytes(&seed, Some(tris)).expect("a seed loads");
+        assert_eq!(back.to_bytes(), seed);
+    }
+}

@@ -5,6 +5,7 @@ mod args;
 mod cmd;
 mod input;
 mod lists;
+mod loaded;
 mod output;
 mod progress;
 

@@ -4,8 +4,9 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-const SUBCOMMANDS: [&str; 8] = [
+const SUBCOMMANDS: [&str; 9] = [
     "info",
+    "build",
     "stats",
     "check",
     "render",

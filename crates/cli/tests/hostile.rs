@@ -126,24 +126,23 @@ fn render_states_the_real_limits() {
     fails_with(&out, "at most 65536 samples per pixel");
 }
 
+/// `simulate builtin:cornell` at 4² on thread model `model` with `--config config`.
+fn simulate_with_config(config: &str, model: &str, dir: &Path) -> Output {
+    let args = [
+        "simulate",
+        "builtin:cornell",
+        "--res",
+        "4",
+        "--model",
+        model,
+    ];
+    dualsplit(&[&args[..], &["--config", config]].concat(), dir)
+}
+
 #[test]
 fn configurations_are_read_only_from_small_regular_files() {
     let dir = tempfile::tempdir().unwrap();
-    let sim = |config: &str| {
-        dualsplit(
-            &[
-                "simulate",
-                "builtin:cornell",
-                "--res",
-                "4",
-                "--model",
-                "fast",
-                "--config",
-                config,
-            ],
-            dir.path(),
-        )
-    };
+    let sim = |config: &str| simulate_with_config(config, "fast", dir.path());
     fails_with(&sim("/dev/zero"), "not a regular file");
     std::fs::write(dir.path().join("big.toml"), vec![b'#'; 2 << 20]).unwrap();
     fails_with(&sim("big.toml"), "larger than 1048576 bytes");
@@ -157,6 +156,52 @@ fn configurations_are_read_only_from_small_regular_files() {
         assert!(ok);
         fails_with(&sim("pipe.toml"), "not a regular file");
     }
+}
+
+#[test]
+fn configuration_values_outside_their_ranges_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = |toml: &str, model: &str| {
+        std::fs::write(dir.path().join("c.toml"), toml).unwrap();
+        simulate_with_config("c.toml", model, dir.path())
+    };
+    // Each once aborted with "memory allocation of N bytes failed", wrapped, or printed
+    // "0 rays" or "NaN J".
+    for (toml, says) in [
+        (
+            "tms = 4294967295",
+            "`tms` = 4294967295 is invalid: must be an integer from 1 to 1024 TMs",
+        ),
+        ("tps_per_tm = 1000000", "`tps_per_tm` = 1000000"),
+        (
+            "[l2]\nsize_bytes = 68719476736",
+            "`l2.size_bytes` = 68719476736",
+        ),
+        (
+            "[units]\nbox_pipes = 4000000000",
+            "`units.box_pipes` = 4000000000",
+        ),
+        (
+            "[dram]\nchannels = 1073741824",
+            "`dram.channels` = 1073741824",
+        ),
+        (
+            "[l1]\nhit_latency = 1000000000000",
+            "`l1.hit_latency` = 1000000000000",
+        ),
+        ("[dram]\nt_cas = 9223372036854775807", "`dram.t_cas`"),
+        ("tms = 65536\ntps_per_tm = 65536", "`tms` = 65536"),
+        ("[energy]\nl1_nj = nan", "`energy.l1_nj` = NaN"),
+    ] {
+        fails_with(&sim(toml, "fast"), says);
+    }
+    fails_with(
+        &sim(
+            "tms = 1024\ntps_per_tm = 1024\n[units]\nlocal_store_bytes = 1048576",
+            "rv32",
+        ),
+        "at most 8192 MiB",
+    );
 }
 
 #[test]

@@ -2,12 +2,13 @@
 //!
 //! Method (tinybvh's habit: check, then time):
 //!
-//! 1. [`ray_sets`] runs every pixel's [`PixelJob`] of a frame on BVH2's memory image (its
-//!    observed traversal, not the CPU-side copy that plain queries use) and keeps each ray
-//!    with BVH2's answer, split by [`RayKind`] (primary, shadow, diffuse), in pixel order. The rays
-//!    are exactly those the renderer traces, so shadow and diffuse rays start on surfaces.
+//! 1. [`ray_sets`] runs every pixel's [`PixelJob`] of a frame on BVH2 (for one saved tree,
+//!    on its own first traversal), through its observed traversal (the memory image, not the
+//!    CPU-side path that plain queries use), and keeps each ray with that answer, split by
+//!    [`RayKind`] (primary, shadow, diffuse), in pixel order. The rays are exactly those the
+//!    renderer traces, so shadow and diffuse rays start on surfaces.
 //! 2. [`measure`] first traces every ray of a set on the structure under test and compares
-//!    the answer with BVH2's bit for bit ([`TraceResult::bit_eq`]); the first mismatch is a
+//!    the answer with the recorded one bit for bit ([`TraceResult::bit_eq`]); the first mismatch is a
 //!    [`RenderError::Mismatch`], never a number.
 //! 3. Then it traces the whole set, in parallel over chunks of [`CHUNK`] rays on every core
 //!    (rayon), until [`MeasureConfig::min_seconds`] and [`MeasureConfig::min_repeats`] are
@@ -22,7 +23,7 @@
 
 use crate::trace::{run_job, trace_query};
 use crate::{PixelJob, RayCounts, RayKind, RayQuery, RenderError, RenderSettings, TraceResult};
-use dualsplit_accel::{AccelKind, NoObserver, Observer, Structures};
+use dualsplit_accel::{AccelKind, NoObserver, Observer, TraversalSet};
 use dualsplit_geometry::Ray;
 use dualsplit_scene::Scene;
 use rayon::prelude::*;
@@ -31,14 +32,15 @@ use std::time::Instant;
 /// Rays per parallel work item while timing.
 pub const CHUNK: usize = 1024;
 
-/// The rays of one kind from a frame, with BVH2's answers.
+/// The rays of one kind from a frame, with the reference's answers (BVH2's for
+/// [`dualsplit_accel::Structures`]; see [`ray_sets`]).
 #[derive(Clone, Debug)]
 pub struct RaySet {
     /// Kind of every ray of the set.
     pub kind: RayKind,
     /// The rays, in pixel order (then issue order within a pixel).
     pub rays: Vec<Ray>,
-    /// BVH2's answer to each ray.
+    /// The reference's answer to each ray.
     pub expected: Vec<TraceResult>,
 }
 
@@ -50,10 +52,12 @@ struct ImageReference;
 impl Observer for ImageReference {}
 
 /// Builds the three ray sets (primary, shadow, diffuse; the *cast* workload's diffuse set is
-/// empty) of a frame of `settings` by running every pixel's job on BVH2's image.
-pub fn ray_sets(
+/// empty) of a frame of `settings` by running every pixel's job on the reference traversal
+/// of `structures` ([`TraversalSet::reference`]: BVH2 for every structure of a scene, the
+/// tree's own traversal for one tree), reading its image.
+pub fn ray_sets<S: TraversalSet>(
     scene: &Scene,
-    structures: &Structures,
+    structures: &S,
     settings: &RenderSettings,
 ) -> Result<[RaySet; 3], RenderError> {
     crate::validate(scene, settings)?;
@@ -67,7 +71,7 @@ pub fn ray_sets(
                 run_job(
                     job,
                     structures,
-                    AccelKind::Bvh2,
+                    structures.reference(),
                     &mut ImageReference,
                     &mut counts,
                     |q, r| v.push((*q, *r)),
@@ -127,8 +131,13 @@ pub struct Throughput {
     pub threads: usize,
 }
 
-/// Traces every ray of `set` on `kind` and compares with BVH2's answers, bit for bit.
-pub fn verify(structures: &Structures, kind: AccelKind, set: &RaySet) -> Result<(), RenderError> {
+/// Traces every ray of `set` on `kind` and compares with the recorded answers, bit for bit.
+pub fn verify<S: TraversalSet>(
+    structures: &S,
+    kind: AccelKind,
+    set: &RaySet,
+) -> Result<(), RenderError> {
+    crate::frame::supported(structures, kind)?;
     let bad = set
         .rays
         .par_iter()
@@ -161,10 +170,10 @@ pub fn verify(structures: &Structures, kind: AccelKind, set: &RaySet) -> Result<
     }
 }
 
-/// Verifies `set` on `kind` against BVH2 ([`verify`]), then times it ([`MeasureConfig`]).
+/// Verifies `set` on `kind` against the recorded answers ([`verify`]), then times it ([`MeasureConfig`]).
 /// An empty set gives zero rays and zero throughput.
-pub fn measure(
-    structures: &Structures,
+pub fn measure<S: TraversalSet>(
+    structures: &S,
     kind: AccelKind,
     set: &RaySet,
     cfg: &MeasureConfig,
@@ -314,8 +323,8 @@ pub fn measure_interleaved(
 }
 
 /// The [`Contender`] trace function of structure `kind` for rays of kind `ray_kind`.
-pub fn trace_fn(
-    structures: &Structures,
+pub fn trace_fn<S: TraversalSet>(
+    structures: &S,
     kind: AccelKind,
     ray_kind: RayKind,
 ) -> impl Fn(&[Ray]) -> u64 + Sync + '_ {

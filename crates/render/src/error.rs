@@ -45,9 +45,10 @@ pub enum RenderError {
         /// Intensity.
         intensity: f32,
     },
-    /// A structure returned a different result than BVH2 for a benchmark ray.
+    /// A structure returned a different result than the reference (BVH2, or the first
+    /// traversal of a single tree) for a benchmark ray.
     #[error(
-        "{accel}: {ray_kind} ray #{index} gives {got}, BVH2 gives {expected} (ray {ray}); refusing to time it"
+        "{accel}: {ray_kind} ray #{index} gives {got}, the reference gives {expected} (ray {ray}); refusing to time it"
     )]
     Mismatch {
         /// Structure name.
@@ -58,10 +59,19 @@ pub enum RenderError {
         index: usize,
         /// The ray, formatted.
         ray: String,
-        /// BVH2's result, formatted.
+        /// The reference's result, formatted.
         expected: String,
         /// The structure's result, formatted.
         got: String,
+    },
+    /// The structures given have no traversal of this kind (one saved tree holds one
+    /// structure).
+    #[error("no {accel} traversal here: the structures given have {available}")]
+    Unsupported {
+        /// The traversal asked for.
+        accel: &'static str,
+        /// The traversals there are, comma-separated.
+        available: String,
     },
     /// Writing an image failed.
     #[error("{path}: {message}")]

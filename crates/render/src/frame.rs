@@ -6,7 +6,7 @@
 
 use crate::trace::run_job;
 use crate::{Image, PixelJob, PixelRecord, RayCounts, RenderError, RenderSettings, trace_pixel};
-use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_accel::{AccelKind, NoObserver, TraversalSet};
 use dualsplit_scene::Scene;
 use rayon::prelude::*;
 
@@ -51,43 +51,7 @@ pub const MAX_BOUNCES: u32 = 1 << 10;
 /// it. The limits are [`MAX_SIDE`], [`MAX_PIXELS`], [`MAX_SPP`], [`MAX_SAMPLES`] and
 /// [`MAX_BOUNCES`]; an error says which one and its value.
 pub fn validate(scene: &Scene, settings: &RenderSettings) -> Result<(), RenderError> {
-    let bad = |reason: String| RenderError::Settings {
-        width: settings.width,
-        height: settings.height,
-        spp: settings.spp,
-        reason,
-    };
-    if settings.width == 0 || settings.height == 0 {
-        return Err(bad("the image has no pixel".into()));
-    }
-    if settings.spp == 0 {
-        return Err(bad("at least one sample per pixel is needed".into()));
-    }
-    if settings.width > MAX_SIDE || settings.height > MAX_SIDE {
-        return Err(bad(format!("at most {MAX_SIDE} pixels per side")));
-    }
-    let pixels = u64::from(settings.width) * u64::from(settings.height);
-    if pixels > MAX_PIXELS {
-        return Err(bad(format!(
-            "{pixels} pixels; at most {MAX_PIXELS} (16384x16384) in a frame, \
-             whose buffers take about 2.4 GB"
-        )));
-    }
-    if settings.spp > MAX_SPP {
-        return Err(bad(format!("at most {MAX_SPP} samples per pixel")));
-    }
-    if pixels * u64::from(settings.spp) > MAX_SAMPLES {
-        return Err(bad(format!(
-            "{} samples; at most {MAX_SAMPLES} (pixels x samples per pixel) in a frame",
-            pixels * u64::from(settings.spp)
-        )));
-    }
-    if settings.bounces > MAX_BOUNCES {
-        return Err(bad(format!(
-            "{} bounces; at most {MAX_BOUNCES}",
-            settings.bounces
-        )));
-    }
+    validate_frame(settings)?;
     let c = &scene.camera;
     let cam_err = |reason| RenderError::Camera {
         eye: c.eye.to_array(),
@@ -127,6 +91,49 @@ pub fn validate(scene: &Scene, settings: &RenderSettings) -> Result<(), RenderEr
     Ok(())
 }
 
+/// The scene-independent part of [`validate`]: frame size, samples and bounces, so a caller
+/// can refuse a frame before it loads the scene.
+pub fn validate_frame(settings: &RenderSettings) -> Result<(), RenderError> {
+    let bad = |reason: String| RenderError::Settings {
+        width: settings.width,
+        height: settings.height,
+        spp: settings.spp,
+        reason,
+    };
+    if settings.width == 0 || settings.height == 0 {
+        return Err(bad("the image has no pixel".into()));
+    }
+    if settings.spp == 0 {
+        return Err(bad("at least one sample per pixel is needed".into()));
+    }
+    if settings.width > MAX_SIDE || settings.height > MAX_SIDE {
+        return Err(bad(format!("at most {MAX_SIDE} pixels per side")));
+    }
+    let pixels = u64::from(settings.width) * u64::from(settings.height);
+    if pixels > MAX_PIXELS {
+        return Err(bad(format!(
+            "{pixels} pixels; at most {MAX_PIXELS} (16384x16384) in a frame, \
+             whose buffers take about 2.4 GB"
+        )));
+    }
+    if settings.spp > MAX_SPP {
+        return Err(bad(format!("at most {MAX_SPP} samples per pixel")));
+    }
+    if pixels * u64::from(settings.spp) > MAX_SAMPLES {
+        return Err(bad(format!(
+            "{} samples; at most {MAX_SAMPLES} (pixels x samples per pixel) in a frame",
+            pixels * u64::from(settings.spp)
+        )));
+    }
+    if settings.bounces > MAX_BOUNCES {
+        return Err(bad(format!(
+            "{} bounces; at most {MAX_BOUNCES}",
+            settings.bounces
+        )));
+    }
+    Ok(())
+}
+
 /// The pixel rectangles of the tiles, row-major.
 fn tiles(settings: &RenderSettings) -> Vec<(u32, u32, u32, u32)> {
     let mut v = Vec::with_capacity(tile_count(settings) as usize);
@@ -148,14 +155,17 @@ fn tiles(settings: &RenderSettings) -> Vec<(u32, u32, u32, u32)> {
 ///
 /// Every [`AccelKind`] returns a bit-identical [`Frame`]: the structures return bit-identical
 /// hits (the geometry crate's robustness rules), and the jobs depend on nothing else.
-pub fn render(
+/// `structures` is every structure of the scene or one tree ([`TraversalSet`]); a `kind` it
+/// lacks is a [`RenderError::Unsupported`].
+pub fn render<S: TraversalSet>(
     scene: &Scene,
-    structures: &Structures,
+    structures: &S,
     kind: AccelKind,
     settings: &RenderSettings,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Frame, RenderError> {
     validate(scene, settings)?;
+    supported(structures, kind)?;
     let done: Vec<(Vec<f32>, RayCounts)> = tiles(settings)
         .into_par_iter()
         .map(|(x0, y0, x1, y1)| {
@@ -194,13 +204,14 @@ pub fn render(
 /// Traces every pixel of the frame with [`trace_pixel`] (in parallel over rows) and returns
 /// the records in row-major order. Memory grows with the ray count: meant for tests, the
 /// simulator's reference streams and small frames.
-pub fn render_records(
+pub fn render_records<S: TraversalSet>(
     scene: &Scene,
-    structures: &Structures,
+    structures: &S,
     kind: AccelKind,
     settings: &RenderSettings,
 ) -> Result<Vec<PixelRecord>, RenderError> {
     validate(scene, settings)?;
+    supported(structures, kind)?;
     Ok((0..settings.height)
         .into_par_iter()
         .flat_map_iter(|y| {
@@ -208,4 +219,16 @@ pub fn render_records(
                 .map(move |x| trace_pixel(structures, kind, scene, settings, x, y, &mut NoObserver))
         })
         .collect())
+}
+
+/// Ok when `structures` has traversal `kind`, else [`RenderError::Unsupported`].
+pub fn supported<S: TraversalSet>(structures: &S, kind: AccelKind) -> Result<(), RenderError> {
+    if structures.supports(kind) {
+        Ok(())
+    } else {
+        Err(RenderError::Unsupported {
+            accel: kind.name(),
+            available: structures.kind_names(),
+        })
+    }
 }

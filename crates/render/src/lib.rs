@@ -61,7 +61,7 @@ pub use dualsplit_accel::AccelKind;
 pub use error::RenderError;
 pub use frame::{
     Frame, MAX_BOUNCES, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, MAX_SPP, TILE, render, render_records,
-    tile_count, validate,
+    supported, tile_count, validate, validate_frame,
 };
 pub use image::{Image, ImageFormat, srgb_encode};
 pub use job::{

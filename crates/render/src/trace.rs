@@ -4,7 +4,7 @@
 //! pixel regenerated alone goes through exactly the code that rendered it in the frame.
 
 use crate::{PixelJob, RayCounts, RayKind, RayQuery, RenderSettings, TraceResult};
-use dualsplit_accel::{AccelKind, Observer, Structures};
+use dualsplit_accel::{AccelKind, Observer, TraversalSet};
 use dualsplit_scene::Scene;
 
 /// One traced ray and its answer.
@@ -64,8 +64,8 @@ fn ray_bits(r: &dualsplit_geometry::Ray) -> [u32; 8] {
 /// Traces one query on structure `kind`: closest hit for primary and diffuse rays, any hit
 /// for shadow rays.
 #[inline]
-pub fn trace_query<O: Observer>(
-    structures: &Structures,
+pub fn trace_query<S: TraversalSet, O: Observer>(
+    structures: &S,
     kind: AccelKind,
     query: &RayQuery,
     obs: &mut O,
@@ -81,9 +81,9 @@ pub fn trace_query<O: Observer>(
 /// Runs `job` to completion on structure `kind`, counting every ray into `counts` and
 /// handing each (query, result) to `sink`; returns the pixel's radiance.
 #[inline]
-pub fn run_job<O: Observer>(
+pub fn run_job<S: TraversalSet, O: Observer>(
     mut job: PixelJob<'_>,
-    structures: &Structures,
+    structures: &S,
     kind: AccelKind,
     obs: &mut O,
     counts: &mut RayCounts,
@@ -102,8 +102,8 @@ pub fn run_job<O: Observer>(
 /// ray, its result and the ray counters. The observer sees every traversal of the pixel in
 /// order. Deterministic: the same arguments give a bitwise-identical record, whatever else
 /// was traced before.
-pub fn trace_pixel<O: Observer>(
-    structures: &Structures,
+pub fn trace_pixel<S: TraversalSet, O: Observer>(
+    structures: &S,
     kind: AccelKind,
     scene: &Scene,
     settings: &RenderSettings,

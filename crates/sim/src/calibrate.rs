@@ -40,7 +40,7 @@ use crate::kernel::{EVENTS, Event, InstrCounts, Recorder, Tally};
 use crate::kernels::{Params, elf};
 use crate::rv32::{FrameMemory, FuClass, Hart, LOCAL_STORE_ADDR, Latches, Op, Program, RunError};
 use crate::{SimAccel, SimError, UnitConfig};
-use dualsplit_accel::Structures;
+use dualsplit_accel::{Structures, TraversalSet};
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::Scene;
 use serde::{Deserialize, Serialize};
@@ -275,8 +275,8 @@ fn workload_name(w: Workload) -> &'static str {
 
 /// Traces one ray of a pixel with `rec` as the observer, then charges the ray's event by
 /// its outcome.
-pub(crate) fn trace_ray(
-    structures: &Structures,
+pub(crate) fn trace_ray<S: TraversalSet>(
+    structures: &S,
     accel: SimAccel,
     kind: RayKind,
     ray: &dualsplit_geometry::Ray,

@@ -8,14 +8,14 @@ use crate::kernels::{FRAME_FLOATS_PER_PIXEL, Params, elf, placement};
 use crate::rv32::{FRAME_BUFFER_ADDR, FrameMemory, PARAMS_ADDR, PROGRAM_BASE, Program};
 use crate::tp::{ClassCounts, Tp};
 use crate::{Chip, SimAccel, SimConfig, SimError, SimResult, ThreadModel, chip::run_compiled};
-use dualsplit_accel::Structures;
+use dualsplit_accel::TraversalSet;
 use dualsplit_render::RenderSettings;
 use dualsplit_scene::Scene;
 
 /// Runs one frame of `accel`'s compiled kernel for `settings` on the chip of `cfg`.
-pub(crate) fn run(
+pub(crate) fn run<S: TraversalSet>(
     scene: &Scene,
-    structures: &Structures,
+    structures: &S,
     accel: SimAccel,
     settings: &RenderSettings,
     cfg: &SimConfig,

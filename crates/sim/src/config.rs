@@ -4,6 +4,7 @@
 //! Every field has a default equal to [`SimConfig::lin2020`], so a TOML file only needs the
 //! values it changes; unknown keys are rejected (a measurement tool never ignores an option).
 
+use crate::ranges::{RANGES, Value};
 use serde::{Deserialize, Serialize};
 
 /// Hardware configuration of the simulated TRaX chip.
@@ -17,8 +18,10 @@ pub struct SimConfig {
     /// Core clock in GHz.
     pub clock_ghz: f64,
     /// The per-TM L1 data cache.
+    #[serde(deserialize_with = "l1_partial")]
     pub l1: CacheConfig,
     /// The chip-wide L2 cache.
+    #[serde(deserialize_with = "l2_partial")]
     pub l2: CacheConfig,
     /// GDDR5 main memory.
     pub dram: DramConfig,
@@ -58,6 +61,41 @@ pub struct CacheConfig {
 
 fn line_interleaved_default() -> bool {
     true
+}
+
+/// A `[l1]` or `[l2]` table as written: the keys it leaves out keep that cache's
+/// [`SimConfig::lin2020`] value (the L1's and the L2's defaults differ, so
+/// `#[serde(default)]` on [`CacheConfig`] could not give them).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PartialCache {
+    size_bytes: Option<u64>,
+    line_bytes: Option<u64>,
+    banks: Option<u32>,
+    associativity: Option<u32>,
+    hit_latency: Option<u64>,
+    line_interleaved: Option<bool>,
+}
+
+impl PartialCache {
+    fn over(self, d: CacheConfig) -> CacheConfig {
+        CacheConfig {
+            size_bytes: self.size_bytes.unwrap_or(d.size_bytes),
+            line_bytes: self.line_bytes.unwrap_or(d.line_bytes),
+            banks: self.banks.unwrap_or(d.banks),
+            associativity: self.associativity.unwrap_or(d.associativity),
+            hit_latency: self.hit_latency.unwrap_or(d.hit_latency),
+            line_interleaved: self.line_interleaved.unwrap_or(d.line_interleaved),
+        }
+    }
+}
+
+fn l1_partial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<CacheConfig, D::Error> {
+    Ok(PartialCache::deserialize(d)?.over(SimConfig::lin2020().l1))
+}
+
+fn l2_partial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<CacheConfig, D::Error> {
+    Ok(PartialCache::deserialize(d)?.over(SimConfig::lin2020().l2))
 }
 
 /// GDDR5 main memory; timings in DRAM clock ticks (`ticks_per_cycle` per core cycle).
@@ -220,12 +258,12 @@ pub enum ConfigError {
     /// A value is out of range.
     #[error("config value `{field}` = {value} is invalid: {reason}")]
     Invalid {
-        /// The key.
+        /// The key, as written in the TOML (`l1.hit_latency`).
         field: &'static str,
-        /// Its value.
-        value: u64,
+        /// Its value as given.
+        value: String,
         /// What it must be.
-        reason: &'static str,
+        reason: String,
     },
 }
 
@@ -324,101 +362,123 @@ impl SimConfig {
         Ok(cfg)
     }
 
-    /// Checks the values the engine relies on.
+    /// Checks every value against its documented range ([`RANGES`]) and the relations
+    /// between values the engine relies on (equal L1 and L2 lines, power-of-two sets).
     pub fn validate(&self) -> Result<(), ConfigError> {
-        let pow2 = |field, v: u64| {
-            if v == 0 || !v.is_power_of_two() {
-                Err(ConfigError::Invalid {
-                    field,
-                    value: v,
-                    reason: "must be a power of two",
-                })
-            } else {
-                Ok(())
+        for (key, value) in self.values() {
+            let range = RANGES
+                .iter()
+                .find(|r| r.key == key)
+                .expect("every key has a range (tested)");
+            range.check(value)?;
+        }
+        for (key, c) in [("l1", &self.l1), ("l2", &self.l2)] {
+            let lines = c.size_bytes / c.line_bytes;
+            let sets = lines / c.associativity as u64;
+            if c.size_bytes % c.line_bytes != 0
+                || lines % c.associativity as u64 != 0
+                || !sets.is_power_of_two()
+            {
+                return Err(ConfigError::Invalid {
+                    field: if key == "l1" {
+                        "l1.size_bytes"
+                    } else {
+                        "l2.size_bytes"
+                    },
+                    value: c.size_bytes.to_string(),
+                    reason: format!(
+                        "{} lines of {} bytes in {}-way sets must make a power-of-two number of sets",
+                        lines, c.line_bytes, c.associativity
+                    ),
+                });
             }
-        };
-        let pos = |field, v: u64| {
-            if v == 0 {
-                Err(ConfigError::Invalid {
-                    field,
-                    value: v,
-                    reason: "must be at least 1",
-                })
-            } else {
-                Ok(())
-            }
-        };
-        pos("tms", self.tms as u64)?;
-        pos("tps_per_tm", self.tps_per_tm as u64)?;
-        pow2("l1.line_bytes", self.l1.line_bytes)?;
-        if self.l1.line_bytes != self.l2.line_bytes || self.l1.line_bytes != 64 {
+        }
+        if self.l1.line_bytes != self.l2.line_bytes {
             return Err(ConfigError::Invalid {
                 field: "l2.line_bytes",
-                value: self.l2.line_bytes,
-                reason: "L1 and L2 lines must both be 64 bytes (one DRAM burst pair)",
-            });
-        }
-        for (f, c) in [("l1", &self.l1), ("l2", &self.l2)] {
-            pow2(
-                if f == "l1" { "l1.banks" } else { "l2.banks" },
-                c.banks as u64,
-            )?;
-            pos(f, c.associativity as u64)?;
-            let sets = c.size_bytes / c.line_bytes / c.associativity as u64;
-            pow2(if f == "l1" { "l1 sets" } else { "l2 sets" }, sets)?;
-        }
-        pow2("dram.channels", self.dram.channels as u64)?;
-        pow2("dram.banks_per_channel", self.dram.banks_per_channel as u64)?;
-        pow2("dram.row_bytes", self.dram.row_bytes)?;
-        if self.dram.row_bytes < 64 {
-            return Err(ConfigError::Invalid {
-                field: "dram.row_bytes",
-                value: self.dram.row_bytes,
-                reason: "must hold at least one 64-byte line",
-            });
-        }
-        pos("dram.ticks_per_cycle", self.dram.ticks_per_cycle)?;
-        pos("dram.t_burst", self.dram.t_burst)?;
-        pos("dram.read_queue", self.dram.read_queue as u64)?;
-        if self.dram.t_rrd > 64 {
-            return Err(ConfigError::Invalid {
-                field: "dram.t_rrd",
-                value: self.dram.t_rrd,
-                reason: "must be at most 64 ticks",
-            });
-        }
-        pos("units.box_pipes", self.units.box_pipes as u64)?;
-        pos("units.tri_pipes", self.units.tri_pipes as u64)?;
-        pos("units.dst_pipes", self.units.dst_pipes as u64)?;
-        pos("units.fpinv_units", self.units.fpinv_units as u64)?;
-        let u = &self.units;
-        for (f, v) in [
-            ("units.fpcmp_units", u.fpcmp_units),
-            ("units.fpminmax_units", u.fpminmax_units),
-            ("units.conv_units", u.conv_units),
-            ("units.branch_units", u.branch_units),
-            ("units.intmul_units", u.intmul_units),
-        ] {
-            pos(f, v as u64)?;
-        }
-        if u.local_store_bytes < 1024
-            || u.local_store_bytes > 1 << 20
-            || !u.local_store_bytes.is_multiple_of(16)
-        {
-            return Err(ConfigError::Invalid {
-                field: "units.local_store_bytes",
-                value: u.local_store_bytes as u64,
-                reason: "must be a multiple of 16 from 1024 to 1048576",
-            });
-        }
-        if !(self.clock_ghz > 0.0 && self.clock_ghz.is_finite()) {
-            return Err(ConfigError::Invalid {
-                field: "clock_ghz",
-                value: 0,
-                reason: "must be a positive finite number",
+                value: self.l2.line_bytes.to_string(),
+                reason: "L1 and L2 lines must both be 64 bytes (one DRAM burst pair)".into(),
             });
         }
         Ok(())
+    }
+
+    /// Every key of the configuration with its value, in TOML key form.
+    pub fn values(&self) -> Vec<(&'static str, Value)> {
+        use Value::{Flag, Int, Real};
+        let (l1, l2, d, u, e) = (&self.l1, &self.l2, &self.dram, &self.units, &self.energy);
+        let int = |v: u32| Int(v as u64);
+        vec![
+            ("tms", int(self.tms)),
+            ("tps_per_tm", int(self.tps_per_tm)),
+            ("clock_ghz", Real(self.clock_ghz)),
+            ("l1.size_bytes", Int(l1.size_bytes)),
+            ("l1.line_bytes", Int(l1.line_bytes)),
+            ("l1.banks", int(l1.banks)),
+            ("l1.associativity", int(l1.associativity)),
+            ("l1.hit_latency", Int(l1.hit_latency)),
+            ("l1.line_interleaved", Flag(l1.line_interleaved)),
+            ("l2.size_bytes", Int(l2.size_bytes)),
+            ("l2.line_bytes", Int(l2.line_bytes)),
+            ("l2.banks", int(l2.banks)),
+            ("l2.associativity", int(l2.associativity)),
+            ("l2.hit_latency", Int(l2.hit_latency)),
+            ("l2.line_interleaved", Flag(l2.line_interleaved)),
+            ("dram.channels", int(d.channels)),
+            ("dram.banks_per_channel", int(d.banks_per_channel)),
+            ("dram.row_bytes", Int(d.row_bytes)),
+            ("dram.ticks_per_cycle", Int(d.ticks_per_cycle)),
+            ("dram.t_cas", Int(d.t_cas)),
+            ("dram.t_rcd", Int(d.t_rcd)),
+            ("dram.t_rp", Int(d.t_rp)),
+            ("dram.t_ras", Int(d.t_ras)),
+            ("dram.t_rc", Int(d.t_rc)),
+            ("dram.t_rrd", Int(d.t_rrd)),
+            ("dram.t_rtp", Int(d.t_rtp)),
+            ("dram.t_ccd", Int(d.t_ccd)),
+            ("dram.t_burst", Int(d.t_burst)),
+            ("dram.read_queue", int(d.read_queue)),
+            ("dram.e_read_nj", Real(d.e_read_nj)),
+            ("dram.e_activate_nj", Real(d.e_activate_nj)),
+            ("dram.background_w", Real(d.background_w)),
+            ("units.box_pipes", int(u.box_pipes)),
+            ("units.box_latency", Int(u.box_latency)),
+            ("units.tri_pipes", int(u.tri_pipes)),
+            ("units.tri_latency", Int(u.tri_latency)),
+            ("units.dst_pipes", int(u.dst_pipes)),
+            ("units.dst_latency", Int(u.dst_latency)),
+            ("units.fpinv_units", int(u.fpinv_units)),
+            ("units.fpinv_latency", Int(u.fpinv_latency)),
+            ("units.atomic_latency", Int(u.atomic_latency)),
+            ("units.int_latency", Int(u.int_latency)),
+            ("units.fpadd_latency", Int(u.fpadd_latency)),
+            ("units.fpmul_latency", Int(u.fpmul_latency)),
+            ("units.fpcmp_units", int(u.fpcmp_units)),
+            ("units.fpcmp_latency", Int(u.fpcmp_latency)),
+            ("units.fpminmax_units", int(u.fpminmax_units)),
+            ("units.fpminmax_latency", Int(u.fpminmax_latency)),
+            ("units.conv_units", int(u.conv_units)),
+            ("units.conv_latency", Int(u.conv_latency)),
+            ("units.branch_units", int(u.branch_units)),
+            ("units.branch_latency", Int(u.branch_latency)),
+            ("units.intmul_units", int(u.intmul_units)),
+            ("units.intmul_latency", Int(u.intmul_latency)),
+            ("units.local_store_latency", Int(u.local_store_latency)),
+            ("units.local_store_bytes", int(u.local_store_bytes)),
+            ("energy.int_nj", Real(e.int_nj)),
+            ("energy.fpadd_nj", Real(e.fpadd_nj)),
+            ("energy.fpmul_nj", Real(e.fpmul_nj)),
+            ("energy.fpcmp_nj", Real(e.fpcmp_nj)),
+            ("energy.fpinv_nj", Real(e.fpinv_nj)),
+            ("energy.rf_access_nj", Real(e.rf_access_nj)),
+            ("energy.icache_nj", Real(e.icache_nj)),
+            ("energy.local_store_nj", Real(e.local_store_nj)),
+            ("energy.l1_nj", Real(e.l1_nj)),
+            ("energy.l2_nj", Real(e.l2_nj)),
+            ("energy.box_pipe_nj", Real(e.box_pipe_nj)),
+            ("energy.tri_pipe_nj", Real(e.tri_pipe_nj)),
+            ("energy.dst_pipe_nj", Real(e.dst_pipe_nj)),
+        ]
     }
 
     /// Peak DRAM bandwidth in bytes per core cycle (64 B per `t_burst` per channel).

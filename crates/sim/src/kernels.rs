@@ -12,7 +12,7 @@ use crate::SimAccel;
 use crate::memory::Placement;
 pub use crate::rv32::{FRAME_BUFFER_ADDR, LOCAL_STORE_ADDR, PARAMS_ADDR};
 use crate::rv32::{PROGRAM_BASE, Program};
-use dualsplit_accel::{MemoryImage, Structures};
+use dualsplit_accel::{MemoryImage, TraversalSet};
 use dualsplit_render::{FrameConstants, RenderSettings, Workload};
 use dualsplit_scene::Scene;
 
@@ -85,15 +85,15 @@ const _: () = assert!(size_of::<Params>() == 156);
 impl Params {
     /// The block for rendering `scene` with `settings` on configuration `accel` (whose
     /// memory image is `structures.image(accel.kind())`).
-    pub fn new(
+    pub fn new<S: TraversalSet>(
         scene: &Scene,
-        structures: &Structures,
+        structures: &S,
         accel: SimAccel,
         settings: &RenderSettings,
     ) -> Params {
         let fc = FrameConstants::new(scene);
         let img = structures.image(accel.kind());
-        let scene_box = structures.dst.scene_box();
+        let scene_box = structures.scene_box();
         let word = |w: usize| u32::try_from(w).expect("image word index fits 32 bits");
         Params {
             width: settings.width,

@@ -42,10 +42,12 @@ mod compiled;
 pub mod config;
 mod cycle;
 pub mod energy;
+pub mod footprint;
 pub mod fu;
 pub mod kernel;
 pub mod kernels;
 pub mod memory;
+pub mod ranges;
 pub mod rv32;
 mod scheduler;
 mod shares;
@@ -69,7 +71,7 @@ pub use shares::StallShares;
 pub use thread::{Stalls, Thread};
 pub use tm::{Issued, Tm, UnitStats, WordAddr};
 
-use dualsplit_accel::{AccelKind, Structures};
+use dualsplit_accel::{AccelKind, TraversalSet};
 use dualsplit_render::RenderSettings;
 use dualsplit_scene::Scene;
 use serde::{Deserialize, Serialize};
@@ -316,17 +318,42 @@ pub enum SimError {
     /// instruction).
     #[error("kernel: {0}")]
     Exec(#[from] rv32::ExecError),
+    /// The simulation would take more host memory than [`footprint::MAX_SIM_BYTES`].
+    #[error(
+        "the simulation would need about {} MiB of memory (threads {} MiB, caches and units {} MiB, DRAM model {} MiB, frame {} MiB, fixed {} MiB); at most {} MiB: lower tms, tps_per_tm, units.local_store_bytes, the cache sizes or the resolution",
+        mib(need.total()), mib(need.threads), mib(need.caches), mib(need.dram), mib(need.frame), mib(need.fixed), mib(*limit)
+    )]
+    Memory {
+        /// The estimate, by term.
+        need: footprint::Footprint,
+        /// The limit.
+        limit: u64,
+    },
+    /// The structures given have no traversal for this configuration (one saved tree holds
+    /// one structure).
+    #[error("no {accel} traversal here: the structures given have {available}")]
+    Unsupported {
+        /// The configuration asked for.
+        accel: &'static str,
+        /// The traversals there are, comma-separated.
+        available: String,
+    },
     /// The `fast` model's measured costs are missing or unreadable.
     #[error("fast model: {0}")]
     Calibration(#[from] calibrate::CalibrationError),
 }
 
+/// Bytes in MiB, rounded up.
+fn mib(bytes: u64) -> u64 {
+    bytes.div_ceil(1 << 20)
+}
+
 /// Simulates one frame of `settings` on `scene` with configuration `accel`, the threads
 /// executing the compiled kernels ([`ThreadModel::Rv32`]); `progress` is called with
 /// (pixels done, pixels total).
-pub fn simulate(
+pub fn simulate<S: TraversalSet>(
     scene: &Scene,
-    structures: &Structures,
+    structures: &S,
     accel: SimAccel,
     settings: &RenderSettings,
     cfg: &SimConfig,
@@ -344,22 +371,30 @@ pub fn simulate(
 }
 
 /// [`simulate`] with the threads' execution model `model`.
-pub fn simulate_model(
+pub fn simulate_model<S: TraversalSet>(
     model: ThreadModel,
     scene: &Scene,
-    structures: &Structures,
+    structures: &S,
     accel: SimAccel,
     settings: &RenderSettings,
     cfg: &SimConfig,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<SimResult, SimError> {
     cfg.validate()?;
+    if !structures.supports(accel.kind()) {
+        return Err(SimError::Unsupported {
+            accel: accel.label(),
+            available: structures.kind_names(),
+        });
+    }
     if settings.width == 0 || settings.height == 0 {
         return Err(SimError::EmptyFrame {
             width: settings.width,
             height: settings.height,
         });
     }
+    let pixels = settings.width as u64 * settings.height as u64;
+    footprint::check(cfg, accel, model, pixels)?;
     match model {
         ThreadModel::Rv32 => compiled::run(scene, structures, accel, settings, cfg, progress),
         ThreadModel::Fast => workload::run(scene, structures, accel, settings, cfg, progress),

@@ -10,7 +10,7 @@ use crate::kernels::{Params, elf, placement};
 use crate::rv32::Program;
 use crate::thread::Thread;
 use crate::{SimAccel, SimConfig, SimError, SimResult, ThreadModel};
-use dualsplit_accel::Structures;
+use dualsplit_accel::TraversalSet;
 use dualsplit_render::{PixelJob, RenderSettings};
 use dualsplit_scene::Scene;
 
@@ -30,14 +30,14 @@ struct Active<'a> {
 /// What tracing a ray needs and gathers: the structures and configuration, the rays and
 /// the recorders' tally (counts and the first range error: no work is handed out after
 /// one).
-struct Tracer<'a> {
-    structures: &'a Structures,
+struct Tracer<'a, S> {
+    structures: &'a S,
     accel: SimAccel,
     rays: u64,
     tally: Tally,
 }
 
-struct Pixels<'a> {
+struct Pixels<'a, S> {
     scene: &'a Scene,
     settings: &'a RenderSettings,
     next: u64,
@@ -46,10 +46,10 @@ struct Pixels<'a> {
     progress: &'a (dyn Fn(u64, u64) + Sync),
     /// Per thread: the pixel it is working on (updated in place, not moved per ray).
     active: Vec<Option<Active<'a>>>,
-    tracer: Tracer<'a>,
+    tracer: Tracer<'a, S>,
 }
 
-impl<'a> Tracer<'a> {
+impl<'a, S: TraversalSet> Tracer<'a, S> {
     /// Records the next ray of `a`'s pixel into `ops`, continuing the instruction run carried
     /// from its previous ray; false when the pixel has no ray left.
     #[inline]
@@ -71,7 +71,7 @@ impl<'a> Tracer<'a> {
     }
 }
 
-impl WorkSource for Pixels<'_> {
+impl<S: TraversalSet> WorkSource for Pixels<'_, S> {
     /// Hands out one ray's ops at a time (a pixel's rays follow one another on the same
     /// thread, the pixel taken from the global counter first): the same op sequence as the
     /// whole pixel recorded at once, but a thread's program stays small, so the replay's
@@ -122,9 +122,9 @@ impl WorkSource for Pixels<'_> {
     }
 }
 
-pub(crate) fn run(
+pub(crate) fn run<S: TraversalSet>(
     scene: &Scene,
-    structures: &Structures,
+    structures: &S,
     accel: SimAccel,
     settings: &RenderSettings,
     cfg: &SimConfig,

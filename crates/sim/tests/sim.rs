@@ -368,3 +368,43 @@ mod synthetic {
         assert!(bytes / end as f64 <= cfg.dram_peak_bytes_per_cycle());
     }
 }
+
+/// One saved-or-built tree (`AnyTree`, what `--tree` gives) simulates exactly as the same
+/// structure among every structure, on both thread models; a configuration whose
+/// traversal the tree lacks is refused.
+#[test]
+fn one_tree_simulates_as_every_structure() {
+    use dualsplit_accel::{AnyTree, Bvh2Tree, DstConfig, DstTree};
+    let (scene, s) = scene();
+    let bvh2 = Bvh2Tree::build(&scene.triangles[..], &Default::default()).unwrap();
+    let dst = AnyTree::from(DstTree::from_bvh2(&bvh2, &DstConfig::hardware()).unwrap());
+    let cfg = tiny();
+    let settings = RenderSettings::new(12, 8, Workload::Path);
+    for model in [ThreadModel::Fast, ThreadModel::Rv32] {
+        for accel in [SimAccel::DstSw, SimAccel::Dst] {
+            let go = |set: &dyn Fn() -> Result<SimResult, dualsplit_sim::SimError>| {
+                let r = set().unwrap();
+                assert!(r.cycles > 0 && r.rays > 0);
+                format!("{r:?}")
+            };
+            let want =
+                go(&|| simulate_model(model, &scene, &s, accel, &settings, &cfg, &|_, _| {}));
+            let got =
+                go(&|| simulate_model(model, &scene, &dst, accel, &settings, &cfg, &|_, _| {}));
+            assert!(got == want, "{model:?} {accel:?}: the results differ");
+        }
+    }
+    let e = simulate(
+        &scene,
+        &dst,
+        SimAccel::Bvh4Plus,
+        &settings,
+        &cfg,
+        &|_, _| {},
+    )
+    .unwrap_err();
+    assert!(
+        matches!(&e, dualsplit_sim::SimError::Unsupported { accel: "BVH4+", available } if available == "dst-sw, dst"),
+        "{e}"
+    );
+}

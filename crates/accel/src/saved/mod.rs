@@ -11,13 +11,14 @@
 //!
 //! Loading checks, in order: the magic, the version, that the sizes in the header add up
 //! to the file's length (before anything is allocated), the checksum, and, when the caller
-//! names the scene, the triangle hash. Each failure is a [`SavedError`]; nothing panics.
+//! names the scene, that the file's triangles are the scene's, bit for bit (the error names
+//! both triangle hashes). Each failure is a [`SavedError`]; nothing panics.
 //!
 //! Loading reads the file into memory rather than mapping it: a file mapping is `unsafe`
 //! (another process may change or truncate the file under it), which this workspace
 //! forbids. The node and index words are read straight into their final buffer
 //! ([`crate::image::Words`], an anonymous huge-page mapping for large images), with no
-//! intermediate copy; the triangles take one extra copy into their shared allocation.
+//! intermediate copy, and the triangles straight into their shared allocation.
 //!
 //! ```
 //! use dualsplit_accel::math::{Ray, Triangle, Vec3};
@@ -307,16 +308,22 @@ impl AnyTree {
                 *w = u32::from_le(*w);
             }
         }
-        let mut tris = vec![Triangle::default(); h.triangles as usize];
+        // Read straight into the shared allocation the tree keeps (a fresh `Arc`, so
+        // `get_mut` always gives it; collecting a sized iterator allocates once).
+        let mut tris: SharedTriangles =
+            std::iter::repeat_n(Triangle::default(), h.triangles as usize).collect();
         {
-            let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut tris[..]);
+            let Some(slice) = std::sync::Arc::get_mut(&mut tris) else {
+                return Err(SavedError::malformed("triangle buffer is shared".into()));
+            };
+            let bytes: &mut [u8] = bytemuck::cast_slice_mut(slice);
             r.read_exact(bytes).map_err(short)?;
             hash.update(&*bytes);
-        }
-        if cfg!(target_endian = "big") {
-            let f: &mut [u32] = bytemuck::cast_slice_mut(&mut tris[..]);
-            for w in f {
-                *w = u32::from_le(*w);
+            if cfg!(target_endian = "big") {
+                let f: &mut [u32] = bytemuck::cast_slice_mut(slice);
+                for w in f {
+                    *w = u32::from_le(*w);
+                }
             }
         }
         let mut sum = [0u8; 32];
@@ -331,16 +338,17 @@ impl AnyTree {
         if <[u8; 32]>::from(hash.finalize()) != sum {
             return Err(SavedError::Checksum);
         }
-        if let Some(scene) = scene {
-            let want = triangle_hash(scene);
-            if want != h.triangle_hash {
-                return Err(SavedError::WrongScene {
-                    expected: hex(&want),
-                    found: hex(&h.triangle_hash),
-                });
-            }
+        // The file's triangles (checksummed with everything else) against the scene's, bit
+        // for bit: cheaper than hashing the scene, and exact. The hashes only name them.
+        if let Some(scene) = scene
+            && bytemuck::cast_slice::<Triangle, u8>(&tris) != bytemuck::cast_slice(scene)
+        {
+            return Err(SavedError::WrongScene {
+                expected: hex(&triangle_hash(scene)),
+                found: hex(&h.triangle_hash),
+            });
         }
-        Ok(assemble(&h, words, SharedTriangles::from(tris)))
+        Ok(assemble(&h, words, tris))
     }
 
     /// Reads a saved tree from bytes (see [`AnyTree::read_from`]).

@@ -6,12 +6,17 @@
 //! `rtcIntersect1` / `rtcOccluded1`): its answers are compared with ours first (differences
 //! must be explained as ties, grazing or interval-boundary hits, see `dualsplit_embree::agree`),
 //! then ours and Embree's are timed interleaved, pass after pass, in one run.
-use super::render::{build_structures, load_scene};
+//!
+//! With `--tree FILE` the saved structure is measured instead of building: its traversals
+//! only (`--accel` must name one of them), on rays recorded with its own first traversal
+//! (`dualsplit check --tree` is what compares a saved tree with a fresh BVH2).
+use super::render::{get_structures, load_scene};
 use crate::args::{parse_accel, parse_res, parse_workload};
+use crate::loaded::Loaded;
 use crate::output::JsonOut;
 use crate::progress::Ctx;
 use anyhow::Context;
-use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_accel::{AccelKind, NoObserver, TraversalSet};
 use dualsplit_embree::{Agreement, EmbreeScene, TErrors, agree_closest, agree_occluded, t_errors};
 use dualsplit_geometry::Ray;
 use dualsplit_render::bench::{
@@ -39,9 +44,16 @@ pub struct Args {
     /// (hairball, forest, atrium, cornell).
     #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
-    /// Structures to measure, comma-separated (bvh2, bvh4, bvh8, dst-sw, dst); default all.
+    /// Structures to measure, comma-separated (bvh2, bvh4, bvh8, dst-sw, dst); default all
+    /// (with --tree, all of the saved structure's traversals).
     #[arg(long, value_delimiter = ',', value_parser = parse_accel)]
     accel: Vec<AccelKind>,
+    /// Measure the tree saved in FILE by `dualsplit build` instead of building; it must come
+    /// from SCENE (its triangles are checked). Only its traversals exist (dst-sw and dst
+    /// for a DST, its own kind for a BVH); the rays and their expected answers come from its
+    /// first one (`check --tree` compares a saved tree with a fresh BVH2).
+    #[arg(long, value_name = "FILE")]
+    tree: Option<std::path::PathBuf>,
     /// Workload whose rays are measured: cast (primary, shadow) or path (primary, shadow, diffuse).
     #[arg(long, default_value = "path", value_parser = parse_workload)]
     workload: Workload,
@@ -94,11 +106,6 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             lines.push(v);
         }
     };
-    let accels = if args.accel.is_empty() {
-        AccelKind::ALL.to_vec()
-    } else {
-        args.accel.clone()
-    };
     let pool = match args.threads {
         Some(n) => Some(
             rayon::ThreadPoolBuilder::new()
@@ -127,8 +134,12 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             settings.height
         );
     }
-    let structures = build_structures(&scene, ctx, json.is_some())?;
-    let sp = ctx.spinner("generating rays on bvh2");
+    let structures = get_structures(&scene, args.tree.as_deref(), ctx, json.is_some())?;
+    let accels = structures.kinds_or_all(&args.accel)?;
+    let sp = ctx.spinner(format!(
+        "generating rays on {}",
+        structures.reference().name()
+    ));
     let t = Instant::now();
     let sets = ray_sets(&scene, &structures, &settings)?;
     sp.finish_and_clear();
@@ -242,7 +253,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
 /// Everything the peer comparison needs.
 struct PeerRun<'a> {
     scene: &'a Scene,
-    structures: &'a Structures,
+    structures: &'a Loaded,
     sets: &'a [RaySet; 3],
     accels: &'a [AccelKind],
     cfg: &'a MeasureConfig,
@@ -286,9 +297,10 @@ impl PeerRun<'_> {
         }
         if !self.json {
             println!(
-                "embree {}: scene built in {build_s:.2} s; agreement with bvh2 (every structure \
+                "embree {}: scene built in {build_s:.2} s; agreement with {} (every structure \
                  above equals it bit for bit):",
-                peer.version()
+                peer.version(),
+                self.structures.reference().name()
             );
             for set in &sets {
                 print_agreement(set.kind.name(), &agreement[set.kind.name()]);
@@ -312,9 +324,10 @@ impl PeerRun<'_> {
                 );
             }
             anyhow::bail!(
-                "embree and bvh2 disagree on {} {kind} rays that no tie, grazing or \
+                "embree and {} disagree on {} {kind} rays that no tie, grazing or \
                  boundary hit explains ({} hit against miss, {} other triangle; the first: \
                  {}); refusing to time them",
+                self.structures.reference().name(),
                 a.hit_miss.unexplained + a.triangle.unexplained,
                 a.hit_miss.unexplained,
                 a.triangle.unexplained,
@@ -430,10 +443,8 @@ impl PeerRun<'_> {
         match set.kind {
             RayKind::Shadow => {
                 let ours: Vec<bool> = set.expected.iter().map(TraceResult::is_hit).collect();
-                let closest = |r: &Ray| {
-                    self.structures
-                        .closest_hit(AccelKind::Bvh2, r, &mut NoObserver)
-                };
+                let reference = self.structures.reference();
+                let closest = |r: &Ray| self.structures.closest_hit(reference, r, &mut NoObserver);
                 agree_occluded(peer, tris, &set.rays, &ours, &closest)
             }
             RayKind::Primary | RayKind::Diffuse => {

@@ -60,7 +60,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let json = crate::output::JsonOut::from_arg(args.json.as_deref())?;
     crate::output::check_file(&args.output, "-o")?;
     let sp = ctx.spinner(format!("loading {}", args.scene));
-    let scene = dualsplit_scene::load(&args.scene)
+    let scene = dualsplit_scene::load_with(&args.scene, &ctx.limits)
         .with_context(|| format!("loading scene {}", args.scene))?;
     sp.set_message(format!("building {}", args.accel));
     let t0 = Instant::now();

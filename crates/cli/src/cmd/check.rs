@@ -4,9 +4,19 @@
 //! jobs on the scene's default camera. BVH2, BVH4, BVH8, the DST software decoder (dst-sw)
 //! and the DST pipeline loop (dst) are all compared. Validation includes the DST rebuilding
 //! every BVH2 box from its planes. Exits nonzero on any failure.
+//!
+//! With `--tree FILE` the saved structure is checked instead: validated (a DST against a
+//! BVH2 built afresh from the scene with the tree's build settings), and each of its
+//! traversals compared ray by ray with that fresh BVH2, which also records the rays. So
+//! a saved file that passes answers every ray as a build from the scene would.
+use crate::loaded::Loaded;
 use crate::progress::Ctx;
-use dualsplit_accel::{AccelKind, CountingObserver, NoObserver};
+use anyhow::Context;
+use dualsplit_accel::{
+    AccelKind, AnyTree, Bvh2Tree, CountingObserver, NoObserver, TraversalSet, ValidationReport,
+};
 use dualsplit_render::RayKind;
+use dualsplit_scene::Scene;
 use rayon::prelude::*;
 use std::process::ExitCode;
 
@@ -20,6 +30,11 @@ pub struct Args {
     /// Rays of each kind (primary, shadow, diffuse) to compare.
     #[arg(long, default_value_t = 20_000, value_parser = super::rays::parse_count)]
     rays: usize,
+    /// Check the tree saved in FILE by `dualsplit build` instead of every structure: it must
+    /// come from SCENE (its triangles are checked); it is validated and each of its
+    /// traversals is compared ray by ray with a BVH2 built afresh from SCENE.
+    #[arg(long, value_name = "FILE")]
+    tree: Option<std::path::PathBuf>,
 }
 
 /// Most ray mismatches printed per structure and ray kind.
@@ -27,11 +42,48 @@ const SHOW: usize = 5;
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
-    let (scene, s) = super::load_and_build(&args.scene, ctx)?;
-    let mut failed = false;
+    let scene = super::load(&args.scene, ctx)?;
+    let subject = Loaded::get(&scene, args.tree.as_deref(), ctx)?;
     println!("{} ({} triangles)", scene.name, scene.triangles.len());
+    let failed = match &subject {
+        Loaded::Built { structures, .. } => {
+            let failed = print_validation(&structures.validate());
+            equivalence(&scene, structures, structures, args.rays, ctx) || failed
+        }
+        Loaded::Saved { tree, .. } => {
+            println!("{}", subject.summary());
+            // The reference: a BVH2 built afresh from the scene, with the tree's settings.
+            let sp = ctx.spinner("building the reference BVH2");
+            let fresh = Bvh2Tree::build(&scene.triangles[..], tree.config())
+                .with_context(|| format!("building the reference BVH2 of {}", scene.spec))?;
+            sp.finish_and_clear();
+            println!(
+                "reference: bvh2 built from the scene in {:.1} ms",
+                fresh.stats().build_ms
+            );
+            let report = match tree {
+                AnyTree::Bvh(b) => b.encoded().validate(),
+                AnyTree::Dst(d) => ValidationReport::of_dst(d.dst(), fresh.logical()),
+            };
+            let failed = print_validation(&[report]);
+            let reference = AnyTree::from(fresh.into_tree());
+            equivalence(&scene, &reference, tree, args.rays, ctx) || failed
+        }
+    };
+    if failed {
+        println!("check FAILED");
+        Ok(ExitCode::FAILURE)
+    } else {
+        println!("check passed");
+        Ok(ExitCode::SUCCESS)
+    }
+}
+
+/// Prints the validation reports; true when one failed.
+fn print_validation(reports: &[ValidationReport]) -> bool {
+    let mut failed = false;
     println!("validation:");
-    for rep in s.validate() {
+    for rep in reports {
         println!(
             "  {:<5} {:<4} internal {:>9} leaves {:>9} triangles {:>9}/{:<9} max depth {:>3} errors {}",
             rep.structure,
@@ -48,8 +100,20 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         }
         failed |= !rep.is_ok();
     }
+    failed
+}
 
-    let sets = super::rays::record(&scene, &s, args.rays, ctx);
+/// Records `n` rays of each kind on `reference`'s BVH2 and compares every traversal of
+/// `subject` with it, ray by ray; prints a table and returns true on any mismatch.
+fn equivalence(
+    scene: &Scene,
+    reference: &impl TraversalSet,
+    subject: &impl TraversalSet,
+    n: usize,
+    ctx: &Ctx,
+) -> bool {
+    let mut failed = false;
+    let sets = super::rays::record(scene, reference, n, ctx);
     println!("equivalence against BVH2 (per-ray averages from CountingObserver):");
     println!(
         "  {:<8} {:<8} {:>8} {:>10} {:>8} {:>8} {:>10} {:>10} {:>10} {:>10}",
@@ -72,9 +136,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         // BVH2's answers (its plain query), computed once per ray set.
         let wants: Vec<Answer> = rays
             .par_iter()
-            .map(|r| answer(&s, AccelKind::Bvh2, what, r, &mut NoObserver))
+            .map(|r| answer(reference, AccelKind::Bvh2, what, r, &mut NoObserver))
             .collect();
-        for kind in AccelKind::ALL {
+        for &kind in subject.kinds() {
             let bar = ctx.bar(rays.len() as u64, format!("{} {:?}", kind.name(), what));
             let (counts, bad) = rays
                 .par_chunks(1024)
@@ -85,9 +149,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                     for (ray, want) in chunk.iter().zip(want) {
                         // The observed traversal (the memory image, as the simulator reads
                         // it) and the plain query (a BVH's CPU-side copy, the DST's plain
-                        // decoder) must both give BVH2's answer.
-                        if answer(&s, kind, what, ray, &mut c) != *want
-                            || answer(&s, kind, what, ray, &mut NoObserver) != *want
+                        // decoder) must both give the reference's answer.
+                        if answer(subject, kind, what, ray, &mut c) != *want
+                            || answer(subject, kind, what, ray, &mut NoObserver) != *want
                         {
                             bad.push(*ray);
                         }
@@ -124,13 +188,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             failed |= !bad.is_empty();
         }
     }
-    if failed {
-        println!("check FAILED");
-        Ok(ExitCode::FAILURE)
-    } else {
-        println!("check passed");
-        Ok(ExitCode::SUCCESS)
-    }
+    failed
 }
 
 /// A ray's answer in comparable form: closest hit as (`t` bits, triangle id), or for shadow
@@ -142,7 +200,7 @@ enum Answer {
 }
 
 fn answer(
-    s: &dualsplit_accel::Structures,
+    s: &impl TraversalSet,
     kind: AccelKind,
     what: RayKind,
     ray: &dualsplit_geometry::Ray,

@@ -1,6 +1,6 @@
 //! Ray sets shared by `check` and `stats`: rays recorded from path-traced pixel jobs.
 use crate::progress::Ctx;
-use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_accel::{NoObserver, TraversalSet};
 use dualsplit_geometry::Ray;
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
 use rayon::prelude::*;
@@ -21,14 +21,16 @@ pub fn parse_count(s: &str) -> Result<usize, String> {
 }
 
 /// Records `n` rays of each kind (primary, shadow, diffuse) from path-traced pixel jobs
-/// (5 bounces), driven by the BVH2's answers; more passes with new seeds until each kind has
+/// (5 bounces), driven by the answers of `s`'s reference traversal (BVH2 for every
+/// structure of a scene); more passes with new seeds until each kind has
 /// `n` rays (at most 64 passes: a scene the camera barely sees yields fewer).
 pub fn record(
     scene: &dualsplit_scene::Scene,
-    s: &Structures,
+    s: &impl TraversalSet,
     n: usize,
     ctx: &Ctx,
 ) -> (Vec<Ray>, Vec<Ray>, Vec<Ray>) {
+    let reference = s.reference();
     let side = (n as f64).sqrt().ceil().max(1.0) as u32;
     let (mut p, mut sh, mut d) = (Vec::new(), Vec::new(), Vec::new());
     let sp = ctx.spinner("recording rays");
@@ -46,13 +48,9 @@ pub fn record(
                 while let Some(q) = job.next_ray() {
                     out.push((q.kind, q.ray));
                     let r = if q.kind == RayKind::Shadow {
-                        TraceResult::Occluded(s.any_hit(AccelKind::Bvh2, &q.ray, &mut NoObserver))
+                        TraceResult::Occluded(s.any_hit(reference, &q.ray, &mut NoObserver))
                     } else {
-                        TraceResult::Closest(s.closest_hit(
-                            AccelKind::Bvh2,
-                            &q.ray,
-                            &mut NoObserver,
-                        ))
+                        TraceResult::Closest(s.closest_hit(reference, &q.ray, &mut NoObserver))
                     };
                     job.submit(r);
                 }

@@ -1,11 +1,15 @@
 //! `dualsplit render`: one frame of a workload on a structure, written as PNG or EXR.
 //!
-//! Also holds the scene and structure loading steps with their spinners that `bench`
-//! shares.
+//! With `--tree FILE` the structure comes from a saved tree file instead of a build
+//! ([`crate::loaded`]); `--accel` then defaults to the tree's own traversal (dst-sw for a
+//! DST) and must be one of its traversals.
+//!
+//! Also holds the scene loading step with its spinner that `bench` shares.
 use crate::args::{View, parse_accel, parse_res, parse_scene, parse_workload};
+use crate::loaded::Loaded;
 use crate::progress::Ctx;
 use anyhow::Context;
-use dualsplit_accel::{AccelKind, BuildConfig, Structures};
+use dualsplit_accel::{AccelKind, TraversalSet};
 use dualsplit_render::{RayCounts, RayKind, RenderSettings, Workload, render, tile_count};
 use dualsplit_scene::Scene;
 use std::path::PathBuf;
@@ -19,9 +23,15 @@ pub struct Args {
     /// (hairball, forest, atrium, cornell).
     #[arg(value_parser = parse_scene)]
     scene: String,
-    /// Structure: bvh2, bvh4, bvh8, dst-sw or dst.
-    #[arg(long, default_value = "bvh2", value_parser = parse_accel)]
-    accel: AccelKind,
+    /// Structure: bvh2, bvh4, bvh8, dst-sw or dst (default bvh2; with --tree, the saved
+    /// structure's traversal: dst-sw for a DST).
+    #[arg(long, value_parser = parse_accel)]
+    accel: Option<AccelKind>,
+    /// Render with the tree saved in FILE by `dualsplit build` instead of building; it must
+    /// come from SCENE (its triangles are checked). Only its traversals exist: dst-sw
+    /// and dst for a DST, its own kind for a BVH.
+    #[arg(long, value_name = "FILE")]
+    tree: Option<PathBuf>,
     /// Workload: cast (primary + shadow ray) or path (5 diffuse bounces with a shadow ray at each hit).
     #[arg(long, default_value = "path", value_parser = parse_workload)]
     workload: Workload,
@@ -69,21 +79,16 @@ pub(crate) fn say(line: &str, stdout_is_data: bool) {
     }
 }
 
-/// Builds every structure behind a spinner (the time line goes as in [`load_scene`]).
-pub(crate) fn build_structures(
+/// Builds every structure, or loads `--tree`, and says how long it took (the time line
+/// goes as in [`load_scene`]).
+pub(crate) fn get_structures(
     scene: &Scene,
+    tree: Option<&std::path::Path>,
     ctx: &Ctx,
     stdout_is_data: bool,
-) -> anyhow::Result<Structures> {
-    let sp = ctx.spinner("building structures");
-    let t = Instant::now();
-    let s = Structures::try_build(&scene.triangles, &BuildConfig::default())
-        .context("building the acceleration structures")?;
-    sp.finish_and_clear();
-    say(
-        &format!("structures built in {:.2} s", t.elapsed().as_secs_f64()),
-        stdout_is_data,
-    );
+) -> anyhow::Result<Loaded> {
+    let s = Loaded::get(scene, tree, ctx)?;
+    say(&s.summary(), stdout_is_data);
     Ok(s)
 }
 
@@ -120,13 +125,21 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         ..RenderSettings::new(args.res.0, args.res.1, args.workload)
     };
     dualsplit_render::validate(&scene, &settings)?;
-    let structures = build_structures(&scene, ctx, false)?;
+    let structures = get_structures(&scene, args.tree.as_deref(), ctx, false)?;
+    let accel = match args.accel {
+        Some(k) => {
+            structures.require(k.name(), k)?;
+            k
+        }
+        None if args.tree.is_some() => structures.reference(),
+        None => AccelKind::Bvh2,
+    };
     let bar = ctx.bar(
         tile_count(&settings),
-        format!("{} {}", args.accel.name(), args.workload.name()),
+        format!("{} {}", accel.name(), args.workload.name()),
     );
     let t = Instant::now();
-    let frame = render(&scene, &structures, args.accel, &settings, &|| bar.inc(1))?;
+    let frame = render(&scene, &structures, accel, &settings, &|| bar.inc(1))?;
     let secs = t.elapsed().as_secs_f64();
     bar.finish_and_clear();
     println!(
@@ -135,7 +148,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         settings.height,
         settings.workload.name(),
         settings.spp,
-        args.accel.name(),
+        accel.name(),
         secs,
         frame.counts.rays() as f64 / secs / 1e6,
         rayon::current_num_threads()

@@ -1,15 +1,20 @@
 //! `dualsplit simulate`: one frame per configuration on the TRaX-style many-core model
 //! (Lin et al. 2020, §4), each printed in full, then compared side by side
 //! ([`summary`]).
+//!
+//! With `--tree FILE` the saved structure is simulated instead of building: only the
+//! configurations of its traversals (DST\* and DST for a DST; BVH4 and BVH4+ for a BVH4),
+//! by default all of them. The JSON is the same as when the structure is built.
 mod summary;
 
 use crate::args::{
     SimAccelArg, View, parse_positive, parse_res, parse_sim_accel, parse_workload, sim_accels,
 };
+use crate::loaded::Loaded;
 use crate::output::JsonOut;
 use crate::progress::Ctx;
 use anyhow::Context;
-use dualsplit_accel::{BuildConfig, Structures};
+use dualsplit_accel::TraversalSet;
 use dualsplit_render::{RenderSettings, Workload};
 use dualsplit_report::units;
 use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel, simulate_model};
@@ -26,9 +31,16 @@ pub struct Args {
     scene: String,
     /// Configurations, comma-separated: bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst,
     /// or all (simulated two at a time). With more than one, a comparison table follows,
-    /// relative to BVH2 when it is listed, else to the first.
-    #[arg(long, value_delimiter = ',', default_value = "dst", value_parser = parse_sim_accel)]
+    /// relative to BVH2 when it is listed, else to the first. Default dst; with --tree,
+    /// every configuration of the saved structure (dst-sw and dst for a DST), and `all`
+    /// means those.
+    #[arg(long, value_delimiter = ',', value_parser = parse_sim_accel)]
     accel: Vec<SimAccelArg>,
+    /// Simulate the tree saved in FILE by `dualsplit build` instead of building; it must
+    /// come from SCENE (its triangles are checked). Only its configurations exist:
+    /// dst-sw and dst for a DST, bvh4 and bvh4+ for a BVH4, and so on.
+    #[arg(long, value_name = "FILE")]
+    tree: Option<std::path::PathBuf>,
     /// Workload: cast (primary + shadow ray) or path (5 diffuse bounces).
     #[arg(long, default_value = "path", value_parser = parse_workload)]
     workload: Workload,
@@ -81,7 +93,6 @@ struct JsonReport<'a> {
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
-    let accels = sim_accels(&args.accel);
     let json = JsonOut::from_arg(args.json.as_deref())?;
     let (workload, model) = (args.workload, args.model);
     let mut cfg = match &args.config {
@@ -95,17 +106,22 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         cfg.tms = t;
     }
     cfg.validate()?;
+    // The frame obeys the renderer's limits, and the chip and frame fit the simulator's
+    // memory bound for every configuration, before the scene is loaded.
+    let settings = RenderSettings::new(args.res.0, args.res.1, workload);
+    dualsplit_render::validate_frame(&settings)?;
+    for accel in SimAccel::ALL {
+        let pixels = args.res.0 as u64 * args.res.1 as u64;
+        dualsplit_sim::footprint::check(&cfg, accel, model, pixels)?;
+    }
 
     let mut scene = super::load(&args.scene, ctx)?;
     args.view.apply(&mut scene)?;
-    let settings = RenderSettings::new(args.res.0, args.res.1, workload);
     // The frame and the camera obey the renderer's limits (the simulator renders the same
     // image), checked before the structures are built.
     dualsplit_render::validate(&scene, &settings)?;
-    let sp = ctx.spinner("building BVH2, BVH4, BVH8, DST");
-    let structures = Structures::try_build(&scene.triangles, &BuildConfig::default())
-        .with_context(|| format!("building the structures of {}", args.scene))?;
-    sp.finish_and_clear();
+    let structures = Loaded::get(&scene, args.tree.as_deref(), ctx)?;
+    let accels = configurations(&args.accel, &structures)?;
 
     // Each run's host time, for the table's `host` line only: a host measurement is never
     // part of a result (the JSON is the same on every machine).
@@ -202,6 +218,31 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The configurations `--accel` names (each checked against a saved tree), or the default:
+/// DST, or with `--tree` every configuration of the saved structure.
+fn configurations(asked: &[SimAccelArg], structures: &Loaded) -> anyhow::Result<Vec<SimAccel>> {
+    let tree = matches!(structures, Loaded::Saved { .. });
+    if asked.is_empty() {
+        return Ok(if tree {
+            SimAccel::ALL
+                .into_iter()
+                .filter(|a| structures.supports(a.kind()))
+                .collect()
+        } else {
+            vec![SimAccel::Dst]
+        });
+    }
+    for item in asked {
+        if let SimAccelArg::One(a) = item {
+            structures.require(a.name(), a.kind())?;
+        }
+    }
+    Ok(sim_accels(asked)
+        .into_iter()
+        .filter(|a| structures.supports(a.kind()))
+        .collect())
 }
 
 /// Prints one configuration's result; `host` is the wall time its simulation took on this

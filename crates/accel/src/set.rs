@@ -1,0 +1,132 @@
+//! [`TraversalSet`]: the structures a workload runs on, each traversal chosen by its
+//! [`AccelKind`]. Two sets exist: every structure of a scene ([`Structures`], all five
+//! kinds) and one saved or built tree ([`AnyTree`], the kinds of
+//! [`TreeKind::accel_kinds`](crate::TreeKind::accel_kinds): `dst-sw` and `dst` for a DST,
+//! its own kind for a BVH). The renderer, the benchmarks and the simulator take either.
+//!
+//! ```
+//! use dualsplit_accel::math::{Ray, Triangle, Vec3};
+//! use dualsplit_accel::{AccelKind, AnyTree, BuildConfig, Bvh2Tree, DstConfig, DstTree};
+//! use dualsplit_accel::{NoObserver, Structures, TraversalSet};
+//! let tris = vec![Triangle::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0))];
+//! let all = Structures::build(&tris, &BuildConfig::default());
+//! let bvh2 = Bvh2Tree::build(&tris[..], &BuildConfig::default())?;
+//! let dst = AnyTree::from(DstTree::from_bvh2(&bvh2, &DstConfig::hardware())?);
+//! assert_eq!(dst.kinds(), [AccelKind::DstSw, AccelKind::Dst]);
+//! assert!(!dst.supports(AccelKind::Bvh2));
+//! assert_eq!(dst.kind_names(), "dst-sw, dst");
+//! let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+//! fn t(s: &impl TraversalSet, kind: AccelKind, ray: &Ray) -> Option<f32> {
+//!     TraversalSet::closest_hit(s, kind, ray, &mut NoObserver).map(|h| h.t)
+//! }
+//! assert_eq!(t(&dst, AccelKind::Dst, &ray), t(&all, AccelKind::Bvh2, &ray));
+//! assert_eq!(TraversalSet::scene_box(&dst), TraversalSet::scene_box(&all));
+//! # Ok::<(), dualsplit_accel::AccelError>(())
+//! ```
+
+use crate::image::MemoryImage;
+use crate::observer::Observer;
+use crate::tree::AnyTree;
+use crate::{AccelKind, Structures};
+use dualsplit_geometry::{Aabb, Hit, Ray};
+
+/// Structures traversed by [`AccelKind`]: what a workload (render, benchmark, simulation)
+/// runs on.
+///
+/// A kind outside [`TraversalSet::kinds`] has no traversal: entry points that take a set
+/// and a kind (`dualsplit_render::render`, `dualsplit_sim::simulate`, ...) refuse it with
+/// an error before tracing; the per-ray methods answer such a kind with a miss.
+pub trait TraversalSet: Sync {
+    /// The traversals this set answers, its reference first (the kind ray sets are
+    /// recorded on: BVH2 for [`Structures`], the tree's first kind for an [`AnyTree`]).
+    fn kinds(&self) -> &[AccelKind];
+
+    /// True when `kind` is one of [`TraversalSet::kinds`].
+    fn supports(&self, kind: AccelKind) -> bool {
+        self.kinds().contains(&kind)
+    }
+
+    /// The command-line names of [`TraversalSet::kinds`], comma-separated (`dst-sw, dst`),
+    /// for messages.
+    fn kind_names(&self) -> String {
+        let names: Vec<&str> = self.kinds().iter().map(|k| k.name()).collect();
+        names.join(", ")
+    }
+
+    /// The reference traversal: the first of [`TraversalSet::kinds`].
+    fn reference(&self) -> AccelKind {
+        self.kinds()[0]
+    }
+
+    /// Closest hit of `ray` through traversal `kind` (a miss for a kind the set lacks).
+    fn closest_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> Option<Hit>;
+
+    /// True when `ray` hits any triangle within `[t_min, t_max]` through traversal `kind`
+    /// (false for a kind the set lacks).
+    fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool;
+
+    /// The memory image traversal `kind` reads (both DST kinds read the same image; a set
+    /// of one tree has one image, whatever `kind` says).
+    fn image(&self, kind: AccelKind) -> &MemoryImage;
+
+    /// The box around every triangle (the BVH2's root box; the DST stores it beside its
+    /// image).
+    fn scene_box(&self) -> Aabb;
+}
+
+impl TraversalSet for Structures {
+    fn kinds(&self) -> &[AccelKind] {
+        &AccelKind::ALL
+    }
+
+    #[inline]
+    fn closest_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        Structures::closest_hit(self, kind, ray, obs)
+    }
+
+    #[inline]
+    fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool {
+        Structures::any_hit(self, kind, ray, obs)
+    }
+
+    fn image(&self, kind: AccelKind) -> &MemoryImage {
+        Structures::image(self, kind)
+    }
+
+    fn scene_box(&self) -> Aabb {
+        self.dst.scene_box()
+    }
+}
+
+impl TraversalSet for AnyTree {
+    fn kinds(&self) -> &[AccelKind] {
+        self.kind().accel_kinds()
+    }
+
+    #[inline]
+    fn closest_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        AnyTree::closest_hit(self, kind, ray, obs).flatten()
+    }
+
+    #[inline]
+    fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool {
+        AnyTree::any_hit(self, kind, ray, obs).unwrap_or(false)
+    }
+
+    fn image(&self, _kind: AccelKind) -> &MemoryImage {
+        AnyTree::image(self)
+    }
+
+    fn scene_box(&self) -> Aabb {
+        match self {
+            AnyTree::Dst(d) => d.dst().scene_box(),
+            // The BVH2's root box is the union of the triangles' boxes (min and max are
+            // exact, so the order does not matter).
+            AnyTree::Bvh(b) => b
+                .image()
+                .triangle_slice()
+                .iter()
+                .fold(Aabb::EMPTY, |acc, t| acc.union(t.bounds())),
+        }
+    }
+}

@@ -1,0 +1,161 @@
+//! What `check`, `bench`, `render` and `simulate` run on: every structure built from the
+//! scene, or with `--tree FILE` the one structure a saved tree file holds (written by
+//! `dualsplit build`). This is the one place `--tree` becomes structures.
+//!
+//! A saved tree answers the traversals of its structure only: `dst-sw` and `dst` for a DST,
+//! its own kind for a BVH2, BVH4 or BVH8 ([`dualsplit_accel::TreeKind::accel_kinds`]).
+//! Asking `--accel` for another is an error that names the file and what it holds. The
+//! tree must come from the scene given: its triangles are checked against the scene's when
+//! it is loaded.
+use crate::progress::Ctx;
+use anyhow::Context;
+use dualsplit_accel::{
+    AccelKind, AnyTree, BuildConfig, MemoryImage, Observer, Structures, TraversalSet,
+};
+use dualsplit_geometry::{Aabb, Hit, Ray};
+use dualsplit_scene::Scene;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The structures a command runs on, with how long they took to get.
+// One value per command: the variants' sizes do not matter.
+#[allow(clippy::large_enum_variant)]
+pub enum Loaded {
+    /// Every structure, built from the scene.
+    Built {
+        /// BVH2, BVH4, BVH8 and the DST.
+        structures: Structures,
+        /// Wall time of the build, in milliseconds.
+        build_ms: f64,
+    },
+    /// One structure, read from a saved tree file.
+    Saved {
+        /// The tree.
+        tree: AnyTree,
+        /// The file it came from.
+        file: PathBuf,
+        /// Wall time of reading and checking the file, in milliseconds.
+        load_ms: f64,
+    },
+}
+
+impl Loaded {
+    /// Builds every structure of `scene` (default build settings), or with `tree` loads
+    /// that file, checking that it was built from `scene`'s triangles; behind a spinner.
+    pub fn get(scene: &Scene, tree: Option<&Path>, ctx: &Ctx) -> anyhow::Result<Loaded> {
+        let t = Instant::now();
+        match tree {
+            None => {
+                let sp = ctx.spinner("building BVH2, BVH4, BVH8, DST");
+                let structures =
+                    Structures::try_build(&scene.triangles, &BuildConfig::default())
+                        .with_context(|| format!("building the structures of {}", scene.spec))?;
+                sp.finish_and_clear();
+                Ok(Loaded::Built {
+                    structures,
+                    build_ms: t.elapsed().as_secs_f64() * 1e3,
+                })
+            }
+            Some(file) => {
+                let sp = ctx.spinner(format!("loading {}", file.display()));
+                let tree = AnyTree::load(file, Some(&scene.triangles)).with_context(|| {
+                    format!("--tree {} with scene {}", file.display(), scene.spec)
+                })?;
+                sp.finish_and_clear();
+                Ok(Loaded::Saved {
+                    tree,
+                    file: file.to_owned(),
+                    load_ms: t.elapsed().as_secs_f64() * 1e3,
+                })
+            }
+        }
+    }
+
+    /// One line saying what was built or loaded and how long it took.
+    pub fn summary(&self) -> String {
+        match self {
+            Loaded::Built { build_ms, .. } => {
+                format!("structures built in {:.2} s", build_ms / 1e3)
+            }
+            Loaded::Saved {
+                tree,
+                file,
+                load_ms,
+            } => format!(
+                "tree {} ({}) loaded in {load_ms:.1} ms (load_ms), no build",
+                file.display(),
+                tree.kind()
+            ),
+        }
+    }
+
+    /// Checks that `kind` (given as `--accel VALUE`) has a traversal here.
+    pub fn require(&self, value: &str, kind: AccelKind) -> anyhow::Result<()> {
+        match self {
+            Loaded::Saved { tree, file, .. } if !tree.supports(kind) => {
+                anyhow::bail!(
+                    "--accel {value}: tree file {} holds a {}, whose traversals are {}; \
+                     save a {} tree with `dualsplit build SCENE --accel {}`, or leave out --tree",
+                    file.display(),
+                    tree.kind(),
+                    tree.kind_names(),
+                    dualsplit_accel::TreeKind::of_accel(kind),
+                    dualsplit_accel::TreeKind::of_accel(kind)
+                )
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The traversals to run: `asked` (each checked with [`Loaded::require`]), or every
+    /// one there is when `asked` is empty.
+    pub fn kinds_or_all(&self, asked: &[AccelKind]) -> anyhow::Result<Vec<AccelKind>> {
+        if asked.is_empty() {
+            return Ok(self.kinds().to_vec());
+        }
+        for &k in asked {
+            self.require(k.name(), k)?;
+        }
+        Ok(asked.to_vec())
+    }
+}
+
+/// Each call goes to the built structures or to the tree.
+impl TraversalSet for Loaded {
+    fn kinds(&self) -> &[AccelKind] {
+        match self {
+            Loaded::Built { structures, .. } => TraversalSet::kinds(structures),
+            Loaded::Saved { tree, .. } => tree.kinds(),
+        }
+    }
+
+    #[inline]
+    fn closest_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        match self {
+            Loaded::Built { structures, .. } => structures.closest_hit(kind, ray, obs),
+            Loaded::Saved { tree, .. } => TraversalSet::closest_hit(tree, kind, ray, obs),
+        }
+    }
+
+    #[inline]
+    fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool {
+        match self {
+            Loaded::Built { structures, .. } => structures.any_hit(kind, ray, obs),
+            Loaded::Saved { tree, .. } => TraversalSet::any_hit(tree, kind, ray, obs),
+        }
+    }
+
+    fn image(&self, kind: AccelKind) -> &MemoryImage {
+        match self {
+            Loaded::Built { structures, .. } => structures.image(kind),
+            Loaded::Saved { tree, .. } => TraversalSet::image(tree, kind),
+        }
+    }
+
+    fn scene_box(&self) -> Aabb {
+        match self {
+            Loaded::Built { structures, .. } => TraversalSet::scene_box(structures),
+            Loaded::Saved { tree, .. } => TraversalSet::scene_box(tree),
+        }
+    }
+}
