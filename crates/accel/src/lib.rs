@@ -32,7 +32,10 @@
 //!   [`DstTree::from_bvh2`] derive the others from a BVH2, each with its [`BuildStats`]
 //!   (times in milliseconds).
 //! * Queries: [`RayQuery`] (`intersect`, `occluded`, batch forms, and the `_observed` forms
-//!   the simulator uses).
+//!   the simulator uses). The plain and batch forms observe nothing, so they run the
+//!   CPU-side path ([`Observer::OBSERVES_NOTHING`]: [`wide::cpu`] for a BVH, the DST's plain
+//!   decoder), made from the image on first use, with the image traversal's answers bit for
+//!   bit; the `_observed` forms read the image.
 //! * DST traversals: [`DstDecoding::Software`] ([`AccelKind::DstSw`], `dst-sw`: the paper's
 //!   DST\*, the fast one on a CPU) and [`DstDecoding::Pipeline`] ([`AccelKind::Dst`], `dst`:
 //!   the hardware pipeline model). [`AccelKind::DST_SOFTWARE`] and

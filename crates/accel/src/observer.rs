@@ -51,6 +51,10 @@ pub enum NodeStep {
 
 /// Told what a traversal kernel does, in order.
 pub trait Observer {
+    /// True for an observer that ignores every report ([`NoObserver`]): a BVH traversal may
+    /// then answer from the CPU-side copy of the image ([`crate::wide::cpu`]), whose answers
+    /// are the image traversal's bit for bit but whose reads are not the image's.
+    const OBSERVES_NOTHING: bool = false;
     /// The kernel reads `bytes` contiguous bytes at byte address `addr` of the structure's
     /// memory image (node words, triangle-index entries, triangle vertices).
     #[inline(always)]
@@ -79,7 +83,9 @@ pub trait Observer {
 /// The observer that observes nothing.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoObserver;
-impl Observer for NoObserver {}
+impl Observer for NoObserver {
+    const OBSERVES_NOTHING: bool = true;
+}
 
 /// Per-ray counters: nodes visited, planes/boxes tested, triangles tested, bytes fetched.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]

@@ -1,12 +1,14 @@
 //! BVH2, BVH4 and BVH8 on the shipped scenes: identical leaves, clean validation, and
 //! per-ray identical answers for primary, shadow and diffuse-bounce rays recorded from
-//! path-traced pixel jobs on each scene's default camera.
+//! path-traced pixel jobs on each scene's default camera: every BVH's plain query (its
+//! CPU-side copy, [`dualsplit_accel::wide::cpu`]) and its image traversal (what the
+//! simulator reads) against the BVH2's image traversal, hit for hit and bit for bit.
 //!
 //! Release builds (`cargo test --release`, what CI runs) compare at least 100K rays of each
 //! kind per scene; debug builds compare 3K of each so that `cargo test` stays quick.
 
 use dualsplit_accel::{AccelKind, BuildConfig, CollapseConfig, NoObserver, Structures, WideBvh};
-use dualsplit_testkit::oracle::key;
+use dualsplit_testkit::oracle::{hit_bits, key};
 use dualsplit_testkit::rays::record_rays;
 use dualsplit_testkit::scenes::load_scene;
 use rayon::prelude::*;
@@ -18,43 +20,79 @@ const RAYS: usize = if cfg!(debug_assertions) {
 };
 
 fn equivalence(name: &str) {
-    let scene = load_scene(name);
+    equivalence_on(name, &load_scene(name), RAYS);
+}
+
+/// Every builtin scene (reduced sizes), with its preset camera; a quarter of the shipped
+/// meshes' ray count (the dense hairball blocks most light paths).
+#[test]
+fn equivalence_builtins() {
+    for spec in [
+        "builtin:cornell",
+        "builtin:atrium?triangles=20000",
+        "builtin:forest?triangles=20000",
+        "builtin:hairball?triangles=20000",
+    ] {
+        let scene = dualsplit_scene::load(spec).expect("builtin scene");
+        equivalence_on(spec, &scene, RAYS / 4);
+    }
+}
+
+fn equivalence_on(name: &str, scene: &dualsplit_scene::Scene, min_rays: usize) {
     let s = Structures::build(&scene.triangles, &BuildConfig::default());
     for rep in s.validate() {
         assert!(rep.is_ok(), "{name}: {rep:?}");
         assert_eq!(rep.triangles_referenced, scene.triangles.len());
     }
-    let side = (RAYS as f64).sqrt().ceil() as u32;
-    let rays = record_rays(&scene, &s, side, RAYS);
+    let side = (min_rays as f64).sqrt().ceil() as u32;
+    let rays = record_rays(scene, &s, side, min_rays);
     assert!(
-        rays.primary.len() >= RAYS,
+        rays.primary.len() >= min_rays,
         "{name}: {} primary",
         rays.primary.len()
     );
     assert!(
-        rays.shadow.len() >= RAYS,
+        rays.shadow.len() >= min_rays,
         "{name}: {} shadow",
         rays.shadow.len()
     );
     assert!(
-        rays.diffuse.len() >= RAYS,
+        rays.diffuse.len() >= min_rays,
         "{name}: {} diffuse",
         rays.diffuse.len()
     );
     for (what, set) in [("primary", &rays.primary), ("diffuse", &rays.diffuse)] {
         set.par_iter().enumerate().for_each(|(i, ray)| {
-            let want = key(s.closest_hit(AccelKind::Bvh2, ray, &mut NoObserver));
-            for kind in [AccelKind::Bvh4, AccelKind::Bvh8] {
-                let got = key(s.closest_hit(kind, ray, &mut NoObserver));
-                assert_eq!(got, want, "{name}: {what} ray {i} {ray:?} on {kind:?}");
+            let want = hit_bits(s.bvh2_image.closest_hit_image(ray, &mut NoObserver));
+            for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+                let b = s.encoded(kind).unwrap();
+                let image = hit_bits(b.closest_hit_image(ray, &mut NoObserver));
+                assert_eq!(
+                    image, want,
+                    "{name}: {what} ray {i} {ray:?} on {kind:?}'s image"
+                );
+                let got = s.closest_hit(kind, ray, &mut NoObserver);
+                assert_eq!(
+                    hit_bits(got),
+                    want,
+                    "{name}: {what} ray {i} {ray:?} on {kind:?}"
+                );
+                assert_eq!(key(got).is_some(), want.is_some());
             }
         });
     }
     rays.shadow.par_iter().enumerate().for_each(|(i, ray)| {
         let want = s
-            .closest_hit(AccelKind::Bvh2, ray, &mut NoObserver)
+            .bvh2_image
+            .closest_hit_image(ray, &mut NoObserver)
             .is_some();
         for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+            let b = s.encoded(kind).unwrap();
+            let image = b.any_hit_image(ray, &mut NoObserver);
+            assert_eq!(
+                image, want,
+                "{name}: shadow ray {i} {ray:?} on {kind:?}'s image"
+            );
             let got = s.any_hit(kind, ray, &mut NoObserver);
             assert_eq!(got, want, "{name}: shadow ray {i} {ray:?} on {kind:?}");
         }

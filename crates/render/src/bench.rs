@@ -3,9 +3,10 @@
 //! Method (tinybvh's habit: check, then time):
 //!
 //! 1. [`ray_sets`] runs every pixel's [`PixelJob`] of a frame on BVH2 (for one saved tree,
-//!    on its own first traversal) and keeps each ray with that answer, split by [`RayKind`]
-//!    (primary, shadow, diffuse), in pixel order. The rays are exactly those the renderer
-//!    traces, so shadow and diffuse rays start on surfaces.
+//!    on its own first traversal), through its observed traversal (the memory image, not the
+//!    CPU-side path that plain queries use), and keeps each ray with that answer, split by
+//!    [`RayKind`] (primary, shadow, diffuse), in pixel order. The rays are exactly those the
+//!    renderer traces, so shadow and diffuse rays start on surfaces.
 //! 2. [`measure`] first traces every ray of a set on the structure under test and compares
 //!    the answer with the recorded one bit for bit ([`TraceResult::bit_eq`]); the first mismatch is a
 //!    [`RenderError::Mismatch`], never a number.
@@ -22,7 +23,7 @@
 
 use crate::trace::{run_job, trace_query};
 use crate::{PixelJob, RayCounts, RayKind, RayQuery, RenderError, RenderSettings, TraceResult};
-use dualsplit_accel::{AccelKind, NoObserver, TraversalSet};
+use dualsplit_accel::{AccelKind, NoObserver, Observer, TraversalSet};
 use dualsplit_geometry::Ray;
 use dualsplit_scene::Scene;
 use rayon::prelude::*;
@@ -43,10 +44,17 @@ pub struct RaySet {
     pub expected: Vec<TraceResult>,
 }
 
+/// An observer that ignores every report but is not [`NoObserver`], so a BVH answers by
+/// traversing its byte-exact image ([`Observer::OBSERVES_NOTHING`] is false): the reference
+/// the timed structures, which answer from their CPU-side copies, are checked against.
+struct ImageReference;
+
+impl Observer for ImageReference {}
+
 /// Builds the three ray sets (primary, shadow, diffuse; the *cast* workload's diffuse set is
 /// empty) of a frame of `settings` by running every pixel's job on the reference traversal
 /// of `structures` ([`TraversalSet::reference`]: BVH2 for every structure of a scene, the
-/// tree's own traversal for one tree).
+/// tree's own traversal for one tree), reading its image.
 pub fn ray_sets<S: TraversalSet>(
     scene: &Scene,
     structures: &S,
@@ -64,7 +72,7 @@ pub fn ray_sets<S: TraversalSet>(
                     job,
                     structures,
                     structures.reference(),
-                    &mut NoObserver,
+                    &mut ImageReference,
                     &mut counts,
                     |q, r| v.push((*q, *r)),
                 );

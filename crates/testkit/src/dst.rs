@@ -3,7 +3,7 @@
 
 use crate::oracle::{check_ray as check_structures, key};
 use dualsplit_accel::dst::{Dst, DstConfig, Partitioning};
-use dualsplit_accel::{BuildConfig, Bvh2, NoObserver, Structures};
+use dualsplit_accel::{BuildConfig, Bvh2, CountingObserver, NoObserver, Structures};
 use dualsplit_geometry::{Hit, Ray, Triangle};
 
 /// The DST presets every DST test loops over: the hardware and software cost presets with
@@ -56,8 +56,21 @@ pub fn build_with(tris: &[Triangle], bcfg: &BuildConfig, cfg: &DstConfig) -> Bui
 /// On the first disagreement, naming the traversal, `what` and the ray.
 pub fn check_dst_ray(dst: &Dst, ray: &Ray, expected: Option<Hit>, what: &str) {
     let want = key(expected);
-    let sw = key(dst.closest_hit(ray, &mut NoObserver));
-    assert_eq!(sw, want, "{what}: software closest hit, ray {ray:?}");
+    let sw = dst.closest_hit(ray, &mut NoObserver);
+    assert_eq!(key(sw), want, "{what}: software closest hit, ray {ray:?}");
+    // Observed, the software decoder reads the image (traverse.rs); plain queries run the
+    // plain decoder (fast.rs). Every bit of their hits agrees.
+    let observed = dst.closest_hit(ray, &mut CountingObserver::default());
+    assert_eq!(
+        crate::oracle::hit_bits(observed),
+        crate::oracle::hit_bits(sw),
+        "{what}: observed vs plain software closest hit, ray {ray:?}"
+    );
+    assert_eq!(
+        dst.any_hit(ray, &mut CountingObserver::default()),
+        expected.is_some(),
+        "{what}: observed software any hit, ray {ray:?}"
+    );
     let pipe = key(dst.closest_hit_pipeline(ray, &mut NoObserver));
     assert_eq!(pipe, want, "{what}: pipeline closest hit, ray {ray:?}");
     let occluded = expected.is_some();

@@ -1,7 +1,7 @@
 //! The brute-force reference: every triangle tested against the ray, the closest hit chosen
 //! in `(t, triangle id)` order. Every structure must match it bit for bit, ray by ray.
 
-use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_accel::{AccelKind, CountingObserver, NoObserver, Structures};
 use dualsplit_geometry::{Hit, PrimId, Ray, Triangle};
 
 /// Closest hit over all triangles on `[t_min, t_max]`, ordered by `(t, triangle id)`: equal
@@ -67,7 +67,44 @@ pub fn check_ray(s: &Structures, tris: &[Triangle], ray: &Ray, what: &str) {
             "{what}: {} any hit vs oracle, ray {ray:?}",
             kind.name()
         );
+        // Observed traversals (what the simulator runs) read the image; plain queries may
+        // not (a BVH's CPU-side copy, the DST's plain decoder). Every bit agrees.
+        let observed = s.closest_hit(kind, ray, &mut CountingObserver::default());
+        assert_eq!(
+            hit_bits(observed),
+            hit_bits(got),
+            "{what}: {} observed vs plain closest hit, ray {ray:?}",
+            kind.name()
+        );
+        assert_eq!(
+            s.any_hit(kind, ray, &mut CountingObserver::default()),
+            want_any,
+            "{what}: {} observed any hit vs oracle, ray {ray:?}",
+            kind.name()
+        );
+        // A BVH answers plain queries from its CPU-side copy; its image traversal (what the
+        // simulator and every counting observer read) must give the same hit, bit for bit.
+        if let Some(b) = s.encoded(kind) {
+            let image = b.closest_hit_image(ray, &mut NoObserver);
+            assert_eq!(
+                hit_bits(image),
+                hit_bits(got),
+                "{what}: {} image traversal vs CPU copy, ray {ray:?}",
+                kind.name()
+            );
+            assert_eq!(
+                b.any_hit_image(ray, &mut NoObserver),
+                want_any,
+                "{what}: {} image any hit vs oracle, ray {ray:?}",
+                kind.name()
+            );
+        }
     }
+}
+
+/// Every bit of a hit: `t`, triangle id, `u`, `v`.
+pub fn hit_bits(h: Option<Hit>) -> Option<[u32; 4]> {
+    h.map(|h| [h.t.to_bits(), h.prim.0, h.u.to_bits(), h.v.to_bits()])
 }
 
 /// [`check_ray`] for each of `rays`, named by its index.

@@ -556,10 +556,5 @@ pub(super) fn encode(
     } else {
         52 * stats.splitting + 4 * bvh.prim_ids.len() as u64
     };
-    Ok(Dst {
-        image,
-        scene_box,
-        config: *cfg,
-        stats,
-    })
+    Ok(Dst::from_parts(image, scene_box, *cfg, stats))
 }

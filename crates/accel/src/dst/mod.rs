@@ -36,6 +36,7 @@
 //! ```
 
 mod encode;
+mod fast;
 mod from_bvh2;
 mod header;
 pub mod pipeline;
@@ -240,6 +241,9 @@ pub struct Dst {
     scene_box: Aabb,
     config: DstConfig,
     stats: DstStats,
+    /// The triangles of the index region in its order, four to a packet, for the plain
+    /// queries' decoder (`fast.rs`); made on first use.
+    packets: std::sync::OnceLock<std::sync::Arc<crate::image::Pages<crate::wide::cpu::TriPacket>>>,
 }
 
 impl Dst {
@@ -286,6 +290,7 @@ impl Dst {
             scene_box,
             config,
             stats,
+            packets: Default::default(),
         }
     }
 }

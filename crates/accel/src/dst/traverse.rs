@@ -210,13 +210,23 @@ fn dst_step(kind: DstNodeKind, code: ReturnCode, carving_leaf: bool) -> NodeStep
 }
 
 impl Dst {
-    /// Closest hit of `ray` (software decoder, DST*), ordered by `(t, prim)`.
+    /// Closest hit of `ray` (software decoder, DST*), ordered by `(t, prim)`. With an
+    /// observer that observes nothing ([`Observer::OBSERVES_NOTHING`]) it runs the plain
+    /// decoder of `fast.rs` (same nodes, triangles from a leaf-ordered copy); both give the
+    /// same answer, bit for bit.
     pub fn closest_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        if O::OBSERVES_NOTHING {
+            return self.traverse_fast::<false>(ray);
+        }
         self.traverse::<O, false>(ray, obs)
     }
 
-    /// True when `ray` hits any triangle within `[t_min, t_max]` (software decoder).
+    /// True when `ray` hits any triangle within `[t_min, t_max]` (software decoder; the
+    /// plain decoder when nothing is observed, as [`Dst::closest_hit`]).
     pub fn any_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+        if O::OBSERVES_NOTHING {
+            return self.traverse_fast::<true>(ray).is_some();
+        }
         self.traverse::<O, true>(ray, obs).is_some()
     }
 

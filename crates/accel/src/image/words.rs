@@ -114,6 +114,72 @@ impl fmt::Debug for Words {
     }
 }
 
+/// An array of plain data that, when large ([`MAPPED_MIN_BYTES`]), lives in an anonymous
+/// mapping advised to use transparent huge pages, as [`Words`] does; dereferences to `[T]`.
+///
+/// For data read at random, such as the CPU-side copies of the traversal
+/// ([`crate::wide::cpu`]): with 4 KiB pages nearly every node of a large scene costs a TLB
+/// miss (a two-level page walk under virtualisation); 2 MiB pages cover it with a few
+/// hundred entries. The contents are the same either way.
+pub struct Pages<T: bytemuck::Pod>(PagesBuf<T>);
+
+enum PagesBuf<T> {
+    Heap(Vec<T>),
+    /// A page-aligned anonymous mapping of `len · size_of::<T>()` bytes.
+    Mapped(MmapMut, usize),
+}
+
+impl<T: bytemuck::Pod> Pages<T> {
+    /// A copy of `items`.
+    pub fn from_slice(items: &[T]) -> Self {
+        let bytes = std::mem::size_of_val(items);
+        // A page-aligned mapping suits any alignment of `T` up to a page.
+        if bytes >= MAPPED_MIN_BYTES
+            && std::mem::align_of::<T>() <= 4096
+            && let Ok(mut map) = MmapMut::map_anon(bytes)
+        {
+            #[cfg(target_os = "linux")]
+            let _ = map.advise(memmap2::Advice::HugePage);
+            map.copy_from_slice(bytemuck::cast_slice(items));
+            return Pages(PagesBuf::Mapped(map, items.len()));
+        }
+        Pages(PagesBuf::Heap(items.to_vec()))
+    }
+}
+
+impl<T: bytemuck::Pod> Deref for Pages<T> {
+    type Target = [T];
+    #[inline(always)]
+    fn deref(&self) -> &[T] {
+        match &self.0 {
+            PagesBuf::Heap(v) => v,
+            PagesBuf::Mapped(m, len) => &bytemuck::cast_slice(&m[..])[..*len],
+        }
+    }
+}
+
+impl<T: bytemuck::Pod> Default for Pages<T> {
+    fn default() -> Self {
+        Pages(PagesBuf::Heap(Vec::new()))
+    }
+}
+
+impl<T: bytemuck::Pod> Clone for Pages<T> {
+    fn clone(&self) -> Self {
+        Self::from_slice(self)
+    }
+}
+
+impl<T: bytemuck::Pod> fmt::Debug for Pages<T> {
+    /// The length and storage, not the contents.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Pages")
+            .field("len", &self.len())
+            .field("mapped", &matches!(self.0, PagesBuf::Mapped(..)))
+            .finish()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,6 +202,20 @@ mod tests {
         assert_eq!((copy[0], copy[n - 1]), (9, 7));
         assert_eq!(big.into_vec().len(), n);
         assert_eq!(Words::zeroed(0).len(), 0);
+    }
+
+    #[test]
+    fn pages_copy_small_and_large_slices() {
+        let small: Vec<[u32; 4]> = (0..10).map(|i| [i, i + 1, i + 2, i + 3]).collect();
+        assert_eq!(&Pages::from_slice(&small)[..], &small[..]);
+        let n = MAPPED_MIN_BYTES / 16 + 5;
+        let big: Vec<[u32; 4]> = (0..n as u32).map(|i| [i, !i, i ^ 7, 3]).collect();
+        let pages = Pages::from_slice(&big);
+        assert_eq!(&pages[..], &big[..]);
+        #[cfg(unix)]
+        assert!(format!("{pages:?}").contains("mapped: true"));
+        assert_eq!(&pages.clone()[..], &big[..]);
+        assert!(Pages::<u32>::default().is_empty());
     }
 
     #[test]

@@ -401,6 +401,7 @@ fn assemble(h: &Header, words: Words, tris: SharedTriangles) -> AnyTree {
                 leaves: leaves as usize,
                 sah_cost,
                 time: Duration::ZERO,
+                cpu: Default::default(),
             };
             AnyTree::Bvh(BvhTree {
                 stats: BuildStats::of_bvh(h.kind, &encoded, 0.0),

@@ -14,9 +14,11 @@
 //! * [`BvhImage`] bundles an encoded structure with its statistics.
 
 mod collapse;
+pub mod cpu;
 pub mod encode;
 mod node4;
 mod node8;
+mod simd;
 pub mod traverse;
 
 pub use collapse::CollapseConfig;
@@ -152,6 +154,8 @@ pub struct BvhImage {
     /// Wall time of the BVH2 build (arity 2) or of the collapse (arity 4, 8); a measurement,
     /// not a result.
     pub time: Duration,
+    /// The CPU-side copy the plain queries traverse ([`cpu`]), made on first use.
+    pub(crate) cpu: std::sync::OnceLock<std::sync::Arc<cpu::CpuBvh>>,
 }
 
 impl BvhImage {
@@ -178,12 +182,51 @@ impl BvhImage {
             leaves: wide.leaf_count(),
             sah_cost: wide.sah_cost(cfg),
             time,
+            cpu: Default::default(),
         })
     }
 
-    /// Closest hit of `ray` (ordered by `(t, prim)`), reading the image.
+    /// The CPU-side copy of the image ([`cpu::CpuBvh`]), made on the first call.
+    pub fn cpu(&self) -> &cpu::CpuBvh {
+        self.cpu.get_or_init(|| {
+            std::sync::Arc::new(match self.arity {
+                2 => cpu::CpuBvh::from_image::<Node2>(&self.image),
+                4 => cpu::CpuBvh::from_image::<Node4>(&self.image),
+                _ => cpu::CpuBvh::from_image::<Node8>(&self.image),
+            })
+        })
+    }
+
+    /// Closest hit of `ray` (ordered by `(t, prim)`). With an observer that observes
+    /// nothing ([`Observer::OBSERVES_NOTHING`]) it traverses the CPU-side copy
+    /// ([`BvhImage::cpu`]); otherwise it reads the image ([`BvhImage::closest_hit_image`]).
+    /// Both give the same answer, bit for bit.
     #[inline]
     pub fn closest_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        if O::OBSERVES_NOTHING
+            && let Some(h) = self.cpu().traverse::<false>(ray)
+        {
+            return h;
+        }
+        self.closest_hit_image(ray, obs)
+    }
+
+    /// True when any triangle is hit within `[ray.t_min, ray.t_max]`; like
+    /// [`BvhImage::closest_hit`], through the CPU-side copy when nothing is observed.
+    #[inline]
+    pub fn any_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+        if O::OBSERVES_NOTHING
+            && let Some(h) = self.cpu().traverse::<true>(ray)
+        {
+            return h.is_some();
+        }
+        self.any_hit_image(ray, obs)
+    }
+
+    /// Closest hit of `ray` (ordered by `(t, prim)`), reading the image and reporting every
+    /// fetch and step to `obs`.
+    #[inline]
+    pub fn closest_hit_image<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
         match self.arity {
             2 => traverse::traverse::<Node2, O, false>(&self.image, ray, obs),
             4 => traverse::traverse::<Node4, O, false>(&self.image, ray, obs),
@@ -191,9 +234,9 @@ impl BvhImage {
         }
     }
 
-    /// True when any triangle is hit within `[ray.t_min, ray.t_max]`.
+    /// True when any triangle is hit within `[ray.t_min, ray.t_max]`, reading the image.
     #[inline]
-    pub fn any_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+    pub fn any_hit_image<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
         match self.arity {
             2 => traverse::traverse::<Node2, O, true>(&self.image, ray, obs),
             4 => traverse::traverse::<Node4, O, true>(&self.image, ray, obs),

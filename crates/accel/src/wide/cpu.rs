@@ -1,0 +1,697 @@
+//! The CPU-side copy of a BVH image that the plain queries traverse: child boxes of each
+//! node stored lane by lane (structure of arrays, 4 children per [`Chunk`]) so that one
+//! SIMD slab test covers 4 children, and triangles copied in leaf order, four to a packet
+//! lane by lane, so that the first stage of the watertight test runs on a leaf at once.
+//!
+//! It is made from the byte-exact image (so from the same BVH2 and collapse: the same
+//! children, the same box words, the same leaves) when a plain query first needs it, and is
+//! used only when the caller observes nothing ([`crate::Observer::OBSERVES_NOTHING`]); the
+//! simulator and every counting observer still read the image through
+//! [`super::traverse`]. The answers are the image traversal's, ray for ray and bit for bit:
+//!
+//! * the box test is [`super::traverse`]'s arithmetic lane by lane: `(p - o) * inv`, far
+//!   planes multiplied by [`EXIT_WIDEN`], the interval clipped by compare-and-select (x86's
+//!   `maxps`/`minps` keep the running bound when a plane distance is NaN, exactly as the
+//!   scalar `if tn > entry`); rays whose interval ends are NaN take the image traversal;
+//! * the triangle test is the same [`Triangle::intersect`] on the same triangle words (a SIMD
+//!   first stage only drops triangles that it would reject at that stage), and hits are kept
+//!   by [`Hit::closer_than`]'s `(t, prim)` order, which makes the closest hit independent of
+//!   the order in which leaves are visited;
+//! * nodes are culled against the same [`cull_limit`] of the best `t`, which keeps every
+//!   leaf that can hold an equally near hit with a smaller id.
+//!
+//! Only the visiting order of a node's hit children differs (nearest first, the rest pushed
+//! by a rank computed from their entry distances, ties in either order; for shadow rays the
+//! first hit child first and the rest as they come), which changes no answer.
+//!
+//! Hit children about to be pushed are prefetched (`simd.rs`), and the chunks and packets
+//! live in transparent huge pages ([`Pages`]). Figures: `docs/performance.md`, "CPU
+//! traversal".
+
+use crate::image::{ChildKind, MemoryImage, NodeLayout, Pages, RUN_END};
+use dualsplit_geometry::{EXIT_WIDEN, Hit, PrimId, Ray, RayPre, Triangle, Vec3, cull_limit};
+use std::cell::Cell;
+use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
+
+/// Children per chunk: one SSE register of `f32`.
+pub const LANES: usize = 4;
+
+/// Child word of a leaf: bit 31 set, bits 0–30 the slot of its first triangle in
+/// [`CpuBvh::packets`] (`4 · packet + lane`).
+pub const LEAF: u32 = 1 << 31;
+
+/// Child word of an empty lane.
+pub const EMPTY: u32 = u32::MAX;
+
+/// Four children of a node: their boxes plane by plane, then their child words.
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C, align(16))]
+pub struct Chunk {
+    /// `planes[p][lane]`: plane `p` of the lane's box, in the image's box-word order
+    /// (min.x, min.y, min.z, max.x, max.y, max.z). Empty lanes hold the degenerate box.
+    pub planes: [[f32; LANES]; 6],
+    /// Per lane: a node (index of its first chunk), a leaf ([`LEAF`] | first triangle) or
+    /// [`EMPTY`].
+    pub child: [u32; LANES],
+}
+
+const EMPTY_CHUNK: Chunk = Chunk {
+    planes: [
+        [f32::INFINITY; LANES],
+        [f32::INFINITY; LANES],
+        [f32::INFINITY; LANES],
+        [f32::NEG_INFINITY; LANES],
+        [f32::NEG_INFINITY; LANES],
+        [f32::NEG_INFINITY; LANES],
+    ],
+    child: [EMPTY; LANES],
+};
+
+/// Four consecutive triangles of the leaf-ordered triangle list, vertex coordinates lane by
+/// lane, with their ids. Leaves follow one another without padding: a leaf starts at any
+/// lane (its child word names the slot `4 · packet + lane`) and ends at the first lane from
+/// there whose id has [`RUN_END`] set; the last packet is padded with [`EMPTY`] lanes.
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C, align(16))]
+pub struct TriPacket {
+    /// `v[3 * vertex + axis][lane]`.
+    pub v: [[f32; LANES]; 9],
+    /// Triangle ids; [`RUN_END`] on a leaf's last one, [`EMPTY`] on padding lanes.
+    pub prim: [u32; LANES],
+}
+
+pub(crate) const EMPTY_PACKET: TriPacket = TriPacket {
+    v: [[0.0; LANES]; 9],
+    prim: [EMPTY; LANES],
+};
+
+/// The CPU-side copy of one BVH image (see the module docs).
+#[derive(Clone, Debug, Default)]
+pub struct CpuBvh {
+    /// Chunks per node: 1 for BVH2 and BVH4, 2 for BVH8.
+    pub chunks_per_node: usize,
+    /// The nodes, each `chunks_per_node` consecutive chunks, the root first.
+    pub chunks: Pages<Chunk>,
+    /// The leaves' triangles in leaf order, four to a packet.
+    pub packets: Pages<TriPacket>,
+}
+
+impl CpuBvh {
+    /// Copies the image of node layout `L` (depth-first, children of a node next to one
+    /// another).
+    pub fn from_image<L: NodeLayout>(img: &MemoryImage) -> Self {
+        let cpn = L::ARITY.div_ceil(LANES);
+        let words = &img.words[..];
+        let triangles = img.triangle_slice();
+        struct Out {
+            chunks: Vec<Chunk>,
+            packets: Vec<TriPacket>,
+        }
+        let mut out = Out {
+            chunks: Vec::new(),
+            packets: Vec::new(),
+        };
+        // (image word of a node, chunk index it is copied to)
+        let mut todo: Vec<(usize, usize)> = vec![(0, 0)];
+        // Triangle slots used (4 per packet).
+        let mut slots = 0usize;
+        out.chunks.extend(std::iter::repeat_n(EMPTY_CHUNK, cpn));
+        while let Some((w, at)) = todo.pop() {
+            let node = L::read(words, w);
+            let mut addr = node.offset() as usize;
+            let mut lane = 0;
+            let mut internal = Vec::new();
+            for k in 0..L::ARITY {
+                let kind = node.kind(k);
+                if kind == ChildKind::Empty {
+                    continue;
+                }
+                let ch = &mut out.chunks[at + lane / LANES];
+                let l = lane % LANES;
+                for (p, &v) in node.box_words(k).iter().enumerate() {
+                    ch.planes[p][l] = v;
+                }
+                match kind {
+                    ChildKind::Leaf => {
+                        let run = words[addr] as usize;
+                        let first = slots as u32;
+                        assert!(first < LEAF, "too many triangle references");
+                        let len = words[run..]
+                            .iter()
+                            .position(|&e| e & RUN_END != 0)
+                            .map_or(0, |p| p + 1);
+                        pack_entries(
+                            &mut out.packets,
+                            &mut slots,
+                            words[run..run + len].iter().copied(),
+                            triangles,
+                        );
+                        ch.child[l] = LEAF | first;
+                    }
+                    _ => internal.push((addr, at + lane / LANES, l)),
+                }
+                addr += L::child_words(kind) as usize;
+                lane += 1;
+            }
+            // Children of one node next to one another, then their subtrees depth-first.
+            let mut subtrees = Vec::with_capacity(internal.len());
+            for (cw, chunk, l) in internal {
+                let idx = out.chunks.len();
+                out.chunks.extend(std::iter::repeat_n(EMPTY_CHUNK, cpn));
+                out.chunks[chunk].child[l] = idx as u32;
+                subtrees.push((cw, idx));
+            }
+            todo.extend(subtrees.into_iter().rev());
+        }
+        CpuBvh {
+            chunks_per_node: cpn,
+            chunks: Pages::from_slice(&out.chunks),
+            packets: Pages::from_slice(&out.packets),
+        }
+    }
+
+    /// Bytes of the copy (chunks and leaf-ordered triangles).
+    pub fn bytes(&self) -> usize {
+        self.chunks.len() * size_of::<Chunk>() + self.packets.len() * size_of::<TriPacket>()
+    }
+
+    /// Closest hit (`ANY = false`) or some hit (`ANY = true`) of `ray`; `None` when the ray
+    /// must take the image traversal instead (its `t_min` or cull limit is NaN).
+    #[inline]
+    pub fn traverse<const ANY: bool>(&self, ray: &Ray) -> Option<Option<Hit>> {
+        if (ray.t_min - cull_limit(ray.t_max)).is_nan() {
+            return None;
+        }
+        let mut stack = STACK.take();
+        stack.clear();
+        let hit = match self.chunks_per_node {
+            1 => self.run::<1, ANY>(ray, &mut stack),
+            _ => self.run::<2, ANY>(ray, &mut stack),
+        };
+        STACK.set(stack);
+        Some(hit)
+    }
+
+    #[inline(always)]
+    fn run<const C: usize, const ANY: bool>(
+        &self,
+        ray: &Ray,
+        stack: &mut Vec<Entry>,
+    ) -> Option<Hit> {
+        let r = ray.precompute();
+        let rs = RaySimd::new(&r);
+        let chunks = &self.chunks[..];
+        let packets = &self.packets[..];
+        let mut best: Option<Hit> = None;
+        let mut best_t = ray.t_max;
+        let mut limit = cull_limit(best_t);
+        let t_lo = f32x4::splat(ray.t_min);
+        let mut cur = 0u32;
+        loop {
+            if cur & LEAF == 0 {
+                let n = cur as usize;
+                let t_hi = f32x4::splat(limit);
+                let mut dv = [f32x4::splat(0.0); C];
+                let mut mask = 0u32;
+                for c in 0..C {
+                    let (entry, m) = rs.test(&chunks[n + c], t_lo, t_hi);
+                    dv[c] = entry;
+                    mask |= m << (LANES * c);
+                }
+                let dist = dv.map(|v| v.to_array());
+                let child = |i: usize| chunks[n + i / LANES].child[i % LANES];
+                let d = |i: usize| dist[i / LANES][i % LANES];
+                if mask != 0 {
+                    let first = mask.trailing_zeros() as usize;
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        cur = child(first);
+                        continue;
+                    }
+                    if ANY {
+                        // Any hit ends the ray: no order is better than another, so the
+                        // first hit child is next and the others are pushed unsorted.
+                        let mut m = rest;
+                        while m != 0 {
+                            let i = m.trailing_zeros() as usize;
+                            m &= m - 1;
+                            let c = child(i);
+                            prefetch_child(chunks, packets, c);
+                            stack.push(Entry { t: d(i), child: c });
+                        }
+                        cur = child(first);
+                        continue;
+                    }
+                    let second = rest.trailing_zeros() as usize;
+                    if rest & (rest - 1) == 0 {
+                        // Two hits: the nearer next, the other on the stack.
+                        let (near, far) = if d(second) < d(first) {
+                            (second, first)
+                        } else {
+                            (first, second)
+                        };
+                        let c = child(far);
+                        prefetch_child(chunks, packets, c);
+                        stack.push(Entry {
+                            t: d(far),
+                            child: c,
+                        });
+                        cur = child(near);
+                        continue;
+                    }
+                    // Three or more: each goes to the stack slot of its rank (the number of
+                    // hit children before it by entry distance, ties by slot), nearest on
+                    // top; then the nearest is taken.
+                    let count = ones(mask);
+                    let mut m = mask;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let c = child(i);
+                        prefetch_child(chunks, packets, c);
+                    }
+                    let base = stack.len();
+                    stack.resize(
+                        base + count,
+                        Entry {
+                            t: 0.0,
+                            child: EMPTY,
+                        },
+                    );
+                    let mut m = mask;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let di = d(i);
+                        // The hit lanes nearer than `i`, or as near and in an earlier slot,
+                        // from one comparison per chunk.
+                        let splat = f32x4::splat(di);
+                        let mut before = 0u32;
+                        for (c, v) in dv.iter().enumerate() {
+                            let lt = v.cmp_lt(splat).move_mask() as u32;
+                            let eq = v.cmp_eq(splat).move_mask() as u32;
+                            let earlier = ((1u32 << i) - 1) >> (LANES * c);
+                            before |= (lt | (eq & earlier)) << (LANES * c);
+                        }
+                        let rank = ones(before & mask);
+                        stack[base + count - 1 - rank] = Entry {
+                            t: di,
+                            child: child(i),
+                        };
+                    }
+                    cur = stack.pop().map_or(EMPTY, |e| e.child);
+                    continue;
+                }
+            } else {
+                let slot = (cur & !LEAF) as usize;
+                if test_leaf::<ANY>(packets, slot, &rs, &r, &mut best, &mut best_t) {
+                    return best;
+                }
+                limit = cull_limit(best_t);
+            }
+            // Next: the nearest stacked entry not beyond the limit.
+            loop {
+                let Some(e) = stack.pop() else {
+                    return best;
+                };
+                if e.t <= limit {
+                    cur = e.child;
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// Set bits of an 8-bit mask: the x86-64 baseline has no `popcnt`, and `count_ones` becomes
+/// a dozen instructions there; a 256-byte table is one load.
+#[inline(always)]
+fn ones(mask: u32) -> usize {
+    const TABLE: [u8; 256] = {
+        let mut t = [0u8; 256];
+        let mut i = 0;
+        while i < 256 {
+            t[i] = (i as u32).count_ones() as u8;
+            i += 1;
+        }
+        t
+    };
+    TABLE[(mask & 0xff) as usize] as usize
+}
+
+/// Prefetches the first chunk of child word `c`'s node or the first packet of its leaf.
+#[inline(always)]
+fn prefetch_child(chunks: &[Chunk], packets: &[TriPacket], c: u32) {
+    if c & LEAF == 0 {
+        super::simd::prefetch(&chunks[c as usize]);
+    } else {
+        super::simd::prefetch(&packets[(c & !LEAF) as usize / LANES]);
+    }
+}
+
+/// Tests the leaf whose first triangle is at `slot` of `packets` (it ends at the first id
+/// from there with [`RUN_END`]) on `[ray.t_min, best_t]`, keeping the closest hit by
+/// [`Hit::closer_than`] in `best` and `best_t`. Returns true when `ANY` and a hit was
+/// accepted.
+#[inline(always)]
+pub(crate) fn test_leaf<const ANY: bool>(
+    packets: &[TriPacket],
+    slot: usize,
+    rs: &RaySimd,
+    r: &RayPre,
+    best: &mut Option<Hit>,
+    best_t: &mut f32,
+) -> bool {
+    let mut i = slot / LANES;
+    // Lanes at or after the leaf's first.
+    let mut from = (0b1111 << (slot % LANES)) & 0b1111;
+    loop {
+        let pk = &packets[i];
+        // Lanes up to the leaf's last (the first id from `from` on with bit 31 set:
+        // RUN_END or padding).
+        let ends = f32x4::new(bytemuck::cast(pk.prim)).move_mask() as u32 & from;
+        let lanes = if ends == 0 {
+            from
+        } else {
+            from & ((ends & ends.wrapping_neg()) << 1).wrapping_sub(1)
+        };
+        // Lanes the scalar test could accept; it decides each of them.
+        let mut m = rs.triangle_candidates(pk) & lanes;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let p = PrimId(pk.prim[l] & !RUN_END);
+            // The triangle's own words, from the packet (already in cache).
+            let vertex =
+                |k: usize| Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l]);
+            let tri = Triangle::new(vertex(0), vertex(1), vertex(2));
+            if let Some(h) = tri.intersect(r, r.ray.t_min, *best_t)
+                && best.is_none_or(|b| !b.closer_than(h.t, p))
+            {
+                *best = Some(Hit {
+                    t: h.t,
+                    prim: p,
+                    u: h.u,
+                    v: h.v,
+                });
+                if ANY {
+                    return true;
+                }
+                *best_t = h.t;
+            }
+        }
+        if ends != 0 {
+            return false;
+        }
+        i += 1;
+        from = 0b1111;
+    }
+}
+
+/// Appends the triangles of the index-run entries `entries` (ids with [`RUN_END`] on each
+/// run's last) to `packets`, slot after slot from `*slots`, padding nothing: the caller
+/// pads the last packet by starting from [`EMPTY_PACKET`]s.
+pub(crate) fn pack_entries(
+    packets: &mut Vec<TriPacket>,
+    slots: &mut usize,
+    entries: impl IntoIterator<Item = u32>,
+    triangles: &[Triangle],
+) {
+    for e in entries {
+        if *slots & (LANES - 1) == 0 {
+            packets.push(EMPTY_PACKET);
+        }
+        let pk = packets.last_mut().expect("pushed");
+        let tri = &triangles[(e & !RUN_END) as usize];
+        let l = *slots % LANES;
+        for (r, row) in pk.v.iter_mut().enumerate() {
+            row[l] = tri.v[r / 3][r % 3];
+        }
+        pk.prim[l] = e;
+        *slots += 1;
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Entry {
+    t: f32,
+    child: u32,
+}
+
+thread_local! {
+    /// The traversal stack's buffer, one per thread, reused from ray to ray.
+    static STACK: Cell<Vec<Entry>> = const { Cell::new(Vec::new()) };
+}
+
+/// The ray's constants broadcast to all lanes, the plane rows its signs pick, and the
+/// watertight test's axes and shear.
+pub(crate) struct RaySimd {
+    o: [f32x4; 3],
+    inv: [f32x4; 3],
+    near: [usize; 3],
+    far: [usize; 3],
+    k: [usize; 3],
+    sx: f32x4,
+    sy: f32x4,
+}
+
+impl RaySimd {
+    /// The constants of the precomputed ray `r`.
+    #[inline(always)]
+    pub(crate) fn new(r: &RayPre) -> Self {
+        let o = r.ray.origin;
+        let inv = r.inv_dir;
+        let s = |a: usize| 3 * r.neg[a] as usize;
+        Self {
+            o: [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)],
+            inv: [
+                f32x4::splat(inv.x),
+                f32x4::splat(inv.y),
+                f32x4::splat(inv.z),
+            ],
+            near: [s(0), 1 + s(1), 2 + s(2)],
+            far: [3 - s(0), 4 - s(1), 5 - s(2)],
+            k: r.k,
+            sx: f32x4::splat(r.shear.x),
+            sy: f32x4::splat(r.shear.y),
+        }
+    }
+
+    /// The lanes of `pk` that [`Triangle::intersect`] might accept: the first stage of that
+    /// test (shear, edge functions `u`, `v`, `w`, same IEEE operations in the same order)
+    /// on four triangles at once, dropping a lane only where the scalar test returns `None`
+    /// at that stage: no edge function is zero (so no f64 recomputation) and their signs
+    /// differ. Every other lane is left to the scalar test, so answers are its answers.
+    #[inline(always)]
+    fn triangle_candidates(&self, pk: &TriPacket) -> u32 {
+        let [kx, ky, kz] = self.k;
+        let rel = |vertex: usize, axis: usize| f32x4::new(pk.v[3 * vertex + axis]) - self.o[axis];
+        let (ax, ay, az) = (rel(0, kx), rel(0, ky), rel(0, kz));
+        let (bx, by, bz) = (rel(1, kx), rel(1, ky), rel(1, kz));
+        let (cx, cy, cz) = (rel(2, kx), rel(2, ky), rel(2, kz));
+        let ax = ax - self.sx * az;
+        let ay = ay - self.sy * az;
+        let bx = bx - self.sx * bz;
+        let by = by - self.sy * bz;
+        let cx = cx - self.sx * cz;
+        let cy = cy - self.sy * cz;
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let zero = f32x4::splat(0.0);
+        let any_zero = u.cmp_eq(zero) | v.cmp_eq(zero) | w.cmp_eq(zero);
+        let neg = u.cmp_lt(zero) | v.cmp_lt(zero) | w.cmp_lt(zero);
+        let pos = u.cmp_gt(zero) | v.cmp_gt(zero) | w.cmp_gt(zero);
+        let reject = (neg & pos).move_mask() as u32 & !(any_zero.move_mask() as u32);
+        0b1111 & !reject
+    }
+
+    /// Entry distances of the chunk's four boxes clipped to `[t_lo, t_hi]`, and the mask of
+    /// the non-empty lanes the ray meets (`entry <= exit`).
+    #[inline(always)]
+    fn test(&self, ch: &Chunk, t_lo: f32x4, t_hi: f32x4) -> (f32x4, u32) {
+        let mut entry = t_lo;
+        let mut exit = t_hi;
+        let widen = f32x4::splat(EXIT_WIDEN);
+        for a in 0..3 {
+            let tn = (f32x4::new(ch.planes[self.near[a]]) - self.o[a]) * self.inv[a];
+            let tf = (f32x4::new(ch.planes[self.far[a]]) - self.o[a]) * self.inv[a] * widen;
+            entry = keep_max(tn, entry);
+            exit = keep_min(tf, exit);
+        }
+        let hit = entry.cmp_le(exit).move_mask() as u32;
+        let empty = i32x4::new(bytemuck::cast::<[u32; LANES], [i32; LANES]>(ch.child))
+            .cmp_eq(i32x4::splat(-1))
+            .move_mask() as u32;
+        (entry, hit & !empty)
+    }
+}
+
+/// `if x > bound { x } else { bound }` per lane: a NaN `x` keeps the bound.
+#[inline(always)]
+fn keep_max(x: f32x4, bound: f32x4) -> f32x4 {
+    #[cfg(all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    ))]
+    {
+        // `maxps x, bound` is `x > bound ? x : bound` (`wide` uses it where SSE is on).
+        x.fast_max(bound)
+    }
+    #[cfg(not(all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    )))]
+    {
+        keep_max_portable(x, bound)
+    }
+}
+
+/// [`keep_max`] by compare and blend, for targets without SSE's `maxps`.
+#[inline(always)]
+#[cfg_attr(
+    all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    ),
+    allow(dead_code)
+)]
+fn keep_max_portable(x: f32x4, bound: f32x4) -> f32x4 {
+    x.cmp_gt(bound).blend(x, bound)
+}
+
+/// `if x < bound { x } else { bound }` per lane: a NaN `x` keeps the bound.
+#[inline(always)]
+fn keep_min(x: f32x4, bound: f32x4) -> f32x4 {
+    #[cfg(all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    ))]
+    {
+        // `minps x, bound` is `x < bound ? x : bound` (`wide` uses it where SSE is on).
+        x.fast_min(bound)
+    }
+    #[cfg(not(all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    )))]
+    {
+        keep_min_portable(x, bound)
+    }
+}
+
+/// [`keep_min`] by compare and blend, for targets without SSE's `minps`.
+#[inline(always)]
+#[cfg_attr(
+    all(
+        any(target_arch = "x86", target_arch = "x86_64"),
+        target_feature = "sse"
+    ),
+    allow(dead_code)
+)]
+fn keep_min_portable(x: f32x4, bound: f32x4) -> f32x4 {
+    x.cmp_lt(bound).blend(x, bound)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dualsplit_geometry::Pcg32;
+
+    /// A coordinate from a small set (box planes through the ray's origin, zero direction
+    /// components, so NaN plane distances) or random.
+    fn coord(rng: &mut Pcg32) -> f32 {
+        match rng.below(6) {
+            0 => 0.0,
+            1 => -0.0,
+            2 => 1.0,
+            3 => -1.0,
+            _ => rng.range_f32(-4.0, 4.0),
+        }
+    }
+
+    /// The chunk test gives, lane by lane, `RayPre::slab`'s hit or miss and entry distance
+    /// (up to the sign of a zero) for every non-NaN interval, with empty lanes never hit.
+    #[test]
+    fn chunk_test_matches_ray_slab() {
+        let mut rng = Pcg32::new(11, 5);
+        let ends = [0.0, -0.0, 0.5, 1e-3, f32::INFINITY, f32::NEG_INFINITY, 3.0];
+        for case in 0..50_000 {
+            let v = |rng: &mut Pcg32| Vec3::new(coord(rng), coord(rng), coord(rng));
+            let r = Ray::new(v(&mut rng), v(&mut rng)).precompute();
+            let mut ch = EMPTY_CHUNK;
+            let mut boxes = Vec::new();
+            for l in 0..LANES {
+                if rng.below(5) == 0 {
+                    continue;
+                }
+                let (p, q) = (v(&mut rng), v(&mut rng));
+                let (lo, hi) = (p.min(q), p.max(q));
+                let w = [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z];
+                for (k, &x) in w.iter().enumerate() {
+                    ch.planes[k][l] = x;
+                }
+                ch.child[l] = l as u32;
+                boxes.push((l, lo, hi));
+            }
+            let t_lo = ends[rng.below(ends.len() as u32) as usize];
+            let t_hi = ends[rng.below(ends.len() as u32) as usize];
+            let (entry, mask) = RaySimd::new(&r).test(&ch, f32x4::splat(t_lo), f32x4::splat(t_hi));
+            let entry = entry.to_array();
+            let mut want = 0;
+            for (l, lo, hi) in boxes {
+                let (e, x) = r.slab(lo, hi, t_lo, t_hi);
+                if e <= x {
+                    want |= 1 << l;
+                    assert_eq!(entry[l], e, "case {case} lane {l}");
+                }
+            }
+            assert_eq!(mask, want, "case {case}: {r:?}");
+        }
+    }
+
+    /// The packet's first stage drops a lane only where `Triangle::intersect` misses: on
+    /// triangles and rays with coordinates from a small set (edges through the ray, zero
+    /// edge functions, degenerate triangles) and random ones.
+    #[test]
+    fn triangle_candidates_keep_every_hit() {
+        let mut rng = Pcg32::new(3, 9);
+        let mut hits = 0;
+        for case in 0..50_000 {
+            let v = |rng: &mut Pcg32| Vec3::new(coord(rng), coord(rng), coord(rng));
+            let r = Ray::new(v(&mut rng), v(&mut rng)).precompute();
+            let tris: Vec<Triangle> = (0..LANES)
+                .map(|_| Triangle::new(v(&mut rng), v(&mut rng), v(&mut rng)))
+                .collect();
+            let mut packets = Vec::new();
+            let mut slots = 0;
+            pack_entries(&mut packets, &mut slots, [0, 1, 2, 3 | RUN_END], &tris);
+            let m = RaySimd::new(&r).triangle_candidates(&packets[0]);
+            for (l, t) in tris.iter().enumerate() {
+                if t.intersect(&r, f32::NEG_INFINITY, f32::INFINITY).is_some() {
+                    hits += 1;
+                    assert!(m & (1 << l) != 0, "case {case} lane {l}: {t:?} {r:?}");
+                }
+            }
+        }
+        assert!(hits > 1000, "{hits} hits");
+    }
+
+    /// `keep_max`/`keep_min` keep the bound for a NaN lane, as the scalar compare does.
+    #[test]
+    fn keep_ignores_nan() {
+        let x = f32x4::new([f32::NAN, 2.0, -1.0, f32::INFINITY]);
+        let b = f32x4::new([1.0, 1.0, 1.0, 1.0]);
+        assert_eq!(keep_max(x, b).to_array(), [1.0, 2.0, 1.0, f32::INFINITY]);
+        assert_eq!(keep_min(x, b).to_array(), [1.0, 1.0, -1.0, 1.0]);
+        // The compare-and-blend forms other targets use agree.
+        assert_eq!(
+            keep_max_portable(x, b).to_array(),
+            keep_max(x, b).to_array()
+        );
+        assert_eq!(
+            keep_min_portable(x, b).to_array(),
+            keep_min(x, b).to_array()
+        );
+    }
+}
