@@ -37,6 +37,7 @@
 //! ```
 
 mod header;
+mod structure;
 
 pub use header::{CHECKSUM_BYTES, FORMAT_VERSION, HEADER_BYTES, MAGIC, WORDS_OFFSET};
 
@@ -98,6 +99,19 @@ pub enum SavedError {
     /// The checksum does not match the contents.
     #[error("tree file is corrupt: checksum mismatch")]
     Checksum,
+    /// The tree's structure is inconsistent (a file forged with a recomputed checksum, or
+    /// written by a faulty encoder): a child or run outside its region, a node reached
+    /// twice, an invalid node header, a triangle id out of range, or counts that contradict
+    /// the header. Checked after the checksum, before the tree is returned.
+    #[error("malformed {structure} tree at word {word}: {what}")]
+    Structure {
+        /// The structure (`bvh2`, `bvh4`, `bvh8`, `dst`).
+        structure: &'static str,
+        /// The image word (node region, or index region for an index entry) at fault.
+        word: u64,
+        /// What is wrong.
+        what: String,
+    },
     /// The tree was built from other triangles than the scene it is used with.
     #[error(
         "tree file was built from another scene (triangle hash {found}, the scene's is {expected})"
@@ -348,7 +362,15 @@ impl AnyTree {
                 found: hex(&h.triangle_hash),
             });
         }
-        Ok(assemble(&h, words, tris))
+        let tree = assemble(&h, words, tris);
+        // Everything a traversal indexes with, so a forged file cannot make one panic,
+        // loop or read the wrong memory (`structure`).
+        structure::check(tree.image(), h.kind, &h.extra).map_err(|v| SavedError::Structure {
+            structure: tree.kind().name(),
+            word: v.word as u64,
+            what: v.what,
+        })?;
+        Ok(tree)
     }
 
     /// Reads a saved tree from bytes (see [`AnyTree::read_from`]).
