@@ -199,10 +199,9 @@ impl<W: Write> HashingWriter<W> {
 }
 
 impl AnyTree {
-    /// The file header of this tree.
-    fn header(&self) -> Header {
-        let img = self.image();
-        let extra = match self {
+    /// The structure's own header fields.
+    fn extra(&self) -> Extra {
+        match self {
             AnyTree::Bvh(b) => Extra::Bvh {
                 internal_nodes: b.encoded.internal_nodes as u64,
                 leaves: b.encoded.leaves as u64,
@@ -213,7 +212,28 @@ impl AnyTree {
                 scene_box: d.dst.scene_box(),
                 stats: d.dst.stats(),
             },
-        };
+        }
+    }
+
+    /// Checks everything a traversal of this tree's image relies on, as loading a saved
+    /// tree does (`docs/tree-format.md`, "Checks on load"): child offsets and index runs
+    /// inside their regions, every node reached once from the root (no cycle), runs ended
+    /// by [`crate::image::RUN_END`] and not overlapping, triangle ids below the triangle
+    /// count, valid DST node headers, and the counts the header records. Linear time.
+    pub fn check_structure(&self) -> Result<(), SavedError> {
+        structure::check(self.image(), self.kind(), &self.extra()).map_err(|v| {
+            SavedError::Structure {
+                structure: self.kind().name(),
+                word: v.word as u64,
+                what: v.what,
+            }
+        })
+    }
+
+    /// The file header of this tree.
+    fn header(&self) -> Header {
+        let img = self.image();
+        let extra = self.extra();
         let (n, i, t) = (
             img.nodes.len() as u64,
             img.indices.len() as u64,
@@ -365,11 +385,7 @@ impl AnyTree {
         let tree = assemble(&h, words, tris);
         // Everything a traversal indexes with, so a forged file cannot make one panic,
         // loop or read the wrong memory (`structure`).
-        structure::check(tree.image(), h.kind, &h.extra).map_err(|v| SavedError::Structure {
-            structure: tree.kind().name(),
-            word: v.word as u64,
-            what: v.what,
-        })?;
+        tree.check_structure()?;
         Ok(tree)
     }
 
