@@ -373,6 +373,13 @@ fn forged_bvh_files_are_structure_errors() {
         f[leaves_at] ^= 1;
         reseal(&mut f);
         expect_structure(&f, 0, "its header says", &case("counts"));
+        // A byte in the zero padding (found by the fuzz target: it loaded, and wrote back
+        // a file without it).
+        let f = forge(&good, |f| f[2595] = 1);
+        match AnyTree::from_bytes(&f, None) {
+            Err(SavedError::Malformed(m)) => assert!(m.contains("header byte 2595"), "{m}"),
+            r => panic!("{kind}: padding: {:?}", r.map(|t| t.kind())),
+        }
         // The untouched file still loads.
         AnyTree::from_bytes(&good, Some(&tris)).expect("the good file loads");
     }

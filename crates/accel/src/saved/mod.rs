@@ -12,7 +12,10 @@
 //! Loading checks, in order: the magic, the version, that the sizes in the header add up
 //! to the file's length (before anything is allocated), the checksum, and, when the caller
 //! names the scene, that the file's triangles are the scene's, bit for bit (the error names
-//! both triangle hashes). Each failure is a [`SavedError`]; nothing panics.
+//! both triangle hashes), then the structure ([`AnyTree::check_structure`]: offsets, runs,
+//! triangle ids, no cycle), so that even a file forged with a recomputed checksum cannot
+//! make a traversal panic, loop or read the wrong memory. Each failure is a [`SavedError`];
+//! nothing panics.
 //!
 //! Loading reads the file into memory rather than mapping it: a file mapping is `unsafe`
 //! (another process may change or truncate the file under it), which this workspace
@@ -221,12 +224,15 @@ impl AnyTree {
     /// by [`crate::image::RUN_END`] and not overlapping, triangle ids below the triangle
     /// count, valid DST node headers, and the counts the header records. Linear time.
     pub fn check_structure(&self) -> Result<(), SavedError> {
-        structure::check(self.image(), self.kind(), &self.extra()).map_err(|v| {
-            SavedError::Structure {
-                structure: self.kind().name(),
-                word: v.word as u64,
-                what: v.what,
-            }
+        structure::check(
+            &structure::Regions::of(self.image()),
+            self.kind(),
+            &self.extra(),
+        )
+        .map_err(|v| SavedError::Structure {
+            structure: self.kind().name(),
+            word: v.word as u64,
+            what: v.what,
         })
     }
 
@@ -379,8 +385,23 @@ impl AnyTree {
         {
             return Err(SavedError::WrongScene {
                 expected: hex(&triangle_hash(scene)),
-                found: hex(&h.triangle_hash),
+                // The triangles' own hash, not the header's copy: a forged header cannot
+                // name another scene than the file holds.
+                found: hex(&triangle_hash(&tris)),
             });
+        }
+        // Only the bytes this version writes: a forged file with other bytes in unused
+        // header fields or the padding would load but not write back the same file.
+        if let Some(at) = h
+            .encode()
+            .iter()
+            .chain(std::iter::repeat(&0u8))
+            .zip(head.iter().chain(&pad))
+            .position(|(a, b)| a != b)
+        {
+            return Err(SavedError::malformed(format!(
+                "header byte {at} is not what this version writes (unused fields and padding are zero)"
+            )));
         }
         let tree = assemble(&h, words, tris);
         // Everything a traversal indexes with, so a forged file cannot make one panic,

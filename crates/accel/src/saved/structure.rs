@@ -20,6 +20,7 @@ use crate::dst::{DstStats, HeaderOffset};
 use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
 use crate::observer::DstNodeKind;
 use crate::tree::TreeKind;
+use std::ops::Range;
 
 /// What is wrong with an image and where.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -53,8 +54,8 @@ impl Bitmap {
 
 /// Checks the index region: every entry a triangle id below the triangle count, the last
 /// one ending a run.
-fn check_indices(img: &MemoryImage) -> Result<(), Violation> {
-    let tris = img.triangle_slice().len();
+fn check_indices(img: &Regions) -> Result<(), Violation> {
+    let tris = img.triangles;
     let words = &img.words[img.indices.clone()];
     for (j, &e) in words.iter().enumerate() {
         let p = (e & !RUN_END) as usize;
@@ -78,12 +79,12 @@ fn check_indices(img: &MemoryImage) -> Result<(), Violation> {
 
 /// The runs of an image: each index word in at most one run.
 struct Runs<'a> {
-    img: &'a MemoryImage,
+    img: &'a Regions<'a>,
     used: Bitmap,
 }
 
 impl<'a> Runs<'a> {
-    fn new(img: &'a MemoryImage) -> Self {
+    fn new(img: &'a Regions<'a>) -> Self {
         Runs {
             img,
             used: Bitmap::new(img.indices.len()),
@@ -118,8 +119,8 @@ impl<'a> Runs<'a> {
 }
 
 /// Checks a BVH image with node layout `L` and the counts its header records.
-pub(crate) fn check_bvh<L: NodeLayout>(
-    img: &MemoryImage,
+fn check_bvh<L: NodeLayout>(
+    img: &Regions,
     internal_nodes: u64,
     leaves: u64,
 ) -> Result<(), Violation> {
@@ -134,7 +135,7 @@ pub(crate) fn check_bvh<L: NodeLayout>(
             ),
         ));
     }
-    let words = &img.words[..];
+    let words = img.words;
     let mut reached = Bitmap::new(nodes.end);
     let mut runs = Runs::new(img);
     let (mut n_internal, mut n_leaves) = (0u64, 0u64);
@@ -157,6 +158,11 @@ pub(crate) fn check_bvh<L: NodeLayout>(
             ));
         }
         let mut addr = start;
+        // Internal children, pushed after the loop in reverse so that slot 0 is walked
+        // first: the walk then follows the depth-first layout forward.
+        const { assert!(L::ARITY <= 8) };
+        let mut inner = [0usize; 8];
+        let mut n_inner = 0;
         for k in 0..L::ARITY {
             let kind = node.kind(k);
             if kind == ChildKind::Empty {
@@ -171,7 +177,10 @@ pub(crate) fn check_bvh<L: NodeLayout>(
                 ));
             }
             match kind {
-                ChildKind::Internal => stack.push(addr),
+                ChildKind::Internal => {
+                    inner[n_inner] = addr;
+                    n_inner += 1;
+                }
                 ChildKind::Leaf => {
                     n_leaves += 1;
                     runs.claim(addr, words[addr] as usize)?;
@@ -180,6 +189,7 @@ pub(crate) fn check_bvh<L: NodeLayout>(
             }
             addr += L::child_words(kind) as usize;
         }
+        stack.extend(inner[..n_inner].iter().rev());
     }
     if (n_internal, n_leaves) != (internal_nodes, leaves) {
         return Err(violation(
@@ -193,11 +203,23 @@ pub(crate) fn check_bvh<L: NodeLayout>(
     Ok(())
 }
 
+/// Bit `h` set for each valid 6-bit DST header code `h` (one shift instead of
+/// [`HeaderOffset::decode`]'s field tests per node).
+const VALID_HEADERS: u64 = {
+    let mut m = 0u64;
+    let mut i = 0;
+    while i < HeaderOffset::ALL_VALID_HEADERS.len() {
+        m |= 1 << HeaderOffset::ALL_VALID_HEADERS[i];
+        i += 1;
+    }
+    m
+};
+
 /// Checks a DST image and the statistics its header records.
-pub(crate) fn check_dst(img: &MemoryImage, stats: &DstStats) -> Result<(), Violation> {
+fn check_dst(img: &Regions, stats: &DstStats) -> Result<(), Violation> {
     check_indices(img)?;
     let nodes = img.nodes.clone();
-    let words = &img.words[..];
+    let words = img.words;
     let mut found = DstStats::default();
     let mut runs = Runs::new(img);
     let mut reached = Bitmap::new(nodes.end);
@@ -228,8 +250,13 @@ pub(crate) fn check_dst(img: &MemoryImage, stats: &DstStats) -> Result<(), Viola
         Ok(())
     };
     while let Some((at, size)) = stack.pop() {
-        let w = HeaderOffset::decode(words[at], at as u32)
-            .map_err(|_| violation(at, format!("invalid node header word {:#010x}", words[at])))?;
+        if (VALID_HEADERS >> (words[at] >> 26)) & 1 == 0 {
+            return Err(violation(
+                at,
+                format!("invalid node header word {:#010x}", words[at]),
+            ));
+        }
+        let w = HeaderOffset::from_bits(words[at]);
         let len = w.size_words();
         if at + len as usize > nodes.end {
             return Err(violation(
@@ -288,8 +315,8 @@ pub(crate) fn check_dst(img: &MemoryImage, stats: &DstStats) -> Result<(), Viola
             s.total_bytes,
         ]
     };
-    found.node_bytes = img.node_bytes();
-    found.index_bytes = img.index_bytes();
+    found.node_bytes = 4 * nodes.len() as u64;
+    found.index_bytes = 4 * img.indices.len() as u64;
     found.total_bytes = found.node_bytes + found.index_bytes + 24;
     if counts(&found) != counts(stats) {
         return Err(violation(
@@ -322,8 +349,43 @@ pub(crate) fn check_dst(img: &MemoryImage, stats: &DstStats) -> Result<(), Viola
     Ok(())
 }
 
-/// Checks the image of a tree of `kind` whose header has `extra`.
-pub(crate) fn check(img: &MemoryImage, kind: TreeKind, extra: &Extra) -> Result<(), Violation> {
+/// The parts of an image the checks read: the node and index words, their regions, and the
+/// number of triangles.
+pub(crate) struct Regions<'a> {
+    /// The node and index regions' words.
+    pub words: &'a [u32],
+    /// Word range of the node region.
+    pub nodes: Range<usize>,
+    /// Word range of the index region.
+    pub indices: Range<usize>,
+    /// Triangles in the triangle region.
+    pub triangles: usize,
+}
+
+impl<'a> Regions<'a> {
+    pub fn of(img: &'a MemoryImage) -> Self {
+        Regions {
+            words: &img.words,
+            nodes: img.nodes.clone(),
+            indices: img.indices.clone(),
+            triangles: img.triangle_slice().len(),
+        }
+    }
+}
+
+/// Checks the regions of a tree of `kind` whose header has `extra`.
+pub(crate) fn check(img: &Regions, kind: TreeKind, extra: &Extra) -> Result<(), Violation> {
+    if img.nodes.end > img.words.len() || img.indices.end > img.words.len() {
+        return Err(violation(
+            0,
+            format!(
+                "regions {:?} and {:?} beyond the {} words",
+                img.nodes,
+                img.indices,
+                img.words.len()
+            ),
+        ));
+    }
     match *extra {
         Extra::Bvh {
             internal_nodes,
@@ -335,5 +397,23 @@ pub(crate) fn check(img: &MemoryImage, kind: TreeKind, extra: &Extra) -> Result<
             _ => check_bvh::<crate::wide::Node8>(img, internal_nodes, leaves),
         },
         Extra::Dst { ref stats, .. } => check_dst(img, stats),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_header_mask_is_decode() {
+        assert_eq!(VALID_HEADERS.count_ones(), 37);
+        for h in 0..64u32 {
+            let word = h << 26;
+            assert_eq!(
+                (VALID_HEADERS >> h) & 1 == 1,
+                HeaderOffset::decode(word, 0).is_ok(),
+                "header {h:06b}"
+            );
+        }
     }
 }
