@@ -328,7 +328,7 @@ fn forged_bvh_files_are_structure_errors() {
         expect_structure(&f, 0, "leaves the node region", &case("offset"));
         // The root's children are the root itself: a cycle.
         let f = forge(&good, |f| set_word(f, ow, root & !mask));
-        expect_structure(&f, 0, "reached twice", &case("cycle"));
+        expect_structure(&f, 0, "in the layout it is at word", &case("cycle"));
         // A triangle id beyond the triangle count (the run end bit kept).
         let e = word(&good, indices.start);
         let f = forge(&good, |f| {
@@ -336,10 +336,19 @@ fn forged_bvh_files_are_structure_errors() {
         });
         let want = format!("names triangle {}", tris.len());
         expect_structure(&f, indices.start, &want, &case("id"));
-        // The last run's end removed: it would run off the index region.
+        // The last run's end removed: it would run off the index region. The error names
+        // the leaf word of that run (the node-region word that starts it).
         let last = indices.end - 1;
+        let last_start = (indices.start..last)
+            .rev()
+            .find(|&j| word(&good, j) & RUN_END != 0)
+            .map_or(indices.start, |j| j + 1);
+        let last_leaf = (nodes.clone())
+            .rev()
+            .find(|&w| word(&good, w) as usize == last_start)
+            .expect("the last leaf word");
         let f = forge(&good, |f| set_word(f, last, word(&good, last) & !RUN_END));
-        expect_structure(&f, last, "does not end a run", &case("run end"));
+        expect_structure(&f, last_leaf, "does not end", &case("run end"));
         // The first run's end removed: it runs into the next run.
         let first_end = (indices.start..indices.end)
             .find(|&j| word(&good, j) & RUN_END != 0)
@@ -350,7 +359,7 @@ fn forged_bvh_files_are_structure_errors() {
         });
         match AnyTree::from_bytes(&f, None) {
             Err(SavedError::Structure { what, .. }) => {
-                assert!(what.contains("another run holds"), "{kind}: {what}")
+                assert!(what.contains("the next run is at word"), "{kind}: {what}")
             }
             r => panic!("{kind}: overlapping runs: {:?}", r.map(|t| t.kind())),
         }
@@ -363,7 +372,7 @@ fn forged_bvh_files_are_structure_errors() {
         match AnyTree::from_bytes(&f, None) {
             Err(SavedError::Structure { word, what, .. }) => {
                 assert_eq!(word, leaf as u64, "{kind}: {what}");
-                assert!(what.contains("outside the index region"), "{kind}: {what}");
+                assert!(what.contains("the next run is at word"), "{kind}: {what}");
             }
             r => panic!("{kind}: leaf word: {:?}", r.map(|t| t.kind())),
         }
@@ -417,7 +426,7 @@ fn forged_dst_files_are_structure_errors() {
         expect_structure(&f, 0, "outside the node region", "dst offset");
         // The root's child is the root: a cycle.
         let f = forge(&good, |f| set_word(f, 0, root & !off));
-        expect_structure(&f, 0, "reached twice", "dst cycle");
+        expect_structure(&f, 0, "in the layout it is at word", "dst cycle");
         // An invalid header code (C = 0, L = 0, A = 11: no splitting axis 3).
         let f = forge(&good, |f| set_word(f, 0, (0b011010 << 26) | (root & off)));
         expect_structure(&f, 0, "invalid node header", "dst header");
@@ -430,7 +439,12 @@ fn forged_dst_files_are_structure_errors() {
         // The last run's end removed.
         let last = indices.end - 1;
         let f = forge(&good, |f| set_word(f, last, word(&good, last) & !RUN_END));
-        expect_structure(&f, last, "does not end a run", "dst run end");
+        match AnyTree::from_bytes(&f, None) {
+            Err(SavedError::Structure { what, .. }) => {
+                assert!(what.contains("does not end"), "dst run end: {what}")
+            }
+            r => panic!("dst run end: {:?}", r.map(|t| t.kind())),
+        }
         // A plain leaf whose run starts beyond the index region.
         let leaf = (nodes.clone())
             .find(|&w| {
@@ -447,7 +461,7 @@ fn forged_dst_files_are_structure_errors() {
         let f = forge(&good, |f| {
             set_word(f, leaf, word(&good, leaf) | (indices.len() as u32))
         });
-        expect_structure(&f, leaf, "outside the index region", "dst leaf run");
+        expect_structure(&f, leaf, "the next run is at word", "dst leaf run");
         AnyTree::from_bytes(&good, Some(&tris)).expect("the good file loads");
     }
 }

@@ -2,14 +2,17 @@
 //! forged with a recomputed checksum gives a [`Violation`] instead of a panic, a hang or a
 //! read of the wrong memory (`docs/tree-format.md`, "Checks on load").
 //!
-//! Both checks walk the tree once from its root with a bitmap of the node words already
-//! reached, so every node is reached exactly once: no cycle, no shared subtree (which could
-//! make one ray's traversal exponential), linear time. Every node and child block must lie
-//! inside the node region, every leaf's run must start inside the index region, and runs
-//! must not overlap (each index word belongs to at most one run, so the runs' total length
-//! is bounded by the region). The index region's entries are all triangle ids below the
-//! triangle count, and its last entry ends a run ([`RUN_END`]), so every run that starts in
-//! the region ends in it. The counts the header records are checked against the walk's.
+//! Both checks walk the tree once from its root, depth first in the encoders' order, and
+//! replay the encoders' bump allocation (`wide/encode.rs`, `dst/encode.rs`: a node's child
+//! block, or a DST node's children, go at the next free node word when the node is
+//! emitted; a leaf's run at the next free index word when the leaf is): every child offset
+//! and every run start must be exactly where that allocation puts it, and the allocation
+//! must end exactly at the end of each region. So the blocks and runs are disjoint and in
+//! order, every node is reached exactly once (no cycle, no shared subtree, which could make
+//! one ray's traversal exponential), every node and run lies inside its region, and the walk
+//! is linear with no bookkeeping beyond its stack. Every run ends with [`RUN_END`] before
+//! the end of the index region, every entry is a triangle id below the triangle count, and
+//! the counts the header records are the walk's.
 //!
 //! What is not checked: box and plane values (a NaN or a box that does not hold its
 //! children costs a traversal wrong answers for that file, never memory safety or
@@ -35,86 +38,72 @@ fn violation(word: usize, what: String) -> Violation {
     Violation { word, what }
 }
 
-/// One bit per word of a region.
-struct Bitmap(Vec<u64>);
-
-impl Bitmap {
-    fn new(len: usize) -> Self {
-        Bitmap(vec![0; len.div_ceil(64)])
-    }
-    /// Sets bit `i`; returns whether it was already set.
-    #[inline(always)]
-    fn set(&mut self, i: usize) -> bool {
-        let (w, b) = (i / 64, 1u64 << (i % 64));
-        let was = self.0[w] & b != 0;
-        self.0[w] |= b;
-        was
-    }
-}
-
-/// Checks the index region: every entry a triangle id below the triangle count, the last
-/// one ending a run.
-fn check_indices(img: &Regions) -> Result<(), Violation> {
-    let tris = img.triangles;
-    let words = &img.words[img.indices.clone()];
-    for (j, &e) in words.iter().enumerate() {
-        let p = (e & !RUN_END) as usize;
-        if p >= tris {
-            return Err(violation(
-                img.indices.start + j,
-                format!("index entry names triangle {p}, the file has {tris}"),
-            ));
-        }
-    }
-    if let Some(&last) = words.last()
-        && last & RUN_END == 0
-    {
-        return Err(violation(
-            img.indices.end - 1,
-            "the last index entry does not end a run (no RUN_END bit)".into(),
-        ));
-    }
-    Ok(())
-}
-
-/// The runs of an image: each index word in at most one run.
+/// The index-region side of the replayed allocation: runs must follow each other.
 struct Runs<'a> {
     img: &'a Regions<'a>,
-    used: Bitmap,
+    /// The image word where the next run must start.
+    next: usize,
 }
 
 impl<'a> Runs<'a> {
     fn new(img: &'a Regions<'a>) -> Self {
         Runs {
+            next: img.indices.start,
             img,
-            used: Bitmap::new(img.indices.len()),
         }
     }
 
-    /// Claims the run starting at image word `start` for the leaf at node word `leaf`;
-    /// returns its length. [`check_indices`] has run, so a run that starts in the region
-    /// ends in it.
-    fn claim(&mut self, leaf: usize, start: usize) -> Result<usize, Violation> {
-        let r = &self.img.indices;
-        if !r.contains(&start) {
+    /// Takes the run starting at image word `start` for the leaf at node word `leaf`: it
+    /// must start where the previous one ended, hold triangle ids below the triangle count
+    /// and end with [`RUN_END`] inside the index region. Returns its length.
+    #[inline(always)]
+    fn take(&mut self, leaf: usize, start: usize) -> Result<usize, Violation> {
+        let (r, tris) = (&self.img.indices, self.img.triangles);
+        if start != self.next {
             return Err(violation(
                 leaf,
-                format!("leaf's index run starts at word {start}, outside the index region {r:?}"),
+                format!(
+                    "leaf's index run starts at word {start}; in the layout the next run is at word {}",
+                    self.next
+                ),
             ));
         }
         let mut j = start;
         loop {
-            if self.used.set(j - r.start) {
+            if j >= r.end {
                 return Err(violation(
                     leaf,
-                    format!("leaf's index run reaches word {j}, which another run holds"),
+                    format!(
+                        "leaf's index run from word {start} does not end (no RUN_END) before the end of the index region {r:?}"
+                    ),
                 ));
             }
-            if self.img.words[j] & RUN_END != 0 {
-                return Ok(j + 1 - start);
+            let e = self.img.words[j];
+            let p = (e & !RUN_END) as usize;
+            if p >= tris {
+                return Err(violation(
+                    j,
+                    format!("index entry names triangle {p}, the file has {tris}"),
+                ));
             }
             j += 1;
+            if e & RUN_END != 0 {
+                self.next = j;
+                return Ok(j - start);
+            }
         }
+    }
+
+    /// After the walk: every index word is in a run.
+    fn finish(&self) -> Result<(), Violation> {
+        let r = &self.img.indices;
+        if self.next != r.end {
+            return Err(violation(
+                self.next,
+                format!("index words {}..{} are in no leaf's run", self.next, r.end),
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -124,7 +113,6 @@ fn check_bvh<L: NodeLayout>(
     internal_nodes: u64,
     leaves: u64,
 ) -> Result<(), Violation> {
-    check_indices(img)?;
     let nodes = img.nodes.clone();
     if nodes.start != 0 || nodes.len() < L::WORDS {
         return Err(violation(
@@ -136,19 +124,28 @@ fn check_bvh<L: NodeLayout>(
         ));
     }
     let words = img.words;
-    let mut reached = Bitmap::new(nodes.end);
     let mut runs = Runs::new(img);
     let (mut n_internal, mut n_leaves) = (0u64, 0u64);
-    reached.set(0);
-    let mut stack = vec![0usize];
-    while let Some(at) = stack.pop() {
+    // The next free node word of the replayed allocation.
+    let mut next = L::WORDS;
+    // (word, is a leaf word): children are pushed in reverse, so they are walked in slot
+    // order, as the encoder emits them.
+    let mut stack = vec![(0usize, false)];
+    while let Some((at, leaf)) = stack.pop() {
+        if leaf {
+            n_leaves += 1;
+            runs.take(at, words[at] as usize)?;
+            continue;
+        }
         n_internal += 1;
+        // Inside the node region: the root by the check above, any other node because its
+        // parent's child block is.
         let node = L::read(words, at);
         let block_len: usize = (0..L::ARITY)
             .map(|k| L::child_words(node.kind(k)) as usize)
             .sum();
         let start = node.offset() as usize;
-        if block_len > 0 && start.saturating_add(block_len) > nodes.end {
+        if start.saturating_add(block_len) > nodes.end {
             return Err(violation(
                 at,
                 format!(
@@ -157,40 +154,38 @@ fn check_bvh<L: NodeLayout>(
                 ),
             ));
         }
-        let mut addr = start;
-        // Internal children, pushed after the loop in reverse so that slot 0 is walked
-        // first: the walk then follows the depth-first layout forward.
+        if start != next {
+            return Err(violation(
+                at,
+                format!(
+                    "node's child block starts at word {start}; in the layout it is at word {next}"
+                ),
+            ));
+        }
+        next += block_len;
         const { assert!(L::ARITY <= 8) };
-        let mut inner = [0usize; 8];
-        let mut n_inner = 0;
+        let mut children = [(0usize, false); 8];
+        let (mut n, mut addr) = (0, start);
         for k in 0..L::ARITY {
             let kind = node.kind(k);
-            if kind == ChildKind::Empty {
-                continue;
+            if kind != ChildKind::Empty {
+                children[n] = (addr, kind == ChildKind::Leaf);
+                n += 1;
+                addr += L::child_words(kind) as usize;
             }
-            if reached.set(addr) {
-                return Err(violation(
-                    at,
-                    format!(
-                        "node's slot {k} child at word {addr} is reached twice (a cycle or a shared child)"
-                    ),
-                ));
-            }
-            match kind {
-                ChildKind::Internal => {
-                    inner[n_inner] = addr;
-                    n_inner += 1;
-                }
-                ChildKind::Leaf => {
-                    n_leaves += 1;
-                    runs.claim(addr, words[addr] as usize)?;
-                }
-                ChildKind::Empty => {}
-            }
-            addr += L::child_words(kind) as usize;
         }
-        stack.extend(inner[..n_inner].iter().rev());
+        stack.extend(children[..n].iter().rev());
     }
+    if next != nodes.end {
+        return Err(violation(
+            next,
+            format!(
+                "node words {next}..{} are in no node's child block",
+                nodes.end
+            ),
+        ));
+    }
+    runs.finish()?;
     if (n_internal, n_leaves) != (internal_nodes, leaves) {
         return Err(violation(
             0,
@@ -217,36 +212,44 @@ const VALID_HEADERS: u64 = {
 
 /// Checks a DST image and the statistics its header records.
 fn check_dst(img: &Regions, stats: &DstStats) -> Result<(), Violation> {
-    check_indices(img)?;
     let nodes = img.nodes.clone();
     let words = img.words;
     let mut found = DstStats::default();
     let mut runs = Runs::new(img);
-    let mut reached = Bitmap::new(nodes.end);
-    // (node word, the size its parent gave it: a splitting node's left size, else 0)
+    // (node word, the size its parent allocated for it: 1 or 3 words)
     let mut stack: Vec<(usize, u32)> = Vec::new();
+    // The next free node word of the replayed allocation.
+    let mut next = 0usize;
     if !nodes.is_empty() {
         if nodes.start != 0 {
             return Err(violation(0, format!("node region {nodes:?} not at word 0")));
         }
-        reached.set(0);
-        stack.push((0, 0));
+        let root = HeaderOffset::from_bits(words[0]).size_words();
+        if root as usize > nodes.len() {
+            return Err(violation(
+                0,
+                format!("{root}-word root node leaves the node region {nodes:?}"),
+            ));
+        }
+        next = root as usize;
+        stack.push((0, root));
     }
-    let mut child = |stack: &mut Vec<(usize, u32)>, at: usize, c: u32, size: u32| {
-        let c = c as usize;
-        if c >= nodes.end {
+    // Allocates `size` words for a child at `c` of the node at `at`: `c` must be the next
+    // free word.
+    let alloc = |next: &mut usize, at: usize, c: usize, size: u32| {
+        if c.saturating_add(size as usize) > nodes.end {
             return Err(violation(
                 at,
                 format!("child at word {c} outside the node region {nodes:?}"),
             ));
         }
-        if reached.set(c) {
+        if c != *next {
             return Err(violation(
                 at,
-                format!("child at word {c} is reached twice (a cycle or a shared child)"),
+                format!("child at word {c}; in the layout it is at word {next}"),
             ));
         }
-        stack.push((c, size));
+        *next += size as usize;
         Ok(())
     };
     while let Some((at, size)) = stack.pop() {
@@ -258,34 +261,42 @@ fn check_dst(img: &Regions, stats: &DstStats) -> Result<(), Violation> {
         }
         let w = HeaderOffset::from_bits(words[at]);
         let len = w.size_words();
-        if at + len as usize > nodes.end {
+        if size != len {
             return Err(violation(
                 at,
-                format!("{len}-word node leaves the node region {nodes:?}"),
+                format!("{len}-word node in a {size}-word slot"),
             ));
         }
-        if size != 0 && size != len {
-            return Err(violation(
-                at,
-                format!("{len}-word left child, its splitting node says {size} words"),
-            ));
-        }
-        let run = |runs: &mut Runs, found: &mut DstStats| -> Result<(), Violation> {
+        let mut run = |found: &mut DstStats| -> Result<(), Violation> {
             let start = img.indices.start.saturating_add(w.offset() as usize);
-            found.index_entries += runs.claim(at, start)? as u64;
+            found.index_entries += runs.take(at, start)? as u64;
             Ok(())
         };
         match w.node_kind() {
             DstNodeKind::Leaf => {
                 found.leaves += 1;
-                run(&mut runs, &mut found)?;
+                run(&mut found)?;
             }
             DstNodeKind::Split => {
                 found.splitting += 1;
-                let (left, ls) = (w.offset(), w.left_size());
+                let (left, ls) = (w.offset() as usize, w.left_size());
+                let right = left + ls as usize;
+                // The right child's size is its own header's (checked when it is walked).
+                let rs = match words.get(right) {
+                    Some(&r) if right < nodes.end => HeaderOffset::from_bits(r).size_words(),
+                    _ => {
+                        return Err(violation(
+                            at,
+                            format!(
+                                "right child at word {right} outside the node region {nodes:?}"
+                            ),
+                        ));
+                    }
+                };
+                alloc(&mut next, at, left, ls + rs)?;
                 // Right first on the stack: the left subtree is walked first.
-                child(&mut stack, at, left + ls, 0)?;
-                child(&mut stack, at, left, ls)?;
+                stack.push((right, rs));
+                stack.push((left, ls));
             }
             kind => {
                 if kind == DstNodeKind::SingleCarve {
@@ -295,13 +306,23 @@ fn check_dst(img: &Regions, stats: &DstStats) -> Result<(), Violation> {
                 }
                 if w.is_leaf_flag() {
                     found.carving_leaves += 1;
-                    run(&mut runs, &mut found)?;
+                    run(&mut found)?;
                 } else {
-                    child(&mut stack, at, w.offset(), 0)?;
+                    // A carving node's child is a carving or splitting node: 3 words.
+                    let c = w.offset() as usize;
+                    alloc(&mut next, at, c, 3)?;
+                    stack.push((c, 3));
                 }
             }
         }
     }
+    if next != nodes.end {
+        return Err(violation(
+            next,
+            format!("node words {next}..{} belong to no node", nodes.end),
+        ));
+    }
+    runs.finish()?;
     let counts = |s: &DstStats| {
         [
             s.splitting,
