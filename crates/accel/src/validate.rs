@@ -74,10 +74,15 @@ impl ValidationReport {
 /// entry belongs to exactly one run, every triangle is referenced exactly once, every child
 /// box holds its node's child boxes or its leaf's triangles (bit-exact), empty slots hold the
 /// degenerate box.
+///
+/// Any words give a report, never a panic or an endless walk: a node, leaf word or index
+/// word reached a second time (a cycle, shared children, overlapping runs) is reported and
+/// not followed again, so the walk takes time linear in the image. Loading a saved tree
+/// runs the narrower check of what traversal relies on (`saved::structure`) instead.
 pub fn validate_image<L: NodeLayout>(img: &MemoryImage) -> ValidationReport {
     let mut rep = ValidationReport {
         structure: L::NAME,
-        triangles: img.triangles.len() / 9,
+        triangles: img.triangle_slice().len(),
         ..Default::default()
     };
     let words = &img.words;
@@ -89,29 +94,39 @@ pub fn validate_image<L: NodeLayout>(img: &MemoryImage) -> ValidationReport {
         rep.error(format!("node region {:?} too small for a root", img.nodes));
         return rep;
     }
+    // Marks the words of `r` reached; false (and an error) when one already was. A node or
+    // run reached twice is not followed again, so a forged image with a cycle or shared
+    // children cannot make the walk loop or repeat itself: it stays linear.
     let cover = |rep: &mut ValidationReport, cover: &mut [u8], r: std::ops::Range<usize>| {
+        let mut fresh = true;
         for w in r {
             cover[w] = cover[w].saturating_add(1);
             if cover[w] == 2 {
                 rep.error(format!("word {w} reached twice"));
             }
+            fresh &= cover[w] == 1;
         }
+        fresh
     };
     // (node word, depth, bounds the node's children must lie in)
     let mut stack: Vec<(usize, usize, Option<Aabb>)> = vec![(0, 0, None)];
     while let Some((at, depth, parent)) = stack.pop() {
+        if !cover(&mut rep, &mut node_cover, at..at + L::WORDS) {
+            continue;
+        }
         rep.internal_nodes += 1;
         rep.max_depth = rep.max_depth.max(depth);
-        cover(&mut rep, &mut node_cover, at..at + L::WORDS);
         let node = *L::read(words, at);
         let mut addr = node.offset() as usize;
         let block_len: usize = (0..L::ARITY)
             .map(|k| L::child_words(node.kind(k)) as usize)
             .sum();
-        if block_len > 0 && (addr < img.nodes.start || addr + block_len > img.nodes.end) {
+        if block_len > 0
+            && (addr < img.nodes.start || addr.saturating_add(block_len) > img.nodes.end)
+        {
             rep.error(format!(
                 "node at word {at}: child block {addr}..{} outside the node region {:?}",
-                addr + block_len,
+                addr.saturating_add(block_len),
                 img.nodes
             ));
             continue;
@@ -134,7 +149,10 @@ pub fn validate_image<L: NodeLayout>(img: &MemoryImage) -> ValidationReport {
                 ChildKind::Internal => stack.push((addr, depth + 1, Some(b))),
                 ChildKind::Leaf => {
                     rep.leaves += 1;
-                    cover(&mut rep, &mut node_cover, addr..addr + 1);
+                    if !cover(&mut rep, &mut node_cover, addr..addr + 1) {
+                        addr += 1;
+                        continue;
+                    }
                     let run = words[addr] as usize;
                     let mut j = run;
                     loop {
@@ -145,11 +163,13 @@ pub fn validate_image<L: NodeLayout>(img: &MemoryImage) -> ValidationReport {
                             ));
                             break;
                         }
-                        cover(
+                        if !cover(
                             &mut rep,
                             &mut index_cover,
                             j - img.indices.start..j - img.indices.start + 1,
-                        );
+                        ) {
+                            break;
+                        }
                         let p = (words[j] & !RUN_END) as usize;
                         if p >= tri_refs.len() {
                             rep.error(format!("index word {j}: triangle {p} out of range"));

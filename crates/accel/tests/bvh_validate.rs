@@ -62,3 +62,41 @@ fn corruptions_are_reported() {
         );
     }
 }
+
+/// Arbitrary words give a report, never a panic or an endless walk: a root whose children
+/// are the root itself (a cycle), and many random word changes.
+#[test]
+fn cycles_and_random_words_end_in_a_report() {
+    let s = scene();
+    let mut rng = Pcg32::new(3, 9);
+    for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+        let enc = s.encoded(kind).expect("a BVH kind");
+        let (off_word, mask) = match kind {
+            AccelKind::Bvh2 => (12, (1u32 << 30) - 1),
+            AccelKind::Bvh4 => (24, (1 << 28) - 1),
+            _ => (48, u32::MAX),
+        };
+        let mut bad = enc.clone();
+        bad.image.words[off_word] &= !mask;
+        let rep = bad.validate();
+        // Each node is walked once at most: the cycle ends.
+        let node_words = bad.image.nodes.len();
+        assert!(!rep.is_ok(), "{kind:?}: cycle not reported");
+        assert!(rep.internal_nodes <= node_words, "{kind:?}: {rep:?}");
+        let words = bad.image.indices.end;
+        for _ in 0..300 {
+            let mut bad = enc.clone();
+            for _ in 0..4 {
+                let w = rng.next_u32() as usize % words;
+                bad.image.words[w] = match rng.next_u32() % 3 {
+                    0 => rng.next_u32(),
+                    1 => bad.image.words[w] ^ (1 << (rng.next_u32() % 32)),
+                    _ => (bad.image.words[w] & 0xF000_0000) | (rng.next_u32() % words as u32),
+                };
+            }
+            let rep = bad.validate();
+            assert_eq!(rep.error_count == 0, rep.errors.is_empty());
+            assert!(rep.internal_nodes <= node_words, "{kind:?}: {rep:?}");
+        }
+    }
+}

@@ -3,6 +3,7 @@
 //! an appended byte, another format version and another scene are rejected with a typed
 //! error, never a panic.
 
+use dualsplit_accel::image::RUN_END;
 use dualsplit_accel::math::{Hit, Ray, Triangle};
 use dualsplit_accel::saved::{FORMAT_VERSION, SavedError, WORDS_OFFSET};
 use dualsplit_accel::{
@@ -243,5 +244,329 @@ fn fuzz_seeds_are_the_files_this_code_writes() {
         assert!(seed.len() < 8 << 10, "{name}: {} bytes", seed.len());
         let back = AnyTree::from_bytes(&seed, Some(tris)).expect("a seed loads");
         assert_eq!(back.to_bytes(), seed);
+    }
+}
+
+// ---- Forged files: a recomputed checksum, a structural error ----------------------------
+
+/// Rewrites the checksum at the end of `file` to match its contents, as a forger would.
+fn reseal(file: &mut [u8]) {
+    use sha2::{Digest, Sha256};
+    let n = file.len() - 32;
+    let sum: [u8; 32] = Sha256::digest(&file[..n]).into();
+    file[n..].copy_from_slice(&sum);
+}
+
+/// Byte offset of image word `w` in a saved file.
+fn at(w: usize) -> usize {
+    WORDS_OFFSET as usize + 4 * w
+}
+
+fn word(file: &[u8], w: usize) -> u32 {
+    u32::from_le_bytes(file[at(w)..at(w) + 4].try_into().expect("4 bytes"))
+}
+
+fn set_word(file: &mut [u8], w: usize, v: u32) {
+    file[at(w)..at(w) + 4].copy_from_slice(&v.to_le_bytes());
+}
+
+/// `good` with `change` applied to its words and the checksum recomputed.
+fn forge(good: &[u8], change: impl FnOnce(&mut Vec<u8>)) -> Vec<u8> {
+    let mut f = good.to_vec();
+    change(&mut f);
+    reseal(&mut f);
+    f
+}
+
+/// Loads a forged file: it must fail with [`SavedError::Structure`] at `want_word`, naming
+/// `want` in its message.
+#[track_caller]
+fn expect_structure(file: &[u8], want_word: usize, want: &str, case: &str) {
+    match AnyTree::from_bytes(file, None) {
+        Err(SavedError::Structure {
+            structure,
+            word,
+            what,
+        }) => {
+            assert_eq!(word, want_word as u64, "{case}: {structure}: {what}");
+            assert!(what.contains(want), "{case}: {structure}: {what}");
+            let e = AnyTree::from_bytes(file, None).expect_err("same");
+            assert!(
+                e.to_string().contains(&format!("at word {want_word}")),
+                "{e}"
+            );
+        }
+        r => panic!(
+            "{case}: expected a structure error, got {:?}",
+            r.map(|t| t.kind())
+        ),
+    }
+}
+
+/// The offset word of a BVH root node and its offset field's mask.
+fn bvh_offset_word(kind: TreeKind) -> (usize, u32) {
+    match kind {
+        TreeKind::Bvh2 => (12, (1 << 30) - 1),
+        TreeKind::Bvh4 => (24, (1 << 28) - 1),
+        _ => (48, u32::MAX),
+    }
+}
+
+#[test]
+fn forged_bvh_files_are_structure_errors() {
+    let tris = scene("builtin:cornell");
+    for tree in trees(&tris).into_iter().take(3) {
+        let kind = tree.kind();
+        let good = tree.to_bytes();
+        let img = tree.image();
+        let (nodes, indices) = (img.nodes.clone(), img.indices.clone());
+        let (ow, mask) = bvh_offset_word(kind);
+        let root = word(&good, ow);
+        let case = |s: &str| format!("{kind} {s}");
+        // A child block beyond the node region.
+        let f = forge(&good, |f| set_word(f, ow, root | mask));
+        expect_structure(&f, 0, "leaves the node region", &case("offset"));
+        // The root's children are the root itself: a cycle.
+        let f = forge(&good, |f| set_word(f, ow, root & !mask));
+        expect_structure(&f, 0, "in the layout it is at word", &case("cycle"));
+        // A triangle id beyond the triangle count (the run end bit kept).
+        let e = word(&good, indices.start);
+        let f = forge(&good, |f| {
+            set_word(f, indices.start, (e & RUN_END) | tris.len() as u32)
+        });
+        let want = format!("names triangle {}", tris.len());
+        expect_structure(&f, indices.start, &want, &case("id"));
+        // The last run's end removed: it would run off the index region. The error names
+        // the leaf word of that run (the node-region word that starts it).
+        let last = indices.end - 1;
+        let last_start = (indices.start..last)
+            .rev()
+            .find(|&j| word(&good, j) & RUN_END != 0)
+            .map_or(indices.start, |j| j + 1);
+        let last_leaf = (nodes.clone())
+            .rev()
+            .find(|&w| word(&good, w) as usize == last_start)
+            .expect("the last leaf word");
+        let f = forge(&good, |f| set_word(f, last, word(&good, last) & !RUN_END));
+        expect_structure(&f, last_leaf, "does not end", &case("run end"));
+        // The first run's end removed: it runs into the next run.
+        let first_end = (indices.start..indices.end)
+            .find(|&j| word(&good, j) & RUN_END != 0)
+            .expect("a run");
+        assert!(first_end < last, "{kind}: one run only");
+        let f = forge(&good, |f| {
+            set_word(f, first_end, word(&good, first_end) & !RUN_END)
+        });
+        match AnyTree::from_bytes(&f, None) {
+            Err(SavedError::Structure { what, .. }) => {
+                assert!(what.contains("the next run is at word"), "{kind}: {what}")
+            }
+            r => panic!("{kind}: overlapping runs: {:?}", r.map(|t| t.kind())),
+        }
+        // A leaf word pointing outside the index region (the first leaf word found in a
+        // node region of boxes and leaf words: a word whose value starts a run).
+        let leaf = (nodes.clone())
+            .find(|&w| word(&good, w) as usize == indices.start)
+            .expect("the first leaf word");
+        let f = forge(&good, |f| set_word(f, leaf, indices.end as u32));
+        match AnyTree::from_bytes(&f, None) {
+            Err(SavedError::Structure { word, what, .. }) => {
+                assert_eq!(word, leaf as u64, "{kind}: {what}");
+                assert!(what.contains("the next run is at word"), "{kind}: {what}");
+            }
+            r => panic!("{kind}: leaf word: {:?}", r.map(|t| t.kind())),
+        }
+        // The header's counts must be the tree's.
+        let mut f = good.clone();
+        let leaves_at = header_bvh_leaves(&good, &tree);
+        f[leaves_at] ^= 1;
+        reseal(&mut f);
+        expect_structure(&f, 0, "its header says", &case("counts"));
+        // A byte in the zero padding (found by the fuzz target: it loaded, and wrote back
+        // a file without it).
+        let f = forge(&good, |f| f[2595] = 1);
+        match AnyTree::from_bytes(&f, None) {
+            Err(SavedError::Malformed(m)) => assert!(m.contains("header byte 2595"), "{m}"),
+            r => panic!("{kind}: padding: {:?}", r.map(|t| t.kind())),
+        }
+        // The untouched file still loads.
+        AnyTree::from_bytes(&good, Some(&tris)).expect("the good file loads");
+    }
+}
+
+/// Byte offset of the header's BVH leaf count (found by its value, after the internal-node
+/// count).
+fn header_bvh_leaves(file: &[u8], tree: &AnyTree) -> usize {
+    let (n, l) = (tree.stats().internal_nodes, tree.stats().leaves);
+    let mut want = n.to_le_bytes().to_vec();
+    want.extend(l.to_le_bytes());
+    let at = file[..512]
+        .windows(16)
+        .position(|w| w == want)
+        .expect("the counts in the header");
+    at + 8
+}
+
+#[test]
+fn forged_dst_files_are_structure_errors() {
+    let tris = scene("builtin:cornell");
+    for tree in trees(&tris).into_iter().skip(3) {
+        let good = tree.to_bytes();
+        let img = tree.image();
+        let (nodes, indices) = (img.nodes.clone(), img.indices.clone());
+        let root = word(&good, 0);
+        let h = dualsplit_accel::dst::HeaderOffset::from_bits(root);
+        assert!(
+            h.is_split() || (h.is_carving() && !h.is_leaf_flag()),
+            "{h:?}"
+        );
+        let off = (1u32 << 26) - 1;
+        // A child beyond the node region.
+        let f = forge(&good, |f| set_word(f, 0, root | off));
+        expect_structure(&f, 0, "outside the node region", "dst offset");
+        // The root's child is the root: a cycle.
+        let f = forge(&good, |f| set_word(f, 0, root & !off));
+        expect_structure(&f, 0, "in the layout it is at word", "dst cycle");
+        // An invalid header code (C = 0, L = 0, A = 11: no splitting axis 3).
+        let f = forge(&good, |f| set_word(f, 0, (0b011010 << 26) | (root & off)));
+        expect_structure(&f, 0, "invalid node header", "dst header");
+        // A triangle id beyond the triangle count.
+        let e = word(&good, indices.start);
+        let f = forge(&good, |f| {
+            set_word(f, indices.start, (e & RUN_END) | 1_000_000)
+        });
+        expect_structure(&f, indices.start, "names triangle 1000000", "dst id");
+        // The last run's end removed.
+        let last = indices.end - 1;
+        let f = forge(&good, |f| set_word(f, last, word(&good, last) & !RUN_END));
+        match AnyTree::from_bytes(&f, None) {
+            Err(SavedError::Structure { what, .. }) => {
+                assert!(what.contains("does not end"), "dst run end: {what}")
+            }
+            r => panic!("dst run end: {:?}", r.map(|t| t.kind())),
+        }
+        // A plain leaf whose run starts beyond the index region.
+        let leaf = (nodes.clone())
+            .find(|&w| {
+                let h = dualsplit_accel::dst::HeaderOffset::from_bits(word(&good, w));
+                h.is_plain_leaf() && h.offset() == 0
+            })
+            .or_else(|| {
+                (nodes.clone()).find(|&w| {
+                    let h = dualsplit_accel::dst::HeaderOffset::from_bits(word(&good, w));
+                    h.is_carving() && h.is_leaf_flag() && h.offset() == 0
+                })
+            })
+            .expect("the leaf of run 0");
+        let f = forge(&good, |f| {
+            set_word(f, leaf, word(&good, leaf) | (indices.len() as u32))
+        });
+        expect_structure(&f, leaf, "the next run is at word", "dst leaf run");
+        AnyTree::from_bytes(&good, Some(&tris)).expect("the good file loads");
+    }
+}
+
+#[test]
+fn tiny_trees_load() {
+    let all = scene("builtin:cornell");
+    for n in [0, 1, 2, 3] {
+        let tris = &all[..n];
+        let Ok(bvh2) = Bvh2Tree::build(tris, &BuildConfig::default()) else {
+            assert!(n == 0, "{n} triangles do not build");
+            continue;
+        };
+        let mut ts: Vec<AnyTree> = [TreeKind::Bvh2, TreeKind::Bvh4, TreeKind::Bvh8]
+            .into_iter()
+            .map(|k| {
+                BvhTree::from_bvh2(&bvh2, k)
+                    .expect("bvh")
+                    .expect("encode")
+                    .into()
+            })
+            .collect();
+        ts.push(
+            DstTree::from_bvh2(&bvh2, &DstConfig::hardware())
+                .expect("dst")
+                .into(),
+        );
+        for t in ts {
+            let back = AnyTree::from_bytes(&t.to_bytes(), Some(tris))
+                .unwrap_or_else(|e| panic!("{} of {n} triangles: {e}", t.kind()));
+            assert_eq!(back.kind(), t.kind());
+        }
+    }
+}
+
+/// Many random word changes of every kind's file, each with a recomputed checksum: the load
+/// is a tree or a typed error, never a panic, and a loaded tree answers rays through every
+/// traversal in bounded time (a cycle or an exponential walk would time out).
+#[test]
+fn random_forgeries_load_or_fail_typed_and_traverse_in_bounded_time() {
+    let tris = scene("builtin:cornell");
+    let trials = if cfg!(debug_assertions) { 300 } else { 4000 };
+    let rays = rays(&tris, 8);
+    let (tx, rx) = std::sync::mpsc::channel();
+    for (i, tree) in trees(&tris).into_iter().enumerate() {
+        let (tx, tris, rays) = (tx.clone(), tris.clone(), rays.clone());
+        std::thread::spawn(move || {
+            let good = tree.to_bytes();
+            let words = tree.image().indices.end;
+            let mut rng = Pcg32::new(77, i as u64);
+            let (mut ok, mut structure, mut other) = (0usize, 0usize, 0usize);
+            for _ in 0..trials {
+                let mut f = good.clone();
+                for _ in 0..1 + rng.next_u32() % 3 {
+                    let w = rng.next_u32() as usize % words;
+                    let old = word(&f, w);
+                    let new = match rng.next_u32() % 4 {
+                        0 => old ^ (1 << (rng.next_u32() % 32)),
+                        1 => rng.next_u32(),
+                        // A plausible offset or index, keeping the high bits (types, header).
+                        2 => (old & 0xfc00_0000) | (rng.next_u32() % words as u32),
+                        _ => old & !(rng.next_u32() % 64),
+                    };
+                    set_word(&mut f, w, new);
+                }
+                reseal(&mut f);
+                match AnyTree::from_bytes(&f, None) {
+                    Ok(t) => {
+                        ok += 1;
+                        for r in &rays {
+                            for &k in t.kind().accel_kinds() {
+                                let _ = t.closest_hit(k, r, &mut NoObserver);
+                                let _ = t.any_hit(k, r, &mut NoObserver);
+                            }
+                            let _ = t.intersect(r);
+                            let _ = t.occluded(r);
+                            if let AnyTree::Dst(d) = &t {
+                                let _ = d.pipeline().intersect(r);
+                                let _ = d.pipeline().occluded(r);
+                            }
+                        }
+                    }
+                    Err(SavedError::Structure { .. }) => structure += 1,
+                    Err(_) => other += 1,
+                }
+            }
+            let _ = tris;
+            tx.send((tree.kind(), ok, structure, other)).expect("send");
+        });
+    }
+    drop(tx);
+    let mut seen = 0;
+    while seen < 5 {
+        let (kind, ok, structure, other) = rx
+            .recv_timeout(std::time::Duration::from_secs(120))
+            .expect("a forgery thread panicked or did not finish in 120 s");
+        assert_eq!(ok + structure + other, trials);
+        // Box and plane words are not checked, so some forgeries load; offsets, runs and
+        // ids are, so many do not.
+        assert!(ok > trials / 20, "{kind}: {ok} of {trials} loaded");
+        assert!(
+            structure > trials / 5,
+            "{kind}: {structure} of {trials} structure errors"
+        );
+        assert_eq!(other, 0, "{kind}: errors other than structure errors");
+        seen += 1;
     }
 }

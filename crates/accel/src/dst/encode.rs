@@ -18,6 +18,9 @@
 //! kernel allows, so first-touch page faults do not dominate). The layout is the one a fully
 //! sequential depth-first emission with bump allocation gives, whatever the thread count
 //! (`tests/dst_convert_reference.rs`).
+//!
+//! Loading a saved tree replays that sequential allocation and rejects any other layout
+//! (`saved/structure.rs`): a change here changes the saved-tree format.
 
 use super::from_bvh2::{Chain, ChainDp, StepTable, plan_split, plane_values};
 use super::header::{HeaderOffset, OFFSET_LIMIT};

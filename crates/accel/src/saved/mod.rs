@@ -12,7 +12,10 @@
 //! Loading checks, in order: the magic, the version, that the sizes in the header add up
 //! to the file's length (before anything is allocated), the checksum, and, when the caller
 //! names the scene, that the file's triangles are the scene's, bit for bit (the error names
-//! both triangle hashes). Each failure is a [`SavedError`]; nothing panics.
+//! both triangle hashes), then the structure ([`AnyTree::check_structure`]: offsets, runs,
+//! triangle ids, no cycle), so that even a file forged with a recomputed checksum cannot
+//! make a traversal panic, loop or read the wrong memory. Each failure is a [`SavedError`];
+//! nothing panics.
 //!
 //! Loading reads the file into memory rather than mapping it: a file mapping is `unsafe`
 //! (another process may change or truncate the file under it), which this workspace
@@ -37,6 +40,7 @@
 //! ```
 
 mod header;
+mod structure;
 
 pub use header::{CHECKSUM_BYTES, FORMAT_VERSION, HEADER_BYTES, MAGIC, WORDS_OFFSET};
 
@@ -98,6 +102,19 @@ pub enum SavedError {
     /// The checksum does not match the contents.
     #[error("tree file is corrupt: checksum mismatch")]
     Checksum,
+    /// The tree's structure is inconsistent (a file forged with a recomputed checksum, or
+    /// written by a faulty encoder): a child or run outside its region, a node reached
+    /// twice, an invalid node header, a triangle id out of range, or counts that contradict
+    /// the header. Checked after the checksum, before the tree is returned.
+    #[error("malformed {structure} tree at word {word}: {what}")]
+    Structure {
+        /// The structure (`bvh2`, `bvh4`, `bvh8`, `dst`).
+        structure: &'static str,
+        /// The image word (node region, or index region for an index entry) at fault.
+        word: u64,
+        /// What is wrong.
+        what: String,
+    },
     /// The tree was built from other triangles than the scene it is used with.
     #[error(
         "tree file was built from another scene (triangle hash {found}, the scene's is {expected})"
@@ -185,10 +202,9 @@ impl<W: Write> HashingWriter<W> {
 }
 
 impl AnyTree {
-    /// The file header of this tree.
-    fn header(&self) -> Header {
-        let img = self.image();
-        let extra = match self {
+    /// The structure's own header fields.
+    fn extra(&self) -> Extra {
+        match self {
             AnyTree::Bvh(b) => Extra::Bvh {
                 internal_nodes: b.encoded.internal_nodes as u64,
                 leaves: b.encoded.leaves as u64,
@@ -199,7 +215,31 @@ impl AnyTree {
                 scene_box: d.dst.scene_box(),
                 stats: d.dst.stats(),
             },
-        };
+        }
+    }
+
+    /// Checks everything a traversal of this tree's image relies on, as loading a saved
+    /// tree does (`docs/tree-format.md`, "Checks on load"): child offsets and index runs
+    /// inside their regions, every node reached once from the root (no cycle), runs ended
+    /// by [`crate::image::RUN_END`] and not overlapping, triangle ids below the triangle
+    /// count, valid DST node headers, and the counts the header records. Linear time.
+    pub fn check_structure(&self) -> Result<(), SavedError> {
+        structure::check(
+            &structure::Regions::of(self.image()),
+            self.kind(),
+            &self.extra(),
+        )
+        .map_err(|v| SavedError::Structure {
+            structure: self.kind().name(),
+            word: v.word as u64,
+            what: v.what,
+        })
+    }
+
+    /// The file header of this tree.
+    fn header(&self) -> Header {
+        let img = self.image();
+        let extra = self.extra();
         let (n, i, t) = (
             img.nodes.len() as u64,
             img.indices.len() as u64,
@@ -345,10 +385,29 @@ impl AnyTree {
         {
             return Err(SavedError::WrongScene {
                 expected: hex(&triangle_hash(scene)),
-                found: hex(&h.triangle_hash),
+                // The triangles' own hash, not the header's copy: a forged header cannot
+                // name another scene than the file holds.
+                found: hex(&triangle_hash(&tris)),
             });
         }
-        Ok(assemble(&h, words, tris))
+        // Only the bytes this version writes: a forged file with other bytes in unused
+        // header fields or the padding would load but not write back the same file.
+        if let Some(at) = h
+            .encode()
+            .iter()
+            .chain(std::iter::repeat(&0u8))
+            .zip(head.iter().chain(&pad))
+            .position(|(a, b)| a != b)
+        {
+            return Err(SavedError::malformed(format!(
+                "header byte {at} is not what this version writes (unused fields and padding are zero)"
+            )));
+        }
+        let tree = assemble(&h, words, tris);
+        // Everything a traversal indexes with, so a forged file cannot make one panic,
+        // loop or read the wrong memory (`structure`).
+        tree.check_structure()?;
+        Ok(tree)
     }
 
     /// Reads a saved tree from bytes (see [`AnyTree::read_from`]).

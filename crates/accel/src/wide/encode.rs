@@ -1,4 +1,8 @@
 //! Writes a [`WideBvh`] into a byte-exact [`MemoryImage`] (layout in [`crate::image`]).
+//!
+//! Loading a saved tree replays this allocation (child blocks and runs bump-allocated in
+//! depth-first slot order) and rejects any other layout (`saved/structure.rs`): a change
+//! here changes the saved-tree format.
 
 use super::{WideBvh, WideChild};
 use crate::image::{ChildKind, ImageError, MemoryImage, NodeLayout, RUN_END, SharedTriangles};
