@@ -18,8 +18,8 @@
 //! nothing panics.
 //!
 //! Loading reads the file into memory rather than mapping it: a file mapping is `unsafe`
-//! (another process may change or truncate the file under it), which this workspace
-//! forbids. The node and index words are read straight into their final buffer
+//! (another process may change or truncate the file under it), and this crate allows
+//! `unsafe` only in its SIMD leaf file (a prefetch hint). The node and index words are read straight into their final buffer
 //! ([`crate::image::Words`], an anonymous huge-page mapping for large images), with no
 //! intermediate copy, and the triangles straight into their shared allocation.
 //!
