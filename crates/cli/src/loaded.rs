@@ -71,6 +71,24 @@ impl Loaded {
         }
     }
 
+    /// What was built or loaded and how long it took, as one JSON object:
+    /// `{"scene", "build_ms"}` or `{"scene", "tree", "kind", "load_ms"}`.
+    pub fn timing_json(&self, scene: &Scene) -> serde_json::Value {
+        match self {
+            Loaded::Built { build_ms, .. } => {
+                serde_json::json!({"scene": scene.name, "build_ms": build_ms})
+            }
+            Loaded::Saved {
+                tree,
+                file,
+                load_ms,
+            } => serde_json::json!({
+                "scene": scene.name, "tree": file.display().to_string(),
+                "kind": tree.kind().to_string(), "load_ms": load_ms,
+            }),
+        }
+    }
+
     /// One line saying what was built or loaded and how long it took.
     pub fn summary(&self) -> String {
         match self {

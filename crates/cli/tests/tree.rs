@@ -148,7 +148,18 @@ fn bench_measures_only_the_saved_structure() {
         stderr(&o)
     );
     let mut accels = Vec::new();
-    for line in stdout(&o).lines() {
+    let out = stdout(&o);
+    let mut lines = out.lines();
+    // The first line says what was loaded and how long it took.
+    let first: serde_json::Value = serde_json::from_str(lines.next().unwrap()).unwrap();
+    assert_eq!(first["kind"], "dst", "{first}");
+    assert!(
+        first["tree"].as_str().unwrap().ends_with("c.dst"),
+        "{first}"
+    );
+    assert!(first["load_ms"].as_f64().unwrap() > 0.0, "{first}");
+    assert!(first.get("build_ms").is_none(), "{first}");
+    for line in lines {
         let v: serde_json::Value = serde_json::from_str(line).expect("JSON lines");
         let a = v["accel"].as_str().expect("accel").to_string();
         if v.get("mrays_per_s").is_some() {

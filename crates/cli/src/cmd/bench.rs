@@ -135,6 +135,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         );
     }
     let structures = get_structures(&scene, args.tree.as_deref(), ctx, json.is_some())?;
+    json_line(structures.timing_json(&scene).to_string());
     let accels = structures.kinds_or_all(&args.accel)?;
     let sp = ctx.spinner(format!(
         "generating rays on {}",
