@@ -527,35 +527,26 @@ impl RaySimd {
     }
 }
 
+/// Whether SSE's `maxps`/`minps` are available: `maxps x, b` is exactly
+/// `x > b ? x : b` and `minps x, b` is `x < b ? x : b` (`wide`'s `fast_max`/`fast_min` use
+/// them where SSE is on), one instruction where the portable form takes a compare and a blend.
+const SSE: bool = cfg!(all(
+    any(target_arch = "x86", target_arch = "x86_64"),
+    target_feature = "sse"
+));
+
 /// `if x > bound { x } else { bound }` per lane: a NaN `x` keeps the bound.
 #[inline(always)]
 fn keep_max(x: f32x4, bound: f32x4) -> f32x4 {
-    #[cfg(all(
-        any(target_arch = "x86", target_arch = "x86_64"),
-        target_feature = "sse"
-    ))]
-    {
-        // `maxps x, bound` is `x > bound ? x : bound` (`wide` uses it where SSE is on).
+    if SSE {
         x.fast_max(bound)
-    }
-    #[cfg(not(all(
-        any(target_arch = "x86", target_arch = "x86_64"),
-        target_feature = "sse"
-    )))]
-    {
+    } else {
         keep_max_portable(x, bound)
     }
 }
 
-/// [`keep_max`] by compare and blend, for targets without SSE's `maxps`.
+/// [`keep_max`] by compare and blend, on any target.
 #[inline(always)]
-#[cfg_attr(
-    all(
-        any(target_arch = "x86", target_arch = "x86_64"),
-        target_feature = "sse"
-    ),
-    allow(dead_code)
-)]
 fn keep_max_portable(x: f32x4, bound: f32x4) -> f32x4 {
     x.cmp_gt(bound).blend(x, bound)
 }
@@ -563,32 +554,15 @@ fn keep_max_portable(x: f32x4, bound: f32x4) -> f32x4 {
 /// `if x < bound { x } else { bound }` per lane: a NaN `x` keeps the bound.
 #[inline(always)]
 fn keep_min(x: f32x4, bound: f32x4) -> f32x4 {
-    #[cfg(all(
-        any(target_arch = "x86", target_arch = "x86_64"),
-        target_feature = "sse"
-    ))]
-    {
-        // `minps x, bound` is `x < bound ? x : bound` (`wide` uses it where SSE is on).
+    if SSE {
         x.fast_min(bound)
-    }
-    #[cfg(not(all(
-        any(target_arch = "x86", target_arch = "x86_64"),
-        target_feature = "sse"
-    )))]
-    {
+    } else {
         keep_min_portable(x, bound)
     }
 }
 
-/// [`keep_min`] by compare and blend, for targets without SSE's `minps`.
+/// [`keep_min`] by compare and blend, on any target.
 #[inline(always)]
-#[cfg_attr(
-    all(
-        any(target_arch = "x86", target_arch = "x86_64"),
-        target_feature = "sse"
-    ),
-    allow(dead_code)
-)]
 fn keep_min_portable(x: f32x4, bound: f32x4) -> f32x4 {
     x.cmp_lt(bound).blend(x, bound)
 }
