@@ -18,23 +18,27 @@ fn bits(h: Option<Hit>) -> Option<(u32, u32, u32, u32)> {
 }
 
 fn trees(tris: &[Triangle]) -> Vec<AnyTree> {
-    let bvh2 = Bvh2Tree::build(tris, &BuildConfig::default()).expect("bvh2");
+    trees_of(&Bvh2Tree::build(tris, &BuildConfig::default()).expect("bvh2"))
+}
+
+/// Every kind of tree from `bvh2`: BVH2, BVH4, BVH8 and both DST presets.
+fn trees_of(bvh2: &Bvh2Tree) -> Vec<AnyTree> {
     let mut out: Vec<AnyTree> = [TreeKind::Bvh2, TreeKind::Bvh4, TreeKind::Bvh8]
         .into_iter()
         .map(|k| {
-            BvhTree::from_bvh2(&bvh2, k)
+            BvhTree::from_bvh2(bvh2, k)
                 .expect("bvh")
                 .expect("encode")
                 .into()
         })
         .collect();
     out.push(
-        DstTree::from_bvh2(&bvh2, &DstConfig::hardware())
+        DstTree::from_bvh2(bvh2, &DstConfig::hardware())
             .expect("dst")
             .into(),
     );
     out.push(
-        DstTree::from_bvh2(&bvh2, &DstConfig::software())
+        DstTree::from_bvh2(bvh2, &DstConfig::software())
             .expect("dst")
             .into(),
     );
@@ -475,20 +479,7 @@ fn tiny_trees_load() {
             assert!(n == 0, "{n} triangles do not build");
             continue;
         };
-        let mut ts: Vec<AnyTree> = [TreeKind::Bvh2, TreeKind::Bvh4, TreeKind::Bvh8]
-            .into_iter()
-            .map(|k| {
-                BvhTree::from_bvh2(&bvh2, k)
-                    .expect("bvh")
-                    .expect("encode")
-                    .into()
-            })
-            .collect();
-        ts.push(
-            DstTree::from_bvh2(&bvh2, &DstConfig::hardware())
-                .expect("dst")
-                .into(),
-        );
+        let ts = trees_of(&bvh2);
         for t in ts {
             let back = AnyTree::from_bytes(&t.to_bytes(), Some(tris))
                 .unwrap_or_else(|e| panic!("{} of {n} triangles: {e}", t.kind()));

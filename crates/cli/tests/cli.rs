@@ -1,8 +1,10 @@
 //! The command line as a user meets it: lists take commas, a missing scene file is named
 //! as missing, output paths are checked before any work starts, and help texts speak the
 //! user's language (no internal identifiers).
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
+
+use common::{dualsplit, stderr, stdout};
+use std::process::Command;
 
 const SUBCOMMANDS: [&str; 9] = [
     "info",
@@ -15,23 +17,6 @@ const SUBCOMMANDS: [&str; 9] = [
     "report",
     "calibrate",
 ];
-
-fn dualsplit(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_dualsplit"))
-        .args(args)
-        .current_dir(cwd)
-        .env_remove("DUALSPLIT_SCENES")
-        .output()
-        .expect("run dualsplit")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
 
 #[test]
 fn space_separated_lists_are_refused_with_the_comma_form() {

@@ -2,27 +2,12 @@
 //! used instead of building, answers exactly as a build would (same image bytes, same
 //! simulation), and a tree of another scene, a damaged file or a structure the file does
 //! not hold is refused with a message naming it and a nonzero exit.
+mod common;
+
+use common::{dualsplit, stderr, stdout};
 use std::path::Path;
-use std::process::{Command, Output};
 
 const SCENE: &str = "builtin:cornell";
-
-fn dualsplit(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_dualsplit"))
-        .args(args)
-        .current_dir(cwd)
-        .env_remove("DUALSPLIT_SCENES")
-        .output()
-        .expect("run dualsplit")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
 
 /// `dualsplit build scene --accel kind -o name` in `dir`; returns the file's path.
 fn build(scene: &str, kind: &str, name: &str, dir: &Path) -> String {

@@ -570,19 +570,8 @@ fn keep_min_portable(x: f32x4, bound: f32x4) -> f32x4 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::wide::traverse::tests::coord;
     use dualsplit_geometry::Pcg32;
-
-    /// A coordinate from a small set (box planes through the ray's origin, zero direction
-    /// components, so NaN plane distances) or random.
-    fn coord(rng: &mut Pcg32) -> f32 {
-        match rng.below(6) {
-            0 => 0.0,
-            1 => -0.0,
-            2 => 1.0,
-            3 => -1.0,
-            _ => rng.range_f32(-4.0, 4.0),
-        }
-    }
 
     /// The chunk test gives, lane by lane, `RayPre::slab`'s hit or miss and entry distance
     /// (up to the sign of a zero) for every non-NaN interval, with empty lanes never hit.

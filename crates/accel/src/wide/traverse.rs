@@ -275,13 +275,14 @@ impl BoxSlab {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use dualsplit_geometry::{Aabb, Pcg32, Vec3};
 
     /// A coordinate from a small set (so that box planes often pass exactly through the
     /// ray's origin and zero direction components make NaN plane distances) or random.
-    fn coord(rng: &mut Pcg32) -> f32 {
+    /// Also the SIMD chunk test's (`cpu.rs`).
+    pub(in crate::wide) fn coord(rng: &mut Pcg32) -> f32 {
         match rng.below(6) {
             0 => 0.0,
             1 => -0.0,
