@@ -343,27 +343,11 @@ fn check_dst(img: &Regions, stats: &DstStats) -> Result<(), Violation> {
         return Err(violation(
             0,
             format!(
-                "the tree has {} splitting, {} single-axis and {} dual-axis carving nodes, \
-                 {} leaves, {} carving leaves, {} index entries, {} node and {} index bytes \
-                 ({} in all); its header says {}, {}, {}, {}, {}, {}, {}, {} ({})",
-                found.splitting,
-                found.single_carving,
-                found.dual_carving,
-                found.leaves,
-                found.carving_leaves,
-                found.index_entries,
-                found.node_bytes,
-                found.index_bytes,
-                found.total_bytes,
-                stats.splitting,
-                stats.single_carving,
-                stats.dual_carving,
-                stats.leaves,
-                stats.carving_leaves,
-                stats.index_entries,
-                stats.node_bytes,
-                stats.index_bytes,
-                stats.total_bytes
+                "the tree has {:?} (splitting, single-axis carving, dual-axis carving, \
+                 leaves, carving leaves, index entries, node bytes, index bytes, total \
+                 bytes); its header says {:?}",
+                counts(&found),
+                counts(stats)
             ),
         ));
     }
