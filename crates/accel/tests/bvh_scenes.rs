@@ -2,11 +2,13 @@
 //! per-ray identical answers for primary, shadow and diffuse-bounce rays recorded from
 //! path-traced pixel jobs on each scene's default camera: every BVH's plain query (its
 //! CPU-side copy, [`dualsplit_accel::wide::cpu`]) and its image traversal (what the
-//! simulator reads) against the BVH2's image traversal, hit for hit and bit for bit.
+//! simulator reads) against the BVH2's image traversal, hit for hit and bit for bit; the
+//! CPU-side copies with every instruction set this CPU has (SSE2, and AVX2 where present).
 //!
 //! Release builds (`cargo test --release`, what CI runs) compare at least 100K rays of each
 //! kind per scene; debug builds compare 3K of each so that `cargo test` stays quick.
 
+use dualsplit_accel::wide::cpu::{CpuBvh, SimdLevel};
 use dualsplit_accel::{AccelKind, BuildConfig, CollapseConfig, NoObserver, Structures, WideBvh};
 use dualsplit_testkit::oracle::{hit_bits, key};
 use dualsplit_testkit::rays::record_rays;
@@ -61,6 +63,20 @@ fn equivalence_on(name: &str, scene: &dualsplit_scene::Scene, min_rays: usize) {
         "{name}: {} diffuse",
         rays.diffuse.len()
     );
+    // Copies with every instruction set, answers taken from the image where a copy declines
+    // the ray (`None`: NaN bounds).
+    let levels = SimdLevel::available();
+    let copies: Vec<(AccelKind, SimdLevel, CpuBvh)> =
+        [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8]
+            .into_iter()
+            .flat_map(|kind| {
+                let b = s.encoded(kind).unwrap();
+                levels.iter().map(move |&l| (kind, l, b.cpu_copy(l)))
+            })
+            .collect();
+    for (kind, level, c) in &copies {
+        assert_eq!(c.level(), *level, "{name}: {kind:?}");
+    }
     for (what, set) in [("primary", &rays.primary), ("diffuse", &rays.diffuse)] {
         set.par_iter().enumerate().for_each(|(i, ray)| {
             let want = hit_bits(s.bvh2_image.closest_hit_image(ray, &mut NoObserver));
@@ -79,6 +95,18 @@ fn equivalence_on(name: &str, scene: &dualsplit_scene::Scene, min_rays: usize) {
                 );
                 assert_eq!(key(got).is_some(), want.is_some());
             }
+            for (kind, level, c) in &copies {
+                let got = c.traverse::<false>(ray).unwrap_or_else(|| {
+                    s.encoded(*kind)
+                        .unwrap()
+                        .closest_hit_image(ray, &mut NoObserver)
+                });
+                assert_eq!(
+                    hit_bits(got),
+                    want,
+                    "{name}: {what} ray {i} {ray:?} on {kind:?} with {level:?}"
+                );
+            }
         });
     }
     rays.shadow.par_iter().enumerate().for_each(|(i, ray)| {
@@ -95,6 +123,20 @@ fn equivalence_on(name: &str, scene: &dualsplit_scene::Scene, min_rays: usize) {
             );
             let got = s.any_hit(kind, ray, &mut NoObserver);
             assert_eq!(got, want, "{name}: shadow ray {i} {ray:?} on {kind:?}");
+        }
+        for (kind, level, c) in &copies {
+            let got = c.traverse::<true>(ray).map_or_else(
+                || {
+                    s.encoded(*kind)
+                        .unwrap()
+                        .any_hit_image(ray, &mut NoObserver)
+                },
+                |h| h.is_some(),
+            );
+            assert_eq!(
+                got, want,
+                "{name}: shadow ray {i} {ray:?} on {kind:?} with {level:?}"
+            );
         }
     });
 }

@@ -81,9 +81,24 @@ impl Ray {
     }
 
     /// Per-ray constants used by the slab and triangle tests.
+    #[inline]
     pub fn precompute(&self) -> RayPre {
         RayPre::new(self)
     }
+}
+
+/// `v[i]` for `i < 3` by selects rather than a load from a computed address (the values
+/// are in registers, and `i` depends on the ray).
+#[inline(always)]
+fn pick(v: [f32; 3], i: usize) -> f32 {
+    let b = v.map(f32::to_bits);
+    f32::from_bits(if i == 0 {
+        b[0]
+    } else if i == 1 {
+        b[1]
+    } else {
+        b[2]
+    })
 }
 
 /// Per-ray precomputed values: the IEEE reciprocal direction (±∞ for zero components), the
@@ -104,34 +119,40 @@ pub struct RayPre {
 
 impl RayPre {
     /// Computes the constants for `ray`.
+    ///
+    /// Branch-free (the axis choice is selects, not jumps, as directions of diffuse rays
+    /// are random) and with the five divisions done two vectors at a time; every value is
+    /// the one the scalar definition gives (IEEE division is correctly rounded lane by lane,
+    /// and `Sz = 1 / d[kz]` is `inv_dir[kz]`):
+    /// `kz` is x when `|dx| >= |dy|` and `|dx| >= |dz|`, else y when `|dy| >= |dz|`, else z
+    /// (so z when a component is NaN); `(kx, ky)` follow it cyclically, swapped when
+    /// `d[kz] < 0` to keep the winding; `Sx = d[kx] / d[kz]`, `Sy = d[ky] / d[kz]`.
+    #[inline]
     pub fn new(ray: &Ray) -> Self {
         let d = ray.dir;
-        let inv_dir = Vec3::ONE / d;
+        let inv = glam::Vec4::ONE / glam::Vec4::new(d.x, d.y, d.z, 1.0);
         let neg = [
             d.x.is_sign_negative(),
             d.y.is_sign_negative(),
             d.z.is_sign_negative(),
         ];
         let a = d.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let shear = Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+        let x_max = (a.x >= a.y) & (a.x >= a.z);
+        let y_max = a.y >= a.z;
+        let kz = (!x_max) as usize * (1 + (!y_max) as usize);
+        let dkz = pick([d.x, d.y, d.z], kz);
+        // (kx, ky) = (kz + 1, kz + 2) mod 3, two bits per kz in a constant.
+        let (kx, ky) = ((0b00_10_01 >> (2 * kz)) & 3, (0b01_00_10 >> (2 * kz)) & 3);
+        let (kx, ky) = if dkz < 0.0 { (ky, kx) } else { (kx, ky) };
+        // d / d[kz] on every axis; Sx and Sy are two of its lanes.
+        let s = glam::Vec4::new(d.x, d.y, d.z, 1.0) / glam::Vec4::splat(dkz);
+        let s = [s.x, s.y, s.z];
         Self {
             ray: *ray,
-            inv_dir,
+            inv_dir: inv.truncate(),
             neg,
             k: [kx, ky, kz],
-            shear,
+            shear: Vec3::new(pick(s, kx), pick(s, ky), pick([inv.x, inv.y, inv.z], kz)),
         }
     }
 

@@ -88,6 +88,21 @@ impl Triangle {
             v = (ax * cy - ay * cx) as f32;
             w = (bx * ay - by * ax) as f32;
         }
+        self.intersect_from_edges(r, [u, v, w], t_lo, t_hi)
+    }
+
+    /// The rest of [`Triangle::intersect`] once its edge functions `[u, v, w]` are known (as
+    /// it computes them, zeros recomputed in f64): the sign test, the determinant, `t` and
+    /// its range, the barycentrics. A SIMD caller that computed the edge functions of several
+    /// triangles with the same operations finishes each here with the same answer.
+    #[inline]
+    pub fn intersect_from_edges(
+        &self,
+        r: &RayPre,
+        [u, v, w]: [f32; 3],
+        t_lo: f32,
+        t_hi: f32,
+    ) -> Option<TriangleHit> {
         if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
             return None;
         }

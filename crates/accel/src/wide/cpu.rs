@@ -28,12 +28,13 @@
 //! live in transparent huge pages ([`Pages`]). Figures: `docs/performance.md`, "CPU
 //! traversal".
 
+use super::simd::{Avx2, Kernel};
 use crate::image::{ChildKind, MemoryImage, NodeLayout, Pages, RUN_END};
 use dualsplit_geometry::{EXIT_WIDEN, Hit, PrimId, Ray, RayPre, Triangle, Vec3, cull_limit};
 use std::cell::Cell;
 use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
 
-/// Children per chunk: one SSE register of `f32`.
+/// Lanes of one SSE register of `f32`: children per [`Chunk`], triangles per [`TriPacket`].
 pub const LANES: usize = 4;
 
 /// Child word of a leaf: bit 31 set, bits 0–30 the slot of its first triangle in
@@ -43,29 +44,28 @@ pub const LEAF: u32 = 1 << 31;
 /// Child word of an empty lane.
 pub const EMPTY: u32 = u32::MAX;
 
-/// Four children of a node: their boxes plane by plane, then their child words.
+/// A BVH2 or BVH4 node of the copy: its children's boxes plane by plane, then their child
+/// words.
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(16))]
 pub struct Chunk {
     /// `planes[p][lane]`: plane `p` of the lane's box, in the image's box-word order
     /// (min.x, min.y, min.z, max.x, max.y, max.z). Empty lanes hold the degenerate box.
     pub planes: [[f32; LANES]; 6],
-    /// Per lane: a node (index of its first chunk), a leaf ([`LEAF`] | first triangle) or
-    /// [`EMPTY`].
+    /// Per lane: a node (its index), a leaf ([`LEAF`] | first triangle) or [`EMPTY`].
     pub child: [u32; LANES],
 }
 
-const EMPTY_CHUNK: Chunk = Chunk {
-    planes: [
-        [f32::INFINITY; LANES],
-        [f32::INFINITY; LANES],
-        [f32::INFINITY; LANES],
-        [f32::NEG_INFINITY; LANES],
-        [f32::NEG_INFINITY; LANES],
-        [f32::NEG_INFINITY; LANES],
-    ],
-    child: [EMPTY; LANES],
-};
+/// A BVH8 node of the copy, laid out as [`Chunk`] with eight lanes, so that one AVX
+/// register holds a plane of all eight children (and two SSE registers one half each).
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C, align(32))]
+pub struct Chunk8 {
+    /// `planes[p][lane]`, as [`Chunk::planes`].
+    pub planes: [[f32; 8]; 6],
+    /// Per lane, as [`Chunk::child`].
+    pub child: [u32; 8],
+}
 
 /// Four consecutive triangles of the leaf-ordered triangle list, vertex coordinates lane by
 /// lane, with their ids. Leaves follow one another without padding: a leaf starts at any
@@ -85,94 +85,286 @@ pub(crate) const EMPTY_PACKET: TriPacket = TriPacket {
     prim: [EMPTY; LANES],
 };
 
+/// A node of the copy with `W` lanes: [`Chunk`] (BVH2 and BVH4) or [`Chunk8`] (BVH8).
+pub(crate) trait Lanes: bytemuck::Pod + Send + Sync + std::fmt::Debug {
+    /// Children per node.
+    const W: usize;
+    /// A node with every lane empty (degenerate boxes, [`EMPTY`] words).
+    const EMPTY: Self;
+    /// Sets lane `l`'s box words (image order) and child word.
+    fn set(&mut self, l: usize, boxw: [f32; 6], child: u32);
+    /// Lane `l`'s child word.
+    fn child(&self, l: usize) -> u32;
+    /// Sets lane `l`'s child word.
+    fn set_child(&mut self, l: usize, child: u32);
+    /// Entry distances (lanes 0–3 in the first vector, 4–7 in the second) and the mask of
+    /// the non-empty lanes the ray meets on `[t_lo, t_hi]`.
+    fn test<I: Isa>(&self, isa: I, rs: &RaySimd, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32);
+}
+
+macro_rules! lanes_impl {
+    ($t:ty, $w:expr, |$n:ident, $isa:ident, $rs:ident, $lo:ident, $hi:ident| $test:expr) => {
+        impl Lanes for $t {
+            const W: usize = $w;
+            const EMPTY: Self = Self {
+                planes: [
+                    [f32::INFINITY; $w],
+                    [f32::INFINITY; $w],
+                    [f32::INFINITY; $w],
+                    [f32::NEG_INFINITY; $w],
+                    [f32::NEG_INFINITY; $w],
+                    [f32::NEG_INFINITY; $w],
+                ],
+                child: [EMPTY; $w],
+            };
+            #[inline]
+            fn set(&mut self, l: usize, boxw: [f32; 6], child: u32) {
+                for (p, v) in boxw.into_iter().enumerate() {
+                    self.planes[p][l] = v;
+                }
+                self.child[l] = child;
+            }
+            #[inline(always)]
+            fn child(&self, l: usize) -> u32 {
+                self.child[l]
+            }
+            #[inline]
+            fn set_child(&mut self, l: usize, child: u32) {
+                self.child[l] = child;
+            }
+            #[inline(always)]
+            fn test<I: Isa>(
+                &self,
+                $isa: I,
+                $rs: &RaySimd,
+                $lo: f32,
+                $hi: f32,
+            ) -> ([f32x4; 2], u32) {
+                let $n = self;
+                $test
+            }
+        }
+    };
+}
+lanes_impl!(Chunk, LANES, |n, _isa, rs, t_lo, t_hi| {
+    let (e, m) = rs.test(&n.planes, &n.child, t_lo, t_hi);
+    ([e, f32x4::splat(0.0)], m)
+});
+lanes_impl!(Chunk8, 8, |n, isa, rs, t_lo, t_hi| isa
+    .test8(rs, n, t_lo, t_hi));
+
+/// The instruction set a traversal runs with: [`Sse2`] (every x86-64 CPU; the portable
+/// `wide` code elsewhere) or [`Avx2`] (one 8-wide box test per BVH8 node, and the whole
+/// traversal compiled for AVX2). Answers are the same bits with either.
+pub(crate) trait Isa: Copy {
+    /// Entry distances (lanes 0–3, then 4–7) and the mask of the non-empty lanes of `n` that
+    /// the ray meets on `[t_lo, t_hi]`.
+    fn test8(self, rs: &RaySimd, n: &Chunk8, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32);
+}
+
+/// Baseline x86-64 (SSE2), or the portable `wide` code on other targets: 4-wide vectors.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Sse2;
+
+impl Isa for Sse2 {
+    #[inline(always)]
+    fn test8(self, rs: &RaySimd, n: &Chunk8, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32) {
+        let half = |h: usize| {
+            rs.test_rows(
+                |p| half_of(&n.planes[p], h),
+                half_of(&n.child, h),
+                t_lo,
+                t_hi,
+            )
+        };
+        let ((e0, m0), (e1, m1)) = (half(0), half(1));
+        ([e0, e1], m0 | m1 << LANES)
+    }
+}
+
+impl Isa for Avx2 {
+    #[inline(always)]
+    fn test8(self, rs: &RaySimd, n: &Chunk8, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32) {
+        let (e, m) = self.slab8(
+            &n.planes, &n.child, rs.near, rs.far, rs.os, rs.invs, t_lo, t_hi, EXIT_WIDEN,
+        );
+        (bytemuck::cast(e), m)
+    }
+}
+
+/// Lanes `4h..4h + 4` of an 8-lane row.
+#[inline(always)]
+fn half_of<T: Copy + Default>(row: &[T; 8], h: usize) -> [T; LANES] {
+    let mut out = [T::default(); LANES];
+    out.copy_from_slice(&row[LANES * h..LANES * (h + 1)]);
+    out
+}
+
+/// Which instructions the plain queries use: the best this CPU has, unless the environment
+/// variable `DUALSPLIT_SIMD` is `sse2` (for measuring one against the other; answers are
+/// the same bits either way).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SimdLevel {
+    /// 4-wide SSE2 code (the portable `wide` code off x86-64).
+    Sse2,
+    /// AVX2: 8-wide BVH8 box tests, the whole traversal compiled for AVX2.
+    Avx2,
+}
+
+impl SimdLevel {
+    /// The best level of this CPU, or SSE2 when `DUALSPLIT_SIMD=sse2`.
+    pub fn detect() -> Self {
+        static LEVEL: std::sync::OnceLock<SimdLevel> = std::sync::OnceLock::new();
+        *LEVEL.get_or_init(|| {
+            let forced =
+                std::env::var("DUALSPLIT_SIMD").is_ok_and(|v| v.eq_ignore_ascii_case("sse2"));
+            if Avx2::detect().is_some() && !forced {
+                Self::Avx2
+            } else {
+                Self::Sse2
+            }
+        })
+    }
+
+    /// Every level this CPU can run, the baseline first.
+    pub fn available() -> Vec<Self> {
+        std::iter::once(Self::Sse2)
+            .chain(Avx2::detect().map(|_| Self::Avx2))
+            .collect()
+    }
+}
+
+/// The nodes of a [`CpuBvh`], one per node of the image, the root first.
+#[derive(Clone, Debug)]
+pub enum CpuNodes {
+    /// BVH2 (two lanes used) or BVH4.
+    Four(Pages<Chunk>),
+    /// BVH8.
+    Eight(Pages<Chunk8>),
+}
+
 /// The CPU-side copy of one BVH image (see the module docs).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct CpuBvh {
-    /// Chunks per node: 1 for BVH2 and BVH4, 2 for BVH8.
-    pub chunks_per_node: usize,
-    /// The nodes, each `chunks_per_node` consecutive chunks, the root first.
-    pub chunks: Pages<Chunk>,
+    /// The nodes, children of a node next to one another, subtrees depth-first.
+    pub nodes: CpuNodes,
     /// The leaves' triangles in leaf order, four to a packet.
     pub packets: Pages<TriPacket>,
+    /// The AVX2 token when the traversal uses AVX2.
+    avx2: Option<Avx2>,
+}
+
+/// What [`copy`] makes: nodes and packets.
+struct Copied<N> {
+    nodes: Vec<N>,
+    packets: Vec<TriPacket>,
+}
+
+/// Copies the image of node layout `L` into nodes of type `N` (`N::W >= L::ARITY`).
+fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage) -> Copied<N> {
+    let words = &img.words[..];
+    let triangles = img.triangle_slice();
+    let mut out = Copied {
+        nodes: vec![N::EMPTY],
+        packets: Vec::new(),
+    };
+    // (image word of a node, node index it is copied to)
+    let mut todo: Vec<(usize, usize)> = vec![(0, 0)];
+    // Triangle slots used (4 per packet).
+    let mut slots = 0usize;
+    while let Some((w, at)) = todo.pop() {
+        let node = L::read(words, w);
+        let mut addr = node.offset() as usize;
+        let mut lane = 0;
+        let mut internal = Vec::new();
+        for k in 0..L::ARITY {
+            let kind = node.kind(k);
+            if kind == ChildKind::Empty {
+                continue;
+            }
+            let mut child = EMPTY;
+            match kind {
+                ChildKind::Leaf => {
+                    let run = words[addr] as usize;
+                    let len = words[run..]
+                        .iter()
+                        .position(|&e| e & RUN_END != 0)
+                        .map_or(0, |p| p + 1);
+                    let first = slots as u32;
+                    assert!(first < LEAF, "too many triangle references");
+                    pack_entries(
+                        &mut out.packets,
+                        &mut slots,
+                        words[run..run + len].iter().copied(),
+                        triangles,
+                    );
+                    child = LEAF | first;
+                }
+                _ => internal.push((addr, lane)),
+            }
+            out.nodes[at].set(lane, *node.box_words(k), child);
+            addr += L::child_words(kind) as usize;
+            lane += 1;
+        }
+        // Children of one node next to one another, then their subtrees depth-first.
+        let mut subtrees = Vec::with_capacity(internal.len());
+        for (cw, l) in internal {
+            let idx = out.nodes.len();
+            out.nodes.push(N::EMPTY);
+            out.nodes[at].set_child(l, idx as u32);
+            subtrees.push((cw, idx));
+        }
+        todo.extend(subtrees.into_iter().rev());
+    }
+    out
 }
 
 impl CpuBvh {
     /// Copies the image of node layout `L` (depth-first, children of a node next to one
-    /// another).
+    /// another), for the instructions of [`SimdLevel::detect`].
     pub fn from_image<L: NodeLayout>(img: &MemoryImage) -> Self {
-        let cpn = L::ARITY.div_ceil(LANES);
-        let words = &img.words[..];
-        let triangles = img.triangle_slice();
-        struct Out {
-            chunks: Vec<Chunk>,
-            packets: Vec<TriPacket>,
-        }
-        let mut out = Out {
-            chunks: Vec::new(),
-            packets: Vec::new(),
+        Self::with_level::<L>(img, SimdLevel::detect())
+    }
+
+    /// [`CpuBvh::from_image`] for the given instructions (SSE2 when this CPU lacks AVX2).
+    pub fn with_level<L: NodeLayout>(img: &MemoryImage, level: SimdLevel) -> Self {
+        let avx2 = match level {
+            SimdLevel::Avx2 => Avx2::detect(),
+            SimdLevel::Sse2 => None,
         };
-        // (image word of a node, chunk index it is copied to)
-        let mut todo: Vec<(usize, usize)> = vec![(0, 0)];
-        // Triangle slots used (4 per packet).
-        let mut slots = 0usize;
-        out.chunks.extend(std::iter::repeat_n(EMPTY_CHUNK, cpn));
-        while let Some((w, at)) = todo.pop() {
-            let node = L::read(words, w);
-            let mut addr = node.offset() as usize;
-            let mut lane = 0;
-            let mut internal = Vec::new();
-            for k in 0..L::ARITY {
-                let kind = node.kind(k);
-                if kind == ChildKind::Empty {
-                    continue;
-                }
-                let ch = &mut out.chunks[at + lane / LANES];
-                let l = lane % LANES;
-                for (p, &v) in node.box_words(k).iter().enumerate() {
-                    ch.planes[p][l] = v;
-                }
-                match kind {
-                    ChildKind::Leaf => {
-                        let run = words[addr] as usize;
-                        let first = slots as u32;
-                        assert!(first < LEAF, "too many triangle references");
-                        let len = words[run..]
-                            .iter()
-                            .position(|&e| e & RUN_END != 0)
-                            .map_or(0, |p| p + 1);
-                        pack_entries(
-                            &mut out.packets,
-                            &mut slots,
-                            words[run..run + len].iter().copied(),
-                            triangles,
-                        );
-                        ch.child[l] = LEAF | first;
-                    }
-                    _ => internal.push((addr, at + lane / LANES, l)),
-                }
-                addr += L::child_words(kind) as usize;
-                lane += 1;
+        if L::ARITY <= LANES {
+            let c = copy::<L, Chunk>(img);
+            Self {
+                nodes: CpuNodes::Four(Pages::from_slice(&c.nodes)),
+                packets: Pages::from_slice(&c.packets),
+                avx2,
             }
-            // Children of one node next to one another, then their subtrees depth-first.
-            let mut subtrees = Vec::with_capacity(internal.len());
-            for (cw, chunk, l) in internal {
-                let idx = out.chunks.len();
-                out.chunks.extend(std::iter::repeat_n(EMPTY_CHUNK, cpn));
-                out.chunks[chunk].child[l] = idx as u32;
-                subtrees.push((cw, idx));
+        } else {
+            let c = copy::<L, Chunk8>(img);
+            Self {
+                nodes: CpuNodes::Eight(Pages::from_slice(&c.nodes)),
+                packets: Pages::from_slice(&c.packets),
+                avx2,
             }
-            todo.extend(subtrees.into_iter().rev());
-        }
-        CpuBvh {
-            chunks_per_node: cpn,
-            chunks: Pages::from_slice(&out.chunks),
-            packets: Pages::from_slice(&out.packets),
         }
     }
 
-    /// Bytes of the copy (chunks and leaf-ordered triangles).
+    /// The instructions the traversal uses.
+    pub fn level(&self) -> SimdLevel {
+        if self.avx2.is_some() {
+            SimdLevel::Avx2
+        } else {
+            SimdLevel::Sse2
+        }
+    }
+
+    /// Bytes of the copy (nodes and leaf-ordered triangles).
     pub fn bytes(&self) -> usize {
-        self.chunks.len() * size_of::<Chunk>() + self.packets.len() * size_of::<TriPacket>()
+        let nodes = match &self.nodes {
+            CpuNodes::Four(n) => n.len() * size_of::<Chunk>(),
+            CpuNodes::Eight(n) => n.len() * size_of::<Chunk8>(),
+        };
+        nodes + self.packets.len() * size_of::<TriPacket>()
     }
 
     /// Closest hit (`ANY = false`) or some hit (`ANY = true`) of `ray`; `None` when the ray
@@ -184,140 +376,164 @@ impl CpuBvh {
         }
         let mut stack = STACK.take();
         stack.clear();
-        let hit = match self.chunks_per_node {
-            1 => self.run::<1, ANY>(ray, &mut stack),
-            _ => self.run::<2, ANY>(ray, &mut stack),
+        let packets = &self.packets[..];
+        let hit = match (&self.nodes, self.avx2) {
+            (CpuNodes::Four(n), None) => run::<_, _, ANY>(Sse2, n, packets, ray, &mut stack),
+            (CpuNodes::Eight(n), None) => run::<_, _, ANY>(Sse2, n, packets, ray, &mut stack),
+            (CpuNodes::Four(n), Some(t)) => t.vectorize(Run::<_, ANY> {
+                isa: t,
+                nodes: n,
+                packets,
+                ray,
+                stack: &mut stack,
+            }),
+            (CpuNodes::Eight(n), Some(t)) => t.vectorize(Run::<_, ANY> {
+                isa: t,
+                nodes: n,
+                packets,
+                ray,
+                stack: &mut stack,
+            }),
         };
         STACK.set(stack);
         Some(hit)
     }
+}
 
+/// [`run`] with AVX2, as a [`Kernel`] for [`Avx2::vectorize`].
+struct Run<'a, N, const ANY: bool> {
+    isa: Avx2,
+    nodes: &'a [N],
+    packets: &'a [TriPacket],
+    ray: &'a Ray,
+    stack: &'a mut Vec<Entry>,
+}
+
+impl<N: Lanes, const ANY: bool> Kernel for Run<'_, N, ANY> {
+    type Output = Option<Hit>;
     #[inline(always)]
-    fn run<const C: usize, const ANY: bool>(
-        &self,
-        ray: &Ray,
-        stack: &mut Vec<Entry>,
-    ) -> Option<Hit> {
-        let r = ray.precompute();
-        let rs = RaySimd::new(&r);
-        let chunks = &self.chunks[..];
-        let packets = &self.packets[..];
-        let mut best: Option<Hit> = None;
-        let mut best_t = ray.t_max;
-        let mut limit = cull_limit(best_t);
-        let t_lo = f32x4::splat(ray.t_min);
-        let mut cur = 0u32;
-        loop {
-            if cur & LEAF == 0 {
-                let n = cur as usize;
-                let t_hi = f32x4::splat(limit);
-                let mut dv = [f32x4::splat(0.0); C];
-                let mut mask = 0u32;
-                for c in 0..C {
-                    let (entry, m) = rs.test(&chunks[n + c], t_lo, t_hi);
-                    dv[c] = entry;
-                    mask |= m << (LANES * c);
+    fn call(self) -> Option<Hit> {
+        run::<N, Avx2, ANY>(self.isa, self.nodes, self.packets, self.ray, self.stack)
+    }
+}
+
+/// The traversal (see the module docs) of `nodes` and `packets` with instructions `I`.
+#[inline(always)]
+fn run<N: Lanes, I: Isa, const ANY: bool>(
+    isa: I,
+    nodes: &[N],
+    packets: &[TriPacket],
+    ray: &Ray,
+    stack: &mut Vec<Entry>,
+) -> Option<Hit> {
+    let r = ray.precompute();
+    let rs = RaySimd::new(&r);
+    let mut best: Option<Hit> = None;
+    let mut best_t = ray.t_max;
+    let mut limit = cull_limit(best_t);
+    let mut cur = 0u32;
+    loop {
+        if cur & LEAF == 0 {
+            let node = &nodes[cur as usize];
+            let (dv, mask) = node.test(isa, &rs, ray.t_min, limit);
+            let dist: [[f32; LANES]; 2] = dv.map(|v| v.to_array());
+            let child = |i: usize| node.child(i);
+            let d = |i: usize| dist[i / LANES][i % LANES];
+            if mask != 0 {
+                let first = mask.trailing_zeros() as usize;
+                let rest = mask & (mask - 1);
+                if rest == 0 {
+                    cur = child(first);
+                    continue;
                 }
-                let dist = dv.map(|v| v.to_array());
-                let child = |i: usize| chunks[n + i / LANES].child[i % LANES];
-                let d = |i: usize| dist[i / LANES][i % LANES];
-                if mask != 0 {
-                    let first = mask.trailing_zeros() as usize;
-                    let rest = mask & (mask - 1);
-                    if rest == 0 {
-                        cur = child(first);
-                        continue;
-                    }
-                    if ANY {
-                        // Any hit ends the ray: no order is better than another, so the
-                        // first hit child is next and the others are pushed unsorted.
-                        let mut m = rest;
-                        while m != 0 {
-                            let i = m.trailing_zeros() as usize;
-                            m &= m - 1;
-                            let c = child(i);
-                            prefetch_child(chunks, packets, c);
-                            stack.push(Entry { t: d(i), child: c });
-                        }
-                        cur = child(first);
-                        continue;
-                    }
-                    let second = rest.trailing_zeros() as usize;
-                    if rest & (rest - 1) == 0 {
-                        // Two hits: the nearer next, the other on the stack.
-                        let (near, far) = if d(second) < d(first) {
-                            (second, first)
-                        } else {
-                            (first, second)
-                        };
-                        let c = child(far);
-                        prefetch_child(chunks, packets, c);
-                        stack.push(Entry {
-                            t: d(far),
-                            child: c,
-                        });
-                        cur = child(near);
-                        continue;
-                    }
-                    // Three or more: each goes to the stack slot of its rank (the number of
-                    // hit children before it by entry distance, ties by slot), nearest on
-                    // top; then the nearest is taken.
-                    let count = ones(mask);
-                    let mut m = mask;
+                if ANY {
+                    // Any hit ends the ray: no order is better than another, so the
+                    // first hit child is next and the others are pushed unsorted.
+                    let mut m = rest;
                     while m != 0 {
                         let i = m.trailing_zeros() as usize;
                         m &= m - 1;
                         let c = child(i);
-                        prefetch_child(chunks, packets, c);
+                        prefetch_child(nodes, packets, c);
+                        stack.push(Entry { t: d(i), child: c });
                     }
-                    let base = stack.len();
-                    stack.resize(
-                        base + count,
-                        Entry {
-                            t: 0.0,
-                            child: EMPTY,
-                        },
-                    );
-                    let mut m = mask;
-                    while m != 0 {
-                        let i = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        let di = d(i);
-                        // The hit lanes nearer than `i`, or as near and in an earlier slot,
-                        // from one comparison per chunk.
-                        let splat = f32x4::splat(di);
-                        let mut before = 0u32;
-                        for (c, v) in dv.iter().enumerate() {
-                            let lt = v.cmp_lt(splat).move_mask() as u32;
-                            let eq = v.cmp_eq(splat).move_mask() as u32;
-                            let earlier = ((1u32 << i) - 1) >> (LANES * c);
-                            before |= (lt | (eq & earlier)) << (LANES * c);
-                        }
-                        let rank = ones(before & mask);
-                        stack[base + count - 1 - rank] = Entry {
-                            t: di,
-                            child: child(i),
-                        };
-                    }
-                    cur = stack.pop().map_or(EMPTY, |e| e.child);
+                    cur = child(first);
                     continue;
                 }
-            } else {
-                let slot = (cur & !LEAF) as usize;
-                if test_leaf::<ANY>(packets, slot, &rs, &r, &mut best, &mut best_t) {
-                    return best;
+                let second = rest.trailing_zeros() as usize;
+                if rest & (rest - 1) == 0 {
+                    // Two hits: the nearer next, the other on the stack.
+                    let (near, far) = if d(second) < d(first) {
+                        (second, first)
+                    } else {
+                        (first, second)
+                    };
+                    let c = child(far);
+                    prefetch_child(nodes, packets, c);
+                    stack.push(Entry {
+                        t: d(far),
+                        child: c,
+                    });
+                    cur = child(near);
+                    continue;
                 }
-                limit = cull_limit(best_t);
+                // Three or more: each goes to the stack slot of its rank (the number of
+                // hit children before it by entry distance, ties by slot), nearest on
+                // top; then the nearest is taken.
+                let count = ones(mask);
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    prefetch_child(nodes, packets, child(i));
+                }
+                let base = stack.len();
+                stack.resize(
+                    base + count,
+                    Entry {
+                        t: 0.0,
+                        child: EMPTY,
+                    },
+                );
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let di = d(i);
+                    // The hit lanes nearer than `i`, or as near and in an earlier slot,
+                    // from one comparison per four lanes.
+                    let splat = f32x4::splat(di);
+                    let mut before = 0u32;
+                    for (c, v) in dv.iter().enumerate().take(N::W.div_ceil(LANES)) {
+                        let lt = v.cmp_lt(splat).move_mask() as u32;
+                        let eq = v.cmp_eq(splat).move_mask() as u32;
+                        let earlier = ((1u32 << i) - 1) >> (LANES * c);
+                        before |= (lt | (eq & earlier)) << (LANES * c);
+                    }
+                    let rank = ones(before & mask);
+                    stack[base + count - 1 - rank] = Entry {
+                        t: di,
+                        child: child(i),
+                    };
+                }
+                cur = stack.pop().map_or(EMPTY, |e| e.child);
+                continue;
             }
-            // Next: the nearest stacked entry not beyond the limit.
-            loop {
-                let Some(e) = stack.pop() else {
-                    return best;
-                };
-                if e.t <= limit {
-                    cur = e.child;
-                    break;
-                }
+        } else {
+            let slot = (cur & !LEAF) as usize;
+            if test_leaf::<ANY>(packets, slot, &rs, &r, &mut best, &mut best_t) {
+                return best;
+            }
+            limit = cull_limit(best_t);
+        }
+        // Next: the nearest stacked entry not beyond the limit.
+        loop {
+            let Some(e) = stack.pop() else {
+                return best;
+            };
+            if e.t <= limit {
+                cur = e.child;
+                break;
             }
         }
     }
@@ -339,11 +555,11 @@ fn ones(mask: u32) -> usize {
     TABLE[(mask & 0xff) as usize] as usize
 }
 
-/// Prefetches the first chunk of child word `c`'s node or the first packet of its leaf.
+/// Prefetches the first line of child word `c`'s node or the first packet of its leaf.
 #[inline(always)]
-fn prefetch_child(chunks: &[Chunk], packets: &[TriPacket], c: u32) {
+fn prefetch_child<N>(nodes: &[N], packets: &[TriPacket], c: u32) {
     if c & LEAF == 0 {
-        super::simd::prefetch(&chunks[c as usize]);
+        super::simd::prefetch(&nodes[c as usize]);
     } else {
         super::simd::prefetch(&packets[(c & !LEAF) as usize / LANES]);
     }
@@ -375,8 +591,10 @@ pub(crate) fn test_leaf<const ANY: bool>(
         } else {
             from & ((ends & ends.wrapping_neg()) << 1).wrapping_sub(1)
         };
-        // Lanes the scalar test could accept; it decides each of them.
-        let mut m = rs.triangle_candidates(pk) & lanes;
+        // Lanes the scalar test could accept; it decides each of them, from the edge
+        // functions computed here unless one is zero (then it recomputes them in f64).
+        let e = rs.triangle_edges(pk);
+        let mut m = e.candidates & lanes;
         while m != 0 {
             let l = m.trailing_zeros() as usize;
             m &= m - 1;
@@ -385,7 +603,12 @@ pub(crate) fn test_leaf<const ANY: bool>(
             let vertex =
                 |k: usize| Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l]);
             let tri = Triangle::new(vertex(0), vertex(1), vertex(2));
-            if let Some(h) = tri.intersect(r, r.ray.t_min, *best_t)
+            let h = if e.zero & (1 << l) != 0 {
+                tri.intersect(r, r.ray.t_min, *best_t)
+            } else {
+                tri.intersect_from_edges(r, [e.u[l], e.v[l], e.w[l]], r.ray.t_min, *best_t)
+            };
+            if let Some(h) = h
                 && best.is_none_or(|b| !b.closer_than(h.t, p))
             {
                 *best = Some(Hit {
@@ -438,6 +661,17 @@ struct Entry {
     child: u32,
 }
 
+/// What [`RaySimd::triangle_edges`] finds for the four triangles of a packet.
+struct Edges {
+    u: [f32; LANES],
+    v: [f32; LANES],
+    w: [f32; LANES],
+    /// Lanes with an edge function equal to zero.
+    zero: u32,
+    /// Lanes [`Triangle::intersect`] might accept.
+    candidates: u32,
+}
+
 thread_local! {
     /// The traversal stack's buffer, one per thread, reused from ray to ray.
     static STACK: Cell<Vec<Entry>> = const { Cell::new(Vec::new()) };
@@ -448,6 +682,10 @@ thread_local! {
 pub(crate) struct RaySimd {
     o: [f32x4; 3],
     inv: [f32x4; 3],
+    /// The origin and reciprocal direction as scalars.
+    os: [f32; 3],
+    invs: [f32; 3],
+    /// Plane rows of the near and far planes per axis.
     near: [usize; 3],
     far: [usize; 3],
     k: [usize; 3],
@@ -469,6 +707,8 @@ impl RaySimd {
                 f32x4::splat(inv.y),
                 f32x4::splat(inv.z),
             ],
+            os: [o.x, o.y, o.z],
+            invs: [inv.x, inv.y, inv.z],
             near: [s(0), 1 + s(1), 2 + s(2)],
             far: [3 - s(0), 4 - s(1), 5 - s(2)],
             k: r.k,
@@ -477,13 +717,13 @@ impl RaySimd {
         }
     }
 
-    /// The lanes of `pk` that [`Triangle::intersect`] might accept: the first stage of that
-    /// test (shear, edge functions `u`, `v`, `w`, same IEEE operations in the same order)
-    /// on four triangles at once, dropping a lane only where the scalar test returns `None`
-    /// at that stage: no edge function is zero (so no f64 recomputation) and their signs
-    /// differ. Every other lane is left to the scalar test, so answers are its answers.
+    /// The first stage of [`Triangle::intersect`] (shear, edge functions `u`, `v`, `w`, the
+    /// same IEEE operations in the same order) on the four triangles of `pk` at once: the
+    /// edge functions, the lanes where one of them is zero (the scalar test recomputes
+    /// those in f64), and the lanes the scalar test might accept: all but those where no
+    /// edge function is zero and their signs differ, which it rejects at that stage.
     #[inline(always)]
-    fn triangle_candidates(&self, pk: &TriPacket) -> u32 {
+    fn triangle_edges(&self, pk: &TriPacket) -> Edges {
         let [kx, ky, kz] = self.k;
         let rel = |vertex: usize, axis: usize| f32x4::new(pk.v[3 * vertex + axis]) - self.o[axis];
         let (ax, ay, az) = (rel(0, kx), rel(0, ky), rel(0, kz));
@@ -499,28 +739,52 @@ impl RaySimd {
         let v = ax * cy - ay * cx;
         let w = bx * ay - by * ax;
         let zero = f32x4::splat(0.0);
-        let any_zero = u.cmp_eq(zero) | v.cmp_eq(zero) | w.cmp_eq(zero);
+        let any_zero = (u.cmp_eq(zero) | v.cmp_eq(zero) | w.cmp_eq(zero)).move_mask() as u32;
         let neg = u.cmp_lt(zero) | v.cmp_lt(zero) | w.cmp_lt(zero);
         let pos = u.cmp_gt(zero) | v.cmp_gt(zero) | w.cmp_gt(zero);
-        let reject = (neg & pos).move_mask() as u32 & !(any_zero.move_mask() as u32);
-        0b1111 & !reject
+        let reject = (neg & pos).move_mask() as u32 & !any_zero;
+        Edges {
+            u: u.to_array(),
+            v: v.to_array(),
+            w: w.to_array(),
+            zero: any_zero,
+            candidates: 0b1111 & !reject,
+        }
     }
 
-    /// Entry distances of the chunk's four boxes clipped to `[t_lo, t_hi]`, and the mask of
+    /// Entry distances of four boxes (`planes[p][lane]`) clipped to `[t_lo, t_hi]`, and the mask of
     /// the non-empty lanes the ray meets (`entry <= exit`).
     #[inline(always)]
-    fn test(&self, ch: &Chunk, t_lo: f32x4, t_hi: f32x4) -> (f32x4, u32) {
-        let mut entry = t_lo;
-        let mut exit = t_hi;
+    fn test(
+        &self,
+        planes: &[[f32; LANES]; 6],
+        child: &[u32; LANES],
+        t_lo: f32,
+        t_hi: f32,
+    ) -> (f32x4, u32) {
+        self.test_rows(|p| planes[p], *child, t_lo, t_hi)
+    }
+
+    /// [`RaySimd::test`] with plane `p`'s row given by `row(p)`.
+    #[inline(always)]
+    fn test_rows(
+        &self,
+        row: impl Fn(usize) -> [f32; LANES],
+        child: [u32; LANES],
+        t_lo: f32,
+        t_hi: f32,
+    ) -> (f32x4, u32) {
+        let mut entry = f32x4::splat(t_lo);
+        let mut exit = f32x4::splat(t_hi);
         let widen = f32x4::splat(EXIT_WIDEN);
         for a in 0..3 {
-            let tn = (f32x4::new(ch.planes[self.near[a]]) - self.o[a]) * self.inv[a];
-            let tf = (f32x4::new(ch.planes[self.far[a]]) - self.o[a]) * self.inv[a] * widen;
+            let tn = (f32x4::new(row(self.near[a])) - self.o[a]) * self.inv[a];
+            let tf = (f32x4::new(row(self.far[a])) - self.o[a]) * self.inv[a] * widen;
             entry = keep_max(tn, entry);
             exit = keep_min(tf, exit);
         }
         let hit = entry.cmp_le(exit).move_mask() as u32;
-        let empty = i32x4::new(bytemuck::cast::<[u32; LANES], [i32; LANES]>(ch.child))
+        let empty = i32x4::new(bytemuck::cast::<[u32; LANES], [i32; LANES]>(child))
             .cmp_eq(i32x4::splat(-1))
             .move_mask() as u32;
         (entry, hit & !empty)
@@ -582,7 +846,7 @@ mod tests {
         for case in 0..50_000 {
             let v = |rng: &mut Pcg32| Vec3::new(coord(rng), coord(rng), coord(rng));
             let r = Ray::new(v(&mut rng), v(&mut rng)).precompute();
-            let mut ch = EMPTY_CHUNK;
+            let mut ch = Chunk::EMPTY;
             let mut boxes = Vec::new();
             for l in 0..LANES {
                 if rng.below(5) == 0 {
@@ -599,7 +863,7 @@ mod tests {
             }
             let t_lo = ends[rng.below(ends.len() as u32) as usize];
             let t_hi = ends[rng.below(ends.len() as u32) as usize];
-            let (entry, mask) = RaySimd::new(&r).test(&ch, f32x4::splat(t_lo), f32x4::splat(t_hi));
+            let (entry, mask) = RaySimd::new(&r).test(&ch.planes, &ch.child, t_lo, t_hi);
             let entry = entry.to_array();
             let mut want = 0;
             for (l, lo, hi) in boxes {
@@ -610,6 +874,48 @@ mod tests {
                 }
             }
             assert_eq!(mask, want, "case {case}: {r:?}");
+        }
+    }
+
+    /// The 8-lane test of a BVH8 node, with SSE2 (two halves) and with AVX2 where this CPU
+    /// has it (one 8-wide test), gives lane by lane `RayPre::slab`'s hit or miss and entry
+    /// distance, empty lanes never hit.
+    #[test]
+    fn chunk8_test_matches_ray_slab() {
+        let mut rng = Pcg32::new(12, 6);
+        let ends = [0.0, -0.0, 0.5, 1e-3, f32::INFINITY, f32::NEG_INFINITY, 3.0];
+        let avx2 = Avx2::detect();
+        for case in 0..30_000 {
+            let v = |rng: &mut Pcg32| Vec3::new(coord(rng), coord(rng), coord(rng));
+            let r = Ray::new(v(&mut rng), v(&mut rng)).precompute();
+            let mut n = Chunk8::EMPTY;
+            let mut boxes = Vec::new();
+            for l in 0..8 {
+                if rng.below(5) == 0 {
+                    continue;
+                }
+                let (p, q) = (v(&mut rng), v(&mut rng));
+                let (lo, hi) = (p.min(q), p.max(q));
+                n.set(l, [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z], l as u32);
+                boxes.push((l, lo, hi));
+            }
+            let t_lo = ends[rng.below(ends.len() as u32) as usize];
+            let t_hi = ends[rng.below(ends.len() as u32) as usize];
+            let rs = RaySimd::new(&r);
+            let mut results = vec![Sse2.test8(&rs, &n, t_lo, t_hi)];
+            results.extend(avx2.map(|t| t.test8(&rs, &n, t_lo, t_hi)));
+            for (dv, mask) in results {
+                let entry: [f32; 8] = bytemuck::cast(dv);
+                let mut want = 0;
+                for &(l, lo, hi) in &boxes {
+                    let (e, x) = r.slab(lo, hi, t_lo, t_hi);
+                    if e <= x {
+                        want |= 1 << l;
+                        assert_eq!(entry[l], e, "case {case} lane {l}");
+                    }
+                }
+                assert_eq!(mask, want, "case {case}: {r:?}");
+            }
         }
     }
 
@@ -629,7 +935,7 @@ mod tests {
             let mut packets = Vec::new();
             let mut slots = 0;
             pack_entries(&mut packets, &mut slots, [0, 1, 2, 3 | RUN_END], &tris);
-            let m = RaySimd::new(&r).triangle_candidates(&packets[0]);
+            let m = RaySimd::new(&r).triangle_edges(&packets[0]).candidates;
             for (l, t) in tris.iter().enumerate() {
                 if t.intersect(&r, f32::NEG_INFINITY, f32::INFINITY).is_some() {
                     hits += 1;
@@ -638,6 +944,49 @@ mod tests {
             }
         }
         assert!(hits > 1000, "{hits} hits");
+    }
+
+    /// A packet lane's answer (no answer outside the candidates; the full scalar test where
+    /// an edge function is zero; else the scalar test finished from the packet's edge
+    /// functions) is `Triangle::intersect`'s, bit for bit, on rays and triangles with
+    /// coordinates from a small set and random ones, on random `t` ranges.
+    #[test]
+    fn packet_answers_are_intersect_answers() {
+        let mut rng = Pcg32::new(17, 2);
+        let ends = [0.0, 0.5, 1.0, 2.0, f32::INFINITY];
+        let (mut hits, mut from_edges) = (0, 0);
+        for case in 0..100_000 {
+            let v = |rng: &mut Pcg32| Vec3::new(coord(rng), coord(rng), coord(rng));
+            let r = Ray::new(v(&mut rng), v(&mut rng)).precompute();
+            let tris: Vec<Triangle> = (0..LANES)
+                .map(|_| Triangle::new(v(&mut rng), v(&mut rng), v(&mut rng)))
+                .collect();
+            let (mut packets, mut slots) = (Vec::new(), 0);
+            pack_entries(&mut packets, &mut slots, [0, 1, 2, 3 | RUN_END], &tris);
+            let e = RaySimd::new(&r).triangle_edges(&packets[0]);
+            let lo = ends[rng.below(2) as usize];
+            let hi = ends[rng.below(ends.len() as u32) as usize];
+            let bits = |h: Option<dualsplit_geometry::TriangleHit>| {
+                h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits()))
+            };
+            for (l, t) in tris.iter().enumerate() {
+                let want = t.intersect(&r, lo, hi);
+                let got = if e.candidates & (1 << l) == 0 {
+                    None
+                } else if e.zero & (1 << l) != 0 {
+                    t.intersect(&r, lo, hi)
+                } else {
+                    from_edges += 1;
+                    t.intersect_from_edges(&r, [e.u[l], e.v[l], e.w[l]], lo, hi)
+                };
+                hits += want.is_some() as u32;
+                assert_eq!(bits(got), bits(want), "case {case} lane {l}: {t:?} {r:?}");
+            }
+        }
+        assert!(
+            hits > 1000 && from_edges > 10_000,
+            "{hits} hits, {from_edges}"
+        );
     }
 
     /// `keep_max`/`keep_min` keep the bound for a NaN lane, as the scalar compare does.

@@ -186,15 +186,21 @@ impl BvhImage {
         })
     }
 
-    /// The CPU-side copy of the image ([`cpu::CpuBvh`]), made on the first call.
+    /// The CPU-side copy of the image ([`cpu::CpuBvh`]) for this CPU's best instructions
+    /// ([`cpu::SimdLevel::detect`]), made on the first call.
     pub fn cpu(&self) -> &cpu::CpuBvh {
-        self.cpu.get_or_init(|| {
-            std::sync::Arc::new(match self.arity {
-                2 => cpu::CpuBvh::from_image::<Node2>(&self.image),
-                4 => cpu::CpuBvh::from_image::<Node4>(&self.image),
-                _ => cpu::CpuBvh::from_image::<Node8>(&self.image),
-            })
-        })
+        self.cpu
+            .get_or_init(|| std::sync::Arc::new(self.cpu_copy(cpu::SimdLevel::detect())))
+    }
+
+    /// A new CPU-side copy of the image whose traversal uses `level`'s instructions (SSE2
+    /// when this CPU lacks them); for comparing levels.
+    pub fn cpu_copy(&self, level: cpu::SimdLevel) -> cpu::CpuBvh {
+        match self.arity {
+            2 => cpu::CpuBvh::with_level::<Node2>(&self.image, level),
+            4 => cpu::CpuBvh::with_level::<Node4>(&self.image, level),
+            _ => cpu::CpuBvh::with_level::<Node8>(&self.image, level),
+        }
     }
 
     /// Closest hit of `ray` (ordered by `(t, prim)`). With an observer that observes

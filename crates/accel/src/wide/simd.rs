@@ -1,20 +1,138 @@
-//! The one place in this crate with `unsafe` code: a cache prefetch hint, which `std::arch`
-//! offers only as an `unsafe` intrinsic. The crate denies `unsafe_code` (its `Cargo.toml`);
-//! this leaf module allows it, and every block carries a SAFETY note.
+//! The one place in this crate with `unsafe` code: cache prefetch hints, and the AVX2 path
+//! of the CPU traversal (a token proving the CPU has AVX2, a way to run code compiled for
+//! it, and the 8-wide box test), which `std::arch` offers only through `unsafe` calls from
+//! code not itself compiled for AVX2. The crate denies `unsafe_code` (its `Cargo.toml`); this
+//! leaf module allows it, and every block carries a SAFETY note.
 #![allow(unsafe_code)]
 
-/// Hints the CPU to bring the cache line holding `*r` into all cache levels. No effect on
-/// results; a no-op on targets other than x86-64.
+/// Hints the CPU to bring every cache line (64 bytes) that `*r` touches into all cache
+/// levels. No effect on results; a no-op on targets other than x86-64.
 #[inline(always)]
 pub fn prefetch<T>(r: &T) {
     #[cfg(target_arch = "x86_64")]
-    // SAFETY: `_mm_prefetch` only needs SSE, which every x86-64 CPU has (it is in the target's
-    // baseline features), and it never dereferences its pointer for the program: it is a hint
-    // that cannot fault. The pointer comes from a live reference anyway.
-    unsafe {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        _mm_prefetch::<_MM_HINT_T0>((r as *const T).cast::<i8>());
+    {
+        let start = (r as *const T).cast::<i8>();
+        let first = start as usize & !63;
+        let end = start as usize + size_of::<T>();
+        let mut line = first;
+        while line < end {
+            // SAFETY: `_mm_prefetch` only needs SSE, which every x86-64 CPU has (it is in the
+            // target's baseline features), and it never dereferences its pointer for the
+            // program: it is a hint that cannot fault, whatever the address. The address is
+            // within a line `*r` touches; `wrapping_byte_add` needs no bounds.
+            unsafe {
+                use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+                _mm_prefetch::<_MM_HINT_T0>(start.wrapping_byte_add(line - start as usize));
+            }
+            line += 64;
+        }
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = r;
+}
+
+/// Code that [`Avx2::vectorize`] runs compiled for AVX2 (a closure cannot carry the
+/// `#[inline(always)]` that makes its body part of the AVX2 function).
+pub trait Kernel {
+    /// What the code returns.
+    type Output;
+    /// Runs the code; implementations are `#[inline(always)]`.
+    fn call(self) -> Self::Output;
+}
+
+/// Proof that this CPU has AVX2 and the bit-manipulation extensions that come with it
+/// (BMI1, BMI2, LZCNT, POPCNT): a value exists only when [`Avx2::detect`] found them all.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Avx2(());
+
+impl Avx2 {
+    /// The token, when the CPU running this has every feature [`Avx2::vectorize`] enables.
+    pub fn detect() -> Option<Self> {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2")
+            && std::is_x86_feature_detected!("bmi1")
+            && std::is_x86_feature_detected!("bmi2")
+            && std::is_x86_feature_detected!("lzcnt")
+            && std::is_x86_feature_detected!("popcnt")
+        {
+            return Some(Self(()));
+        }
+        None
+    }
+
+    /// Runs `k` inside a function compiled with AVX2 enabled, so that `k`'s inlined code
+    /// (SSE code included, which then takes the three-operand VEX forms) may use it. Enabling
+    /// AVX2 does not let the compiler fuse multiplies and adds (Rust never contracts them),
+    /// so every float result is the baseline build's.
+    #[inline(always)]
+    pub fn vectorize<K: Kernel>(self, k: K) -> K::Output {
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
+            fn with_avx2<K: Kernel>(k: K) -> K::Output {
+                k.call()
+            }
+            // SAFETY: `self` exists only when `detect` found every feature `with_avx2`
+            // enables on this CPU.
+            unsafe { with_avx2(k) }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        k.call()
+    }
+
+    /// Slab test of eight boxes stored plane by plane (`planes[p][lane]`, planes in the box
+    /// word order min.x, min.y, min.z, max.x, max.y, max.z), the same arithmetic as the
+    /// 4-wide test lane by lane: near plane `p = near[a]` gives `(p - o[a]) * inv[a]`, far
+    /// plane `far[a]` the same times `widen`; the entry is the largest of `t_lo` and the
+    /// near distances, the exit the smallest of `t_hi` and the far ones, a NaN distance
+    /// keeping the running bound (`vmaxps`/`vminps` return their second operand then).
+    /// Returns the entry distances and the mask of lanes with `entry <= exit` whose child
+    /// word is not `u32::MAX` (an empty lane).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn slab8(
+        self,
+        planes: &[[f32; 8]; 6],
+        child: &[u32; 8],
+        near: [usize; 3],
+        far: [usize; 3],
+        o: [f32; 3],
+        inv: [f32; 3],
+        t_lo: f32,
+        t_hi: f32,
+        widen: f32,
+    ) -> ([f32; 8], u32) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            let row = |p: usize| -> __m256 { bytemuck::cast(planes[p]) };
+            // SAFETY: every intrinsic below needs at most AVX2, which `self` proves this CPU
+            // has (`detect`); none touches memory (rows come in as values).
+            unsafe {
+                let w = _mm256_set1_ps(widen);
+                let mut entry = _mm256_set1_ps(t_lo);
+                let mut exit = _mm256_set1_ps(t_hi);
+                for a in 0..3 {
+                    let oa = _mm256_set1_ps(o[a]);
+                    let ia = _mm256_set1_ps(inv[a]);
+                    let tn = _mm256_mul_ps(_mm256_sub_ps(row(near[a]), oa), ia);
+                    let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(row(far[a]), oa), ia), w);
+                    entry = _mm256_max_ps(tn, entry);
+                    exit = _mm256_min_ps(tf, exit);
+                }
+                let hit = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(entry, exit)) as u32;
+                let words: __m256i = bytemuck::cast(*child);
+                let empty = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
+                    words,
+                    _mm256_set1_epi32(-1),
+                ))) as u32;
+                (bytemuck::cast(entry), hit & !empty)
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = (planes, child, near, far, o, inv, t_lo, t_hi, widen);
+            unreachable!("no Avx2 token exists off x86-64")
+        }
+    }
 }
