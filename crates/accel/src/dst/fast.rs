@@ -14,7 +14,8 @@ use super::header::HeaderOffset;
 use super::pipeline::le_or_nan;
 use super::traverse::{Entry, Stack};
 use crate::image::Pages;
-use crate::wide::cpu::{RaySimd, TriPacket, pack_entries, test_leaf};
+use crate::wide::cpu::{RaySimd, TriPacket, avx2_token, pack_entries, test_leaf};
+use crate::wide::simd::Kernel;
 use dualsplit_geometry::{Hit, Ray, cull_limit, widen_exit};
 use std::sync::Arc;
 
@@ -36,9 +37,19 @@ impl Dst {
         })
     }
 
-    /// Closest hit (`ANY = false`) or some hit (`ANY = true`) of `ray`.
+    /// Closest hit (`ANY = false`) or some hit (`ANY = true`) of `ray`; compiled for AVX2
+    /// where the plain BVH queries use it
+    /// ([`crate::wide::cpu::SimdLevel::detect`]), the same answers.
     #[inline]
     pub(super) fn traverse_fast<const ANY: bool>(&self, ray: &Ray) -> Option<Hit> {
+        match avx2_token() {
+            Some(t) => t.vectorize(Fast::<ANY> { dst: self, ray }),
+            None => self.fast::<ANY>(ray),
+        }
+    }
+
+    #[inline(always)]
+    fn fast<const ANY: bool>(&self, ray: &Ray) -> Option<Hit> {
         if self.is_empty() {
             return None;
         }
@@ -161,5 +172,19 @@ impl Dst {
                 }
             }
         }
+    }
+}
+
+/// [`Dst::traverse_fast`]'s body as a [`Kernel`], to run compiled for AVX2.
+struct Fast<'a, const ANY: bool> {
+    dst: &'a Dst,
+    ray: &'a Ray,
+}
+
+impl<const ANY: bool> Kernel for Fast<'_, ANY> {
+    type Output = Option<Hit>;
+    #[inline(always)]
+    fn call(self) -> Option<Hit> {
+        self.dst.fast::<ANY>(self.ray)
     }
 }

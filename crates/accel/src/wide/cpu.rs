@@ -226,12 +226,26 @@ impl SimdLevel {
         })
     }
 
+    /// The AVX2 token when the level is AVX2 and this CPU has it.
+    fn token(self) -> Option<Avx2> {
+        match self {
+            Self::Avx2 => Avx2::detect(),
+            Self::Sse2 => None,
+        }
+    }
+
     /// Every level this CPU can run, the baseline first.
     pub fn available() -> Vec<Self> {
         std::iter::once(Self::Sse2)
             .chain(Avx2::detect().map(|_| Self::Avx2))
             .collect()
     }
+}
+
+/// The AVX2 token when [`SimdLevel::detect`] chooses AVX2.
+pub(crate) fn avx2_token() -> Option<Avx2> {
+    static TOKEN: std::sync::OnceLock<Option<Avx2>> = std::sync::OnceLock::new();
+    *TOKEN.get_or_init(|| SimdLevel::detect().token())
 }
 
 /// The nodes of a [`CpuBvh`], one per node of the image, the root first.
@@ -328,10 +342,7 @@ impl CpuBvh {
 
     /// [`CpuBvh::from_image`] for the given instructions (SSE2 when this CPU lacks AVX2).
     pub fn with_level<L: NodeLayout>(img: &MemoryImage, level: SimdLevel) -> Self {
-        let avx2 = match level {
-            SimdLevel::Avx2 => Avx2::detect(),
-            SimdLevel::Sse2 => None,
-        };
+        let avx2 = level.token();
         if L::ARITY <= LANES {
             let c = copy::<L, Chunk>(img);
             Self {

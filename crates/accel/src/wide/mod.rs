@@ -18,7 +18,7 @@ pub mod cpu;
 pub mod encode;
 mod node4;
 mod node8;
-mod simd;
+pub(crate) mod simd;
 pub mod traverse;
 
 pub use collapse::CollapseConfig;
