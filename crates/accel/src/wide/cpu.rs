@@ -1,32 +1,41 @@
 //! The CPU-side copy of a BVH image that the plain queries traverse: child boxes of each
-//! node stored lane by lane (structure of arrays, 4 children per [`Chunk`]) so that one
-//! SIMD slab test covers 4 children, and triangles copied in leaf order, four to a packet
-//! lane by lane, so that the first stage of the watertight test runs on a leaf at once.
+//! node stored lane by lane (structure of arrays: a [`Chunk`] of 4 lanes for BVH2 and BVH4,
+//! a [`Chunk8`] of 8 for BVH8) so that one SIMD slab test covers a node, and triangles
+//! copied in leaf order, four to a packet lane by lane, so that the first stage of the
+//! watertight test runs on four triangles at once.
 //!
 //! It is made from the byte-exact image (so from the same BVH2 and collapse: the same
-//! children, the same box words, the same leaves) when a plain query first needs it, and is
-//! used only when the caller observes nothing ([`crate::Observer::OBSERVES_NOTHING`]); the
-//! simulator and every counting observer still read the image through
-//! [`super::traverse`]. The answers are the image traversal's, ray for ray and bit for bit:
+//! children, the same box words) when a plain query first needs it, and is used only when
+//! the caller observes nothing ([`crate::Observer::OBSERVES_NOTHING`]); the simulator and
+//! every counting observer still read the image through [`super::traverse`]. One change of
+//! shape: an internal child whose subtree holds at most [`MERGE_MAX`] triangles becomes one
+//! leaf holding them all, under the same box. The answers are the image traversal's, ray
+//! for ray and bit for bit:
 //!
 //! * the box test is [`super::traverse`]'s arithmetic lane by lane: `(p - o) * inv`, far
 //!   planes multiplied by [`EXIT_WIDEN`], the interval clipped by compare-and-select (x86's
 //!   `maxps`/`minps` keep the running bound when a plane distance is NaN, exactly as the
 //!   scalar `if tn > entry`); rays whose interval ends are NaN take the image traversal;
-//! * the triangle test is the same [`Triangle::intersect`] on the same triangle words (a SIMD
-//!   first stage only drops triangles that it would reject at that stage), and hits are kept
-//!   by [`Hit::closer_than`]'s `(t, prim)` order, which makes the closest hit independent of
-//!   the order in which leaves are visited;
+//! * the triangle test is [`Triangle::intersect`] on the same triangle words (a SIMD first
+//!   stage computes its edge functions with the same operations, drops only triangles it
+//!   would reject at that stage, and the scalar [`Triangle::intersect_from_edges`] finishes
+//!   the others), and hits are kept by [`Hit::closer_than`]'s `(t, prim)` order, which makes
+//!   the closest hit independent of the order in which triangles are tested;
 //! * nodes are culled against the same [`cull_limit`] of the best `t`, which keeps every
-//!   leaf that can hold an equally near hit with a smaller id.
+//!   box that can hold an equally near hit with a smaller id; a merged leaf is entered
+//!   whenever its subtree's root would be, and then tests every triangle the subtree could
+//!   have led to (and more), so it can add no closer hit and lose none.
 //!
 //! Only the visiting order of a node's hit children differs (nearest first, the rest pushed
 //! by a rank computed from their entry distances, ties in either order; for shadow rays the
 //! first hit child first and the rest as they come), which changes no answer.
 //!
-//! Hit children about to be pushed are prefetched (`simd.rs`), and the chunks and packets
-//! live in transparent huge pages ([`Pages`]). Figures: `docs/performance.md`, "CPU
-//! traversal".
+//! Instructions ([`SimdLevel`]): with AVX2 (detected at run time) a BVH8 node is one 8-wide
+//! test and the whole traversal is compiled for AVX2 (`simd.rs`); otherwise SSE2, which
+//! every x86-64 CPU has (two 4-wide tests per BVH8 node), or `wide`'s portable code
+//! elsewhere. Hit children about to be pushed are prefetched (every line of the node or
+//! packet), and nodes and packets live in transparent huge pages ([`Pages`]). Figures:
+//! `docs/performance.md`, "CPU traversal".
 
 use super::simd::{Avx2, Kernel};
 use crate::image::{ChildKind, MemoryImage, NodeLayout, Pages, RUN_END};
@@ -268,6 +277,15 @@ pub struct CpuBvh {
     avx2: Option<Avx2>,
 }
 
+/// The most triangles of a subtree that the copy turns into one leaf (four packets).
+///
+/// The paper's BVH2 has small leaves (1.8 triangles on average on dragon_box, SAH with equal
+/// node and triangle costs), and each leaf visit is a cache miss on its packet; testing up
+/// to 16 triangles four at a time is cheaper than descending two more node levels. Chosen
+/// by measurement (docs/performance.md, "Leaf merging": 0, 4, 8, 12, 16, 24 and 32 on
+/// dragon_box and sponza_dabrovic); answers do not depend on it.
+pub const MERGE_MAX: usize = 16;
+
 /// What [`copy`] makes: nodes and packets.
 struct Copied<N> {
     nodes: Vec<N>,
@@ -297,6 +315,23 @@ fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage) -> Copied<N> {
                 continue;
             }
             let mut child = EMPTY;
+            // An internal child whose subtree holds few triangles becomes one leaf of them.
+            let merged = if kind == ChildKind::Internal {
+                let mut e = Vec::new();
+                gather::<L>(words, addr, MERGE_MAX, &mut e).then_some(e)
+            } else {
+                None
+            };
+            if let Some(mut e) = merged {
+                let last = e.len() - 1;
+                e[last] |= RUN_END;
+                let first = slots as u32;
+                pack_entries(&mut out.packets, &mut slots, e, triangles);
+                out.nodes[at].set(lane, *node.box_words(k), LEAF | first);
+                addr += L::child_words(kind) as usize;
+                lane += 1;
+                continue;
+            }
             match kind {
                 ChildKind::Leaf => {
                     let run = words[addr] as usize;
@@ -640,6 +675,39 @@ pub(crate) fn test_leaf<const ANY: bool>(
         i += 1;
         from = 0b1111;
     }
+}
+
+/// Appends to `out` the triangle ids (without [`RUN_END`]) of the leaves of the subtree whose
+/// node is at image word `w`, depth-first in child order; false (with `out` holding part of
+/// them) as soon as there are more than `limit`.
+fn gather<L: NodeLayout>(words: &[u32], w: usize, limit: usize, out: &mut Vec<u32>) -> bool {
+    let node = L::read(words, w);
+    let mut addr = node.offset() as usize;
+    for k in 0..L::ARITY {
+        let kind = node.kind(k);
+        match kind {
+            ChildKind::Empty => continue,
+            ChildKind::Leaf => {
+                let run = words[addr] as usize;
+                for &e in &words[run..] {
+                    out.push(e & !RUN_END);
+                    if e & RUN_END != 0 {
+                        break;
+                    }
+                }
+            }
+            ChildKind::Internal => {
+                if !gather::<L>(words, addr, limit, out) {
+                    return false;
+                }
+            }
+        }
+        if out.len() > limit {
+            return false;
+        }
+        addr += L::child_words(kind) as usize;
+    }
+    true
 }
 
 /// Appends the triangles of the index-run entries `entries` (ids with [`RUN_END`] on each
