@@ -14,7 +14,7 @@ use super::header::HeaderOffset;
 use super::pipeline::le_or_nan;
 use super::traverse::{Entry, Stack};
 use crate::image::Pages;
-use crate::wide::cpu::{RaySimd, TriPacket, avx2_token, pack_entries, test_leaf};
+use crate::wide::cpu::{PackedHit, RaySimd, TriPacket, avx2_token, pack_entries, test_leaf};
 use crate::wide::simd::Kernel;
 use dualsplit_geometry::{Hit, Ray, cull_limit, widen_exit};
 use std::sync::Arc;
@@ -43,7 +43,7 @@ impl Dst {
     #[inline]
     pub(super) fn traverse_fast<const ANY: bool>(&self, ray: &Ray) -> Option<Hit> {
         match avx2_token() {
-            Some(t) => t.vectorize(Fast::<ANY> { dst: self, ray }),
+            Some(t) => t.vectorize(Fast::<ANY> { dst: self, ray }).unpack(),
             None => self.fast::<ANY>(ray),
         }
     }
@@ -182,9 +182,9 @@ struct Fast<'a, const ANY: bool> {
 }
 
 impl<const ANY: bool> Kernel for Fast<'_, ANY> {
-    type Output = Option<Hit>;
+    type Output = PackedHit;
     #[inline(always)]
-    fn call(self) -> Option<Hit> {
-        self.dst.fast::<ANY>(self.ray)
+    fn call(self) -> PackedHit {
+        PackedHit::pack(self.dst.fast::<ANY>(self.ray))
     }
 }

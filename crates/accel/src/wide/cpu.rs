@@ -426,20 +426,24 @@ impl CpuBvh {
         let hit = match (&self.nodes, self.avx2) {
             (CpuNodes::Four(n), None) => run::<_, _, ANY>(Sse2, n, packets, ray, &mut stack),
             (CpuNodes::Eight(n), None) => run::<_, _, ANY>(Sse2, n, packets, ray, &mut stack),
-            (CpuNodes::Four(n), Some(t)) => t.vectorize(Run::<_, ANY> {
-                isa: t,
-                nodes: n,
-                packets,
-                ray,
-                stack: &mut stack,
-            }),
-            (CpuNodes::Eight(n), Some(t)) => t.vectorize(Run::<_, ANY> {
-                isa: t,
-                nodes: n,
-                packets,
-                ray,
-                stack: &mut stack,
-            }),
+            (CpuNodes::Four(n), Some(t)) => t
+                .vectorize(Run::<_, ANY> {
+                    isa: t,
+                    nodes: n,
+                    packets,
+                    ray,
+                    stack: &mut stack,
+                })
+                .unpack(),
+            (CpuNodes::Eight(n), Some(t)) => t
+                .vectorize(Run::<_, ANY> {
+                    isa: t,
+                    nodes: n,
+                    packets,
+                    ray,
+                    stack: &mut stack,
+                })
+                .unpack(),
         };
         STACK.set(stack);
         Some(hit)
@@ -456,10 +460,48 @@ struct Run<'a, N, const ANY: bool> {
 }
 
 impl<N: Lanes, const ANY: bool> Kernel for Run<'_, N, ANY> {
-    type Output = Option<Hit>;
+    type Output = PackedHit;
     #[inline(always)]
-    fn call(self) -> Option<Hit> {
-        run::<N, Avx2, ANY>(self.isa, self.nodes, self.packets, self.ray, self.stack)
+    fn call(self) -> PackedHit {
+        PackedHit::pack(run::<N, Avx2, ANY>(
+            self.isa,
+            self.nodes,
+            self.packets,
+            self.ray,
+            self.stack,
+        ))
+    }
+}
+
+/// An `Option<Hit>` in 128 bits (t, prim, u, v from the low end; a miss has prim
+/// `u32::MAX`, which no triangle id reaches), so that it comes back from the AVX2 function
+/// in two registers rather than through memory, where the caller's 16-byte load of the
+/// callee's four 4-byte stores cannot be forwarded and stalls.
+#[derive(Clone, Copy)]
+pub(crate) struct PackedHit(u128);
+
+impl PackedHit {
+    /// Packs `h`.
+    #[inline(always)]
+    pub(crate) fn pack(h: Option<Hit>) -> Self {
+        Self(h.map_or(u128::MAX, |h| {
+            h.t.to_bits() as u128
+                | (h.prim.0 as u128) << 32
+                | (h.u.to_bits() as u128) << 64
+                | (h.v.to_bits() as u128) << 96
+        }))
+    }
+
+    /// The hit packed.
+    #[inline(always)]
+    pub(crate) fn unpack(self) -> Option<Hit> {
+        let word = |k: u32| (self.0 >> (32 * k)) as u32;
+        (word(1) != u32::MAX).then(|| Hit {
+            t: f32::from_bits(word(0)),
+            prim: PrimId(word(1)),
+            u: f32::from_bits(word(2)),
+            v: f32::from_bits(word(3)),
+        })
     }
 }
 
@@ -1066,6 +1108,37 @@ mod tests {
             hits > 1000 && from_edges > 10_000,
             "{hits} hits, {from_edges}"
         );
+    }
+
+    /// `PackedHit` gives back every hit and the miss, bit for bit.
+    #[test]
+    fn packed_hits_round_trip() {
+        let hits = [
+            None,
+            Some(Hit {
+                t: 0.0,
+                prim: PrimId(0),
+                u: 0.0,
+                v: 1.0,
+            }),
+            Some(Hit {
+                t: f32::MAX,
+                prim: PrimId(RUN_END - 1),
+                u: -0.0,
+                v: f32::MIN_POSITIVE,
+            }),
+            Some(Hit {
+                t: 3.25,
+                prim: PrimId(12_345),
+                u: 0.125,
+                v: 0.75,
+            }),
+        ];
+        let bits =
+            |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits()));
+        for h in hits {
+            assert_eq!(bits(PackedHit::pack(h).unpack()), bits(h));
+        }
     }
 
     /// `keep_max`/`keep_min` keep the bound for a NaN lane, as the scalar compare does.

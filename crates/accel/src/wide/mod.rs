@@ -209,22 +209,39 @@ impl BvhImage {
     /// Both give the same answer, bit for bit.
     #[inline]
     pub fn closest_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        if O::OBSERVES_NOTHING
-            && let Some(h) = self.cpu().traverse::<false>(ray)
-        {
-            return h;
+        if O::OBSERVES_NOTHING {
+            return match self.cpu().traverse::<false>(ray) {
+                Some(h) => h,
+                None => self.declined_closest(ray, obs),
+            };
         }
         self.closest_hit_image(ray, obs)
+    }
+
+    /// [`BvhImage::closest_hit_image`] of a ray the CPU-side copy declines (NaN bounds),
+    /// kept out of line so that the plain query's frame stays small.
+    #[cold]
+    #[inline(never)]
+    fn declined_closest<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        self.closest_hit_image(ray, obs)
+    }
+
+    /// [`BvhImage::any_hit_image`] of a ray the CPU-side copy declines, out of line.
+    #[cold]
+    #[inline(never)]
+    fn declined_any<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+        self.any_hit_image(ray, obs)
     }
 
     /// True when any triangle is hit within `[ray.t_min, ray.t_max]`; like
     /// [`BvhImage::closest_hit`], through the CPU-side copy when nothing is observed.
     #[inline]
     pub fn any_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
-        if O::OBSERVES_NOTHING
-            && let Some(h) = self.cpu().traverse::<true>(ray)
-        {
-            return h.is_some();
+        if O::OBSERVES_NOTHING {
+            return match self.cpu().traverse::<true>(ray) {
+                Some(h) => h.is_some(),
+                None => self.declined_any(ray, obs),
+            };
         }
         self.any_hit_image(ray, obs)
     }
