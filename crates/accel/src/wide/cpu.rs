@@ -314,43 +314,34 @@ fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage) -> Copied<N> {
             if kind == ChildKind::Empty {
                 continue;
             }
-            let mut child = EMPTY;
-            // An internal child whose subtree holds few triangles becomes one leaf of them.
-            let merged = if kind == ChildKind::Internal {
-                let mut e = Vec::new();
-                gather::<L>(words, addr, MERGE_MAX, &mut e).then_some(e)
-            } else {
-                None
-            };
-            if let Some(mut e) = merged {
-                let last = e.len() - 1;
-                e[last] |= RUN_END;
-                let first = slots as u32;
-                pack_entries(&mut out.packets, &mut slots, e, triangles);
-                out.nodes[at].set(lane, *node.box_words(k), LEAF | first);
-                addr += L::child_words(kind) as usize;
-                lane += 1;
-                continue;
-            }
-            match kind {
+            // A leaf's entries; an internal child whose subtree holds few triangles becomes
+            // one leaf of them.
+            let entries = match kind {
                 ChildKind::Leaf => {
                     let run = words[addr] as usize;
                     let len = words[run..]
                         .iter()
                         .position(|&e| e & RUN_END != 0)
                         .map_or(0, |p| p + 1);
+                    Some(words[run..run + len].to_vec())
+                }
+                _ => gather::<L>(words, addr, MERGE_MAX),
+            };
+            let child = match entries {
+                // A subtree without triangles (only a forged saved tree has one) holds
+                // nothing to hit.
+                Some(e) if e.is_empty() => EMPTY,
+                Some(e) => {
                     let first = slots as u32;
                     assert!(first < LEAF, "too many triangle references");
-                    pack_entries(
-                        &mut out.packets,
-                        &mut slots,
-                        words[run..run + len].iter().copied(),
-                        triangles,
-                    );
-                    child = LEAF | first;
+                    pack_entries(&mut out.packets, &mut slots, e, triangles);
+                    LEAF | first
                 }
-                _ => internal.push((addr, lane)),
-            }
+                None => {
+                    internal.push((addr, lane));
+                    EMPTY
+                }
+            };
             out.nodes[at].set(lane, *node.box_words(k), child);
             addr += L::child_words(kind) as usize;
             lane += 1;
@@ -423,30 +414,35 @@ impl CpuBvh {
         let mut stack = STACK.take();
         stack.clear();
         let packets = &self.packets[..];
-        let hit = match (&self.nodes, self.avx2) {
-            (CpuNodes::Four(n), None) => run::<_, _, ANY>(Sse2, n, packets, ray, &mut stack),
-            (CpuNodes::Eight(n), None) => run::<_, _, ANY>(Sse2, n, packets, ray, &mut stack),
-            (CpuNodes::Four(n), Some(t)) => t
-                .vectorize(Run::<_, ANY> {
-                    isa: t,
-                    nodes: n,
-                    packets,
-                    ray,
-                    stack: &mut stack,
-                })
-                .unpack(),
-            (CpuNodes::Eight(n), Some(t)) => t
-                .vectorize(Run::<_, ANY> {
-                    isa: t,
-                    nodes: n,
-                    packets,
-                    ray,
-                    stack: &mut stack,
-                })
-                .unpack(),
+        let hit = match &self.nodes {
+            CpuNodes::Four(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, &mut stack),
+            CpuNodes::Eight(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, &mut stack),
         };
         STACK.set(stack);
         Some(hit)
+    }
+}
+
+/// [`run`] with SSE2, or with AVX2 inside [`Avx2::vectorize`] when `avx2` holds the token.
+#[inline(always)]
+fn dispatch<N: Lanes, const ANY: bool>(
+    avx2: Option<Avx2>,
+    nodes: &[N],
+    packets: &[TriPacket],
+    ray: &Ray,
+    stack: &mut Vec<Entry>,
+) -> Option<Hit> {
+    match avx2 {
+        None => run::<N, Sse2, ANY>(Sse2, nodes, packets, ray, stack),
+        Some(isa) => isa
+            .vectorize(Run::<N, ANY> {
+                isa,
+                nodes,
+                packets,
+                ray,
+                stack,
+            })
+            .unpack(),
     }
 }
 
@@ -719,37 +715,43 @@ pub(crate) fn test_leaf<const ANY: bool>(
     }
 }
 
-/// Appends to `out` the triangle ids (without [`RUN_END`]) of the leaves of the subtree whose
-/// node is at image word `w`, depth-first in child order; false (with `out` holding part of
-/// them) as soon as there are more than `limit`.
-fn gather<L: NodeLayout>(words: &[u32], w: usize, limit: usize, out: &mut Vec<u32>) -> bool {
-    let node = L::read(words, w);
-    let mut addr = node.offset() as usize;
-    for k in 0..L::ARITY {
-        let kind = node.kind(k);
-        match kind {
-            ChildKind::Empty => continue,
-            ChildKind::Leaf => {
-                let run = words[addr] as usize;
-                for &e in &words[run..] {
-                    out.push(e & !RUN_END);
-                    if e & RUN_END != 0 {
-                        break;
+/// The index entries of the leaves of the subtree whose node is at image word `w` (a node's
+/// leaves, then its internal children's subtrees in child order), [`RUN_END`] on the last
+/// one only; `None` when there are more
+/// than `limit`. Iterative: a saved tree may hold long chains of nodes.
+fn gather<L: NodeLayout>(words: &[u32], w: usize, limit: usize) -> Option<Vec<u32>> {
+    let mut out = Vec::new();
+    let mut todo = vec![w];
+    while let Some(w) = todo.pop() {
+        let node = L::read(words, w);
+        let mut addr = node.offset() as usize;
+        let mut inner = Vec::new();
+        for k in 0..L::ARITY {
+            let kind = node.kind(k);
+            match kind {
+                ChildKind::Empty => continue,
+                ChildKind::Leaf => {
+                    let run = words[addr] as usize;
+                    for &e in &words[run..] {
+                        out.push(e & !RUN_END);
+                        if e & RUN_END != 0 || out.len() > limit {
+                            break;
+                        }
                     }
                 }
+                ChildKind::Internal => inner.push(addr),
             }
-            ChildKind::Internal => {
-                if !gather::<L>(words, addr, limit, out) {
-                    return false;
-                }
+            if out.len() > limit {
+                return None;
             }
+            addr += L::child_words(kind) as usize;
         }
-        if out.len() > limit {
-            return false;
-        }
-        addr += L::child_words(kind) as usize;
+        todo.extend(inner.into_iter().rev());
     }
-    true
+    if let Some(last) = out.last_mut() {
+        *last |= RUN_END;
+    }
+    Some(out)
 }
 
 /// Appends the triangles of the index-run entries `entries` (ids with [`RUN_END`] on each
