@@ -72,7 +72,7 @@ pub struct Chunk {
 pub struct Chunk8 {
     /// `planes[p][lane]`, as [`Chunk::planes`].
     pub planes: [[f32; 8]; 6],
-    /// Per lane, as [`Chunk::child`].
+    /// Per lane, as in [`Chunk`]: a node, a leaf or [`EMPTY`].
     pub child: [u32; 8],
 }
 
