@@ -1,3 +1,5 @@
+use crate::TriangleHit;
+
 /// A triangle id: the triangle's index in the scene's triangle array, which every
 /// structure's leaves and the hit it returns name it by.
 #[derive(
@@ -47,6 +49,28 @@ impl Hit {
     #[inline]
     pub fn closer_than(&self, t: f32, prim: PrimId) -> bool {
         self.t < t || (self.t == t && self.prim < prim)
+    }
+
+    /// The hit `h` of triangle `prim`.
+    #[inline]
+    pub fn on(prim: PrimId, h: TriangleHit) -> Self {
+        Self {
+            t: h.t,
+            prim,
+            u: h.u,
+            v: h.v,
+        }
+    }
+
+    /// Puts the hit `h` of triangle `prim` into `best` unless `best` is closer by
+    /// [`Hit::closer_than`]'s order; true when it did.
+    #[inline]
+    pub fn keep_closest(best: &mut Option<Hit>, prim: PrimId, h: TriangleHit) -> bool {
+        let keep = best.is_none_or(|b| !b.closer_than(h.t, prim));
+        if keep {
+            *best = Some(Self::on(prim, h));
+        }
+        keep
     }
 }
 

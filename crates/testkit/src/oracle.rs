@@ -13,15 +13,7 @@ pub fn oracle_closest(tris: &[Triangle], ray: &Ray) -> Option<Hit> {
         let Some(h) = tri.intersect(&r, ray.t_min, ray.t_max) else {
             continue;
         };
-        let prim = PrimId(i as u32);
-        if best.is_none_or(|b| !b.closer_than(h.t, prim)) {
-            best = Some(Hit {
-                t: h.t,
-                prim,
-                u: h.u,
-                v: h.v,
-            });
-        }
+        Hit::keep_closest(&mut best, PrimId(i as u32), h);
     }
     best
 }

@@ -12,7 +12,7 @@
 use super::Dst;
 use super::header::HeaderOffset;
 use super::pipeline::le_or_nan;
-use super::traverse::{Entry, Stack};
+use super::traverse::{Stack, dual_carve, split_next};
 use crate::image::Pages;
 use crate::wide::cpu::{PackedHit, RaySimd, TriPacket, avx2_token, pack_entries, test_leaf};
 use crate::wide::simd::Kernel;
@@ -92,25 +92,18 @@ impl Dst {
                     let t2 = plane_t(a, pf);
                     let near_hit = le_or_nan(t_min, t1);
                     let far_hit = le_or_nan(t2, t_max);
-                    if far_hit {
-                        if near_hit {
-                            stack.push(Entry {
-                                node: far,
-                                t_min: t_min.max(t2),
-                                t_max,
-                            });
-                        } else {
-                            node = far;
-                            t_min = t_min.max(t2);
+                    let (push, next) =
+                        split_next(near_hit, far_hit, (near, far), (t1, t2), t_min, t_max);
+                    if let Some(e) = push {
+                        stack.push(e);
+                    }
+                    match next {
+                        Some((n, lo, hi)) => {
+                            (node, t_min, t_max) = (n, lo, hi);
                             continue;
                         }
+                        None => None,
                     }
-                    if near_hit {
-                        node = near;
-                        t_max = t_max.min(t1);
-                        continue;
-                    }
-                    None
                 }
             } else {
                 let (p0, p1) = (f32::from_bits(words[at + 1]), f32::from_bits(words[at + 2]));
@@ -125,23 +118,8 @@ impl Dst {
                         t_max.min(widen_exit(plane_t(a, pe))),
                     )
                 } else {
-                    // Dual-axis carving: a plane is an exit plane iff its "lower bound" bit
-                    // equals the ray's sign on its axis; exits are widened.
                     let (a0, a1) = w.axis_pair().axes();
-                    let c = w.corner();
-                    let (ta, tb) = (plane_t(a0, p0), plane_t(a1, p1));
-                    let (mut lo, mut hi) = (t_min, t_max);
-                    if neg[a0] == c.first_lower {
-                        hi = hi.min(widen_exit(ta));
-                    } else {
-                        lo = lo.max(ta);
-                    }
-                    if neg[a1] == c.second_lower {
-                        hi = hi.min(widen_exit(tb));
-                    } else {
-                        lo = lo.max(tb);
-                    }
-                    (lo, hi)
+                    dual_carve(&neg, w, (plane_t(a0, p0), plane_t(a1, p1)), t_min, t_max)
                 };
                 if le_or_nan(lo, hi) {
                     t_min = lo;

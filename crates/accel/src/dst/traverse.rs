@@ -161,21 +161,10 @@ impl<'a> Tracer<'a> {
             obs.triangle_test(p, h.is_some());
             if let Some(h) = h {
                 if ANY {
-                    self.best = Some(Hit {
-                        t: h.t,
-                        prim: p,
-                        u: h.u,
-                        v: h.v,
-                    });
+                    self.best = Some(Hit::on(p, h));
                     return RunResult::Occluded;
                 }
-                if self.best.is_none_or(|b| !b.closer_than(h.t, p)) {
-                    self.best = Some(Hit {
-                        t: h.t,
-                        prim: p,
-                        u: h.u,
-                        v: h.v,
-                    });
+                if Hit::keep_closest(&mut self.best, p, h) {
                     self.best_t = h.t;
                 }
             }
@@ -207,6 +196,63 @@ fn dst_step(kind: DstNodeKind, code: ReturnCode, carving_leaf: bool) -> NodeStep
         code,
         carving_leaf,
     }
+}
+
+/// After a splitting node with near and far children `near`, `far` (by the ray's sign), `t1`
+/// where the ray leaves the near child's half-space and `t2` where it enters the far one:
+/// the entry to push (the far child, when both are hit) and the node to go on with and its
+/// interval (`None`: pop). Shared by the observed traversal and the plain decoder.
+#[inline(always)]
+pub(super) fn split_next(
+    near_hit: bool,
+    far_hit: bool,
+    (near, far): (u32, u32),
+    (t1, t2): (f32, f32),
+    t_min: f32,
+    t_max: f32,
+) -> (Option<Entry>, Option<(u32, f32, f32)>) {
+    let far_entry = (far, t_min.max(t2), t_max);
+    match (near_hit, far_hit) {
+        (true, true) => (
+            Some(Entry {
+                node: far,
+                t_min: far_entry.1,
+                t_max,
+            }),
+            Some((near, t_min, t_max.min(t1))),
+        ),
+        (true, false) => (None, Some((near, t_min, t_max.min(t1)))),
+        (false, true) => (None, Some(far_entry)),
+        (false, false) => (None, None),
+    }
+}
+
+/// The interval `(lo, hi)` left of `[t_min, t_max]` by a dual-axis carving node `w` whose
+/// planes lie at ray parameters `ta` (first axis) and `tb` (second): a plane is an exit
+/// plane iff its "lower bound" bit equals the ray's sign `neg` on its axis (Lin et al. 2020,
+/// Fig. 2); exit planes are widened (`widen_exit`) and clamp `hi`, entry planes raise `lo`.
+#[inline(always)]
+pub(super) fn dual_carve(
+    neg: &[bool; 3],
+    w: HeaderOffset,
+    (ta, tb): (f32, f32),
+    t_min: f32,
+    t_max: f32,
+) -> (f32, f32) {
+    let (a0, a1) = w.axis_pair().axes();
+    let c = w.corner();
+    let (mut lo, mut hi) = (t_min, t_max);
+    if neg[a0] == c.first_lower {
+        hi = hi.min(widen_exit(ta));
+    } else {
+        lo = lo.max(ta);
+    }
+    if neg[a1] == c.second_lower {
+        hi = hi.min(widen_exit(tb));
+    } else {
+        lo = lo.max(tb);
+    }
+    (lo, hi)
 }
 
 impl Dst {
@@ -260,26 +306,19 @@ impl Dst {
                         ReturnCode::from_bits(near_hit as u8 + far_hit as u8),
                         false,
                     ));
-                    if far_hit {
-                        if near_hit {
-                            tr.stack.push(Entry {
-                                node: far,
-                                t_min: t_min.max(t2),
-                                t_max,
-                            });
-                            obs.push();
-                        } else {
-                            node = far;
-                            t_min = t_min.max(t2);
+                    let (push, next) =
+                        split_next(near_hit, far_hit, (near, far), (t1, t2), t_min, t_max);
+                    if let Some(e) = push {
+                        tr.stack.push(e);
+                        obs.push();
+                    }
+                    match next {
+                        Some((n, lo, hi)) => {
+                            (node, t_min, t_max) = (n, lo, hi);
                             continue;
                         }
+                        None => None,
                     }
-                    if near_hit {
-                        node = near;
-                        t_max = t_max.min(t1);
-                        continue;
-                    }
-                    None
                 }
                 kind => {
                     // Carving: exit planes clamp t_max, entry planes raise t_min.
@@ -294,23 +333,8 @@ impl Dst {
                         (t_min.max(t2), t_max.min(t1))
                     } else {
                         let (a0, a1) = w.axis_pair().axes();
-                        let c = w.corner();
-                        let (ta, tb) = (tr.r.plane_t(a0, p0), tr.r.plane_t(a1, p1));
-                        let (mut lo, mut hi) = (t_min, t_max);
-                        // A plane is an exit plane iff its "lower bound" bit equals the
-                        // ray's sign on its axis (Lin et al. 2020, Fig. 2).
-                        // Exit planes are widened (`widen_exit`), entry planes are not.
-                        if tr.r.neg[a0] == c.first_lower {
-                            hi = hi.min(widen_exit(ta));
-                        } else {
-                            lo = lo.max(ta);
-                        }
-                        if tr.r.neg[a1] == c.second_lower {
-                            hi = hi.min(widen_exit(tb));
-                        } else {
-                            lo = lo.max(tb);
-                        }
-                        (lo, hi)
+                        let t = (tr.r.plane_t(a0, p0), tr.r.plane_t(a1, p1));
+                        dual_carve(&tr.r.neg, w, t, t_min, t_max)
                     };
                     let hit = le_or_nan(lo, hi);
                     let leaf = w.is_leaf_flag();

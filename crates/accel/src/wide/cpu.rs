@@ -469,7 +469,7 @@ impl<N: Lanes, const ANY: bool> Kernel for Run<'_, N, ANY> {
     }
 }
 
-/// An `Option<Hit>` in 128 bits (t, prim, u, v from the low end; a miss has prim
+/// An `Option<Hit>` in 128 bits (the hit's bytes; a miss is all ones, so its prim is
 /// `u32::MAX`, which no triangle id reaches), so that it comes back from the AVX2 function
 /// in two registers rather than through memory, where the caller's 16-byte load of the
 /// callee's four 4-byte stores cannot be forwarded and stalls.
@@ -480,24 +480,14 @@ impl PackedHit {
     /// Packs `h`.
     #[inline(always)]
     pub(crate) fn pack(h: Option<Hit>) -> Self {
-        Self(h.map_or(u128::MAX, |h| {
-            h.t.to_bits() as u128
-                | (h.prim.0 as u128) << 32
-                | (h.u.to_bits() as u128) << 64
-                | (h.v.to_bits() as u128) << 96
-        }))
+        Self(h.map_or(u128::MAX, bytemuck::cast))
     }
 
     /// The hit packed.
     #[inline(always)]
     pub(crate) fn unpack(self) -> Option<Hit> {
-        let word = |k: u32| (self.0 >> (32 * k)) as u32;
-        (word(1) != u32::MAX).then(|| Hit {
-            t: f32::from_bits(word(0)),
-            prim: PrimId(word(1)),
-            u: f32::from_bits(word(2)),
-            v: f32::from_bits(word(3)),
-        })
+        let h: Hit = bytemuck::cast(self.0);
+        (h.prim.0 != u32::MAX).then_some(h)
     }
 }
 
@@ -693,14 +683,8 @@ pub(crate) fn test_leaf<const ANY: bool>(
                 tri.intersect_from_edges(r, [e.u[l], e.v[l], e.w[l]], r.ray.t_min, *best_t)
             };
             if let Some(h) = h
-                && best.is_none_or(|b| !b.closer_than(h.t, p))
+                && Hit::keep_closest(best, p, h)
             {
-                *best = Some(Hit {
-                    t: h.t,
-                    prim: p,
-                    u: h.u,
-                    v: h.v,
-                });
                 if ANY {
                     return true;
                 }
@@ -960,60 +944,19 @@ mod tests {
     use crate::wide::traverse::tests::coord;
     use dualsplit_geometry::Pcg32;
 
-    /// The chunk test gives, lane by lane, `RayPre::slab`'s hit or miss and entry distance
-    /// (up to the sign of a zero) for every non-NaN interval, with empty lanes never hit.
-    #[test]
-    fn chunk_test_matches_ray_slab() {
-        let mut rng = Pcg32::new(11, 5);
-        let ends = [0.0, -0.0, 0.5, 1e-3, f32::INFINITY, f32::NEG_INFINITY, 3.0];
-        for case in 0..50_000 {
-            let v = |rng: &mut Pcg32| Vec3::new(coord(rng), coord(rng), coord(rng));
-            let r = Ray::new(v(&mut rng), v(&mut rng)).precompute();
-            let mut ch = Chunk::EMPTY;
-            let mut boxes = Vec::new();
-            for l in 0..LANES {
-                if rng.below(5) == 0 {
-                    continue;
-                }
-                let (p, q) = (v(&mut rng), v(&mut rng));
-                let (lo, hi) = (p.min(q), p.max(q));
-                let w = [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z];
-                for (k, &x) in w.iter().enumerate() {
-                    ch.planes[k][l] = x;
-                }
-                ch.child[l] = l as u32;
-                boxes.push((l, lo, hi));
-            }
-            let t_lo = ends[rng.below(ends.len() as u32) as usize];
-            let t_hi = ends[rng.below(ends.len() as u32) as usize];
-            let (entry, mask) = RaySimd::new(&r).test(&ch.planes, &ch.child, t_lo, t_hi);
-            let entry = entry.to_array();
-            let mut want = 0;
-            for (l, lo, hi) in boxes {
-                let (e, x) = r.slab(lo, hi, t_lo, t_hi);
-                if e <= x {
-                    want |= 1 << l;
-                    assert_eq!(entry[l], e, "case {case} lane {l}");
-                }
-            }
-            assert_eq!(mask, want, "case {case}: {r:?}");
-        }
-    }
-
-    /// The 8-lane test of a BVH8 node, with SSE2 (two halves) and with AVX2 where this CPU
-    /// has it (one 8-wide test), gives lane by lane `RayPre::slab`'s hit or miss and entry
-    /// distance, empty lanes never hit.
-    #[test]
-    fn chunk8_test_matches_ray_slab() {
-        let mut rng = Pcg32::new(12, 6);
+    /// The box test of a node of type `N` with SSE2, and with AVX2 where this CPU has it,
+    /// gives lane by lane `RayPre::slab`'s hit or miss and entry distance (up to the sign of
+    /// a zero) for every non-NaN interval, empty lanes never hit; `cases` random nodes.
+    fn node_tests_match_ray_slab<N: Lanes>(seed: (u64, u64), cases: usize) {
+        let mut rng = Pcg32::new(seed.0, seed.1);
         let ends = [0.0, -0.0, 0.5, 1e-3, f32::INFINITY, f32::NEG_INFINITY, 3.0];
         let avx2 = Avx2::detect();
-        for case in 0..30_000 {
+        for case in 0..cases {
             let v = |rng: &mut Pcg32| Vec3::new(coord(rng), coord(rng), coord(rng));
             let r = Ray::new(v(&mut rng), v(&mut rng)).precompute();
-            let mut n = Chunk8::EMPTY;
+            let mut n = N::EMPTY;
             let mut boxes = Vec::new();
-            for l in 0..8 {
+            for l in 0..N::W {
                 if rng.below(5) == 0 {
                     continue;
                 }
@@ -1025,8 +968,8 @@ mod tests {
             let t_lo = ends[rng.below(ends.len() as u32) as usize];
             let t_hi = ends[rng.below(ends.len() as u32) as usize];
             let rs = RaySimd::new(&r);
-            let mut results = vec![Sse2.test8(&rs, &n, t_lo, t_hi)];
-            results.extend(avx2.map(|t| t.test8(&rs, &n, t_lo, t_hi)));
+            let mut results = vec![n.test(Sse2, &rs, t_lo, t_hi)];
+            results.extend(avx2.map(|t| n.test(t, &rs, t_lo, t_hi)));
             for (dv, mask) in results {
                 let entry: [f32; 8] = bytemuck::cast(dv);
                 let mut want = 0;
@@ -1040,6 +983,18 @@ mod tests {
                 assert_eq!(mask, want, "case {case}: {r:?}");
             }
         }
+    }
+
+    /// A BVH2/BVH4 node's 4-lane test.
+    #[test]
+    fn chunk_test_matches_ray_slab() {
+        node_tests_match_ray_slab::<Chunk>((11, 5), 50_000);
+    }
+
+    /// A BVH8 node's 8-lane test: two SSE halves, or one 8-wide AVX2 test.
+    #[test]
+    fn chunk8_test_matches_ray_slab() {
+        node_tests_match_ray_slab::<Chunk8>((12, 6), 30_000);
     }
 
     /// The packet's first stage drops a lane only where `Triangle::intersect` misses: on

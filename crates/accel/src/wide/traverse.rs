@@ -108,15 +108,9 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
                     obs.triangle_test(p, false);
                     continue;
                 };
-                let accept = best.is_none_or(|b| !b.closer_than(h.t, p));
+                let accept = Hit::keep_closest(&mut best, p, h);
                 obs.triangle_test(p, accept);
                 if accept {
-                    best = Some(Hit {
-                        t: h.t,
-                        prim: p,
-                        u: h.u,
-                        v: h.v,
-                    });
                     if ANY {
                         return best;
                     }
