@@ -79,8 +79,18 @@ pub type SimulateFn<'a> = dyn Fn(
 /// errors as "simulator unavailable: …".
 pub fn real_simulator(model: ThreadModel) -> Box<SimulateFn<'static>> {
     Box::new(move |scene, structures, accel, settings, cfg, progress| {
-        dualsplit_sim::simulate_model(model, scene, structures, accel, settings, cfg, progress)
-            .map_err(|e| format!("simulator unavailable: {e}"))
+        dualsplit_sim::simulate(
+            &dualsplit_sim::FrameRequest {
+                scene,
+                structures,
+                accel,
+                settings,
+                cfg,
+                model,
+            },
+            progress,
+        )
+        .map_err(|e| format!("simulator unavailable: {e}"))
     })
 }
 

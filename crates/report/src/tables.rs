@@ -759,13 +759,15 @@ mod tests {
         let mut cfg = SimConfig::lin2020();
         cfg.tms = 2;
         for model in dualsplit_sim::ThreadModel::ALL {
-            let r = dualsplit_sim::simulate_model(
-                model,
-                &scene,
-                &s,
-                SimAccel::Dst,
-                &settings,
-                &cfg,
+            let r = dualsplit_sim::simulate(
+                &dualsplit_sim::FrameRequest {
+                    scene: &scene,
+                    structures: &s,
+                    accel: SimAccel::Dst,
+                    settings: &settings,
+                    cfg: &cfg,
+                    model,
+                },
                 &|_, _| {},
             )
             .unwrap();

@@ -19,8 +19,8 @@ use divan::counter::ItemsCount;
 use dualsplit_accel::{MemoryImage, Structures};
 use dualsplit_render::{RenderSettings, Workload};
 use dualsplit_sim::SimAccel;
-use dualsplit_sim::kernels::{LOCAL_STORE_BYTES, Params, elf};
-use dualsplit_sim::rv32::{FrameMemory, Hart, Program, run_fast};
+use dualsplit_sim::model::rv32::kernels::{LOCAL_STORE_BYTES, Params, elf};
+use dualsplit_sim::model::rv32::{FrameMemory, Hart, Program, run_fast};
 
 fn main() {
     divan::main();

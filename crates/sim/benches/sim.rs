@@ -24,9 +24,11 @@
 
 use divan::counter::ItemsCount;
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
-use dualsplit_sim::kernel::{Op, Pipe};
-use dualsplit_sim::{Chip, Thread, WorkSource, run_chip};
-use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel, simulate_model};
+use dualsplit_sim::hw::{Chip, pipe::Pipe};
+use dualsplit_sim::model::fast::op::Op;
+use dualsplit_sim::model::fast::replay::{WorkSource, run as run_chip};
+use dualsplit_sim::model::fast::thread::Thread;
+use dualsplit_sim::{FrameRequest, SimAccel, SimConfig, SimResult, ThreadModel, simulate};
 use std::sync::OnceLock;
 
 fn main() {
@@ -152,7 +154,20 @@ fn bench_model(
     let settings =
         dualsplit_render::RenderSettings::new(res, res, dualsplit_render::Workload::Path);
     let cfg = SimConfig::lin2020();
-    let sim = || simulate_model(model, scene, s, accel, &settings, &cfg, &|_, _| {}).unwrap();
+    let sim = || {
+        simulate(
+            &FrameRequest {
+                scene,
+                structures: s,
+                accel,
+                settings: &settings,
+                cfg: &cfg,
+                model,
+            },
+            &|_, _| {},
+        )
+        .unwrap()
+    };
     b.counter(ItemsCount::new(items(&sim()))).bench(sim);
 }
 

@@ -5,18 +5,20 @@
 
 use dualsplit_accel::{BuildConfig, Structures};
 use dualsplit_render::{RenderSettings, Workload};
-use dualsplit_sim::{SimAccel, SimConfig, simulate};
+use dualsplit_sim::{FrameRequest, SimAccel, SimConfig, simulate};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let scene = dualsplit_scene::load("builtin:cornell")?;
     let structures = Structures::try_build(&scene.triangles, &BuildConfig::default())?;
     let settings = RenderSettings::new(16, 16, Workload::Cast);
     let r = simulate(
-        &scene,
-        &structures,
-        SimAccel::Dst,
-        &settings,
-        &SimConfig::lin2020(),
+        &FrameRequest::new(
+            &scene,
+            &structures,
+            SimAccel::Dst,
+            &settings,
+            &SimConfig::lin2020(),
+        ),
         &|_, _| {},
     )?;
     println!("{} cycles, {:.4} ms per frame", r.cycles, r.frame_ms);

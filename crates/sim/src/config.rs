@@ -4,6 +4,7 @@
 //! Every field has a default equal to [`SimConfig::lin2020`], so a TOML file only needs the
 //! values it changes; unknown keys are rejected (a measurement tool never ignores an option).
 
+pub use crate::ranges::ConfigError;
 use crate::ranges::{RANGES, Value};
 use serde::{Deserialize, Serialize};
 
@@ -247,24 +248,6 @@ impl Default for EnergyConfig {
     fn default() -> Self {
         SimConfig::lin2020().energy
     }
-}
-
-/// Why a configuration was rejected.
-#[derive(Debug, thiserror::Error)]
-pub enum ConfigError {
-    /// The TOML did not parse or had an unknown key.
-    #[error("config parse error: {0}")]
-    Parse(#[from] toml::de::Error),
-    /// A value is out of range.
-    #[error("config value `{field}` = {value} is invalid: {reason}")]
-    Invalid {
-        /// The key, as written in the TOML (`l1.hit_latency`).
-        field: &'static str,
-        /// Its value as given.
-        value: String,
-        /// What it must be.
-        reason: String,
-    },
 }
 
 impl SimConfig {

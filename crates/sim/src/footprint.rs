@@ -16,8 +16,10 @@
 //! `crates/sim/tests/footprint.rs` runs simulations under an allocator capped at this
 //! estimate (so a single byte beyond it fails the test) and prints how much of it they used.
 
-use crate::kernels::FRAME_FLOATS_PER_PIXEL;
-use crate::{SimAccel, SimConfig, ThreadModel};
+use crate::accel::SimAccel;
+use crate::config::SimConfig;
+use crate::model::ThreadModel;
+use crate::model::rv32::kernels::FRAME_FLOATS_PER_PIXEL;
 
 /// Per thread, besides its local store: the `rv32` hart and scoreboard or the fast model's
 /// thread and pixel state.
@@ -103,13 +105,31 @@ pub fn check(
     accel: SimAccel,
     model: ThreadModel,
     pixels: u64,
-) -> Result<(), crate::SimError> {
+) -> Result<(), TooLarge> {
     let need = Footprint::estimate(cfg, accel, model, pixels);
     if need.total() > MAX_SIM_BYTES {
-        return Err(crate::SimError::Memory {
+        return Err(TooLarge {
             need,
             limit: MAX_SIM_BYTES,
         });
     }
     Ok(())
+}
+
+/// A simulation that would take more host memory than [`MAX_SIM_BYTES`].
+#[derive(Debug, thiserror::Error)]
+#[error(
+        "the simulation would need about {} MiB of memory (threads {} MiB, caches and units {} MiB, DRAM model {} MiB, frame {} MiB, fixed {} MiB); at most {} MiB: lower tms, tps_per_tm, units.local_store_bytes, the cache sizes or the resolution",
+        mib(need.total()), mib(need.threads), mib(need.caches), mib(need.dram), mib(need.frame), mib(need.fixed), mib(*limit)
+    )]
+pub struct TooLarge {
+    /// The estimate, by term.
+    pub need: Footprint,
+    /// The limit.
+    pub limit: u64,
+}
+
+/// Bytes in MiB, rounded up.
+fn mib(bytes: u64) -> u64 {
+    bytes.div_ceil(1 << 20)
 }

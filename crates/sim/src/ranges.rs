@@ -10,7 +10,23 @@
 //! model describes (the paper's Table 1 chip sits well inside each); what fits the host's
 //! memory is checked separately ([`crate::footprint`]).
 
-use crate::config::ConfigError;
+/// Why a configuration was rejected.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The TOML did not parse or had an unknown key.
+    #[error("config parse error: {0}")]
+    Parse(#[from] toml::de::Error),
+    /// A value is out of range.
+    #[error("config value `{field}` = {value} is invalid: {reason}")]
+    Invalid {
+        /// The key, as written in the TOML (`l1.hit_latency`).
+        field: &'static str,
+        /// Its value as given.
+        value: String,
+        /// What it must be.
+        reason: String,
+    },
+}
 
 /// A configuration value as read.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,6 +1,6 @@
 //! Where a simulated frame's thread-cycles went, as shares of all of them.
 
-use crate::SimResult;
+use crate::result::SimResult;
 use serde::Serialize;
 
 /// Shares of all thread-cycles (cycles × threads) by what a thread waited for.

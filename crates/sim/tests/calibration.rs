@@ -4,8 +4,9 @@
 
 use dualsplit_accel::Structures;
 use dualsplit_render::{RenderSettings, Workload};
-use dualsplit_sim::calibrate::{CALIBRATION_TOML, FRAMES, calibrate, to_toml};
-use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel, simulate_model};
+use dualsplit_sim::model::fast::calibrate::{FRAMES, calibrate, to_toml};
+use dualsplit_sim::model::fast::costs::CALIBRATION_TOML;
+use dualsplit_sim::{FrameRequest, SimAccel, SimConfig, SimResult, ThreadModel, simulate};
 
 #[test]
 fn committed_calibration_is_what_the_kernels_measure() {
@@ -61,7 +62,18 @@ fn run(model: ThreadModel, spec: &str, accel: SimAccel, wl: Workload) -> SimResu
     // 256 threads for 4096 pixels: the chip stays busy to the end of the frame.
     cfg.tms = 8;
     let settings = RenderSettings::new(64, 64, wl);
-    simulate_model(model, &scene, &s, accel, &settings, &cfg, &|_, _| {}).unwrap()
+    simulate(
+        &FrameRequest {
+            scene: &scene,
+            structures: &s,
+            accel,
+            settings: &settings,
+            cfg: &cfg,
+            model,
+        },
+        &|_, _| {},
+    )
+    .unwrap()
 }
 
 /// The `fast` model against the compiled kernels on scenes outside the calibration set:

@@ -3,7 +3,7 @@
 
 use dualsplit_accel::Structures;
 use dualsplit_render::{RenderSettings, Workload};
-use dualsplit_sim::{SimAccel, SimConfig, ThreadModel, simulate_model};
+use dualsplit_sim::{FrameRequest, SimAccel, SimConfig, ThreadModel, simulate};
 
 fn tiny() -> SimConfig {
     SimConfig::from_toml(include_str!("../../../configs/tiny.toml")).unwrap()
@@ -17,8 +17,20 @@ fn compiled_kernels_give_the_renderers_pixels() {
     for workload in Workload::ALL {
         let settings = RenderSettings::new(12, 12, workload);
         for accel in SimAccel::ALL {
-            let run =
-                |m| simulate_model(m, &scene, &s, accel, &settings, &cfg, &|_, _| {}).unwrap();
+            let run = |m| {
+                simulate(
+                    &FrameRequest {
+                        scene: &scene,
+                        structures: &s,
+                        accel,
+                        settings: &settings,
+                        cfg: &cfg,
+                        model: m,
+                    },
+                    &|_, _| {},
+                )
+                .unwrap()
+            };
             let (rv, fast) = (run(ThreadModel::Rv32), run(ThreadModel::Fast));
             for (i, (a, b)) in rv.radiance.iter().zip(&fast.radiance).enumerate() {
                 assert_eq!(
@@ -49,13 +61,15 @@ fn a_frame_beyond_the_memory_map_is_a_typed_error() {
     let s = Structures::build(&scene.triangles, &Default::default());
     // 4096² pixels × 12 bytes is beyond the 128 MiB between the frame buffer and the program.
     let settings = RenderSettings::new(4096, 4096, Workload::Cast);
-    let e = simulate_model(
-        ThreadModel::Rv32,
-        &scene,
-        &s,
-        SimAccel::Dst,
-        &settings,
-        &tiny(),
+    let e = simulate(
+        &FrameRequest {
+            scene: &scene,
+            structures: &s,
+            accel: SimAccel::Dst,
+            settings: &settings,
+            cfg: &tiny(),
+            model: ThreadModel::Rv32,
+        },
         &|_, _| {},
     )
     .unwrap_err();

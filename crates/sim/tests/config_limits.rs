@@ -7,7 +7,7 @@ use dualsplit_geometry::{Triangle, Vec3};
 use dualsplit_render::{RenderSettings, Workload};
 use dualsplit_scene::Scene;
 use dualsplit_sim::ranges::{RANGES, Value};
-use dualsplit_sim::{SimAccel, SimConfig, SimError, ThreadModel, simulate_model};
+use dualsplit_sim::{FrameRequest, SimAccel, SimConfig, SimError, ThreadModel, simulate};
 
 fn refused(toml: &str, key: &str) -> String {
     let e = SimConfig::from_toml(toml).expect_err(toml).to_string();
@@ -128,13 +128,15 @@ fn chips_at_the_ends_of_the_ranges_simulate() {
         let mut cycles = Vec::new();
         for toml in [small, slow.as_str()] {
             let cfg = SimConfig::from_toml(toml).unwrap();
-            let r = simulate_model(
-                model,
-                &scene,
-                &s,
-                SimAccel::Dst,
-                &settings,
-                &cfg,
+            let r = simulate(
+                &FrameRequest {
+                    scene: &scene,
+                    structures: &s,
+                    accel: SimAccel::Dst,
+                    settings: &settings,
+                    cfg: &cfg,
+                    model,
+                },
                 &|_, _| {},
             )
             .unwrap_or_else(|e| panic!("{model:?} {toml}: {e}"));
@@ -167,20 +169,22 @@ fn chips_too_large_for_the_host_are_refused_before_allocating() {
         (ThreadModel::Fast, caches),
     ] {
         let cfg = SimConfig::from_toml(toml).unwrap();
-        match simulate_model(
-            model,
-            &scene,
-            &s,
-            SimAccel::Bvh2,
-            &settings,
-            &cfg,
+        match simulate(
+            &FrameRequest {
+                scene: &scene,
+                structures: &s,
+                accel: SimAccel::Bvh2,
+                settings: &settings,
+                cfg: &cfg,
+                model,
+            },
             &|_, _| {},
         ) {
-            Err(e @ SimError::Memory { .. }) => {
-                let SimError::Memory { need, limit } = &e else {
+            Err(e @ SimError::Memory(_)) => {
+                let SimError::Memory(too_large) = &e else {
                     unreachable!()
                 };
-                assert!(need.total() > *limit);
+                assert!(too_large.need.total() > too_large.limit);
                 let msg = e.to_string();
                 assert!(
                     msg.contains("at most 8192 MiB") && msg.contains("lower tms"),

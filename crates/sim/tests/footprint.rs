@@ -7,7 +7,7 @@ use cap::Cap;
 use dualsplit_accel::Structures;
 use dualsplit_render::{RenderSettings, Workload};
 use dualsplit_sim::footprint::Footprint;
-use dualsplit_sim::{SimAccel, SimConfig, ThreadModel, simulate_model};
+use dualsplit_sim::{FrameRequest, SimAccel, SimConfig, ThreadModel, simulate};
 use std::alloc::System;
 
 #[global_allocator]
@@ -51,7 +51,18 @@ fn simulations_stay_within_their_estimate() {
         let est = Footprint::estimate(&cfg, accel, model, (res * res) as u64).total();
         let (before, max_before) = (ALLOC.allocated(), ALLOC.max_allocated());
         ALLOC.set_limit(before + est as usize).unwrap();
-        let r = simulate_model(model, &scene, &s, accel, &settings, &cfg, &|_, _| {}).unwrap();
+        let r = simulate(
+            &FrameRequest {
+                scene: &scene,
+                structures: &s,
+                accel,
+                settings: &settings,
+                cfg: &cfg,
+                model,
+            },
+            &|_, _| {},
+        )
+        .unwrap();
         // The allocator keeps only its all-time peak: this run's is known when it set it.
         let peak = ALLOC.max_allocated();
         ALLOC.set_limit(usize::MAX).unwrap();

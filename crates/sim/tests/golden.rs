@@ -21,7 +21,9 @@
 
 use dualsplit_accel::Structures;
 use dualsplit_render::{RenderSettings, Workload};
-use dualsplit_sim::{MODEL_VERSION, SimAccel, SimConfig, SimResult, ThreadModel, simulate_model};
+use dualsplit_sim::{
+    FrameRequest, MODEL_VERSION, SimAccel, SimConfig, SimResult, ThreadModel, simulate,
+};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -163,13 +165,15 @@ fn run_all(missing: &mut Vec<String>) -> Vec<Golden> {
             let settings = RenderSettings::new(w, h, wl);
             for model in ThreadModel::ALL {
                 for accel in SimAccel::ALL {
-                    let r = simulate_model(
-                        model,
-                        &scene,
-                        &structures,
-                        accel,
-                        &settings,
-                        &cfg,
+                    let r = simulate(
+                        &FrameRequest {
+                            scene: &scene,
+                            structures: &structures,
+                            accel,
+                            settings: &settings,
+                            cfg: &cfg,
+                            model,
+                        },
                         &|_, _| {},
                     )
                     .unwrap_or_else(|e| panic!("{short} {wl_name} {}: {e}", accel.name()));

@@ -8,8 +8,10 @@ use dualsplit_accel::Structures;
 use dualsplit_render::{RenderSettings, Workload, render};
 use dualsplit_scene::Scene;
 use dualsplit_sim::SimAccel;
-use dualsplit_sim::kernels::{FRAME_FLOATS_PER_PIXEL, LOCAL_STORE_BYTES, Params, elf, elf_name};
-use dualsplit_sim::rv32::{Program, run_frame};
+use dualsplit_sim::model::rv32::kernels::{
+    FRAME_FLOATS_PER_PIXEL, LOCAL_STORE_BYTES, Params, elf, elf_name,
+};
+use dualsplit_sim::model::rv32::{Program, run_frame};
 
 /// Loads a scene spec; shipped meshes live in `shared/scenes` beside the repository. A
 /// missing mesh skips the test locally and fails it under CI (`CI=1`).

@@ -3,7 +3,7 @@
 //! the expected frame-buffer words; malformed headers give typed errors.
 
 use dualsplit_accel::MemoryImage;
-use dualsplit_sim::rv32::{
+use dualsplit_sim::model::rv32::{
     ElfError, FRAME_BUFFER_ADDR, FrameMemory, Hart, Op, PROGRAM_BASE, Program, RunError,
     run_to_halt,
 };

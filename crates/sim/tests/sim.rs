@@ -4,7 +4,7 @@ use dualsplit_accel::{DstNodeKind, NoObserver, NodeStep, Observer, Structures};
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::Scene;
-use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel, simulate, simulate_model};
+use dualsplit_sim::{FrameRequest, SimAccel, SimConfig, SimResult, ThreadModel, simulate};
 
 fn config(name: &str) -> String {
     let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/");
@@ -62,7 +62,18 @@ fn run_model(
     cfg: &SimConfig,
 ) -> SimResult {
     let settings = RenderSettings::new(24, 16, wl);
-    simulate_model(model, scene, s, accel, &settings, cfg, &|_, _| {}).unwrap()
+    simulate(
+        &FrameRequest {
+            scene,
+            structures: s,
+            accel,
+            settings: &settings,
+            cfg,
+            model,
+        },
+        &|_, _| {},
+    )
+    .unwrap()
 }
 
 #[test]
@@ -139,7 +150,11 @@ fn simulated_pixels_equal_the_renderers() {
     for wl in [Workload::Cast, Workload::Path] {
         let settings = RenderSettings::new(24, 16, wl);
         for accel in SimAccel::ALL {
-            let r = simulate(&scene, &s, accel, &settings, &cfg, &|_, _| {}).unwrap();
+            let r = simulate(
+                &FrameRequest::new(&scene, &s, accel, &settings, &cfg),
+                &|_, _| {},
+            )
+            .unwrap();
             let mut rays = 0;
             for y in 0..16 {
                 for x in 0..24 {
@@ -183,7 +198,20 @@ fn dst_and_dst_sw_pixels_equal_the_renderers_and_use_their_units() {
     let cfg = tiny();
     for wl in [Workload::Cast, Workload::Path] {
         let settings = RenderSettings::new(24, 16, wl);
-        let sim = |m, a| simulate_model(m, &scene, &s, a, &settings, &cfg, &|_, _| {}).unwrap();
+        let sim = |m, a| {
+            simulate(
+                &FrameRequest {
+                    scene: &scene,
+                    structures: &s,
+                    accel: a,
+                    settings: &settings,
+                    cfg: &cfg,
+                    model: m,
+                },
+                &|_, _| {},
+            )
+            .unwrap()
+        };
         let hw = sim(ThreadModel::Fast, SimAccel::Dst);
         let sw = sim(ThreadModel::Fast, SimAccel::DstSw);
         let (hw_rv32, sw_rv32) = (
@@ -291,7 +319,13 @@ fn parallel_box_pipelines_issue_once_per_node() {
 fn empty_frame_is_an_error() {
     let (scene, s) = scene();
     let settings = RenderSettings::new(0, 16, Workload::Cast);
-    assert!(simulate(&scene, &s, SimAccel::Dst, &settings, &tiny(), &|_, _| {}).is_err());
+    assert!(
+        simulate(
+            &FrameRequest::new(&scene, &s, SimAccel::Dst, &settings, &tiny()),
+            &|_, _| {}
+        )
+        .is_err()
+    );
 }
 
 /// A memory-heavy synthetic stream through the engine directly (the placeholder traversal
@@ -299,8 +333,10 @@ fn empty_frame_is_an_error() {
 mod synthetic {
     use dualsplit_geometry::Pcg32;
     use dualsplit_sim::SimConfig;
-    use dualsplit_sim::kernel::{Op, Pipe};
-    use dualsplit_sim::{Chip, Thread, WorkSource, run_chip};
+    use dualsplit_sim::hw::{Chip, pipe::Pipe};
+    use dualsplit_sim::model::fast::op::Op;
+    use dualsplit_sim::model::fast::replay::{WorkSource, run as run_chip};
+    use dualsplit_sim::model::fast::thread::Thread;
 
     struct Random {
         rng: Pcg32,
@@ -387,19 +423,37 @@ fn one_tree_simulates_as_every_structure() {
                 assert!(r.cycles > 0 && r.rays > 0);
                 format!("{r:?}")
             };
-            let want =
-                go(&|| simulate_model(model, &scene, &s, accel, &settings, &cfg, &|_, _| {}));
-            let got =
-                go(&|| simulate_model(model, &scene, &dst, accel, &settings, &cfg, &|_, _| {}));
+            let want = go(&|| {
+                simulate(
+                    &FrameRequest {
+                        scene: &scene,
+                        structures: &s,
+                        accel,
+                        settings: &settings,
+                        cfg: &cfg,
+                        model,
+                    },
+                    &|_, _| {},
+                )
+            });
+            let got = go(&|| {
+                simulate(
+                    &FrameRequest {
+                        scene: &scene,
+                        structures: &dst,
+                        accel,
+                        settings: &settings,
+                        cfg: &cfg,
+                        model,
+                    },
+                    &|_, _| {},
+                )
+            });
             assert!(got == want, "{model:?} {accel:?}: the results differ");
         }
     }
     let e = simulate(
-        &scene,
-        &dst,
-        SimAccel::Bvh4Plus,
-        &settings,
-        &cfg,
+        &FrameRequest::new(&scene, &dst, SimAccel::Bvh4Plus, &settings, &cfg),
         &|_, _| {},
     )
     .unwrap_err();

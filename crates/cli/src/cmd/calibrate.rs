@@ -5,7 +5,7 @@
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_sim::SimConfig;
-use dualsplit_sim::calibrate::{FRAMES, calibrate, to_toml};
+use dualsplit_sim::model::fast::calibrate::{FRAMES, calibrate, to_toml};
 use std::path::PathBuf;
 use std::process::ExitCode;
 

@@ -97,13 +97,15 @@ pub fn simulate_entry(
         structure_bytes(&structures, AccelKind::Dst).map_err(fail)?;
     }
     let settings = RenderSettings::new(entry.width, entry.height, entry.workload);
-    dualsplit_sim::simulate_model(
-        entry.thread_model,
-        &scene,
-        &structures,
-        entry.accel,
-        &settings,
-        &entry.config,
+    dualsplit_sim::simulate(
+        &dualsplit_sim::FrameRequest {
+            scene: &scene,
+            structures: &structures,
+            accel: entry.accel,
+            settings: &settings,
+            cfg: &entry.config,
+            model: entry.thread_model,
+        },
         progress,
     )
     .map_err(|e| fail(format!("simulating: {e}")))

@@ -17,7 +17,7 @@ use anyhow::Context;
 use dualsplit_accel::TraversalSet;
 use dualsplit_render::{RenderSettings, Workload};
 use dualsplit_report::units;
-use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel, simulate_model};
+use dualsplit_sim::{FrameRequest, SimAccel, SimConfig, SimResult, ThreadModel, simulate};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use summary::{Summary, summarize};
@@ -129,13 +129,15 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         let total = settings.width as u64 * settings.height as u64;
         let bar = ctx.bar(total, format!("{} {}", accel.label(), workload.name()));
         let t0 = Instant::now();
-        let r = simulate_model(
-            model,
-            &scene,
-            &structures,
-            accel,
-            &settings,
-            &cfg,
+        let r = simulate(
+            &FrameRequest {
+                scene: &scene,
+                structures: &structures,
+                accel,
+                settings: &settings,
+                cfg: &cfg,
+                model,
+            },
             &|done, _| bar.set_position(done),
         )
         .with_context(|| format!("simulating {}", accel.label()))?;

@@ -1,0 +1,92 @@
+//! One simulated frame: the request and the entry point.
+
+use crate::accel::SimAccel;
+use crate::config::SimConfig;
+use crate::error::SimError;
+use crate::footprint;
+use crate::model::{ThreadModel, fast, rv32};
+use crate::result::SimResult;
+use dualsplit_accel::TraversalSet;
+use dualsplit_render::RenderSettings;
+use dualsplit_scene::Scene;
+
+/// One frame to simulate: the scene and its structures, the configuration simulated, the
+/// frame's workload and size, the chip, and how its threads execute their kernel.
+#[derive(Clone, Copy)]
+pub struct FrameRequest<'a, S> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Its structures (a [`dualsplit_accel::Structures`] or one saved tree).
+    pub structures: &'a S,
+    /// The configuration simulated.
+    pub accel: SimAccel,
+    /// Workload, resolution, samples, camera and light.
+    pub settings: &'a RenderSettings,
+    /// The chip.
+    pub cfg: &'a SimConfig,
+    /// How the threads execute their kernel.
+    pub model: ThreadModel,
+}
+
+impl<'a, S: TraversalSet> FrameRequest<'a, S> {
+    /// A request for `accel` on the reference thread model ([`ThreadModel::Rv32`]).
+    pub fn new(
+        scene: &'a Scene,
+        structures: &'a S,
+        accel: SimAccel,
+        settings: &'a RenderSettings,
+        cfg: &'a SimConfig,
+    ) -> Self {
+        Self {
+            scene,
+            structures,
+            accel,
+            settings,
+            cfg,
+            model: ThreadModel::Rv32,
+        }
+    }
+
+    /// The same request with thread model `model`.
+    pub fn with_model(self, model: ThreadModel) -> Self {
+        Self { model, ..self }
+    }
+
+    /// Pixels in the frame.
+    pub fn pixels(&self) -> u64 {
+        self.settings.width as u64 * self.settings.height as u64
+    }
+}
+
+/// Simulates one frame; `progress` is called with (pixels done, pixels total).
+pub fn simulate<S: TraversalSet>(
+    frame: &FrameRequest<'_, S>,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<SimResult, SimError> {
+    let FrameRequest {
+        structures,
+        accel,
+        settings,
+        cfg,
+        model,
+        ..
+    } = *frame;
+    cfg.validate()?;
+    if !structures.supports(accel.kind()) {
+        return Err(SimError::Unsupported {
+            accel: accel.label(),
+            available: structures.kind_names(),
+        });
+    }
+    if settings.width == 0 || settings.height == 0 {
+        return Err(SimError::EmptyFrame {
+            width: settings.width,
+            height: settings.height,
+        });
+    }
+    footprint::check(cfg, accel, model, frame.pixels())?;
+    match model {
+        ThreadModel::Rv32 => rv32::frame::run(frame, progress),
+        ThreadModel::Fast => fast::frame::run(frame, progress),
+    }
+}

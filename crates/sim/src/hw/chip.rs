@@ -1,0 +1,113 @@
+//! The chip: its units, and the requests a thread makes of them.
+//!
+//! Hardware (Lin et al. 2020, §2.3, §4, Table 1): `tms` thread multiprocessors of
+//! `tps_per_tm` thread processors each; each TM has its L1, pipelines, reciprocal unit and
+//! functional-unit pools ([`Tm`]); all TMs share the L2 and the DRAM ([`L2`]) and the global
+//! atomic unit from which threads take their pixels ([`AtomicUnit`]). A thread model drives
+//! them through [`Chip::units`]; the event loop is `engine::run`.
+
+use crate::config::SimConfig;
+use crate::hw::atomic::AtomicUnit;
+use crate::hw::counts::UnitStats;
+use crate::hw::memory::{CacheStats, DramStats, L2};
+use crate::hw::stalls::Stalls;
+use crate::hw::tm::Tm;
+
+/// The chip's units.
+pub struct Chip {
+    tms: Vec<Tm>,
+    l2: L2,
+    atomic: AtomicUnit,
+    stalls: Stalls,
+}
+
+/// The units one thread drives: its TM's, the L2 behind them, the chip's atomic unit, and
+/// the counters of where the threads' cycles went.
+pub struct Units<'a> {
+    /// The thread's TM.
+    pub tm: &'a mut Tm,
+    /// The L2 (for the TM's misses).
+    pub l2: &'a mut L2,
+    /// The global atomic unit.
+    pub atomic: &'a mut AtomicUnit,
+    /// The threads' stall counters.
+    pub stalls: &'a mut Stalls,
+}
+
+/// The chip's counters.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ChipStats {
+    /// L1 and L2 counters, summed over the TMs.
+    pub caches: CacheStats,
+    /// Pipeline and reciprocal-unit ops, summed over the TMs.
+    pub units: UnitStats,
+    /// Where the threads' cycles went, summed over the threads.
+    pub stalls: Stalls,
+    /// DRAM counters.
+    pub dram: DramStats,
+}
+
+impl Chip {
+    /// A cold chip; `box_pipes` ray-box pipelines per TM (the "+" configurations use the
+    /// node arity).
+    pub fn new(cfg: &SimConfig, box_pipes: u32) -> Self {
+        Self {
+            tms: (0..cfg.tms).map(|_| Tm::new(cfg, box_pipes)).collect(),
+            l2: L2::new(cfg),
+            atomic: AtomicUnit::new(cfg.units.atomic_latency),
+            stalls: Stalls::default(),
+        }
+    }
+
+    /// The units a thread on TM `tm` drives.
+    #[inline(always)]
+    pub fn units(&mut self, tm: usize) -> Units<'_> {
+        Units {
+            tm: &mut self.tms[tm],
+            l2: &mut self.l2,
+            atomic: &mut self.atomic,
+            stalls: &mut self.stalls,
+        }
+    }
+
+    /// TM `tm` and the L2, read-only (host prefetch hints).
+    #[inline(always)]
+    pub fn tm(&self, tm: usize) -> (&Tm, &L2) {
+        (&self.tms[tm], &self.l2)
+    }
+
+    /// Sets the thread-cycles spent idle at the end of the frame.
+    pub fn set_idle(&mut self, idle: u64) {
+        self.stalls.idle = idle;
+    }
+
+    /// Adds stall cycles a thread model accounts for itself (the `fast` model's measured
+    /// dependency and pipeline-latency stalls).
+    pub fn add_stalls(&mut self, dependency: u64, pipeline_latency: u64) {
+        self.stalls.dependency += dependency;
+        self.stalls.pipeline_latency += pipeline_latency;
+    }
+
+    /// The counters so far.
+    pub fn stats(&self) -> ChipStats {
+        let mut s = ChipStats {
+            stalls: self.stalls,
+            dram: self.l2.dram_stats(),
+            ..ChipStats::default()
+        };
+        for tm in &self.tms {
+            tm.add_stats(&mut s.caches, &mut s.units);
+        }
+        self.l2.add_stats(&mut s.caches);
+        s
+    }
+
+    /// One word load by TM `tm` whose L1 bank slot is `slot` (already reserved): the cycle
+    /// the data is in the register.
+    #[cfg(test)]
+    pub(crate) fn load_word(&mut self, tm: usize, word: u64, slot: u64) -> u64 {
+        self.tms[tm]
+            .load_word(&mut self.l2, word, crate::hw::Cycle(slot))
+            .get()
+    }
+}

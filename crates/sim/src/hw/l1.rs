@@ -1,0 +1,213 @@
+//! A TM's L1 data cache controller (Lin et al. 2020, §2.3, Table 1; SimTRaX `L1Cache.cc`):
+//! direct-mapped by default, `l1.banks` word banks (bank = word address mod the bank count,
+//! one access per bank per cycle); a hit returns its word `l1.hit_latency` cycles after its
+//! bank slot, a miss goes to the shared [`L2`] and the line is installed when its fill
+//! arrives; a miss to a line in flight waits for that fill (no second L2 access). Stores
+//! are write-around.
+
+use crate::config::CacheConfig;
+use crate::hw::Cycle;
+use crate::hw::addr::WordAddr;
+use crate::hw::issued::Issued;
+use crate::hw::memory::{Cache, CacheStats, L2, Lookup};
+use crate::hw::slots::{self, BankSlots};
+
+/// One TM's L1: tags, bank reservation tables and counters.
+pub struct L1 {
+    cache: Cache,
+    banks: BankSlots,
+    /// `l1.banks − 1` (a power of two).
+    bank_mask: u64,
+    /// log2(words per line).
+    line_word_shift: u32,
+    latency: u64,
+    accesses: u64,
+    hits: u64,
+    merged: u64,
+}
+
+impl L1 {
+    /// A cold L1 of configuration `cfg`.
+    pub fn new(cfg: &CacheConfig) -> Self {
+        Self {
+            cache: Cache::new(cfg.size_bytes, cfg.line_bytes, cfg.associativity),
+            banks: BankSlots::new(cfg.banks),
+            bank_mask: cfg.banks as u64 - 1,
+            line_word_shift: (cfg.line_bytes / 4).trailing_zeros(),
+            latency: cfg.hit_latency,
+            accesses: 0,
+            hits: 0,
+            merged: 0,
+        }
+    }
+
+    /// A load of `words` consecutive words from `addr`, one word per issue slot from cycle
+    /// `at` (`now ≤ at` is the current event time: no later request starts before it).
+    /// Each word takes its L1 bank's first free cycle at or after its turn; the words of one
+    /// line segment share one tag lookup (later words see what a second lookup would: a hit
+    /// once the fill has arrived, merged before). `ready` is when the last word is in the
+    /// register, `busy` the cycles lost to bank conflicts.
+    ///
+    /// Host speed: a segment whose banks are all free in its cycles is placed with one
+    /// bitmap test ([`BankSlots::try_run`]) and its words are counted at once; only a bank
+    /// conflict takes the word-by-word path.
+    #[inline(always)]
+    pub fn load(
+        &mut self,
+        l2: &mut L2,
+        addr: WordAddr,
+        words: u64,
+        at: Cycle,
+        now: Cycle,
+    ) -> Issued {
+        let shift = self.line_word_shift;
+        let mut c = at;
+        let mut w = addr.0;
+        let end = w + words;
+        let (mut ready, mut busy) = (Cycle::ZERO, 0);
+        while w < end {
+            let seg_end = (((w >> shift) + 1) << shift).min(end);
+            let k = seg_end - w;
+            let (last, r) = if self.banks.try_run(w & self.bank_mask, c.get(), k) {
+                let (r, fill) = self.first_word(l2, w, c, now);
+                self.count_words(c + 1, k - 1, fill);
+                (c + k - 1, r.max(fill))
+            } else {
+                let (last, r, stall) = self.segment_conflict(l2, w, k, c, now);
+                busy += stall;
+                (last, r)
+            };
+            ready = ready.max(r).max(last + self.latency);
+            c = last + 1;
+            w = seg_end;
+        }
+        Issued {
+            next_issue: c,
+            ready,
+            busy,
+        }
+    }
+
+    /// A store of `words` words from `addr` issued from cycle `at`: write-around (the L1
+    /// neither allocates nor updates a line; the data goes on to memory), each word taking
+    /// its L1 bank slot like a load's. The thread does not wait for it: `ready` is the last
+    /// word's bank slot. The memory beyond the L1 is not modelled for stores (as SimTRaX,
+    /// which counts no write traffic).
+    pub fn store(&mut self, addr: WordAddr, words: u64, at: Cycle, now: Cycle) -> Issued {
+        let shift = self.line_word_shift;
+        let (mut c, mut w, end, mut busy) = (at, addr.0, addr.0 + words, 0);
+        while w < end {
+            let seg_end = (((w >> shift) + 1) << shift).min(end);
+            let k = seg_end - w;
+            let run = (self.banks).reserve_run(w & self.bank_mask, c.get(), k, now.get(), 0);
+            busy += run.stall;
+            c = Cycle(run.last + 1);
+            w = seg_end;
+        }
+        Issued {
+            next_issue: c,
+            ready: Cycle(c.get().saturating_sub(1)).max(at),
+            busy,
+        }
+    }
+
+    /// Reads (without effect) the L1 tag and, when the L1 holds another line there, the L2
+    /// tag of `addr`'s line, and returns a value to keep the reads: the event loop calls it
+    /// for the coming loads of a wake-up cycle so the host cache misses of their lookups
+    /// overlap. Changes nothing simulated.
+    #[inline]
+    pub fn touch(&self, l2: &L2, addr: WordAddr) -> u64 {
+        let line = addr.0 >> self.line_word_shift;
+        let l1 = self.cache.peek(line);
+        // Most loads hit the L1 and never read the L2's tags (1 MB at random).
+        if l1 == line { l1 } else { l1 ^ l2.peek(line) }
+    }
+
+    /// The first word of a line segment, at its bank slot `slot`: the tag lookup, and on a
+    /// miss the L2 read and the line's installation at its fill. Returns the cycle the word
+    /// is in the register and the line's fill cycle.
+    #[inline(always)]
+    fn first_word(&mut self, l2: &mut L2, w: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
+        self.accesses += 1;
+        let line = w >> self.line_word_shift;
+        match self.cache.lookup(line, slot) {
+            Lookup::Present { fill } if fill <= slot => {
+                self.hits += 1;
+                (slot + self.latency, fill)
+            }
+            Lookup::Present { fill } => {
+                self.merged += 1;
+                (fill.max(slot + self.latency), fill)
+            }
+            Lookup::Absent => self.miss(l2, line, w, slot, now),
+        }
+    }
+
+    #[inline(never)]
+    fn miss(&mut self, l2: &mut L2, line: u64, w: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
+        let ready = l2.read(line, w, slot, now);
+        self.cache.install(line, ready, slot);
+        (ready, ready)
+    }
+
+    /// Counts `n` words of a line filled at `fill`, at consecutive cycles from `c`: hits
+    /// from the fill on, merged before.
+    #[inline(always)]
+    fn count_words(&mut self, c: Cycle, n: u64, fill: Cycle) {
+        let hits = slots::at_or_after(c.get(), n, fill.get());
+        self.accesses += n;
+        self.hits += hits;
+        self.merged += n - hits;
+    }
+
+    /// A line segment of `k` words from `w` (issue from cycle `c`) some of whose banks are
+    /// busy: the first word takes its bank's first free cycle and looks the line up, the
+    /// rest are placed after it word by word. Returns the last word's cycle, the cycle the
+    /// data is in the register, and the bank stall.
+    #[inline(never)]
+    fn segment_conflict(
+        &mut self,
+        l2: &mut L2,
+        w: u64,
+        k: u64,
+        c: Cycle,
+        now: Cycle,
+    ) -> (Cycle, Cycle, u64) {
+        let slot = Cycle(
+            self.banks
+                .reserve_word(w & self.bank_mask, c.get(), now.get()),
+        );
+        let mut stall = slot - c;
+        let (r, fill) = self.first_word(l2, w, slot, now);
+        let mut last = slot;
+        if k > 1 {
+            let run = self.banks.reserve_run(
+                (w + 1) & self.bank_mask,
+                slot.get() + 1,
+                k - 1,
+                now.get(),
+                fill.get(),
+            );
+            stall += run.stall;
+            last = Cycle(run.last);
+            let hits = run.at_or_after;
+            self.accesses += k - 1;
+            self.hits += hits;
+            self.merged += k - 1 - hits;
+        }
+        (last, r.max(fill), stall)
+    }
+
+    /// One word load at bank slot `slot` (already reserved): the cycle the data is in the
+    /// register.
+    #[cfg(test)]
+    pub(crate) fn load_word(&mut self, l2: &mut L2, word: u64, slot: Cycle) -> Cycle {
+        self.first_word(l2, word, slot, Cycle::ZERO).0
+    }
+    /// Adds the L1's counters to `caches`.
+    pub fn add_stats(&self, caches: &mut CacheStats) {
+        caches.l1_accesses += self.accesses;
+        caches.l1_hits += self.hits;
+        caches.l1_merged += self.merged;
+    }
+}

@@ -1,0 +1,858 @@
+//! GDDR5 main memory: channels of banks with open rows, per-channel data bus, read queue
+//! (SimTRaX's USIMM configuration `gddr5_8ch.cfg` and timing file `1Gb_x16_amd2GHz.vi`;
+//! USIMM `memory_controller.cc`, `scheduler.cc`).
+//!
+//! Address mapping (SimTRaX mapping 1), from the low bits up: line offset → column →
+//! channel → bank → row, so one row of one channel holds `row_bytes` contiguous bytes.
+//!
+//! Each read is reserved when it arrives (immediate response, Eyerman et al. 2021):
+//!
+//! * **row hit** (bank's open row): column command at the bank's next column slot;
+//! * **closed** (no open row): activate, then after t_RCD the column command;
+//! * **conflict** (another row open): precharge (≥ t_RAS after its activate, ≥ t_RTP after
+//!   its last read), activate after t_RP (≥ t_RC after the previous activate, ≥ t_RRD after
+//!   the channel's previous activate), column command after t_RCD;
+//!
+//! then the data leaves t_CAS later in the channel bus's first free burst slot (slots are
+//! t_burst long; a later-reserved row hit may fill a gap before an earlier conflict's data).
+//! A full read queue delays the request until the first of its channel's in-flight reads
+//! completes (back-pressure). The queue is kept on the bus table itself: each in-flight
+//! read is marked *pending* on its data-bus slot, which is also its completion time.
+//!
+//! **Row-hit-first scheduling (FR-FCFS).** Each bank keeps its schedule as a short list of
+//! row *epochs*: the row, its activation tick and the last tick a column command may use it
+//! (`close`: the next epoch's activation − t_RP − t_RTP; open-ended for the last epoch).
+//! A read to a row that is open in an epoch still ahead of it is served there as a row hit
+//! — in front of the older reads that caused the next epoch's precharge — provided its
+//! column command (delayed to its data-bus slot) fits before `close`. That is what an
+//! FR-FCFS controller does with the requests queued while t_RAS / t_RC / t_RRD hold a row
+//! open: the oldest request to the open row goes first, the oldest conflict when none is
+//! left. Because every read learns its completion when it arrives (the reservation model),
+//! a row hit never *extends* an epoch: already promised later epochs keep their times, so a
+//! hit arriving after `close` opens a new epoch like any conflict.
+//!
+//! **Host cost.** A DRAM read is on the replay's hot path (1.5 per node visit in the
+//! synthetic bench), so the state a read touches is kept small and in few host cache lines:
+//! the bank record is one 64-byte line holding the open row, the earliest epoch's expiry
+//! tick and a 64-bit summary of the earlier epochs' rows, so most reads neither expire nor
+//! scan epochs; the epochs themselves (16 bytes each) sit in one slab of per-bank rings; the
+//! read queue is a bit plane of the bus table; the bus and t_RRD tables
+//! ([`SparseSlots`]) settle most requests with one inline word test. The tests keep a
+//! plain implementation of the same model (heap, `VecDeque`, plain sets) as a reference and
+//! compare every read's result on random streams.
+
+use crate::config::DramConfig;
+use crate::hw::slots::SparseSlots;
+use crate::hw::{Cycle, Tick};
+use serde::{Deserialize, Serialize};
+
+/// How a read found its bank.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DramAccess {
+    /// The row was open.
+    RowHit,
+    /// No row was open.
+    Closed,
+    /// Another row was open.
+    Conflict,
+}
+
+/// Counters of the DRAM.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DramStats {
+    /// 64-byte reads served.
+    pub reads: u64,
+    /// Row activations.
+    pub activations: u64,
+    /// Reads that hit the open row.
+    pub row_hits: u64,
+    /// Reads to a closed bank.
+    pub row_closed: u64,
+    /// Reads that had to close another row.
+    pub row_conflicts: u64,
+    /// Core cycles reads spent waiting for a read-queue entry (summed over reads).
+    pub queue_wait_cycles: u64,
+    /// Sum over reads of (completion − arrival) in core cycles.
+    pub latency_cycles: u64,
+    /// Core cycle of the last completion.
+    pub last_done: Cycle,
+}
+
+/// A row's time open in a bank's schedule. Its `close` (the last tick a column command
+/// may read it) is the next epoch's activate − t_RP − t_RTP, open-ended for the last
+/// epoch: it is derived from the next entry rather than stored, so an epoch is 16 bytes
+/// and opening one writes nothing else.
+#[derive(Clone, Copy, Debug)]
+struct Epoch {
+    row: u64,
+    /// Tick of its activate.
+    act: Tick,
+}
+
+/// Ticks an epoch is kept after its `close` (reads arrive slightly out of order: fluffy
+/// time).
+const EPOCH_KEEP: u64 = 256;
+
+/// `Bank::open_row` when no row is open (rows are line numbers / 128 or less: < 2^58).
+const NO_ROW: u64 = u64::MAX;
+
+/// One bank: 64 bytes, one host cache line. Its row epochs are a ring in [`Epochs`]; the
+/// record keeps what most reads need so that they do not touch the ring: when the
+/// earliest epoch expires, and which rows the earlier epochs hold.
+#[derive(Clone, Debug)]
+#[repr(align(64))]
+struct Bank {
+    /// The open row (the last epoch's), or [`NO_ROW`].
+    open_row: u64,
+    /// Tick of the last activate.
+    act: Tick,
+    /// Earliest tick of the next column command.
+    col_ready: Tick,
+    /// Tick of the last column command (for t_RTP).
+    last_col: Tick,
+    /// The earliest epoch expires once a read's tick exceeds this: its close (the next
+    /// epoch's activate − t_RP − t_RTP) + [`EPOCH_KEEP`]; `Tick::MAX` while only one epoch
+    /// is live.
+    expiry: Tick,
+    /// Bit `row mod 64` set for each live epoch but the last (and possibly for expired
+    /// ones: refreshed whenever a read scans them all), so a read whose bit is clear has no
+    /// earlier epoch of its row to try.
+    rows: u64,
+    /// Ring position of the earliest live epoch.
+    head: u32,
+    /// Live epochs (`0` before the first activate).
+    len: u32,
+}
+
+impl Default for Bank {
+    fn default() -> Self {
+        Self {
+            open_row: NO_ROW,
+            act: Tick(0),
+            col_ready: Tick(0),
+            last_col: Tick(0),
+            expiry: Tick::MAX,
+            rows: 0,
+            head: 0,
+            len: 0,
+        }
+    }
+}
+
+/// Every bank's live row epochs, oldest first: bank `b`'s ring is
+/// `slab[b · cap .. (b + 1) · cap]` (`cap` a power of two, doubled for all banks the first
+/// time one needs more), so opening an epoch writes 16 bytes and no allocation is touched.
+#[derive(Clone, Debug)]
+struct Epochs {
+    slab: Vec<Epoch>,
+    /// log2(`cap`).
+    shift: u32,
+}
+
+impl Epochs {
+    fn new(banks: usize) -> Self {
+        let shift = 3;
+        Self {
+            slab: vec![
+                Epoch {
+                    row: 0,
+                    act: Tick(0),
+                };
+                banks << shift
+            ],
+            shift,
+        }
+    }
+
+    /// Slab index of bank `b`'s `i`-th live epoch.
+    #[inline]
+    fn at(&self, b: usize, bank: &Bank, i: u32) -> usize {
+        let mask = (1u32 << self.shift) - 1;
+        (b << self.shift) + (bank.head.wrapping_add(i) & mask) as usize
+    }
+
+    /// `expiry` for bank `b` whose epochs are as they are now (`gap` = t_RP + t_RTP).
+    #[inline]
+    fn expiry(&self, b: usize, bank: &Bank, gap: u64) -> Tick {
+        if bank.len < 2 {
+            Tick::MAX
+        } else {
+            (self.slab[self.at(b, bank, 1)].act - gap).saturating_add(EPOCH_KEEP)
+        }
+    }
+
+    /// Drops bank `b`'s epochs closed more than [`EPOCH_KEEP`] ticks before tick `a` (the
+    /// last epoch never closes).
+    #[inline]
+    fn expire(&self, b: usize, bank: &mut Bank, a: Tick, gap: u64) {
+        if bank.expiry < a {
+            self.expire_slow(b, bank, a, gap);
+        }
+    }
+
+    #[inline]
+    fn expire_slow(&self, b: usize, bank: &mut Bank, a: Tick, gap: u64) {
+        while bank.expiry < a {
+            bank.head = bank.head.wrapping_add(1);
+            bank.len -= 1;
+            bank.expiry = self.expiry(b, bank, gap);
+        }
+    }
+
+    /// Opens `row` at tick `act` in bank `b` (the bank's open row and activate are still
+    /// the previous epoch's; its ring has room: [`Dram::read_at`] grows it first).
+    #[inline]
+    fn push(&mut self, b: usize, bank: &mut Bank, row: u64, act: Tick, gap: u64) {
+        debug_assert!(bank.len < 1 << self.shift);
+        let i = self.at(b, bank, bank.len);
+        self.slab[i] = Epoch { row, act };
+        if bank.len > 0 {
+            bank.rows |= 1 << (bank.open_row & 63);
+        }
+        bank.len += 1;
+        if bank.len == 2 {
+            bank.expiry = (act - gap).saturating_add(EPOCH_KEEP);
+        }
+    }
+
+    /// Doubles every bank's ring; each ring starts at position 0 afterwards.
+    #[cold]
+    fn grow(&mut self, banks: &mut [Bank]) {
+        let shift = self.shift + 1;
+        let mut slab = vec![
+            Epoch {
+                row: 0,
+                act: Tick(0),
+            };
+            banks.len() << shift
+        ];
+        for (b, bank) in banks.iter_mut().enumerate() {
+            for i in 0..bank.len {
+                slab[(b << shift) + i as usize] = self.slab[self.at(b, bank, i)];
+            }
+            bank.head = 0;
+        }
+        (self.slab, self.shift) = (slab, shift);
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+struct Channel {
+    /// Data-bus reservations in units of one burst (t_burst ticks). The read queue is the
+    /// bus's pending plane: a read in flight is marked pending on its bus slot `s`, and its
+    /// data is complete at tick `(s + 1) · t_burst` (every read has a slot of its own, so
+    /// the earliest pending slot is the earliest completion).
+    bus: SparseSlots<2>,
+    /// Activations, each holding t_RRD ticks (minimum spacing between activations).
+    acts: SparseSlots,
+}
+
+/// The DRAM system.
+#[derive(Clone, Debug)]
+pub struct Dram {
+    cfg: DramConfig,
+    banks: Vec<Bank>,
+    epochs: Epochs,
+    channels: Vec<Channel>,
+    col_bits: u32,
+    ch_bits: u32,
+    bank_bits: u32,
+    /// Divisions by t_burst and by ticks_per_cycle.
+    burst: Divisor,
+    tpc: Divisor,
+    stats: DramStats,
+}
+
+/// Division by a timing constant: a shift when it is a power of two (t_burst = 4 and
+/// ticks_per_cycle = 2 in the shipped configs), otherwise a division. A 64-bit division
+/// costs tens of cycles on the host and `read_at` makes several per DRAM read.
+#[derive(Clone, Copy, Debug)]
+struct Divisor {
+    d: u64,
+    shift: Option<u32>,
+}
+
+impl Divisor {
+    fn new(d: u64) -> Self {
+        Self {
+            d,
+            shift: d.is_power_of_two().then(|| d.trailing_zeros()),
+        }
+    }
+
+    /// `x / d`.
+    #[inline(always)]
+    fn div(self, x: u64) -> u64 {
+        match self.shift {
+            Some(s) => x >> s,
+            None => x / self.d,
+        }
+    }
+
+    /// `x.div_ceil(d)`.
+    #[inline(always)]
+    fn div_ceil(self, x: u64) -> u64 {
+        match self.shift {
+            Some(s) => (x >> s) + u64::from(x & (self.d - 1) != 0),
+            None => x.div_ceil(self.d),
+        }
+    }
+}
+
+impl Dram {
+    /// All banks closed, all buses idle.
+    pub fn new(cfg: &DramConfig) -> Self {
+        Self {
+            cfg: cfg.clone(),
+            banks: vec![Bank::default(); (cfg.channels * cfg.banks_per_channel) as usize],
+            epochs: Epochs::new((cfg.channels * cfg.banks_per_channel) as usize),
+            channels: vec![Channel::default(); cfg.channels as usize],
+            col_bits: (cfg.row_bytes / 64).trailing_zeros(),
+            ch_bits: cfg.channels.trailing_zeros(),
+            bank_bits: cfg.banks_per_channel.trailing_zeros(),
+            burst: Divisor::new(cfg.t_burst),
+            tpc: Divisor::new(cfg.ticks_per_cycle),
+            stats: DramStats::default(),
+        }
+    }
+
+    /// (channel, bank, row) of a line number (byte address / 64).
+    pub fn map(&self, line: u64) -> (usize, usize, u64) {
+        let (ch, b, row) = self.locate(line);
+        (ch, b >> self.ch_bits, row)
+    }
+
+    /// The mapping of [`Dram::map`] as indices: (channel, bank record, row), bank records
+    /// numbered bank · channels + channel, so both indices are masks of the same bits by
+    /// power-of-two table lengths (and the indexing needs no bounds test).
+    #[inline]
+    fn locate(&self, line: u64) -> (usize, usize, u64) {
+        let x = line >> self.col_bits;
+        (
+            x as usize & (self.channels.len() - 1),
+            x as usize & (self.banks.len() - 1),
+            x >> (self.ch_bits + self.bank_bits),
+        )
+    }
+
+    /// Reads `line` arriving at core cycle `arrive`; returns the core cycle its data has
+    /// arrived and how the bank was found.
+    pub fn read(&mut self, line: u64, arrive: Cycle) -> (Cycle, DramAccess) {
+        self.read_at(line, arrive, Cycle::ZERO)
+    }
+
+    /// As [`Dram::read`], when no read will ever arrive before core cycle `now` (the
+    /// engine's current event time, `now ≤ arrive`): the channel's reservation tables then
+    /// forget what ended before it. The result is the same as `read`'s.
+    pub fn read_at(&mut self, line: u64, arrive: Cycle, now: Cycle) -> (Cycle, DramAccess) {
+        debug_assert!(now <= arrive);
+        let c = &self.cfg;
+        let tpc = c.ticks_per_cycle;
+        let (chi, b, row) = self.locate(line);
+        // Room for one more epoch in the bank's ring (this read opens at most one).
+        if self.banks[b].len == 1 << self.epochs.shift {
+            self.epochs.grow(&mut self.banks);
+        }
+        let ch = &mut self.channels[chi];
+        let floor = now.to_ticks(tpc).get();
+        ch.bus.forget_before(self.burst.div(floor));
+        ch.acts.forget_before(floor);
+        // The read's tick; the schedule below is in ticks.
+        let mut a = arrive.to_ticks(tpc);
+        // Reads complete by `a` leave the queue: slot `s` completes at (s + 1) · t_burst ≤ a,
+        // i.e. s < ⌊a / t_burst⌋ (every pending slot is at or after the bus floor, which
+        // is at most that: the floor comes from `now ≤ arrive`).
+        ch.bus.retire_before(self.burst.div(a.get()));
+        if ch.bus.pending() >= c.read_queue
+            && let Some(s) = ch.bus.retire_first()
+        {
+            let d = Tick(s * c.t_burst + c.t_burst);
+            self.stats.queue_wait_cycles += self.tpc.div_ceil(d - a);
+            a = d;
+        }
+        let bank = &mut self.banks[b];
+        let gap = c.t_rp + c.t_rtp;
+        let epochs = &mut self.epochs;
+        epochs.expire(b, bank, a, gap);
+        // Row-hit-first: an earlier epoch of this row still ahead of the read serves it
+        // (the last epoch is the open row's).
+        if bank.open_row != row && bank.rows & 1 << (row & 63) != 0 {
+            let mut hit = None;
+            let mut rows = 0;
+            for i in 0..bank.len - 1 {
+                let e = epochs.slab[epochs.at(b, bank, i)];
+                rows |= 1 << (e.row & 63);
+                if e.row != row {
+                    continue;
+                }
+                let close = epochs.slab[epochs.at(b, bank, i + 1)].act - gap;
+                let col = a.max(e.act + c.t_rcd);
+                if col > close {
+                    continue;
+                }
+                // The column command waits for its data-bus slot (t_CAS before it).
+                let slot = ch.bus.peek(self.burst.div_ceil((col + c.t_cas).get()));
+                if Tick(slot * c.t_burst) - c.t_cas <= close {
+                    hit = Some(slot);
+                    break;
+                }
+            }
+            if hit.is_none() {
+                bank.rows = rows;
+            }
+            if let Some(slot) = hit {
+                ch.bus.reserve_pending(slot);
+                let done = Tick(slot * c.t_burst + c.t_burst);
+                return self.finish(arrive, done, DramAccess::RowHit);
+            }
+        }
+        let (col, kind) = match bank.open_row {
+            r if r == row => (a.max(bank.col_ready), DramAccess::RowHit),
+            open => {
+                let mut act = a;
+                let kind = if open != NO_ROW {
+                    let pre = a.max(bank.act + c.t_ras).max(bank.last_col + c.t_rtp);
+                    act = pre + c.t_rp;
+                    DramAccess::Conflict
+                } else {
+                    DramAccess::Closed
+                };
+                if open != NO_ROW || bank.act > Tick(0) {
+                    act = act.max(bank.act + c.t_rc);
+                }
+                act = Tick(ch.acts.reserve_span(act.get(), c.t_rrd.max(1)));
+                epochs.push(b, bank, row, act, gap);
+                bank.act = act;
+                bank.open_row = row;
+                ((act + c.t_rcd).max(bank.col_ready), kind)
+            }
+        };
+        bank.col_ready = col + c.t_ccd;
+        bank.last_col = col;
+        // The data bus takes the first free burst slot once the data is ready; a read whose
+        // row is open can use a slot before a conflicting read reserved earlier, which is
+        // the effect of FR-FCFS on the bus.
+        let data = ch
+            .bus
+            .reserve_pending(self.burst.div_ceil((col + c.t_cas).get()))
+            * c.t_burst;
+        let done = Tick(data + c.t_burst);
+        self.finish(arrive, done, kind)
+    }
+
+    /// Counts a read arriving at core cycle `arrive` whose data is complete at tick `done`.
+    fn finish(&mut self, arrive: Cycle, done: Tick, kind: DramAccess) -> (Cycle, DramAccess) {
+        let done_cycle = Cycle(self.tpc.div_ceil(done.get()));
+        let s = &mut self.stats;
+        match kind {
+            DramAccess::RowHit => s.row_hits += 1,
+            DramAccess::Closed => s.row_closed += 1,
+            DramAccess::Conflict => s.row_conflicts += 1,
+        }
+        s.latency_cycles += done_cycle - arrive;
+        s.last_done = s.last_done.max(done_cycle);
+        (done_cycle, kind)
+    }
+
+    /// Counters so far.
+    pub fn stats(&self) -> DramStats {
+        // Every read is a row hit, a closed bank or a conflict, and activates a row unless
+        // it is a row hit: the two sums are not counted on the way.
+        let s = self.stats;
+        DramStats {
+            reads: s.row_hits + s.row_closed + s.row_conflicts,
+            activations: s.row_closed + s.row_conflicts,
+            ..s
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::SimConfig;
+    use dualsplit_geometry::Pcg32;
+
+    impl Dram {
+        /// [`Dram::read`] in plain cycle numbers.
+        fn rd(&mut self, line: u64, arrive: u64) -> (u64, DramAccess) {
+            let (done, kind) = self.read(line, Cycle(arrive));
+            (done.get(), kind)
+        }
+
+        /// [`Dram::read_at`] in plain cycle numbers.
+        fn rd_at(&mut self, line: u64, arrive: u64, now: u64) -> (u64, DramAccess) {
+            let (done, kind) = self.read_at(line, Cycle(arrive), Cycle(now));
+            (done.get(), kind)
+        }
+    }
+
+    fn dram() -> Dram {
+        Dram::new(&SimConfig::lin2020().dram)
+    }
+
+    /// The same DRAM model (Lin et al. 2020 §5's GDDR5 memory) written for clarity, not
+    /// host speed: reservations in plain sets of taken ticks,
+    /// the read queue a min-heap of completion ticks, each bank's epochs a `VecDeque`.
+    mod reference {
+        use super::super::{DramAccess, DramStats, EPOCH_KEEP};
+        use crate::Cycle;
+        use crate::config::DramConfig;
+        use std::cmp::Reverse;
+        use std::collections::{BTreeSet, BinaryHeap, VecDeque};
+
+        /// Taken ticks (or bus slots), all remembered.
+        #[derive(Clone, Default)]
+        struct Taken(BTreeSet<u64>);
+
+        impl Taken {
+            /// First start `s ≥ c` where `[s, s + len)` is free.
+            fn find(&self, c: u64, len: u64) -> u64 {
+                let mut s = c;
+                while let Some(&x) = self.0.range(s..s + len).next() {
+                    s = x + 1;
+                }
+                s
+            }
+            fn reserve_span(&mut self, c: u64, len: u64) -> u64 {
+                let s = self.find(c, len);
+                self.0.extend(s..s + len);
+                s
+            }
+        }
+
+        #[derive(Clone, Copy)]
+        struct Epoch {
+            row: u64,
+            act: u64,
+            close: u64,
+        }
+
+        #[derive(Clone, Default)]
+        struct Bank {
+            epochs: VecDeque<Epoch>,
+            open_row: Option<u64>,
+            act: u64,
+            col_ready: u64,
+            last_col: u64,
+        }
+
+        #[derive(Clone, Default)]
+        struct Channel {
+            bus: Taken,
+            acts: Taken,
+            inflight: BinaryHeap<Reverse<u64>>,
+        }
+
+        /// The reference model.
+        pub struct RefDram {
+            cfg: DramConfig,
+            banks: Vec<Bank>,
+            channels: Vec<Channel>,
+            /// Counters, as [`super::super::Dram::stats`].
+            pub stats: DramStats,
+        }
+
+        impl RefDram {
+            pub fn new(cfg: &DramConfig) -> Self {
+                Self {
+                    cfg: cfg.clone(),
+                    banks: vec![Bank::default(); (cfg.channels * cfg.banks_per_channel) as usize],
+                    channels: vec![Channel::default(); cfg.channels as usize],
+                    stats: DramStats::default(),
+                }
+            }
+
+            pub fn read(&mut self, line: u64, arrive: u64) -> (u64, DramAccess) {
+                let c = &self.cfg;
+                let tpc = c.ticks_per_cycle;
+                let x = line / (c.row_bytes / 64);
+                let chi = (x % c.channels as u64) as usize;
+                let x = x / c.channels as u64;
+                let bi = (x % c.banks_per_channel as u64) as usize;
+                let row = x / c.banks_per_channel as u64;
+                let ch = &mut self.channels[chi];
+                let mut a = arrive * tpc;
+                while ch.inflight.peek().is_some_and(|&Reverse(d)| d <= a) {
+                    ch.inflight.pop();
+                }
+                if ch.inflight.len() >= c.read_queue as usize {
+                    let Reverse(d) = ch.inflight.pop().expect("queue is full");
+                    self.stats.queue_wait_cycles += (d - a).div_ceil(tpc);
+                    a = d;
+                }
+                let bank = &mut self.banks[chi * c.banks_per_channel as usize + bi];
+                while bank
+                    .epochs
+                    .front()
+                    .is_some_and(|e| e.close.saturating_add(EPOCH_KEEP) < a)
+                {
+                    bank.epochs.pop_front();
+                }
+                let mut result = None;
+                if bank.open_row != Some(row) {
+                    for e in bank.epochs.iter().filter(|e| e.row == row) {
+                        let col = a.max(e.act + c.t_rcd);
+                        if col > e.close {
+                            continue;
+                        }
+                        let slot = ch.bus.find((col + c.t_cas).div_ceil(c.t_burst), 1);
+                        if slot * c.t_burst - c.t_cas <= e.close {
+                            ch.bus.reserve_span(slot, 1);
+                            result = Some((slot * c.t_burst + c.t_burst, DramAccess::RowHit));
+                            break;
+                        }
+                    }
+                }
+                let (done, kind) = match result {
+                    Some(r) => r,
+                    None => {
+                        let (col, kind) = match bank.open_row {
+                            Some(r) if r == row => (a.max(bank.col_ready), DramAccess::RowHit),
+                            open => {
+                                let mut act = a;
+                                let kind = if open.is_some() {
+                                    let pre =
+                                        a.max(bank.act + c.t_ras).max(bank.last_col + c.t_rtp);
+                                    act = pre + c.t_rp;
+                                    DramAccess::Conflict
+                                } else {
+                                    DramAccess::Closed
+                                };
+                                if open.is_some() || bank.act > 0 {
+                                    act = act.max(bank.act + c.t_rc);
+                                }
+                                act = ch.acts.reserve_span(act, c.t_rrd.max(1));
+                                if let Some(last) = bank.epochs.back_mut() {
+                                    last.close = act - c.t_rp - c.t_rtp;
+                                }
+                                bank.epochs.push_back(Epoch {
+                                    row,
+                                    act,
+                                    close: u64::MAX,
+                                });
+                                bank.act = act;
+                                bank.open_row = Some(row);
+                                self.stats.activations += 1;
+                                ((act + c.t_rcd).max(bank.col_ready), kind)
+                            }
+                        };
+                        bank.col_ready = col + c.t_ccd;
+                        bank.last_col = col;
+                        let slot = ch.bus.reserve_span((col + c.t_cas).div_ceil(c.t_burst), 1);
+                        (slot * c.t_burst + c.t_burst, kind)
+                    }
+                };
+                ch.inflight.push(Reverse(done));
+                let done_cycle = done.div_ceil(tpc);
+                let s = &mut self.stats;
+                s.reads += 1;
+                match kind {
+                    DramAccess::RowHit => s.row_hits += 1,
+                    DramAccess::Closed => s.row_closed += 1,
+                    DramAccess::Conflict => s.row_conflicts += 1,
+                }
+                s.latency_cycles += done_cycle - arrive;
+                s.last_done = s.last_done.max(Cycle(done_cycle));
+                (done_cycle, kind)
+            }
+        }
+    }
+
+    /// Every read's completion and kind, and the counters, equal the reference model's on
+    /// random streams: lines concentrated on a few channels, banks and rows (row hits,
+    /// conflicts, earlier epochs of the same row), arrivals jittered ahead of a rising
+    /// event time with idle gaps (the rings recycle) and bursts, read queues from 1 entry
+    /// (always full) to 64 (full in the bursts, or not at all in the light streams), and
+    /// timings that are not powers of two.
+    #[test]
+    fn reads_match_the_reference_model_on_random_streams() {
+        for seed in 0..24u64 {
+            let mut rng = Pcg32::new(seed, 21);
+            let mut cfg = SimConfig::lin2020().dram;
+            cfg.read_queue = [1, 2, 5, 16, 64, 64][seed as usize % 6];
+            // Bursts separated by idle gaps; "light" streams also advance between reads.
+            let light = seed % 6 == 4;
+            if seed % 4 == 3 {
+                (cfg.ticks_per_cycle, cfg.t_burst, cfg.t_rrd) = (3, 3, 7);
+            }
+            let mut d = Dram::new(&cfg);
+            let mut r = reference::RefDram::new(&cfg);
+            let lines_per_row = cfg.row_bytes / 64;
+            let (chs, banks, rows) = (1 + rng.below(3), 1 + rng.below(4), 1 + rng.below(6));
+            let mut now = 0;
+            for i in 0..4000 {
+                now += match rng.below(400) {
+                    0..2 => 2000 + rng.below(5000) as u64,
+                    2..80 if light => rng.below(40) as u64,
+                    _ => 0,
+                };
+                let arrive = now + rng.below(60) as u64;
+                let (ch, bank, row) = (rng.below(chs), rng.below(banks), rng.below(rows));
+                let line = ((row as u64 * cfg.banks_per_channel as u64 + bank as u64)
+                    * cfg.channels as u64
+                    + ch as u64)
+                    * lines_per_row
+                    + rng.below(lines_per_row as u32) as u64;
+                let got = d.rd_at(line, arrive, now);
+                assert_eq!(got, r.read(line, arrive), "seed {seed}, read {i}");
+            }
+            assert_eq!(d.stats(), r.stats, "seed {seed}");
+            if !light {
+                assert!(
+                    d.stats().queue_wait_cycles > 0,
+                    "seed {seed}: queue never full"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn closed_then_hit_then_conflict_exact_latencies() {
+        let mut d = dram();
+        // Closed: tRCD 14 + tCAS 14 + burst 2 = 30 core cycles.
+        assert_eq!(d.rd(0, 1000), (1030, DramAccess::Closed));
+        // Row hit on the same row (line 1 is column 1 of row 0): tCAS 14 + burst 2.
+        assert_eq!(d.rd(1, 2000), (2016, DramAccess::RowHit));
+        // Conflict: same channel and bank, next row. Lines per row 128, channels 16, banks 16.
+        let other_row = 128 * 16 * 16;
+        assert_eq!(d.map(other_row), (0, 0, 1));
+        // tRP 14 + tRCD 14 + tCAS 14 + burst 2 = 44.
+        assert_eq!(d.rd(other_row, 3000), (3044, DramAccess::Conflict));
+        let s = d.stats();
+        assert_eq!((s.reads, s.activations, s.row_hits), (3, 2, 1));
+    }
+
+    #[test]
+    fn conflict_waits_for_t_ras() {
+        let mut d = dram();
+        assert_eq!(d.rd(0, 0).0, 30);
+        // Immediately conflicting: precharge may not start before act + tRAS (35 ns).
+        // act at 0, pre at 35 ns, act at 49 ns (= tRC too), data at 49 + 14 + 14 = 77 ns,
+        // rounded up to the 2 ns burst slot grid (78), + burst 2 = 80.
+        assert_eq!(d.rd(128 * 16 * 16, 0), (80, DramAccess::Conflict));
+    }
+
+    #[test]
+    fn row_hit_overtakes_an_older_conflict() {
+        let mut d = dram();
+        let row1 = 128 * 16 * 16;
+        // A: row 0, closed: act at tick 0, column 28, data slot 14 (ticks 56–60): cycle 30.
+        assert_eq!(d.rd(0, 0), (30, DramAccess::Closed));
+        // B: row 1, conflict: precharge at t_RAS (70), act 98 (= t_RC), column 126, data at
+        // 154 rounded up to the burst grid 156, done 160 ticks: cycle 80. Row 0's epoch now
+        // closes at 98 − t_RP 28 − t_RTP 15 = tick 55.
+        assert_eq!(d.rd(row1, 0), (80, DramAccess::Conflict));
+        // C: row 0 again, one cycle after B. In arrival order it would be a second conflict
+        // (≥ 49 ns after B's activate). Row-hit-first: row 0 is still open before B's
+        // precharge, so C is a row hit: column at 28, data slot 14 is A's, so slot 15
+        // (column effectively at 60 − 28 = 32 ≤ 55), done at tick 64: cycle 32, before B.
+        assert_eq!(d.rd(1, 1), (32, DramAccess::RowHit));
+        // D: row 0 at cycle 20 (tick 40): column 40, data at 68 = slot 17, done 72: cycle 36.
+        assert_eq!(d.rd(2, 20), (36, DramAccess::RowHit));
+        // E: row 0 at cycle 30 (tick 60 > 55): too late for row 0's epoch, so a conflict
+        // after B: precharge at B's act 98 + t_RAS 70 = 168, act 196 (= 98 + t_RC), column
+        // 224, data 252, done 256 ticks: cycle 128.
+        assert_eq!(d.rd(3, 30), (128, DramAccess::Conflict));
+        let s = d.stats();
+        assert_eq!(
+            (s.reads, s.activations, s.row_hits, s.row_conflicts),
+            (5, 3, 2, 2)
+        );
+    }
+
+    #[test]
+    fn interleaved_rows_pay_one_activation_per_row_and_epoch() {
+        // Two rows of one bank requested alternately, all at once: in arrival order every
+        // read would be a conflict (8 activations); row-hit-first groups them per row.
+        let mut d = dram();
+        let row1 = 128 * 16 * 16;
+        for i in 0..4 {
+            d.rd(i, 0);
+            d.rd(row1 + i, 0);
+        }
+        let s = d.stats();
+        assert_eq!((s.reads, s.activations, s.row_hits), (8, 2, 6));
+    }
+
+    #[test]
+    fn a_backed_up_bank_does_not_delay_another_bank_of_its_channel() {
+        let mut d = dram();
+        let row = 128 * 16 * 16;
+        // 20 different rows of bank 0 (channel 0), all at cycle 0: each waits t_RC for the
+        // previous one, so the last data is ~1 µs ahead.
+        let last = (0..20).map(|r| d.rd(r * row, 0).0).max().unwrap();
+        assert!(last > 900, "{last}");
+        // Bank 1 of channel 0 at cycle 0: closed row, its activation only spaced t_RRD
+        // (13 ticks) after bank 0's first: act 13, column 41, data at 69 rounded to the
+        // burst grid 72, done 76 ticks = cycle 38 (not behind bank 0's far-future bursts).
+        assert_eq!(d.rd(128 * 16, 0), (38, DramAccess::Closed));
+    }
+
+    #[test]
+    fn divisor_equals_plain_division() {
+        for d in [1u64, 2, 3, 4, 5, 8, 12, 16] {
+            let div = Divisor::new(d);
+            for x in (0..200).chain([u64::MAX - 1, u64::MAX]) {
+                assert_eq!(div.div(x), x / d, "{x} / {d}");
+                assert_eq!(div.div_ceil(x), x.div_ceil(d), "{x} div_ceil {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn mapping_is_column_channel_bank_row() {
+        let d = dram();
+        assert_eq!(d.map(127), (0, 0, 0));
+        assert_eq!(d.map(128), (1, 0, 0));
+        assert_eq!(d.map(128 * 16), (0, 1, 0));
+    }
+
+    #[test]
+    fn one_channel_streams_at_one_line_per_burst() {
+        let mut d = dram();
+        // 100 row-hit reads of one row arriving together: the bus serialises them.
+        let dones: Vec<_> = (0..100).map(|i| d.rd(i % 128, 0).0).collect();
+        for w in dones.windows(2) {
+            assert_eq!(w[1] - w[0], 2, "one 64-B line per 2 ns per channel");
+        }
+    }
+
+    #[test]
+    fn saturates_at_peak_bandwidth_and_no_faster() {
+        let cfg = SimConfig::lin2020();
+        let mut d = Dram::new(&cfg.dram);
+        // 64 K lines, all requested at cycle 0, spread over every channel and bank.
+        let n = 65_536u64;
+        let last = (0..n).map(|l| d.rd(l, 0).0).max().unwrap();
+        let bytes_per_cycle = (n * 64) as f64 / last as f64;
+        let peak = cfg.dram_peak_bytes_per_cycle();
+        assert_eq!(peak, 512.0);
+        assert!(
+            bytes_per_cycle <= peak,
+            "{bytes_per_cycle} above peak {peak}"
+        );
+        assert!(
+            bytes_per_cycle > 0.97 * peak,
+            "{bytes_per_cycle} well below peak"
+        );
+    }
+
+    #[test]
+    fn full_read_queue_back_pressures() {
+        let mut cfg = SimConfig::lin2020().dram;
+        cfg.read_queue = 2;
+        let mut d = Dram::new(&cfg);
+        d.rd(0, 0);
+        d.rd(1, 0);
+        d.rd(2, 0);
+        assert!(d.stats().queue_wait_cycles > 0);
+        let mut cfg = SimConfig::lin2020().dram;
+        cfg.read_queue = 64;
+        let mut d = Dram::new(&cfg);
+        (0..3).for_each(|l| {
+            d.rd(l, 0);
+        });
+        assert_eq!(d.stats().queue_wait_cycles, 0);
+    }
+}

@@ -1,0 +1,96 @@
+//! The shared L2 cache and the DRAM behind it.
+//!
+//! Hardware (Lin et al. 2020, §4, Table 1; SimTRaX `L2Cache.cc`): one L2 for all TMs,
+//! `l2.banks` banks that each accept one access per cycle, direct-mapped by default, with
+//! `l2.hit_latency` cycles from the bank slot to the data. The bank of an access is its
+//! line address mod the bank count (`l2.line_interleaved = true`: a banked cache keeps a
+//! line in one bank and interleaves by block address, Hennessy & Patterson, *Computer
+//! Architecture*, 5th ed., §2.2) or, as SimTRaX does, its word address mod the bank count.
+//! A miss goes to DRAM ([`Dram`]) when the tag lookup is done and the line is installed
+//! when the DRAM's data arrives; a miss to a line already in flight waits for that fill.
+
+use crate::config::SimConfig;
+use crate::hw::Cycle;
+use crate::hw::memory::{Cache, CacheStats, Dram, DramStats, Lookup};
+use crate::hw::slots::Slots;
+
+/// The L2: tags, banks and the DRAM it reads from.
+pub struct L2 {
+    tags: Cache,
+    banks: Vec<Slots>,
+    /// `banks − 1` (a power of two).
+    bank_mask: u64,
+    line_interleaved: bool,
+    /// L1 hit latency + L2 hit latency: from the L2 bank slot to the data in the register.
+    hit_latency: u64,
+    dram: Dram,
+    accesses: u64,
+    hits: u64,
+    merged: u64,
+    bank_wait: u64,
+}
+
+impl L2 {
+    /// A cold L2 and DRAM.
+    pub fn new(cfg: &SimConfig) -> Self {
+        Self {
+            tags: Cache::new(cfg.l2.size_bytes, cfg.l2.line_bytes, cfg.l2.associativity),
+            banks: vec![Slots::default(); cfg.l2.banks as usize],
+            bank_mask: cfg.l2.banks as u64 - 1,
+            line_interleaved: cfg.l2.line_interleaved,
+            hit_latency: cfg.l1.hit_latency + cfg.l2.hit_latency,
+            dram: Dram::new(&cfg.dram),
+            accesses: 0,
+            hits: 0,
+            merged: 0,
+            bank_wait: 0,
+        }
+    }
+
+    /// Reads `line` for an L1 miss of word `word` whose L1 slot was `at`; returns the cycle
+    /// the data is in the requesting thread's register. `now` (≤ `at`) is the current event
+    /// time: no later request starts before it.
+    pub fn read(&mut self, line: u64, word: u64, at: Cycle, now: Cycle) -> Cycle {
+        let bank_addr = if self.line_interleaved { line } else { word };
+        let b = (bank_addr & self.bank_mask) as usize;
+        let slot = Cycle(self.banks[b].reserve(at.get()));
+        self.bank_wait += slot - at;
+        self.accesses += 1;
+        let data = slot + self.hit_latency;
+        match self.tags.lookup(line, slot) {
+            Lookup::Present { fill } if fill <= slot => {
+                self.hits += 1;
+                data
+            }
+            Lookup::Present { fill } => {
+                self.merged += 1;
+                fill.max(data)
+            }
+            Lookup::Absent => {
+                let (done, _) = self.dram.read_at(line, data, now);
+                self.tags.install(line, done, slot);
+                done
+            }
+        }
+    }
+
+    /// The tag word of `line`'s first way, read without effect: lets the event loop bring
+    /// the host memory of a coming lookup into the host's cache ahead of time.
+    #[inline]
+    pub fn peek(&self, line: u64) -> u64 {
+        self.tags.peek(line)
+    }
+
+    /// Adds the L2's counters to `c`.
+    pub fn add_stats(&self, c: &mut CacheStats) {
+        c.l2_accesses += self.accesses;
+        c.l2_hits += self.hits;
+        c.l2_merged += self.merged;
+        c.l2_bank_wait += self.bank_wait;
+    }
+
+    /// The DRAM's counters.
+    pub fn dram_stats(&self) -> DramStats {
+        self.dram.stats()
+    }
+}

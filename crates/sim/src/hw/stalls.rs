@@ -1,0 +1,29 @@
+//! Where the threads' cycles went, whichever thread model drives them.
+
+use serde::{Deserialize, Serialize};
+
+/// Why a thread waited (stall breakdown, in thread-cycles).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Stalls {
+    /// Waiting for load data (L1 hit latency, L2, DRAM).
+    pub memory: u64,
+    /// Waiting for a pipeline result (latency).
+    pub pipeline_latency: u64,
+    /// Waiting for a free pipeline (contention with the TM's other threads).
+    pub pipeline_busy: u64,
+    /// Waiting for the shared reciprocal unit's result or a free slot on it.
+    pub fpinv: u64,
+    /// An L1 bank already used this cycle (bank conflict).
+    pub l1_bank: u64,
+    /// Waiting for the global atomic unit (pixel hand-out).
+    pub atomic: u64,
+    /// Finished early while other threads still ran.
+    pub idle: u64,
+    /// Compiled kernels: waiting for an operand from a functional unit's latency (ALU, FP,
+    /// pools, the reciprocal unit, the local store).
+    #[serde(default)]
+    pub dependency: u64,
+    /// Compiled kernels: waiting for a free unit of a shared pool or the reciprocal unit.
+    #[serde(default)]
+    pub fu_busy: u64,
+}

@@ -1,0 +1,152 @@
+//! A thread multiprocessor (TM): the units its thread processors share.
+//!
+//! Hardware (Lin et al. 2020, §2.3 and §4, Table 1; SimTRaX `L1Cache.cc`,
+//! `FunctionalUnit`s): each TM has
+//!
+//! * an **L1 data cache** ([`L1`]);
+//! * **ray-box, ray-triangle and dual-split pipelines** ([`Pipelines`]);
+//! * a **reciprocal unit** (`fpinv_units` of them), shared by the TM's threads, one op per
+//!   cycle, result after `fpinv_latency`;
+//! * the **shared functional-unit pools** of the compiled kernels' threads ([`Pools`]: FP
+//!   compare, min/max, conversion, branch, integer multiply).
+//!
+//! Every unit is a reservation table: a request learns the cycle it gets the unit (the first
+//! free cycle at or after it asks) and the cycle its result is ready. The methods take the
+//! cycle the thread issues the request and return both; either thread model drives the TM
+//! through them.
+
+use crate::config::SimConfig;
+use crate::hw::Cycle;
+use crate::hw::addr::WordAddr;
+use crate::hw::counts::UnitStats;
+use crate::hw::fu::Pools;
+use crate::hw::issued::Issued;
+use crate::hw::l1::L1;
+use crate::hw::memory::{CacheStats, L2};
+use crate::hw::pipe::{Pipe, Pipelines};
+use crate::hw::slots::{Slots, earliest};
+
+/// One TM's L1, pipelines, reciprocal units and functional-unit pools.
+pub struct Tm {
+    l1: L1,
+    pipes: Pipelines,
+    fpinv: Vec<Slots>,
+    fpinv_latency: u64,
+    /// The shared pools of the compiled kernels' threads.
+    pub pools: Pools,
+    units: UnitStats,
+}
+
+impl Tm {
+    /// An idle TM with a cold L1; `box_pipes` ray-box pipelines (the "+" configurations use
+    /// the node arity).
+    pub fn new(cfg: &SimConfig, box_pipes: u32) -> Self {
+        Self {
+            l1: L1::new(&cfg.l1),
+            pipes: Pipelines::new(&cfg.units, box_pipes),
+            fpinv: vec![Slots::default(); cfg.units.fpinv_units as usize],
+            fpinv_latency: cfg.units.fpinv_latency,
+            pools: Pools::new(&cfg.units),
+            units: UnitStats::default(),
+        }
+    }
+
+    /// A load through the TM's L1 ([`L1::load`]).
+    #[inline(always)]
+    pub fn load(
+        &mut self,
+        l2: &mut L2,
+        addr: WordAddr,
+        words: u64,
+        at: Cycle,
+        now: Cycle,
+    ) -> Issued {
+        self.l1.load(l2, addr, words, at, now)
+    }
+
+    /// A store through the TM's L1 ([`L1::store`]).
+    #[inline]
+    pub fn store(&mut self, addr: WordAddr, words: u64, at: Cycle, now: Cycle) -> Issued {
+        self.l1.store(addr, words, at, now)
+    }
+
+    /// `n` ops on the TM's pipelines ([`Pipelines::issue`]).
+    #[inline(always)]
+    pub fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool, at: Cycle) -> Issued {
+        self.pipes.issue(pipe, n, parallel, at, &mut self.units)
+    }
+
+    /// One reciprocal on the TM's shared reciprocal unit(s), requested at `at`.
+    #[inline]
+    pub fn reciprocal(&mut self, at: Cycle) -> Issued {
+        let s = earliest(&mut self.fpinv, at);
+        self.units.fpinv_ops += 1;
+        Issued {
+            next_issue: s + 1,
+            ready: s + self.fpinv_latency,
+            busy: s - at,
+        }
+    }
+
+    /// Reads (without effect) the tags `addr`'s load will look up ([`L1::touch`]).
+    #[inline]
+    pub fn touch(&self, l2: &L2, addr: WordAddr) -> u64 {
+        self.l1.touch(l2, addr)
+    }
+
+    /// Adds the TM's counters to `caches` and `units`.
+    pub fn add_stats(&self, caches: &mut CacheStats, units: &mut UnitStats) {
+        self.l1.add_stats(caches);
+        units.box_ops += self.units.box_ops;
+        units.tri_ops += self.units.tri_ops;
+        units.dst_ops += self.units.dst_ops;
+        units.fpinv_ops += self.units.fpinv_ops;
+    }
+
+    /// One word load at bank slot `slot` (already reserved): the cycle the data is in the
+    /// register.
+    #[cfg(test)]
+    pub(crate) fn load_word(&mut self, l2: &mut L2, word: u64, slot: Cycle) -> Cycle {
+        self.l1.load_word(l2, word, slot)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The TM's interface as a thread model other than the macro-op replay drives it:
+    /// typed requests at a cycle, the cycle the result is ready.
+    #[test]
+    fn the_tm_answers_requests_at_a_cycle() {
+        let cfg = SimConfig::lin2020();
+        let mut l2 = L2::new(&cfg);
+        let mut tm = Tm::new(&cfg, 1);
+        // A cold 3-word load at byte 0: L1 1 + L2 3 + closed row 30; words at 0, 1, 2.
+        let c = Cycle;
+        let r = tm.load(&mut l2, WordAddr::from_byte(0), 3, c(0), c(0));
+        assert_eq!((r.next_issue, r.ready, r.busy), (c(3), c(34), 0));
+        // The same words again: L1 hits, the last at cycle 102, data at 103.
+        let r = tm.load(&mut l2, WordAddr(0), 3, c(100), c(100));
+        assert_eq!((r.next_issue, r.ready), (c(103), c(103)));
+        // A store to bank 0 in cycle 200 and a load of word 16 (bank 0) in the same cycle:
+        // the load waits one cycle for the bank; a store allocates no line.
+        let s = tm.store(WordAddr(32), 1, c(200), c(200));
+        assert_eq!((s.next_issue, s.ready, s.busy), (c(201), c(200), 0));
+        let r = tm.load(&mut l2, WordAddr(16), 1, c(200), c(200));
+        assert_eq!((r.next_issue, r.busy), (c(202), 1));
+        // Dual-split op: result after 8 cycles; the pipe is taken in its cycle.
+        let p = tm.pipe(Pipe::DualSplit, 1, false, c(300));
+        assert_eq!((p.next_issue, p.ready), (c(301), c(308)));
+        let p = tm.pipe(Pipe::DualSplit, 1, false, c(300));
+        assert_eq!((p.next_issue, p.ready, p.busy), (c(302), c(309), 1));
+        // Reciprocal: 16 cycles (lin2020 `fpinv_latency`).
+        let f = tm.reciprocal(c(400));
+        let ready = c(400 + cfg.units.fpinv_latency);
+        assert_eq!((f.next_issue, f.ready), (c(401), ready));
+        let (mut c, mut u) = (CacheStats::default(), UnitStats::default());
+        tm.add_stats(&mut c, &mut u);
+        assert_eq!((c.l1_accesses, c.l1_hits), (7, 3));
+        assert_eq!((u.dst_ops, u.fpinv_ops), (2, 1));
+    }
+}

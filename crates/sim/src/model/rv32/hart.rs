@@ -1,0 +1,793 @@
+//! One hardware thread (a TP's thread): architectural state and the functional executor.
+
+use super::decode::{CSR_FCSR, CSR_FRM, Info, Op, decode};
+use super::elf::Program;
+use super::memory::{LOCAL_STORE_ADDR, MemFault, Memory};
+use crate::hw::fu::FuClass;
+use dualsplit_accel::dst::HeaderOffset;
+use dualsplit_accel::dst::pipeline::{PipelineInput, step as dst_step};
+use dualsplit_geometry::{Ray, RayPre, Triangle, Vec3};
+
+/// RISC-V's canonical NaN, the result of every arithmetic instruction whose result is NaN,
+/// and the "miss" result of `rt.box` and `rt.tri`.
+pub const CANONICAL_NAN: u32 = 0x7FC0_0000;
+
+/// A memory access made by a retired instruction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct MemAccess {
+    /// Byte address of the first byte.
+    pub addr: u32,
+    /// Number of 32-bit words touched (1 for byte and half-word accesses; 6, 6N, 9 or 3
+    /// for `rt.box`, `rt.boxn`, `rt.tri`, `rt.dst`); 0 when the instruction made no access.
+    pub words: u8,
+    /// `true` for a store.
+    pub store: bool,
+    /// `true` when the access is to the TP's local store (not through the L1).
+    pub local: bool,
+}
+
+impl MemAccess {
+    /// No access.
+    pub const NONE: MemAccess = MemAccess {
+        addr: 0,
+        words: 0,
+        store: false,
+        local: false,
+    };
+    /// `true` when there was an access.
+    #[inline]
+    pub fn is_some(&self) -> bool {
+        self.words != 0
+    }
+}
+
+/// What a timing model needs from one executed instruction. `Copy`, 16 bytes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Retired {
+    /// Functional-unit class (loads and stores to the local store are
+    /// [`FuClass::LocalLoad`]/[`FuClass::LocalStore`]), registers read and written, latches.
+    pub info: Info,
+    /// The memory access, if any.
+    pub mem: MemAccess,
+    /// A taken branch or a jump.
+    pub taken: bool,
+}
+
+impl Retired {
+    /// The functional-unit class.
+    #[inline]
+    pub fn fu(&self) -> FuClass {
+        self.info.fu
+    }
+    /// `true` for `ebreak`.
+    #[inline]
+    pub fn is_halt(&self) -> bool {
+        self.info.fu == FuClass::Halt
+    }
+}
+
+/// An instruction that could not execute. Every variant names the pc.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ExecError {
+    /// The pc is misaligned or outside the program's text.
+    #[error("pc {pc:#010x}: instruction fetch outside the program's text")]
+    Fetch {
+        /// The pc.
+        pc: u32,
+    },
+    /// The word at the pc does not decode.
+    #[error("pc {pc:#010x}: illegal instruction {word:#010x} ({reason})")]
+    Illegal {
+        /// The pc.
+        pc: u32,
+        /// The word.
+        word: u32,
+        /// Why it does not decode.
+        reason: &'static str,
+    },
+    /// A misaligned load or store (words and memory operands need 4-byte alignment,
+    /// half-words 2).
+    #[error("pc {pc:#010x}: misaligned {bytes}-byte access at {addr:#010x}")]
+    Misaligned {
+        /// The pc.
+        pc: u32,
+        /// The address.
+        addr: u32,
+        /// Access size in bytes.
+        bytes: u32,
+    },
+    /// A load or store to an address no region maps.
+    #[error("pc {pc:#010x}: access to unmapped address {addr:#010x}")]
+    Unmapped {
+        /// The pc.
+        pc: u32,
+        /// The address.
+        addr: u32,
+    },
+    /// A store to a read-only region (image, parameters, program).
+    #[error("pc {pc:#010x}: store to read-only address {addr:#010x}")]
+    ReadOnly {
+        /// The pc.
+        pc: u32,
+        /// The address.
+        addr: u32,
+    },
+    /// `rt.atominc` on a global register that does not exist.
+    #[error("pc {pc:#010x}: no global register {index}")]
+    NoGlobal {
+        /// The pc.
+        pc: u32,
+        /// The register index.
+        index: u32,
+    },
+    /// `rt.setk` with an axis field above 2, or bits above bit 5.
+    #[error("pc {pc:#010x}: rt.setk value {value:#x} is not kx | ky << 2 | kz << 4 with axes 0-2")]
+    BadAxes {
+        /// The pc.
+        pc: u32,
+        /// `x[rs1]`.
+        value: u32,
+    },
+    /// A CSR write that sets `frm` to a mode other than RNE.
+    #[error("pc {pc:#010x}: frm set to {rm} (only round-to-nearest-even is modelled)")]
+    RoundingMode {
+        /// The pc.
+        pc: u32,
+        /// The mode written.
+        rm: u32,
+    },
+}
+
+/// The DST latch `D`: the outputs of the last `rt.dst` other than its code and offset.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct DstLatch {
+    /// `t_min_out`.
+    pub t_min_out: f32,
+    /// `t_max_out`.
+    pub t_max_out: f32,
+    /// `offset_stack`.
+    pub offset_stack: u32,
+}
+
+/// One hardware thread's architectural state.
+#[derive(Clone, Debug)]
+pub struct Hart {
+    /// Integer registers (`x[0]` is always 0).
+    pub x: [u32; 32],
+    /// Float registers, as f32 bits.
+    pub f: [u32; 32],
+    /// Program counter.
+    pub pc: u32,
+    /// The ray register set `R` (`ray.origin`, `inv_dir`, `neg`, `k`, `shear`; `ray.dir`,
+    /// `t_min`, `t_max` are not part of `R` and stay as constructed).
+    pub ray: RayPre,
+    /// The box latch `B`.
+    pub box_latch: [f32; 8],
+    /// The DST latch `D`.
+    pub dst_latch: DstLatch,
+    /// The TP's private local store, at [`LOCAL_STORE_ADDR`].
+    pub local: Box<[u8]>,
+    /// Set by `ebreak`.
+    pub halted: bool,
+}
+
+/// The initial ray register set: origin 0, inverse direction +∞ (direction +0), axes
+/// (0, 1, 2), shear 0.
+pub fn initial_ray() -> RayPre {
+    RayPre {
+        ray: Ray::new(Vec3::ZERO, Vec3::ZERO),
+        inv_dir: Vec3::INFINITY,
+        neg: [false; 3],
+        k: [0, 1, 2],
+        shear: Vec3::ZERO,
+    }
+}
+
+#[inline(always)]
+fn canon(v: f32) -> u32 {
+    if v.is_nan() {
+        CANONICAL_NAN
+    } else {
+        v.to_bits()
+    }
+}
+
+/// `fmin.s` (RISC-V F, v2.2): a NaN operand is ignored unless both are NaN (then the
+/// canonical NaN); −0 < +0.
+#[inline]
+pub fn fmin(a: u32, b: u32) -> u32 {
+    let (x, y) = (f32::from_bits(a), f32::from_bits(b));
+    match (x.is_nan(), y.is_nan()) {
+        (true, true) => CANONICAL_NAN,
+        (true, false) => b,
+        (false, true) => a,
+        _ if x < y => a,
+        _ if y < x => b,
+        _ => a | b, // equal: only ±0 differ, and −0 (sign bit set) is the smaller
+    }
+}
+
+/// `fmax.s` (RISC-V F, v2.2): a NaN operand is ignored unless both are NaN (then the
+/// canonical NaN); +0 > −0.
+#[inline]
+pub fn fmax(a: u32, b: u32) -> u32 {
+    let (x, y) = (f32::from_bits(a), f32::from_bits(b));
+    match (x.is_nan(), y.is_nan()) {
+        (true, true) => CANONICAL_NAN,
+        (true, false) => b,
+        (false, true) => a,
+        _ if x > y => a,
+        _ if y > x => b,
+        _ => a & b, // equal: +0 (sign bit clear) is the larger
+    }
+}
+
+/// `fclass.s`: the one-hot class mask.
+pub fn fclass(a: u32) -> u32 {
+    let v = f32::from_bits(a);
+    let neg = a >> 31 != 0;
+    let bit = if v.is_nan() {
+        if a & 0x0040_0000 != 0 { 9 } else { 8 }
+    } else if v.is_infinite() {
+        if neg { 0 } else { 7 }
+    } else if v == 0.0 {
+        if neg { 3 } else { 4 }
+    } else if v.is_subnormal() {
+        if neg { 2 } else { 5 }
+    } else if neg {
+        1
+    } else {
+        6
+    };
+    1 << bit
+}
+
+/// Rounds `v` to an integral value by the static rounding mode `rm` (0 RNE, 1 RTZ, 2 RDN,
+/// 3 RUP, 4 RMM, 7 dynamic = RNE).
+#[inline]
+fn round_rm(v: f32, rm: i32) -> f32 {
+    match rm {
+        1 => v.trunc(),
+        2 => v.floor(),
+        3 => v.ceil(),
+        4 => v.round(),
+        _ => v.round_ties_even(),
+    }
+}
+
+/// `fcvt.w.s`: saturating, NaN → `i32::MAX`.
+#[inline]
+pub fn fcvt_w_s(a: u32, rm: i32) -> u32 {
+    let v = f32::from_bits(a);
+    if v.is_nan() {
+        i32::MAX as u32
+    } else {
+        round_rm(v, rm) as i32 as u32
+    }
+}
+
+/// `fcvt.wu.s`: saturating, NaN → `u32::MAX`.
+#[inline]
+pub fn fcvt_wu_s(a: u32, rm: i32) -> u32 {
+    let v = f32::from_bits(a);
+    if v.is_nan() {
+        u32::MAX
+    } else {
+        round_rm(v, rm) as u32
+    }
+}
+
+impl Hart {
+    /// A thread at `prog`'s entry with a zeroed local store of `local_store_bytes` bytes and
+    /// `sp` (`x2`) at its top.
+    pub fn new(prog: &Program, local_store_bytes: u32) -> Hart {
+        let mut x = [0; 32];
+        x[2] = LOCAL_STORE_ADDR.wrapping_add(local_store_bytes);
+        Hart {
+            x,
+            f: [0; 32],
+            pc: prog.entry,
+            ray: initial_ray(),
+            box_latch: [0.0; 8],
+            dst_latch: DstLatch::default(),
+            local: vec![0; local_store_bytes as usize].into_boxed_slice(),
+            halted: false,
+        }
+    }
+
+    /// Float register `f[n]` as f32.
+    #[inline]
+    pub fn fr(&self, n: usize) -> f32 {
+        f32::from_bits(self.f[n])
+    }
+
+    /// Resets the thread to `prog`'s entry: registers, latches and ray registers to their
+    /// initial values, `sp` to the local store's top; the local store keeps its bytes.
+    pub fn reset(&mut self, prog: &Program) {
+        self.x = [0; 32];
+        self.x[2] = LOCAL_STORE_ADDR.wrapping_add(self.local.len() as u32);
+        self.f = [0; 32];
+        self.pc = prog.entry;
+        self.ray = initial_ray();
+        self.box_latch = [0.0; 8];
+        self.dst_latch = DstLatch::default();
+        self.halted = false;
+    }
+
+    #[inline(always)]
+    fn fault(&self, f: MemFault, addr: u32, index: u32) -> ExecError {
+        let pc = self.pc;
+        match f {
+            MemFault::Unmapped => ExecError::Unmapped { pc, addr },
+            MemFault::ReadOnly => ExecError::ReadOnly { pc, addr },
+            MemFault::NoGlobal => ExecError::NoGlobal { pc, index },
+        }
+    }
+
+    /// Checks that `addr` is aligned to its `bytes` and notes the one-word access in `acc`;
+    /// the offset in the local store when `addr` is the local store's.
+    #[inline(always)]
+    fn begin_access(
+        &self,
+        addr: u32,
+        bytes: u32,
+        store: bool,
+        acc: &mut MemAccess,
+    ) -> Result<Option<usize>, ExecError> {
+        if addr & (bytes - 1) != 0 {
+            return Err(ExecError::Misaligned {
+                pc: self.pc,
+                addr,
+                bytes,
+            });
+        }
+        let local = addr >= LOCAL_STORE_ADDR;
+        *acc = MemAccess {
+            addr,
+            words: 1,
+            store,
+            local,
+        };
+        Ok(local.then(|| (addr - LOCAL_STORE_ADDR) as usize))
+    }
+
+    /// Loads `N` bytes at `addr` (aligned to `N`): local store, program, or global memory.
+    #[inline(always)]
+    fn load<const N: usize, M: Memory>(
+        &self,
+        prog: &Program,
+        mem: &mut M,
+        addr: u32,
+        acc: &mut MemAccess,
+    ) -> Result<[u8; N], ExecError> {
+        if let Some(o) = self.begin_access(addr, N as u32, false, acc)? {
+            return self
+                .local
+                .get(o..o + N)
+                .and_then(|s| s.try_into().ok())
+                .ok_or(ExecError::Unmapped { pc: self.pc, addr });
+        }
+        if addr >= super::PROGRAM_BASE {
+            return prog
+                .read(addr, N)
+                .and_then(|s| s.try_into().ok())
+                .ok_or(ExecError::Unmapped { pc: self.pc, addr });
+        }
+        mem.load::<N>(addr).map_err(|f| self.fault(f, addr, 0))
+    }
+
+    /// Stores `N` bytes at `addr` (aligned to `N`): local store or global memory.
+    #[inline(always)]
+    fn store<const N: usize, M: Memory>(
+        &mut self,
+        mem: &mut M,
+        addr: u32,
+        bytes: [u8; N],
+        acc: &mut MemAccess,
+    ) -> Result<(), ExecError> {
+        if let Some(o) = self.begin_access(addr, N as u32, true, acc)? {
+            let pc = self.pc;
+            self.local
+                .get_mut(o..o + N)
+                .ok_or(ExecError::Unmapped { pc, addr })?
+                .copy_from_slice(&bytes);
+            return Ok(());
+        }
+        if addr >= super::PROGRAM_BASE {
+            return Err(if prog_maps(addr) {
+                ExecError::ReadOnly { pc: self.pc, addr }
+            } else {
+                ExecError::Unmapped { pc: self.pc, addr }
+            });
+        }
+        mem.store::<N>(addr, bytes)
+            .map_err(|f| self.fault(f, addr, 0))
+    }
+
+    /// Reads the `out.len()` words of a memory operand at `addr` (4-aligned).
+    #[inline(always)]
+    fn operand_words<M: Memory>(
+        &self,
+        prog: &Program,
+        mem: &mut M,
+        addr: u32,
+        out: &mut [u32],
+        acc: &mut MemAccess,
+    ) -> Result<(), ExecError> {
+        if addr & 3 != 0 {
+            return Err(ExecError::Misaligned {
+                pc: self.pc,
+                addr,
+                bytes: 4,
+            });
+        }
+        *acc = MemAccess {
+            addr,
+            words: out.len() as u8,
+            store: false,
+            local: addr >= LOCAL_STORE_ADDR,
+        };
+        if addr < super::PROGRAM_BASE {
+            return mem
+                .load_words(addr, out)
+                .map_err(|f| self.fault(f, addr, 0));
+        }
+        let bytes = if addr >= LOCAL_STORE_ADDR {
+            let o = (addr - LOCAL_STORE_ADDR) as usize;
+            self.local.get(o..o + 4 * out.len())
+        } else {
+            prog.read(addr, 4 * out.len())
+        }
+        .ok_or(ExecError::Unmapped { pc: self.pc, addr })?;
+        for (w, c) in out.iter_mut().zip(bytes.chunks_exact(4)) {
+            *w = u32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+        }
+        Ok(())
+    }
+
+    /// The box test of `rt.box`/`rt.boxn` on the six words `b` (min xyz, max xyz): the
+    /// entry distance on a hit, else the canonical NaN.
+    #[inline(always)]
+    fn box_test(&self, b: &[u32], t_lo: f32, t_hi: f32) -> (bool, u32) {
+        let v = |k: usize| f32::from_bits(b[k]);
+        let (entry, exit) = self.ray.slab(
+            Vec3::new(v(0), v(1), v(2)),
+            Vec3::new(v(3), v(4), v(5)),
+            t_lo,
+            t_hi,
+        );
+        if entry <= exit {
+            (true, entry.to_bits())
+        } else {
+            (false, CANONICAL_NAN)
+        }
+    }
+
+    /// Executes one instruction at the pc (functionally) and returns what a timing model
+    /// needs about it. After `ebreak` the thread is [`Hart::halted`] and the pc stays on
+    /// the `ebreak`; stepping again retires it again.
+    #[inline]
+    pub fn step<M: Memory>(&mut self, prog: &Program, mem: &mut M) -> Result<Retired, ExecError> {
+        let pc = self.pc;
+        let Some(ins) = prog.fetch(pc) else {
+            return Err(ExecError::Fetch { pc });
+        };
+        let (op, imm) = (ins.op, ins.imm);
+        // Register numbers are read where used; `& 31` lets the compiler drop the register
+        // files' bounds checks.
+        macro_rules! rd {
+            () => {
+                (ins.rd as usize & 31)
+            };
+        }
+        let rs1 = ins.rs1 as usize & 31;
+        macro_rules! rs2 {
+            () => {
+                (ins.rs2 as usize & 31)
+            };
+        }
+        macro_rules! rs3 {
+            () => {
+                (ins.rs3 as usize & 31)
+            };
+        }
+        let mut next = pc.wrapping_add(4);
+        let mut acc = MemAccess::NONE;
+        let mut taken = false;
+        // Operands are read by the arms that use them (reading all five up front costs
+        // more than the dispatch).
+        macro_rules! a {
+            () => {
+                self.x[rs1]
+            };
+        }
+        macro_rules! b {
+            () => {
+                self.x[rs2!()]
+            };
+        }
+        macro_rules! fa {
+            () => {
+                f32::from_bits(self.f[rs1])
+            };
+        }
+        macro_rules! fb {
+            () => {
+                f32::from_bits(self.f[rs2!()])
+            };
+        }
+        macro_rules! fc {
+            () => {
+                f32::from_bits(self.f[rs3!()])
+            };
+        }
+        macro_rules! ea {
+            () => {
+                self.x[rs1].wrapping_add(imm as u32)
+            };
+        }
+        macro_rules! wx {
+            ($v:expr) => {{
+                self.x[rd!()] = $v;
+            }};
+        }
+        macro_rules! wf {
+            ($v:expr) => {{
+                self.f[rd!()] = $v;
+            }};
+        }
+        macro_rules! branch {
+            ($c:expr) => {{
+                if $c {
+                    next = pc.wrapping_add(imm as u32);
+                    taken = true;
+                }
+            }};
+        }
+        use Op::*;
+        match op {
+            Lui => wx!(imm as u32),
+            Auipc => wx!(pc.wrapping_add(imm as u32)),
+            Jal => {
+                wx!(next);
+                next = pc.wrapping_add(imm as u32);
+                taken = true;
+            }
+            Jalr => {
+                let target = ea!() & !1; // read before the link write (rd may be rs1)
+                wx!(next);
+                next = target;
+                taken = true;
+            }
+            Beq => branch!(a!() == b!()),
+            Bne => branch!(a!() != b!()),
+            Blt => branch!((a!() as i32) < (b!() as i32)),
+            Bge => branch!((a!() as i32) >= (b!() as i32)),
+            Bltu => branch!(a!() < b!()),
+            Bgeu => branch!(a!() >= b!()),
+            Lb => wx!(self.load::<1, M>(prog, mem, ea!(), &mut acc)?[0] as i8 as i32 as u32),
+            Lbu => wx!(self.load::<1, M>(prog, mem, ea!(), &mut acc)?[0] as u32),
+            Lh => {
+                wx!(
+                    i16::from_le_bytes(self.load::<2, M>(prog, mem, ea!(), &mut acc)?) as i32
+                        as u32
+                )
+            }
+            Lhu => wx!(u16::from_le_bytes(self.load::<2, M>(prog, mem, ea!(), &mut acc)?) as u32),
+            Lw => wx!(u32::from_le_bytes(self.load::<4, M>(
+                prog,
+                mem,
+                ea!(),
+                &mut acc
+            )?)),
+            Flw => wf!(u32::from_le_bytes(self.load::<4, M>(
+                prog,
+                mem,
+                ea!(),
+                &mut acc
+            )?)),
+            Sb => self.store::<1, M>(mem, ea!(), [b!() as u8], &mut acc)?,
+            Sh => self.store::<2, M>(mem, ea!(), (b!() as u16).to_le_bytes(), &mut acc)?,
+            Sw => self.store::<4, M>(mem, ea!(), b!().to_le_bytes(), &mut acc)?,
+            Fsw => {
+                let v = self.f[rs2!()];
+                self.store::<4, M>(mem, ea!(), v.to_le_bytes(), &mut acc)?
+            }
+            Addi => wx!(ea!()),
+            Slti => wx!(((a!() as i32) < imm) as u32),
+            Sltiu => wx!((a!() < imm as u32) as u32),
+            Xori => wx!(a!() ^ imm as u32),
+            Ori => wx!(a!() | imm as u32),
+            Andi => wx!(a!() & imm as u32),
+            Slli => wx!(a!() << imm),
+            Srli => wx!(a!() >> imm),
+            Srai => wx!(((a!() as i32) >> imm) as u32),
+            Add => wx!(a!().wrapping_add(b!())),
+            Sub => wx!(a!().wrapping_sub(b!())),
+            Sll => wx!(a!() << (b!() & 31)),
+            Slt => wx!(((a!() as i32) < (b!() as i32)) as u32),
+            Sltu => wx!((a!() < b!()) as u32),
+            Xor => wx!(a!() ^ b!()),
+            Srl => wx!(a!() >> (b!() & 31)),
+            Sra => wx!(((a!() as i32) >> (b!() & 31)) as u32),
+            Or => wx!(a!() | b!()),
+            And => wx!(a!() & b!()),
+            Mul => wx!(a!().wrapping_mul(b!())),
+            Mulh => wx!(((a!() as i32 as i64 * b!() as i32 as i64) >> 32) as u32),
+            Mulhsu => wx!(((a!() as i32 as i64 * b!() as i64) >> 32) as u32),
+            Mulhu => wx!(((a!() as u64 * b!() as u64) >> 32) as u32),
+            Div => wx!(if b!() == 0 {
+                u32::MAX
+            } else {
+                (a!() as i32).wrapping_div(b!() as i32) as u32
+            }),
+            Divu => wx!(a!().checked_div(b!()).unwrap_or(u32::MAX)),
+            Rem => wx!(if b!() == 0 {
+                a!()
+            } else {
+                (a!() as i32).wrapping_rem(b!() as i32) as u32
+            }),
+            Remu => wx!(if b!() == 0 { a!() } else { a!() % b!() }),
+            Fence => {}
+            Ebreak => {
+                self.halted = true;
+                next = pc;
+            }
+            Csrrw | Csrrs | Csrrc | Csrrwi | Csrrsi | Csrrci => {
+                // fflags, frm and fcsr all read 0 (fflags not modelled, frm = RNE).
+                let src = if matches!(op, Csrrw | Csrrs | Csrrc) {
+                    a!()
+                } else {
+                    rs1 as u32
+                };
+                let writes = matches!(op, Csrrw | Csrrwi) || rs1 != 0;
+                let new = match op {
+                    Csrrw | Csrrwi => src,
+                    Csrrs | Csrrsi => src,
+                    _ => 0,
+                };
+                let rm = match imm {
+                    CSR_FRM => new & 7,
+                    CSR_FCSR => (new >> 5) & 7,
+                    _ => 0,
+                };
+                if writes && rm != 0 {
+                    return Err(ExecError::RoundingMode { pc, rm });
+                }
+                wx!(0);
+            }
+            FmaddS => wf!(canon(fa!().mul_add(fb!(), fc!()))),
+            FmsubS => wf!(canon(fa!().mul_add(fb!(), -fc!()))),
+            FnmsubS => wf!(canon((-fa!()).mul_add(fb!(), fc!()))),
+            FnmaddS => wf!(canon((-fa!()).mul_add(fb!(), -fc!()))),
+            FaddS => wf!(canon(fa!() + fb!())),
+            FsubS => wf!(canon(fa!() - fb!())),
+            FmulS => wf!(canon(fa!() * fb!())),
+            FdivS => wf!(canon(fa!() / fb!())),
+            FsqrtS => wf!(canon(fa!().sqrt())),
+            FsgnjS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (self.f[rs2!()] & 0x8000_0000)),
+            FsgnjnS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (!self.f[rs2!()] & 0x8000_0000)),
+            FsgnjxS => wf!(self.f[rs1] ^ (self.f[rs2!()] & 0x8000_0000)),
+            FminS => wf!(fmin(self.f[rs1], self.f[rs2!()])),
+            FmaxS => wf!(fmax(self.f[rs1], self.f[rs2!()])),
+            FcvtWS => wx!(fcvt_w_s(self.f[rs1], imm)),
+            FcvtWuS => wx!(fcvt_wu_s(self.f[rs1], imm)),
+            FmvXW => wx!(self.f[rs1]),
+            FeqS => wx!((fa!() == fb!()) as u32),
+            FltS => wx!((fa!() < fb!()) as u32),
+            FleS => wx!((fa!() <= fb!()) as u32),
+            FclassS => wx!(fclass(self.f[rs1])),
+            FcvtSW => wf!((a!() as i32 as f32).to_bits()),
+            FcvtSWu => wf!((a!() as f32).to_bits()),
+            FmvWX => wf!(a!()),
+            RtSetOrg => self.ray.ray.origin = Vec3::new(fa!(), fb!(), fc!()),
+            RtSetInv => {
+                self.ray.inv_dir = Vec3::new(fa!(), fb!(), fc!());
+                self.ray.neg = [
+                    fa!().is_sign_negative(),
+                    fb!().is_sign_negative(),
+                    fc!().is_sign_negative(),
+                ];
+            }
+            RtSetShear => self.ray.shear = Vec3::new(fa!(), fb!(), fc!()),
+            RtSetK => {
+                let k = [a!() & 3, (a!() >> 2) & 3, (a!() >> 4) & 3];
+                if a!() >> 6 != 0 || k.contains(&3) {
+                    return Err(ExecError::BadAxes { pc, value: a!() });
+                }
+                self.ray.k = k.map(|v| v as usize);
+            }
+            RtRcp => wf!(canon(1.0 / fa!())),
+            RtAtomInc => {
+                let old = mem.atominc(a!()).map_err(|f| self.fault(f, 0, a!()))?;
+                wx!(old);
+            }
+            RtBox => {
+                let mut w = [0u32; 6];
+                self.operand_words(prog, mem, a!(), &mut w, &mut acc)?;
+                wf!(self.box_test(&w, fb!(), fc!()).1);
+            }
+            RtBoxN => {
+                let n = imm as usize;
+                let mut w = [0u32; 48];
+                self.operand_words(prog, mem, a!(), &mut w[..6 * n], &mut acc)?;
+                let mut mask = 0;
+                for k in 0..n {
+                    let (hit, entry) = self.box_test(&w[6 * k..6 * k + 6], fb!(), fc!());
+                    mask |= (hit as u32) << k;
+                    self.box_latch[k] = f32::from_bits(entry);
+                }
+                wx!(mask);
+            }
+            RtBoxGet => wf!(self.box_latch[imm as usize & 7].to_bits()),
+            RtTri => {
+                let mut w = [0u32; 9];
+                self.operand_words(prog, mem, a!(), &mut w, &mut acc)?;
+                let v = |k: usize| {
+                    Vec3::new(
+                        f32::from_bits(w[3 * k]),
+                        f32::from_bits(w[3 * k + 1]),
+                        f32::from_bits(w[3 * k + 2]),
+                    )
+                };
+                let tri = Triangle {
+                    v: [v(0), v(1), v(2)],
+                };
+                wf!(match tri.intersect(&self.ray, fb!(), fc!()) {
+                    Some(h) => h.t.to_bits(),
+                    None => CANONICAL_NAN,
+                });
+            }
+            RtDst => {
+                let mut w = [0u32; 3];
+                self.operand_words(prog, mem, a!(), &mut w, &mut acc)?;
+                let out = dst_step(&PipelineInput {
+                    word: HeaderOffset::from_bits(w[0]),
+                    p0: f32::from_bits(w[1]),
+                    p1: f32::from_bits(w[2]),
+                    origin: self.ray.ray.origin.to_array(),
+                    inv_dir: self.ray.inv_dir.to_array(),
+                    t_min: fb!(),
+                    t_max: fc!(),
+                });
+                self.dst_latch = DstLatch {
+                    t_min_out: out.t_min_out,
+                    t_max_out: out.t_max_out,
+                    offset_stack: out.offset_stack,
+                };
+                wx!(out.code as u32 | (out.offset << 2));
+            }
+            RtDstGet => match imm {
+                0 => wf!(self.dst_latch.t_min_out.to_bits()),
+                1 => wf!(self.dst_latch.t_max_out.to_bits()),
+                _ => wx!(self.dst_latch.offset_stack),
+            },
+            Illegal => {
+                let word = imm as u32;
+                let reason = decode(word).err().map_or("illegal", |e| e.reason);
+                return Err(ExecError::Illegal { pc, word, reason });
+            }
+        }
+        self.x[0] = 0;
+        self.pc = next;
+        let mut info = ins.info;
+        if acc.local && matches!(info.fu, FuClass::Load | FuClass::Store) {
+            info.fu = if acc.store {
+                FuClass::LocalStore
+            } else {
+                FuClass::LocalLoad
+            };
+        }
+        Ok(Retired {
+            info,
+            mem: acc,
+            taken,
+        })
+    }
+}
+
+/// `true` when `addr` is in the program region (stores there are read-only faults).
+#[inline]
+fn prog_maps(addr: u32) -> bool {
+    (super::PROGRAM_BASE..super::PROGRAM_END).contains(&addr)
+}

@@ -1,0 +1,190 @@
+//! The one table of the ray-tracing instructions' encodings (`docs/isa.md`, "Encoding").
+//!
+//! The decoder reads it ([`super::decode`]); `kernels/rt.h` emits the same fields with
+//! `.insn`, and `docs/isa.md` lists them: the test `rt_table_agrees_with_rt_h_and_isa_md`
+//! checks that all three say the same. Adding an instruction is one row here, one `.insn`
+//! in `rt.h`, one row in `isa.md`, and its [`Op`] in the executor (`docs/extending.md`).
+
+use super::decode::Op;
+
+/// Opcode of the custom-0 space (`rt.set*`, `rt.rcp`, `rt.atominc`).
+pub const OPCODE_CUSTOM0: u32 = 0x0B;
+/// Opcode of the custom-1 space (`rt.box`, `rt.boxn`, `rt.boxget`, `rt.tri`, `rt.dst`,
+/// `rt.dstget`).
+pub const OPCODE_CUSTOM1: u32 = 0x2B;
+
+/// The instruction format (`.insn r4` or `.insn r`) and the function field checked beside
+/// `funct3`, with its largest valid value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// R4: `rs3` in bits 27–31, `funct2` in bits 25–26, at most this value.
+    R4 {
+        /// Largest valid `funct2`.
+        funct2_max: u32,
+    },
+    /// R: `funct7` in bits 25–31, at most this value.
+    R {
+        /// Largest valid `funct7`.
+        funct7_max: u32,
+    },
+}
+
+/// What the function field (`funct2` or `funct7`) becomes in the decoded immediate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Imm {
+    /// Nothing (the field must be 0).
+    None,
+    /// The box count `N = 2 << funct2` of `rt.boxn`.
+    BoxCount,
+    /// The field itself (the latch index of `rt.boxget`, `rt.dstget`).
+    Field,
+}
+
+/// One ray-tracing instruction's encoding and operands.
+#[derive(Clone, Copy, Debug)]
+pub struct RtEncoding {
+    /// Mnemonic, as in `docs/isa.md` (`rt.box`); `rt.h` names its function `rt_box`.
+    pub mnemonic: &'static str,
+    /// The decoded operation.
+    pub op: Op,
+    /// [`OPCODE_CUSTOM0`] or [`OPCODE_CUSTOM1`].
+    pub opcode: u32,
+    /// `funct3`.
+    pub funct3: u32,
+    /// Format and function field.
+    pub format: Format,
+    /// Registers read and written: `rd`, `rs1`, `rs2`, `rs3` (an unused one decodes as 0).
+    pub regs: [bool; 4],
+    /// The decoded immediate.
+    pub imm: Imm,
+}
+
+const fn row(
+    mnemonic: &'static str,
+    op: Op,
+    opcode: u32,
+    funct3: u32,
+    format: Format,
+    regs: [bool; 4],
+    imm: Imm,
+) -> RtEncoding {
+    RtEncoding {
+        mnemonic,
+        op,
+        opcode,
+        funct3,
+        format,
+        regs,
+        imm,
+    }
+}
+
+const R4: Format = Format::R4 { funct2_max: 0 };
+const R: Format = Format::R { funct7_max: 0 };
+/// `rs1`, `rs2`, `rs3` read; no `rd`.
+const SET3: [bool; 4] = [false, true, true, true];
+/// `rd` written from `rs1`.
+const UNARY: [bool; 4] = [true, true, false, false];
+/// `rd` from a memory operand at `rs1` and the interval `rs2`, `rs3`.
+const MEM: [bool; 4] = [true, true, true, true];
+/// `rd` only (a latch read).
+const GET: [bool; 4] = [true, false, false, false];
+
+/// Every ray-tracing instruction (Lin et al. 2020, §2.3, §3; `docs/isa.md`).
+pub const RT_INSTRUCTIONS: [RtEncoding; 12] = [
+    row(
+        "rt.setorg",
+        Op::RtSetOrg,
+        OPCODE_CUSTOM0,
+        0,
+        R4,
+        SET3,
+        Imm::None,
+    ),
+    row(
+        "rt.setinv",
+        Op::RtSetInv,
+        OPCODE_CUSTOM0,
+        1,
+        R4,
+        SET3,
+        Imm::None,
+    ),
+    row(
+        "rt.setshear",
+        Op::RtSetShear,
+        OPCODE_CUSTOM0,
+        2,
+        R4,
+        SET3,
+        Imm::None,
+    ),
+    row(
+        "rt.setk",
+        Op::RtSetK,
+        OPCODE_CUSTOM0,
+        3,
+        R,
+        [false, true, false, false],
+        Imm::None,
+    ),
+    row("rt.rcp", Op::RtRcp, OPCODE_CUSTOM0, 4, R, UNARY, Imm::None),
+    row(
+        "rt.atominc",
+        Op::RtAtomInc,
+        OPCODE_CUSTOM0,
+        5,
+        R,
+        UNARY,
+        Imm::None,
+    ),
+    row("rt.box", Op::RtBox, OPCODE_CUSTOM1, 0, R4, MEM, Imm::None),
+    row(
+        "rt.boxn",
+        Op::RtBoxN,
+        OPCODE_CUSTOM1,
+        1,
+        Format::R4 { funct2_max: 2 },
+        MEM,
+        Imm::BoxCount,
+    ),
+    row(
+        "rt.boxget",
+        Op::RtBoxGet,
+        OPCODE_CUSTOM1,
+        2,
+        Format::R { funct7_max: 7 },
+        GET,
+        Imm::Field,
+    ),
+    row("rt.tri", Op::RtTri, OPCODE_CUSTOM1, 3, R4, MEM, Imm::None),
+    row("rt.dst", Op::RtDst, OPCODE_CUSTOM1, 4, R4, MEM, Imm::None),
+    row(
+        "rt.dstget",
+        Op::RtDstGet,
+        OPCODE_CUSTOM1,
+        5,
+        Format::R { funct7_max: 2 },
+        GET,
+        Imm::Field,
+    ),
+];
+
+/// The table row of the custom instruction word `w`, with its decoded immediate; `None`
+/// when its opcode, `funct3` or function field names no instruction.
+pub fn lookup(w: u32) -> Option<(&'static RtEncoding, i32)> {
+    let (opcode, f3) = (w & 0x7F, (w >> 12) & 7);
+    let e = RT_INSTRUCTIONS
+        .iter()
+        .find(|e| e.opcode == opcode && e.funct3 == f3)?;
+    let field = match e.format {
+        Format::R4 { funct2_max } => Some((w >> 25) & 3).filter(|&f| f <= funct2_max),
+        Format::R { funct7_max } => Some(w >> 25).filter(|&f| f <= funct7_max),
+    }?;
+    let imm = match e.imm {
+        Imm::None => 0,
+        Imm::BoxCount => 2 << field,
+        Imm::Field => field as i32,
+    };
+    Some((e, imm))
+}

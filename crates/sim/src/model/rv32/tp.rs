@@ -1,0 +1,472 @@
+//! The thread processor (TP) that executes compiled kernels: one RV32IMF hardware thread
+//! with the ray-tracing instructions of `docs/isa.md` (`rv32/` decodes and executes them).
+//!
+//! Hardware (Lin et al. 2020, §2.3; SimTRaX `IssueUnit.cc`, `ThreadState.cc`,
+//! `BranchUnit.cc`):
+//!
+//! * **Single issue, in order**: the instruction at the pc issues when every source
+//!   register is ready (a per-register scoreboard of ready cycles: a *dependency* stall
+//!   otherwise) and its unit accepts it in that cycle (a *busy-unit* stall otherwise). It
+//!   executes at issue; its result is in the destination register `latency` cycles later.
+//!   Branches resolve at issue, with no penalty (no predictor). One instruction per cycle.
+//! * **Its own datapath** (§2.3: "its own program counter, register file, and basic
+//!   datapath functional units (integer ALU, floating point add/sub/mult)") and its private
+//!   local store (the stack; `units.local_store_latency`).
+//! * **The TM's shared units**: the FP compare, min/max, conversion, branch and integer
+//!   multiply pools (`fu.rs`), the reciprocal/divide unit, the L1 and the ray-box,
+//!   ray-triangle and dual-split pipelines (`tm.rs`); the chip's atomic unit (`atomic.rs`).
+//! * **Loads are non-blocking**: a load takes one L1 bank slot per word and the thread goes
+//!   on issuing; only an instruction that reads the loaded register waits.
+//! * **Ray-tracing instructions with a memory operand** (`rt.box`, `rt.boxn`, `rt.tri`,
+//!   `rt.dst`) read their words through the L1 like a load of the same words, then wait in
+//!   the issue stage until the last word has arrived and the pipeline accepts them.
+//!
+//! Every stalled cycle is counted once, under the cause of the wait that ended last: the
+//! producer of the operand waited for (memory, a pipeline, or another unit's latency:
+//! *dependency*), or the unit that was busy.
+//!
+//! Host speed: instructions on the TP's own units touch no shared state, so the TP runs
+//! them ahead of the current event time (up to [`LOOKAHEAD`] cycles; its clock simply
+//! advances); it goes back to the scheduler only before an instruction on a shared unit
+//! whose cycle has not come yet. Results are the same as waking the thread every cycle.
+
+use crate::config::UnitConfig;
+use crate::engine::Wake;
+use crate::hw::fu::{ClassCounts, FuClass, Pool, fu_index};
+use crate::hw::issued::Issued;
+use crate::hw::memory::L2;
+use crate::hw::pipe::Pipe;
+use crate::hw::tm::Tm;
+use crate::hw::{Cycle, Stalls, Units, WordAddr};
+use crate::model::rv32::placement::Placement;
+use crate::model::rv32::{
+    ExecError, FrameMemory, Hart, LOCAL_STORE_ADDR, Latches, Op, Program, Retired,
+};
+
+/// The farthest a TP runs instructions on its own units and pools ahead of the current
+/// event time.
+pub const LOOKAHEAD: u64 = 256;
+
+/// Why a register is not ready yet: the kind of unit that produces it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Producer {
+    /// A functional unit's latency (ALU, FP, pools, reciprocal unit, local store).
+    Unit,
+    /// A load from the L1.
+    Memory,
+    /// A ray pipeline.
+    Pipeline,
+    /// The global atomic unit.
+    Atomic,
+}
+
+/// A ray-tracing instruction whose memory words are on their way: it issues on its
+/// pipeline once they have arrived.
+#[derive(Clone, Copy, Debug)]
+struct Waiting {
+    pipe: Pipe,
+    n: u8,
+    /// Scoreboard index of its destination register (if any).
+    dst: Option<usize>,
+    latches: Latches,
+}
+
+/// One thread processor.
+pub struct Tp {
+    hart: Hart,
+    tm: u32,
+    /// The cycle of its next issue slot.
+    t: Cycle,
+    /// Scoreboard: the cycle each register's pending result arrives (`x0..x31`,
+    /// `f0..f31`), and what produces it.
+    ready: [Cycle; 64],
+    producer: [Producer; 64],
+    /// The same for the ray registers `R`, the box latch `B` and the DST latch `D`.
+    ray_ready: Cycle,
+    box_ready: Cycle,
+    dst_ready: Cycle,
+    /// The latest result of any instruction so far.
+    last: Cycle,
+    waiting: Option<Waiting>,
+    /// Rays traced: each sets the ray registers' origin once (`rt.setorg`).
+    rays: u64,
+}
+
+impl Tp {
+    /// A TP on TM `tm` about to run `prog` from its entry point.
+    pub fn new(prog: &Program, tm: usize, local_store_bytes: u32) -> Self {
+        Self {
+            hart: Hart::new(prog, local_store_bytes),
+            tm: tm as u32,
+            t: Cycle::ZERO,
+            ready: [Cycle::ZERO; 64],
+            producer: [Producer::Unit; 64],
+            ray_ready: Cycle::ZERO,
+            box_ready: Cycle::ZERO,
+            dst_ready: Cycle::ZERO,
+            last: Cycle::ZERO,
+            waiting: None,
+            rays: 0,
+        }
+    }
+
+    /// The TM the TP belongs to.
+    #[inline]
+    pub fn tm(&self) -> usize {
+        self.tm as usize
+    }
+
+    /// Rays traced so far.
+    pub fn rays(&self) -> u64 {
+        self.rays
+    }
+
+    /// Executes instructions while they can issue by `now` (those on the TP's own units
+    /// and pools by `now + LOOKAHEAD`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &mut self,
+        prog: &Program,
+        mem: &mut FrameMemory<'_>,
+        cfg: &UnitConfig,
+        u: Units<'_>,
+        placement: &Placement,
+        counts: &mut ClassCounts,
+        now: Cycle,
+    ) -> Result<Wake, ExecError> {
+        let Units {
+            tm,
+            l2,
+            atomic,
+            stalls,
+        } = u;
+        if let Some(w) = self.waiting.take() {
+            // Its words have arrived (the thread slept until then): the pipeline op issues.
+            let r = tm.pipe(w.pipe, w.n, w.n > 1, self.t);
+            stalls.pipeline_busy += r.busy;
+            self.finish_pipe(r, w);
+        }
+        loop {
+            let Some(ins) = prog.fetch(self.hart.pc) else {
+                // The executor names the faulting pc.
+                return Err(self
+                    .hart
+                    .step(prog, mem)
+                    .expect_err("fetch outside the text"));
+            };
+            let info = ins.info;
+            // Operands.
+            let (mut at, mut why) = (self.t, Producer::Unit);
+            for r in info.src {
+                if let Some(i) = r.index()
+                    && self.ready[i] > at
+                {
+                    (at, why) = (self.ready[i], self.producer[i]);
+                }
+            }
+            let l = info.latches;
+            for (reads, ready, p) in [
+                (l.has(Latches::READS_RAY), self.ray_ready, Producer::Unit),
+                (
+                    l.has(Latches::READS_BOX),
+                    self.box_ready,
+                    Producer::Pipeline,
+                ),
+                (
+                    l.has(Latches::READS_DST),
+                    self.dst_ready,
+                    Producer::Pipeline,
+                ),
+            ] {
+                if reads && ready > at {
+                    (at, why) = (ready, p);
+                }
+            }
+            if at > self.t {
+                let d = at - self.t;
+                match why {
+                    Producer::Unit => stalls.dependency += d,
+                    Producer::Memory => stalls.memory += d,
+                    Producer::Pipeline => stalls.pipeline_latency += d,
+                    Producer::Atomic => stalls.atomic += d,
+                }
+                self.t = at;
+            }
+            let shared = match info.fu {
+                // A load or store is the L1's unless it addresses the local store.
+                FuClass::Load | FuClass::Store => {
+                    let addr = self.hart.x[ins.rs1 as usize].wrapping_add(ins.imm as u32);
+                    addr < LOCAL_STORE_ADDR
+                }
+                fu => on_shared_unit(fu),
+            };
+            if (shared && self.t > now) || self.t > now + LOOKAHEAD {
+                return Ok(Wake::At(self.t));
+            }
+            let r = self.hart.step(prog, mem)?;
+            // The executed class (a load or store whose address is the local store's).
+            let info = r.info;
+            counts[fu_index(info.fu)] += 1;
+            self.rays += (ins.op == Op::RtSetOrg) as u64;
+            let dst = info.dst.index();
+            let t = self.t;
+            // (issue cycle, result latency, producer) for units that take one slot.
+            let (slot, lat, p) = match info.fu {
+                FuClass::IntAlu | FuClass::FpMove => (t, cfg.int_latency, Producer::Unit),
+                FuClass::FpAdd => (t, cfg.fpadd_latency, Producer::Unit),
+                FuClass::FpMul | FuClass::FpFma => (t, cfg.fpmul_latency, Producer::Unit),
+                FuClass::LocalLoad | FuClass::LocalStore => {
+                    (t, cfg.local_store_latency, Producer::Unit)
+                }
+                FuClass::FpCmp => pool(&mut tm.pools.fpcmp, t, stalls),
+                FuClass::FpMinMax => pool(&mut tm.pools.fpminmax, t, stalls),
+                FuClass::FpConv => pool(&mut tm.pools.conv, t, stalls),
+                FuClass::Branch => pool(&mut tm.pools.branch, t, stalls),
+                FuClass::IntMul => pool(&mut tm.pools.intmul, t, stalls),
+                FuClass::IntDiv | FuClass::FpDiv | FuClass::FpSqrt | FuClass::Rcp => {
+                    let i = tm.reciprocal(t);
+                    stalls.fu_busy += i.busy;
+                    one_slot(i, Producer::Unit)
+                }
+                FuClass::Atomic => {
+                    let i = atomic.increment(t);
+                    stalls.atomic += i.busy;
+                    one_slot(i, Producer::Atomic)
+                }
+                FuClass::Load => {
+                    let i = l1_load(tm, l2, placement, &r, t, now, stalls);
+                    self.t = i.next_issue;
+                    self.write(dst, i.ready, Producer::Memory);
+                    continue;
+                }
+                FuClass::Store => {
+                    let i = tm.store(
+                        WordAddr::from_byte(placement.physical(r.mem.addr)),
+                        r.mem.words as u64,
+                        t,
+                        now,
+                    );
+                    stalls.l1_bank += i.busy;
+                    self.t = i.next_issue;
+                    self.last = self.last.max(i.ready);
+                    continue;
+                }
+                FuClass::BoxPipe(_) | FuClass::TriPipe | FuClass::DstPipe => {
+                    let (pipe, n) = match info.fu {
+                        FuClass::BoxPipe(n) => (Pipe::Box, n),
+                        FuClass::TriPipe => (Pipe::Triangle, 1),
+                        _ => (Pipe::DualSplit, 1),
+                    };
+                    let i = l1_load(tm, l2, placement, &r, t, now, stalls);
+                    let w = Waiting {
+                        pipe,
+                        n,
+                        dst,
+                        latches: l,
+                    };
+                    // The words are in the unit's operand latches at `i.ready`; the
+                    // instruction holds the issue stage until then.
+                    let arrive = i.ready.max(i.next_issue);
+                    stalls.memory += arrive - i.next_issue;
+                    self.t = arrive;
+                    if arrive > now {
+                        self.waiting = Some(w);
+                        return Ok(Wake::At(arrive));
+                    }
+                    let p = tm.pipe(pipe, n, n > 1, arrive);
+                    stalls.pipeline_busy += p.busy;
+                    self.finish_pipe(p, w);
+                    continue;
+                }
+                FuClass::Halt => {
+                    self.last = self.last.max(self.t);
+                    return Ok(Wake::Done(self.last));
+                }
+            };
+            self.t = slot + 1;
+            self.write(dst, slot + lat, p);
+            if l.has(Latches::WRITES_RAY) {
+                self.ray_ready = slot + lat;
+            }
+        }
+    }
+
+    /// A pipeline op issued with timing `r`: its results in the destination register and
+    /// the latches it writes.
+    fn finish_pipe(&mut self, r: Issued, w: Waiting) {
+        self.t = r.next_issue;
+        self.write(w.dst, r.ready, Producer::Pipeline);
+        if w.latches.has(Latches::WRITES_BOX) {
+            self.box_ready = r.ready;
+        }
+        if w.latches.has(Latches::WRITES_DST) {
+            self.dst_ready = r.ready;
+        }
+    }
+
+    #[inline]
+    fn write(&mut self, dst: Option<usize>, at: Cycle, p: Producer) {
+        if let Some(i) = dst {
+            self.ready[i] = at;
+            self.producer[i] = p;
+        }
+        self.last = self.last.max(at);
+    }
+}
+
+/// The L1 load of an executed instruction's memory words from cycle `t`.
+#[inline]
+fn l1_load(
+    tm: &mut Tm,
+    l2: &mut L2,
+    placement: &Placement,
+    r: &Retired,
+    t: Cycle,
+    now: Cycle,
+    stalls: &mut Stalls,
+) -> Issued {
+    let words = r.mem.words as u64;
+    let i = tm.load(
+        l2,
+        WordAddr::from_byte(placement.physical(r.mem.addr)),
+        words,
+        t,
+        now,
+    );
+    stalls.l1_bank += i.busy;
+    i
+}
+
+/// A one-slot request's timing as (issue cycle, latency, producer).
+#[inline]
+fn one_slot(i: Issued, p: Producer) -> (Cycle, u64, Producer) {
+    let slot = i.next_issue - 1;
+    (slot, i.ready - slot, p)
+}
+
+/// One operation on a pool from cycle `t`: (issue cycle, latency, producer).
+#[inline]
+fn pool(p: &mut Pool, t: Cycle, stalls: &mut Stalls) -> (Cycle, u64, Producer) {
+    let s = p.reserve(t);
+    stalls.fu_busy += s - t;
+    (s, p.latency(), Producer::Unit)
+}
+
+/// Whether an instruction of class `fu` uses a unit shared with other threads that keeps a
+/// reservation table bound to the current time (the L1, the ray pipelines, the reciprocal
+/// unit, the atomic unit): it issues only when its cycle has come.
+#[inline]
+fn on_shared_unit(fu: FuClass) -> bool {
+    matches!(
+        fu,
+        FuClass::BoxPipe(_)
+            | FuClass::TriPipe
+            | FuClass::DstPipe
+            | FuClass::IntDiv
+            | FuClass::FpDiv
+            | FuClass::FpSqrt
+            | FuClass::Rcp
+            | FuClass::Atomic
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SimConfig;
+    use crate::engine;
+    use crate::hw::Chip;
+    use crate::model::rv32::PROGRAM_BASE;
+    use crate::model::rv32::frame::Compiled;
+    use crate::model::rv32::tests::asm::*;
+    use dualsplit_accel::MemoryImage;
+
+    /// Runs `words` (an `ebreak` appended) on `threads` TPs of one TM; returns the end
+    /// cycle and the stalls.
+    fn run(cfg: &SimConfig, words: &[u32], threads: u32) -> (u64, Stalls) {
+        let mut w = words.to_vec();
+        w.push(EBREAK);
+        let prog = Program::from_words(PROGRAM_BASE, &w);
+        let image = MemoryImage::with_triangles(64, 0, Vec::new().into());
+        let mut mem = FrameMemory::new(&image, &[], 64);
+        let mut chip = Chip::new(cfg, 1);
+        let placement =
+            crate::model::rv32::placement::Placement::new(0, 4 * w.len() as u64, 64, 64);
+        let mut threads = Compiled {
+            tps: (0..threads).map(|_| Tp::new(&prog, 0, 4096)).collect(),
+            prog: &prog,
+            mem: &mut mem,
+            placement: &placement,
+            cfg: &cfg.units,
+            counts: [0; crate::hw::fu::FU_CLASSES],
+            handed_out: 0,
+            progress: &mut |_| {},
+        };
+        let end = engine::run(&mut chip, &mut threads).unwrap();
+        (end.get(), chip.stats().stalls)
+    }
+
+    fn fadd(rd: u32, rs1: u32, rs2: u32) -> u32 {
+        fp(0x00, 0, rd, rs1, rs2)
+    }
+
+    #[test]
+    fn independent_instructions_issue_one_per_cycle() {
+        // addi ×3 at cycles 0, 1, 2; ebreak at 3; the last result is in at 3.
+        let (end, s) = run(
+            &SimConfig::lin2020(),
+            &[addi(1, 0, 1), addi(2, 0, 2), addi(3, 0, 3)],
+            1,
+        );
+        assert_eq!(end, 3);
+        assert_eq!(s.dependency, 0);
+    }
+
+    #[test]
+    fn a_dependent_fp_add_waits_for_the_adders_latency() {
+        // fadd f1 at 0 (ready at 2), fadd f2 = f1 + f1 waits to 2 (1 dependency cycle),
+        // ready at 4; ebreak at 3.
+        let cfg = SimConfig::lin2020();
+        assert_eq!(cfg.units.fpadd_latency, 2);
+        let (end, s) = run(&cfg, &[fadd(1, 0, 0), fadd(2, 1, 1)], 1);
+        assert_eq!(s.dependency, 1);
+        assert_eq!(end, 4);
+    }
+
+    #[test]
+    fn a_full_pool_delays_the_second_thread() {
+        // Two threads multiply at cycle 0 on a TM with one integer multiplier: the second
+        // issues at 1, its ebreak at 2.
+        let mut cfg = SimConfig::lin2020();
+        cfg.units.intmul_units = 1;
+        let mul = r(0x33, 0, 1, 3, 1, 2);
+        let (end, s) = run(&cfg, &[mul], 2);
+        assert_eq!(s.fu_busy, 1);
+        assert_eq!(end, 2);
+    }
+
+    #[test]
+    fn a_load_use_waits_for_memory_and_is_counted_as_memory() {
+        // lw x1, 0(x0) misses everywhere; addi x2, x1, 1 waits for it.
+        let cfg = SimConfig::lin2020();
+        let (end, s) = run(&cfg, &[i(0x03, 2, 1, 0, 0), addi(2, 1, 1)], 1);
+        // A closed-row DRAM read: at least t_rcd + t_cas = 28 ns at lin2020.
+        assert!(s.memory >= 28, "{s:?}");
+        assert_eq!(s.dependency, 0);
+        // lw at 0, its data in at 1 + memory, addi then, ebreak the cycle after.
+        assert_eq!(end, 1 + s.memory + 1);
+    }
+
+    #[test]
+    fn local_store_accesses_do_not_touch_the_l1() {
+        // sw x0, -4(sp) at 0; lw x1, -4(sp) at 1, in at 2; addi at 2; ebreak at 3.
+        let cfg = SimConfig::lin2020();
+        let (end, s) = run(
+            &cfg,
+            &[s(0x23, 2, 2, 0, -4), i(0x03, 2, 1, 2, -4), addi(3, 1, 1)],
+            1,
+        );
+        assert_eq!(s.memory, 0);
+        assert_eq!(end, 3);
+    }
+}
