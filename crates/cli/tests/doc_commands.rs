@@ -50,8 +50,14 @@ fn doc_files() -> Vec<PathBuf> {
 
 /// Splits a shell line into words: whitespace separates, single and double quotes group,
 /// an unquoted `#` at the start of a word ends the line, and an unquoted `|`, `;`, `&&` or
-/// `>` word ends the command.
+/// `>` word ends the command. A quote that is never closed (an apostrophe in a synopsis's
+/// prose, `report's`) is an ordinary character.
 fn shell_words(line: &str) -> Vec<String> {
+    split_words(line, true).unwrap_or_else(|| split_words(line, false).unwrap_or_default())
+}
+
+/// [`shell_words`] with or without quoting; `None` when a quote is left open.
+fn split_words(line: &str, quoting: bool) -> Option<Vec<String>> {
     let mut words = Vec::new();
     let mut cur = String::new();
     let mut in_word = false;
@@ -60,7 +66,7 @@ fn shell_words(line: &str) -> Vec<String> {
         match quote {
             Some(q) if c == q => quote = None,
             Some(_) => cur.push(c),
-            None if c == '\'' || c == '"' => {
+            None if quoting && (c == '\'' || c == '"') => {
                 quote = Some(c);
                 in_word = true;
             }
@@ -77,6 +83,9 @@ fn shell_words(line: &str) -> Vec<String> {
             }
         }
     }
+    if quote.is_some() {
+        return None;
+    }
     if in_word {
         words.push(cur);
     }
@@ -85,7 +94,7 @@ fn shell_words(line: &str) -> Vec<String> {
         .position(|w| ["|", ";", "&&", "||", ">", "2>", "&"].contains(&w.as_str()))
         .unwrap_or(words.len());
     words.truncate(end);
-    words
+    Some(words)
 }
 
 /// The `dualsplit` arguments of a shell line, or `None` when the line runs something else
@@ -358,6 +367,8 @@ fn lines_are_split_as_a_shell_would() {
             "1000"
         ]
     );
+    let w = shell_words("plan [report's options] [--accel a,b]");
+    assert_eq!(w, ["plan", "[report's", "options]", "[--accel", "a,b]"]);
     let argv = dualsplit_argv(&shell_words("cargo run --release -- report --full")).unwrap();
     assert_eq!(argv, ["report", "--full"]);
     let other = "cargo run --release -p dualsplit-scene --example preview -- builtin:atrium";
