@@ -1,4 +1,4 @@
-//! Conversion speed bar (issue 3): converting `dragon_box.ply.gz` (871K triangles) into a
+//! Conversion speed bar: converting `dragon_box.ply.gz` (871K triangles) into a
 //! DST must take at most 10 % of its BVH2 build time. Both are timed here.
 //!
 //! `cargo bench -p dualsplit-accel --bench dst_convert`

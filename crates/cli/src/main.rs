@@ -28,6 +28,11 @@ struct Cli {
     #[arg(long, global = true, value_name = "BYTES",
           default_value_t = dualsplit_scene::Limits::DEFAULT_MAX_BYTES)]
     max_scene_bytes: u64,
+    /// Parse the command line and stop: exit 0 when it is valid, clap's usage error
+    /// otherwise. Nothing is loaded or written (the docs' command test runs every command
+    /// line the docs show with it).
+    #[arg(long, global = true, hide = true)]
+    parse_only: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -75,6 +80,9 @@ fn main() -> std::process::ExitCode {
         }
     }
     let cli = Cli::parse();
+    if cli.parse_only {
+        return std::process::ExitCode::SUCCESS;
+    }
     let mut ctx = progress::Ctx::new(cli.quiet);
     ctx.limits = dualsplit_scene::Limits {
         max_triangles: cli.max_triangles,

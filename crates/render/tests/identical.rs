@@ -1,5 +1,5 @@
 //! Every structure renders a bit-identical image (and identical ray counters) of the same
-//! scene, for both workloads (issue 4, "Done means").
+//! scene, for both workloads.
 
 use dualsplit_accel::{AccelKind, BuildConfig, Structures};
 use dualsplit_render::{RenderSettings, Workload, render};

@@ -1,6 +1,6 @@
-//! Scene loading speed (issue 2 speed bar: `dragon_sponza.ply.gz`, 6.2M triangles, in at most
-//! 3 s), with its components measured separately: reading, gzip inflation, PLY parsing and
-//! the whole `load_file` (which also applies the degenerate/non-finite rule and bounds).
+//! Scene loading speed (the bar: `dragon_sponza.ply.gz`, 6.2M triangles, in at most 3 s),
+//! with its components measured separately: reading, gzip inflation, PLY parsing and the
+//! whole `load_file` (which also applies the degenerate/non-finite rule and bounds).
 //!
 //! `cargo bench -p dualsplit-scene --bench load`. The figures are in `docs/performance.md`.
 

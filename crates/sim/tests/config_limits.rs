@@ -1,5 +1,5 @@
 //! Configuration values outside their documented ranges are typed errors naming the key and
-//! the value (issue 20's reproducers among them), values at the ends of every range run, and
+//! the value (reproducers of earlier crashes among them), values at the ends of every range run, and
 //! a chip too large for the host's memory is refused before anything is allocated.
 
 use dualsplit_accel::Structures;
