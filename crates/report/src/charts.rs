@@ -31,16 +31,8 @@ pub(crate) fn register_font() {
 /// The colour of a configuration: blues for BVH2, greens for BVH4, oranges for BVH8,
 /// purple for DST*, red for DST.
 pub fn color(a: SimAccel) -> RGBColor {
-    match a {
-        SimAccel::Bvh2 => RGBColor(31, 90, 180),
-        SimAccel::Bvh2Plus => RGBColor(110, 160, 230),
-        SimAccel::Bvh4 => RGBColor(30, 130, 60),
-        SimAccel::Bvh4Plus => RGBColor(120, 200, 120),
-        SimAccel::Bvh8 => RGBColor(200, 110, 0),
-        SimAccel::Bvh8Plus => RGBColor(245, 180, 80),
-        SimAccel::DstSw => RGBColor(130, 70, 170),
-        SimAccel::Dst => RGBColor(210, 30, 40),
-    }
+    let [r, g, b] = a.color();
+    RGBColor(r, g, b)
 }
 
 fn chart_err(chart: &str) -> impl Fn(String) -> ReportError + '_ {

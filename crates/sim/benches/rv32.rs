@@ -9,7 +9,7 @@
 //! Wall-clock throughput on the shared 2-core host varies with load; a deterministic
 //! measure is callgrind/cachegrind's host instructions per simulated instruction:
 //! `valgrind --tool=cachegrind --cache-sim=no <bench binary> --bench kernel_frame::Dst
-//! --sample-count 1 --sample-size 1`, then the `run_fast` lines of `cg_annotate` divided by
+//! --sample-count 1 --sample-size 1`, then the `run_counting` lines of `cg_annotate` divided by
 //! the simulated instructions (two frames: the count run and one sample). At the commit
 //! that added this note: 46 host instructions per simulated instruction (7.76 M simulated
 //! instructions per DST frame); divan: int_loop ≈ 180–320 M instructions/s, kernel_frame
@@ -20,7 +20,7 @@ use dualsplit_accel::{MemoryImage, Structures};
 use dualsplit_render::{RenderSettings, Workload};
 use dualsplit_sim::SimAccel;
 use dualsplit_sim::model::rv32::kernels::{LOCAL_STORE_BYTES, Params, elf};
-use dualsplit_sim::model::rv32::{FrameMemory, Hart, Program, run_fast};
+use dualsplit_sim::model::rv32::{FrameMemory, Hart, Program, run_counting};
 
 fn main() {
     divan::main();
@@ -72,11 +72,14 @@ fn int_loop_instructions(bencher: divan::Bencher) {
     let n = 2 + 5 * ITERS as u64 + 1;
     let mut hart = Hart::new(&prog, 4096);
     let mut mem = FrameMemory::new(&image, &[], 0);
-    assert_eq!(run_fast(&mut hart, &prog, &mut mem, u64::MAX).unwrap(), n);
+    assert_eq!(
+        run_counting(&mut hart, &prog, &mut mem, u64::MAX).unwrap(),
+        n
+    );
     assert_eq!(hart.x[6], ITERS);
     bencher.counter(ItemsCount::new(n)).bench_local(|| {
         hart.reset(&prog);
-        run_fast(&mut hart, &prog, &mut mem, u64::MAX).unwrap()
+        run_counting(&mut hart, &prog, &mut mem, u64::MAX).unwrap()
     });
 }
 
@@ -91,7 +94,7 @@ fn kernel_frame(bencher: divan::Bencher, accel: SimAccel) {
     let run = || {
         let mut mem = FrameMemory::new(image, params.as_bytes(), params.frame_bytes());
         let mut hart = Hart::new(&prog, LOCAL_STORE_BYTES);
-        run_fast(&mut hart, &prog, &mut mem, u64::MAX).unwrap()
+        run_counting(&mut hart, &prog, &mut mem, u64::MAX).unwrap()
     };
     let n = run();
     bencher.counter(ItemsCount::new(n)).bench_local(run);

@@ -1,68 +1,103 @@
 //! The simulated configurations: which structure, traversed how, on which units.
+//!
+//! Every configuration is registered once, in the [`sim_accels!`] invocation below: its
+//! variant, command-line name, the paper's label, the traversal it runs, its ray-box pipes
+//! for the "+" configurations, its chart colour, and its two compiled kernels
+//! (`kernels/build/<name>-{cast,path}.elf`, which `kernels/Makefile`'s `CONFIGS` builds; a
+//! test checks the two lists agree). The CLI, the simulator, the kernel table, the
+//! calibration and the charts read it from here (`docs/extending.md`).
 
 use crate::config::SimConfig;
 use dualsplit_accel::AccelKind;
 use serde::{Deserialize, Serialize};
 
-/// The eight simulated configurations of the paper (§4).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum SimAccel {
+/// One kernel ELF of `kernels/build/`, compiled into the binary.
+macro_rules! kernel {
+    ($name:expr) => {
+        include_bytes!(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../kernels/build/",
+            $name
+        ))
+    };
+}
+
+/// Defines [`SimAccel`] and its registry from one list.
+macro_rules! sim_accels {
+    ($(
+        $(#[doc = $doc:literal])*
+        $v:ident = $name:literal, $label:literal, $kind:ident, parallel: $par:expr, color: $rgb:expr;
+    )*) => {
+        /// The simulated configurations: the paper's eight (§4).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+        #[serde(rename_all = "kebab-case")]
+        pub enum SimAccel {
+            $( $(#[doc = $doc])* $v, )*
+        }
+
+        impl SimAccel {
+            /// All, in the paper's table order.
+            pub const ALL: [SimAccel; [$($name),*].len()] = [$(SimAccel::$v),*];
+
+            /// The registry entry of `self`.
+            const fn info(self) -> &'static Info {
+                &INFO[self as usize]
+            }
+        }
+
+        const INFO: [Info; [$($name),*].len()] = [$(
+            Info {
+                name: $name,
+                label: $label,
+                kind: AccelKind::$kind,
+                parallel: $par,
+                color: $rgb,
+                kernels: [kernel!(concat!($name, "-cast.elf")), kernel!(concat!($name, "-path.elf"))],
+            },
+        )*];
+    };
+}
+
+/// What the registry knows of one configuration.
+struct Info {
+    name: &'static str,
+    label: &'static str,
+    kind: AccelKind,
+    /// Ray-box pipes testing all of a node's children in one issue slot (the "+"
+    /// configurations), if any.
+    parallel: Option<u32>,
+    color: [u8; 3],
+    /// The compiled kernels, cast then path.
+    kernels: [&'static [u8]; 2],
+}
+
+sim_accels! {
     /// BVH2, child boxes tested one after another on the TM's ray-box pipeline.
-    Bvh2,
+    Bvh2 = "bvh2", "BVH2", Bvh2, parallel: None, color: [31, 90, 180];
     /// BVH2 with 2 ray-box pipelines (all child boxes in parallel).
-    Bvh2Plus,
+    Bvh2Plus = "bvh2+", "BVH2+", Bvh2, parallel: Some(2), color: [110, 160, 230];
     /// BVH4, serial box tests.
-    Bvh4,
+    Bvh4 = "bvh4", "BVH4", Bvh4, parallel: None, color: [30, 130, 60];
     /// BVH4 with 4 ray-box pipelines.
-    Bvh4Plus,
+    Bvh4Plus = "bvh4+", "BVH4+", Bvh4, parallel: Some(4), color: [120, 200, 120];
     /// BVH8, serial box tests.
-    Bvh8,
+    Bvh8 = "bvh8", "BVH8", Bvh8, parallel: None, color: [200, 110, 0];
     /// BVH8 with 8 ray-box pipelines.
-    Bvh8Plus,
+    Bvh8Plus = "bvh8+", "BVH8+", Bvh8, parallel: Some(8), color: [245, 180, 80];
     /// DST decoded in software (DST*).
-    DstSw,
+    DstSw = "dst-sw", "DST*", DstSw, parallel: None, color: [130, 70, 170];
     /// DST on the dual-split pipeline.
-    Dst,
+    Dst = "dst", "DST", Dst, parallel: None, color: [210, 30, 40];
 }
 
 impl SimAccel {
-    /// All eight, in the paper's table order.
-    pub const ALL: [SimAccel; 8] = [
-        SimAccel::Bvh2,
-        SimAccel::Bvh2Plus,
-        SimAccel::Bvh4,
-        SimAccel::Bvh4Plus,
-        SimAccel::Bvh8,
-        SimAccel::Bvh8Plus,
-        SimAccel::DstSw,
-        SimAccel::Dst,
-    ];
     /// Command-line name: `bvh2`, `bvh2+`, ..., `dst-sw`, `dst`.
     pub fn name(self) -> &'static str {
-        match self {
-            SimAccel::Bvh2 => "bvh2",
-            SimAccel::Bvh2Plus => "bvh2+",
-            SimAccel::Bvh4 => "bvh4",
-            SimAccel::Bvh4Plus => "bvh4+",
-            SimAccel::Bvh8 => "bvh8",
-            SimAccel::Bvh8Plus => "bvh8+",
-            SimAccel::DstSw => "dst-sw",
-            SimAccel::Dst => "dst",
-        }
+        self.info().name
     }
     /// The paper's label: `BVH2`, `BVH2+`, ..., `DST*`, `DST`.
     pub fn label(self) -> &'static str {
-        match self {
-            SimAccel::Bvh2 => "BVH2",
-            SimAccel::Bvh2Plus => "BVH2+",
-            SimAccel::Bvh4 => "BVH4",
-            SimAccel::Bvh4Plus => "BVH4+",
-            SimAccel::Bvh8 => "BVH8",
-            SimAccel::Bvh8Plus => "BVH8+",
-            SimAccel::DstSw => "DST*",
-            SimAccel::Dst => "DST",
-        }
+        self.info().label
     }
     /// Parses a command-line name.
     pub fn parse(s: &str) -> Option<Self> {
@@ -70,34 +105,29 @@ impl SimAccel {
     }
     /// The traversal this configuration runs.
     pub fn kind(self) -> AccelKind {
-        match self {
-            SimAccel::Bvh2 | SimAccel::Bvh2Plus => AccelKind::Bvh2,
-            SimAccel::Bvh4 | SimAccel::Bvh4Plus => AccelKind::Bvh4,
-            SimAccel::Bvh8 | SimAccel::Bvh8Plus => AccelKind::Bvh8,
-            SimAccel::DstSw => AccelKind::DstSw,
-            SimAccel::Dst => AccelKind::Dst,
-        }
+        self.info().kind
     }
     /// The "+" configurations: all child boxes of a node tested in one issue slot, on as
     /// many ray-box pipelines (§4).
     pub fn parallel_boxes(self) -> bool {
-        matches!(
-            self,
-            SimAccel::Bvh2Plus | SimAccel::Bvh4Plus | SimAccel::Bvh8Plus
-        )
+        self.info().parallel.is_some()
     }
     /// DST and DST\*: the traversal of the dual-split tree (stack entries carry
     /// `[t_min, t_max]`).
     pub fn is_dst(self) -> bool {
-        matches!(self, SimAccel::Dst | SimAccel::DstSw)
+        matches!(self.kind(), AccelKind::Dst | AccelKind::DstSw)
     }
-    /// Ray-box pipelines per TM: the node arity for the "+" configurations (§4).
+    /// Ray-box pipelines per TM: the node arity for the "+" configurations (§4), else the
+    /// configuration's `units.box_pipes`.
     pub fn box_pipes(self, cfg: &SimConfig) -> u32 {
-        match self {
-            SimAccel::Bvh2Plus => 2,
-            SimAccel::Bvh4Plus => 4,
-            SimAccel::Bvh8Plus => 8,
-            _ => cfg.units.box_pipes,
-        }
+        self.info().parallel.unwrap_or(cfg.units.box_pipes)
+    }
+    /// The colour of its series in the report's charts (RGB).
+    pub fn color(self) -> [u8; 3] {
+        self.info().color
+    }
+    /// Its compiled kernel for workload `cast` (`path == false`) or `path`: an RV32IMF ELF.
+    pub fn kernel(self, path: bool) -> &'static [u8] {
+        self.info().kernels[path as usize]
     }
 }

@@ -2,7 +2,7 @@
 //! before anything is allocated, so that a configuration that would not fit is refused with
 //! a message instead of aborting the process ("memory allocation of N bytes failed").
 //!
-//! The estimate is an upper bound of what [`crate::simulate_model`] allocates itself (the
+//! The estimate is an upper bound of what [`crate::simulate`] allocates itself (the
 //! scene and the structures are the caller's), term by term from the units' allocations:
 //!
 //! | term | bytes |
@@ -99,7 +99,7 @@ impl Footprint {
 }
 
 /// Refuses a simulation whose [`Footprint::estimate`] exceeds [`MAX_SIM_BYTES`]; callers
-/// may check before they load the scene, [`crate::simulate_model`] checks again.
+/// may check before they load the scene, [`crate::simulate`] checks again.
 pub fn check(
     cfg: &SimConfig,
     accel: SimAccel,

@@ -1,6 +1,6 @@
 //! The event loop: one loop for both thread models.
 //!
-//! The wheel ([`wheel`]) hands out the threads whose next step can start at the next cycle
+//! The timing wheel (`wheel.rs`) hands out the threads whose next step can start at the next cycle
 //! with events. Each is stepped by its thread model ([`Threads::step`]) against its TM's
 //! units while it can start in that cycle, and goes back to sleep until the cycle it can
 //! continue ([`Wake`]). The frame ends when the last result of the last thread has arrived.

@@ -63,7 +63,7 @@ pub struct InstrCounts {
 
 impl InstrCounts {
     /// The counts of a compiled-kernel frame from its instructions per
-    /// [`FuClass`](crate::model::rv32::FuClass) (indexed by [`crate::model::rv32::run::fu_index`]) and the TMs'
+    /// [`FuClass`] (indexed by [`fu_index`]) and the TMs'
     /// pipeline op counts, in the classes the energy model prices: integer ALU, branch,
     /// integer multiply and conversion/move instructions as `int`; FP add as `fpadd`; FP
     /// multiply and fused multiply-add as `fpmul`; FP compare and min/max as `fpcmp`;

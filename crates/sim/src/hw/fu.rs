@@ -7,13 +7,13 @@
 //! cycle from all of the TM's threads together; an operation that finds the pool full in its
 //! cycle waits for the next cycle with a free unit (an *FU-contention* stall in SimTRaX's
 //! `IssueUnit.cc`). The reciprocal/divide unit, the ray pipelines and the L1 are the TM's
-//! own units (`tm.rs`), not pools.
+//! own units (`hw/tm.rs`), not pools.
 
 use crate::config::UnitConfig;
 use crate::hw::Cycle;
 
 /// Cycles a pool remembers around the current time. Requests are made at most
-/// [`crate::tp::LOOKAHEAD`] cycles after the current event time and never before it, so
+/// [`crate::model::rv32::tp::LOOKAHEAD`] cycles after the current event time and never before it, so
 /// two live cycles are never this far apart and never share a ring entry.
 const RING: usize = 1024;
 
@@ -138,7 +138,7 @@ mod tests {
 /// The functional unit an instruction issues to (SimTRaX's FU classes: `sim/ReadConfig.cc`
 /// and the unit lines of `samples/configs/bigcache.config`, plus the ray-tracing units of
 /// `docs/isa.md`). Loads and stores are
-/// [`FuClass::Load`]/[`FuClass::Store`] in the decoded [`Info`]; the executor turns them into
+/// [`FuClass::Load`]/[`FuClass::Store`] in the decoded `Info`; the executor turns them into
 /// [`FuClass::LocalLoad`]/[`FuClass::LocalStore`] when the address is in the local store.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum FuClass {

@@ -7,7 +7,7 @@
 
 use crate::config::CacheConfig;
 use crate::hw::Cycle;
-use crate::hw::addr::WordAddr;
+use crate::hw::addr::{LineAddr, WordAddr};
 use crate::hw::issued::Issued;
 use crate::hw::memory::{Cache, CacheStats, L2, Lookup};
 use crate::hw::slots::{self, BankSlots};
@@ -62,7 +62,7 @@ impl L1 {
     ) -> Issued {
         let shift = self.line_word_shift;
         let mut c = at;
-        let mut w = addr.0;
+        let mut w = addr.get();
         let end = w + words;
         let (mut ready, mut busy) = (Cycle::ZERO, 0);
         while w < end {
@@ -95,7 +95,7 @@ impl L1 {
     /// which counts no write traffic).
     pub fn store(&mut self, addr: WordAddr, words: u64, at: Cycle, now: Cycle) -> Issued {
         let shift = self.line_word_shift;
-        let (mut c, mut w, end, mut busy) = (at, addr.0, addr.0 + words, 0);
+        let (mut c, mut w, end, mut busy) = (at, addr.get(), addr.get() + words, 0);
         while w < end {
             let seg_end = (((w >> shift) + 1) << shift).min(end);
             let k = seg_end - w;
@@ -117,10 +117,14 @@ impl L1 {
     /// overlap. Changes nothing simulated.
     #[inline]
     pub fn touch(&self, l2: &L2, addr: WordAddr) -> u64 {
-        let line = addr.0 >> self.line_word_shift;
+        let line = LineAddr::new(addr.get() >> self.line_word_shift);
         let l1 = self.cache.peek(line);
         // Most loads hit the L1 and never read the L2's tags (1 MB at random).
-        if l1 == line { l1 } else { l1 ^ l2.peek(line) }
+        if l1 == line.get() {
+            l1
+        } else {
+            l1 ^ l2.peek(line)
+        }
     }
 
     /// The first word of a line segment, at its bank slot `slot`: the tag lookup, and on a
@@ -130,7 +134,7 @@ impl L1 {
     fn first_word(&mut self, l2: &mut L2, w: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
         self.accesses += 1;
         let line = w >> self.line_word_shift;
-        match self.cache.lookup(line, slot) {
+        match self.cache.lookup(LineAddr::new(line), slot) {
             Lookup::Present { fill } if fill <= slot => {
                 self.hits += 1;
                 (slot + self.latency, fill)
@@ -145,8 +149,8 @@ impl L1 {
 
     #[inline(never)]
     fn miss(&mut self, l2: &mut L2, line: u64, w: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
-        let ready = l2.read(line, w, slot, now);
-        self.cache.install(line, ready, slot);
+        let ready = l2.read(LineAddr::new(line), WordAddr::new(w), slot, now);
+        self.cache.install(LineAddr::new(line), ready, slot);
         (ready, ready)
     }
 

@@ -127,13 +127,13 @@ mod tests {
         let r = tm.load(&mut l2, WordAddr::from_byte(0), 3, c(0), c(0));
         assert_eq!((r.next_issue, r.ready, r.busy), (c(3), c(34), 0));
         // The same words again: L1 hits, the last at cycle 102, data at 103.
-        let r = tm.load(&mut l2, WordAddr(0), 3, c(100), c(100));
+        let r = tm.load(&mut l2, WordAddr::new(0), 3, c(100), c(100));
         assert_eq!((r.next_issue, r.ready), (c(103), c(103)));
         // A store to bank 0 in cycle 200 and a load of word 16 (bank 0) in the same cycle:
         // the load waits one cycle for the bank; a store allocates no line.
-        let s = tm.store(WordAddr(32), 1, c(200), c(200));
+        let s = tm.store(WordAddr::new(32), 1, c(200), c(200));
         assert_eq!((s.next_issue, s.ready, s.busy), (c(201), c(200), 0));
-        let r = tm.load(&mut l2, WordAddr(16), 1, c(200), c(200));
+        let r = tm.load(&mut l2, WordAddr::new(16), 1, c(200), c(200));
         assert_eq!((r.next_issue, r.busy), (c(202), 1));
         // Dual-split op: result after 8 cycles; the pipe is taken in its cycle.
         let p = tm.pipe(Pipe::DualSplit, 1, false, c(300));

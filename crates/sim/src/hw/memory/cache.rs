@@ -22,6 +22,7 @@
 //! (`docs/simulator.md`, "TM scaling").
 
 use crate::hw::Cycle;
+use crate::hw::addr::LineAddr;
 use rustc_hash::FxHashMap;
 
 /// The result of a tag lookup.
@@ -296,7 +297,8 @@ impl Cache {
     /// A line a direct-mapped cache holds in its way is answered inline
     /// (`Cache::find_direct`); the rest goes through `Cache::lookup_general`.
     #[inline]
-    pub fn lookup(&mut self, line: u64, now: Cycle) -> Lookup {
+    pub fn lookup(&mut self, line: LineAddr, now: Cycle) -> Lookup {
+        let line = line.get();
         if let Some(fill) = self.find_direct(line) {
             return Lookup::Present { fill };
         }
@@ -348,7 +350,8 @@ impl Cache {
 
     /// The tag word of `line`'s first way, read without effect (see `Thread::touch`).
     #[inline]
-    pub fn peek(&self, line: u64) -> u64 {
+    pub fn peek(&self, line: LineAddr) -> u64 {
+        let line = line.get();
         let s = self.set(line);
         match &self.ways {
             Ways::Narrow(w) => w[s].line.get(),
@@ -388,7 +391,8 @@ impl Cache {
     /// A direct-mapped cache with 32-bit tags whose way holds no line still in flight (most
     /// installs) is served inline; the rest goes through `Cache::install_general`.
     #[inline]
-    pub fn install(&mut self, line: u64, fill: Cycle, now: Cycle) {
+    pub fn install(&mut self, line: LineAddr, fill: Cycle, now: Cycle) {
+        let line = line.get();
         let (fill, now) = (fill.get(), now.get());
         let s = self.set(line);
         if self.assoc == 1
@@ -449,12 +453,12 @@ mod tests {
     impl Cache {
         /// [`Cache::lookup`] at cycle `now`.
         fn lk(&mut self, line: u64, now: u64) -> Lookup {
-            self.lookup(line, Cycle(now))
+            self.lookup(LineAddr::new(line), Cycle(now))
         }
 
         /// [`Cache::install`] of a fill at cycle `fill` made at `now`.
         fn ins(&mut self, line: u64, fill: u64, now: u64) {
-            self.install(line, Cycle(fill), Cycle(now))
+            self.install(LineAddr::new(line), Cycle(fill), Cycle(now))
         }
 
         /// A lookup at cycle 0 on a copy (no effect on `self`).

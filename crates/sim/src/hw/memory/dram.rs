@@ -42,6 +42,7 @@
 //! compare every read's result on random streams.
 
 use crate::config::DramConfig;
+use crate::hw::addr::LineAddr;
 use crate::hw::slots::SparseSlots;
 use crate::hw::{Cycle, Tick};
 use serde::{Deserialize, Serialize};
@@ -317,7 +318,8 @@ impl Dram {
     }
 
     /// (channel, bank, row) of a line number (byte address / 64).
-    pub fn map(&self, line: u64) -> (usize, usize, u64) {
+    pub fn map(&self, line: LineAddr) -> (usize, usize, u64) {
+        let line = line.get();
         let (ch, b, row) = self.locate(line);
         (ch, b >> self.ch_bits, row)
     }
@@ -337,14 +339,15 @@ impl Dram {
 
     /// Reads `line` arriving at core cycle `arrive`; returns the core cycle its data has
     /// arrived and how the bank was found.
-    pub fn read(&mut self, line: u64, arrive: Cycle) -> (Cycle, DramAccess) {
+    pub fn read(&mut self, line: LineAddr, arrive: Cycle) -> (Cycle, DramAccess) {
         self.read_at(line, arrive, Cycle::ZERO)
     }
 
     /// As [`Dram::read`], when no read will ever arrive before core cycle `now` (the
     /// engine's current event time, `now ≤ arrive`): the channel's reservation tables then
     /// forget what ended before it. The result is the same as `read`'s.
-    pub fn read_at(&mut self, line: u64, arrive: Cycle, now: Cycle) -> (Cycle, DramAccess) {
+    pub fn read_at(&mut self, line: LineAddr, arrive: Cycle, now: Cycle) -> (Cycle, DramAccess) {
+        let line = line.get();
         debug_assert!(now <= arrive);
         let c = &self.cfg;
         let tpc = c.ticks_per_cycle;
@@ -476,13 +479,13 @@ mod tests {
     impl Dram {
         /// [`Dram::read`] in plain cycle numbers.
         fn rd(&mut self, line: u64, arrive: u64) -> (u64, DramAccess) {
-            let (done, kind) = self.read(line, Cycle(arrive));
+            let (done, kind) = self.read(LineAddr::new(line), Cycle(arrive));
             (done.get(), kind)
         }
 
         /// [`Dram::read_at`] in plain cycle numbers.
         fn rd_at(&mut self, line: u64, arrive: u64, now: u64) -> (u64, DramAccess) {
-            let (done, kind) = self.read_at(line, Cycle(arrive), Cycle(now));
+            let (done, kind) = self.read_at(LineAddr::new(line), Cycle(arrive), Cycle(now));
             (done.get(), kind)
         }
     }
@@ -716,7 +719,7 @@ mod tests {
         assert_eq!(d.rd(1, 2000), (2016, DramAccess::RowHit));
         // Conflict: same channel and bank, next row. Lines per row 128, channels 16, banks 16.
         let other_row = 128 * 16 * 16;
-        assert_eq!(d.map(other_row), (0, 0, 1));
+        assert_eq!(d.map(LineAddr::new(other_row)), (0, 0, 1));
         // tRP 14 + tRCD 14 + tCAS 14 + burst 2 = 44.
         assert_eq!(d.rd(other_row, 3000), (3044, DramAccess::Conflict));
         let s = d.stats();
@@ -803,9 +806,9 @@ mod tests {
     #[test]
     fn mapping_is_column_channel_bank_row() {
         let d = dram();
-        assert_eq!(d.map(127), (0, 0, 0));
-        assert_eq!(d.map(128), (1, 0, 0));
-        assert_eq!(d.map(128 * 16), (0, 1, 0));
+        assert_eq!(d.map(LineAddr::new(127)), (0, 0, 0));
+        assert_eq!(d.map(LineAddr::new(128)), (1, 0, 0));
+        assert_eq!(d.map(LineAddr::new(128 * 16)), (0, 1, 0));
     }
 
     #[test]

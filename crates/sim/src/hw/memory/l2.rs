@@ -11,6 +11,7 @@
 
 use crate::config::SimConfig;
 use crate::hw::Cycle;
+use crate::hw::addr::{LineAddr, WordAddr};
 use crate::hw::memory::{Cache, CacheStats, Dram, DramStats, Lookup};
 use crate::hw::slots::Slots;
 
@@ -50,8 +51,12 @@ impl L2 {
     /// Reads `line` for an L1 miss of word `word` whose L1 slot was `at`; returns the cycle
     /// the data is in the requesting thread's register. `now` (≤ `at`) is the current event
     /// time: no later request starts before it.
-    pub fn read(&mut self, line: u64, word: u64, at: Cycle, now: Cycle) -> Cycle {
-        let bank_addr = if self.line_interleaved { line } else { word };
+    pub fn read(&mut self, line: LineAddr, word: WordAddr, at: Cycle, now: Cycle) -> Cycle {
+        let bank_addr = if self.line_interleaved {
+            line.get()
+        } else {
+            word.get()
+        };
         let b = (bank_addr & self.bank_mask) as usize;
         let slot = Cycle(self.banks[b].reserve(at.get()));
         self.bank_wait += slot - at;
@@ -77,7 +82,7 @@ impl L2 {
     /// The tag word of `line`'s first way, read without effect: lets the event loop bring
     /// the host memory of a coming lookup into the host's cache ahead of time.
     #[inline]
-    pub fn peek(&self, line: u64) -> u64 {
+    pub fn peek(&self, line: LineAddr) -> u64 {
         self.tags.peek(line)
     }
 

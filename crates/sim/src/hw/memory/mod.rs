@@ -1,5 +1,5 @@
 //! The memory hierarchy behind the TMs' L1 data caches: one shared L2 ([`L2`]) and GDDR5
-//! DRAM ([`Dram`]). The L1 tags use the same [`Cache`] and belong to each TM (`tm.rs`).
+//! DRAM ([`Dram`]). The L1 tags use the same [`Cache`] and belong to each TM (`hw/l1.rs`).
 //!
 //! Timing is by reservation ("immediate response", Eyerman et al. 2021): an access learns
 //! its completion cycle when it is made. Each cache line's tag entry stores the cycle its

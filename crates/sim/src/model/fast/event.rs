@@ -5,7 +5,7 @@ use dualsplit_accel::DstNodeKind;
 use dualsplit_accel::dst::pipeline::ReturnCode;
 
 /// A traversal or workload event the `fast` model charges its kernel's instructions for.
-/// Their costs are measured per configuration and workload ([`crate::calibrate`]).
+/// Their costs are measured per configuration and workload ([`crate::model::fast::calibrate`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Event {
     /// A pixel taken from the global counter: its camera ray's set-up and the radiance

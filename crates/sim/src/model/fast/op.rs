@@ -7,7 +7,7 @@ use crate::hw::pipe::Pipe;
 /// Eight bytes (a one-byte tag and narrow fields), so that the replay's op buffers take
 /// half the host cache lines of a 16-byte op (`docs/simulator.md`, "How the simulator
 /// runs fast").
-/// The narrow fields are checked where ops are made ([`Op::load`], [`Recorder`]): a value
+/// The narrow fields are checked where ops are made ([`Op::load`], [`Recorder`](crate::model::fast::recorder::Recorder)): a value
 /// that does not fit is an [`OpRangeError`], never a silent wrap.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Op {

@@ -1,5 +1,5 @@
 //! The `fast` thread model's kernel costs: what each traversal event costs in the compiled
-//! kernels, measured by `calibrate.rs`, and the recording observer that turns a traversal's
+//! kernels, measured by `model/fast/calibrate.rs`, and the recording observer that turns a traversal's
 //! events into macro-operations.
 //!
 //! The traversal code is the real one (`dualsplit_accel::Structures`); this module only
@@ -8,7 +8,7 @@
 //! instructions around it, every triangle test a ray-triangle pipeline op. The instructions
 //! around them are not counted by hand: each [`Event`] carries the instructions per
 //! functional-unit class and the dependency stall cycles that the configuration's compiled
-//! kernel spends on it, fitted to the kernels' own execution ([`crate::calibrate`]).
+//! kernel spends on it, fitted to the kernels' own execution ([`crate::model::fast::calibrate`]).
 
 use crate::accel::SimAccel;
 use crate::hw::pipe::Pipe;
@@ -26,7 +26,7 @@ use dualsplit_render::{RayKind, TraceResult};
 /// Consecutive events' instructions merge into one [`Op::Issue`] run, kept in the recorder
 /// and written out when a load or pipeline op follows or the recording ends
 /// ([`Recorder::finish`], [`Recorder::finish_open`]). Costs are fractional (measured
-/// averages): the run sums them in units of 2^-[`FRAC_BITS`](FRAC_BITS)
+/// averages): the run sums them in units of 2^-[`FRAC_BITS`]
 /// and writes whole cycles, carrying the fraction into the next run, so a thread's issue
 /// cycles are its events' summed costs to within one cycle.
 pub struct Recorder<'a> {

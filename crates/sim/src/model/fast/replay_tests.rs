@@ -232,11 +232,11 @@ fn a_pipeline_op_takes_only_its_issue_slots() {
         n,
         parallel,
     };
-    // The latency the kernel exposes is part of the measured issue runs (`calibrate.rs`):
+    // The latency the kernel exposes is part of the measured issue runs (`model/fast/calibrate.rs`):
     // issue at 0, use at 1: end 2.
     let (end, _) = one_thread(&cfg, 1, vec![box_op(1, false), use_data()]);
     assert_eq!(end, 2);
-    // Four serial box tests on one pipe: issue 0..3, use at 4: end 5.
+    // Four serial box tests on one pipe: issued in cycles 0 to 3, used at 4: end 5.
     let (end, _) = one_thread(&cfg, 1, vec![box_op(4, false), use_data()]);
     assert_eq!(end, 5);
     // Four in parallel on four pipes: one issue, use at 1: end 2.

@@ -1,5 +1,5 @@
 //! What the recorders of one frame count: events, loads, atomics, and the first step that
-//! did not fit an [`Op`].
+//! did not fit an [`Op`](crate::model::fast::op::Op).
 
 use crate::accel::SimAccel;
 use crate::hw::counts::{InstrCounts, Mix};
@@ -10,7 +10,7 @@ use dualsplit_accel::DstNodeKind;
 use dualsplit_accel::dst::pipeline::ReturnCode;
 
 /// What the recorders of one frame count, summed over every ray: events, loads and atomics,
-/// and the first step that did not fit an [`Op`].
+/// and the first step that did not fit an [`Op`](crate::model::fast::op::Op).
 #[derive(Clone, Debug)]
 pub struct Tally {
     pub(super) accel: SimAccel,
@@ -118,7 +118,7 @@ impl Tally {
         self.costs.totals(&self.events)[PIPELINE]
     }
 
-    /// The first step that did not fit an [`Op`] (a program is then incomplete).
+    /// The first step that did not fit an [`Op`](crate::model::fast::op::Op) (a program is then incomplete).
     pub fn error(&self) -> Option<OpRangeError> {
         self.error
     }

@@ -1,13 +1,13 @@
 //! The thread processor (TP): one hardware thread replaying the macro-ops its kernel
-//! recorded (`kernel.rs`).
+//! recorded (`recorder.rs`).
 //!
 //! Hardware (Lin et al. 2020, §2.3, §4; SimTRaX `ThreadProcessor.cc`): single issue, in
 //! order, one instruction per cycle. Loads are non-blocking: each word takes one issue slot
 //! and the thread goes on issuing; any other op first waits until every outstanding result
 //! (loads, pipeline ops, reciprocals, the atomic) has arrived, because the next step of a
 //! traversal kernel consumes the previous step's data. Loads, pipeline ops and reciprocals
-//! go to the thread's TM (`tm.rs`), the pixel counter to the chip's atomic unit
-//! (`atomic.rs`). The thread counts where its cycles go ([`Stalls`]).
+//! go to the thread's TM (`hw/tm.rs`), the pixel counter to the chip's atomic unit
+//! (`hw/atomic.rs`). The thread counts where its cycles go ([`Stalls`]).
 
 use crate::engine::HOPS;
 use crate::hw::Cycle;
@@ -136,13 +136,13 @@ impl Thread {
                 Op::Issue { n, fpinv: 0 } => self.t += n as u64,
                 Op::Issue { n, fpinv } => self.issue_fpinv(n, fpinv, tm, stalls),
                 Op::Load { word, words } => {
-                    let r = tm.load(l2, WordAddr(word as u64), words as u64, self.t, now);
+                    let r = tm.load(l2, WordAddr::new(word as u64), words as u64, self.t, now);
                     stalls.l1_bank += r.busy;
                     self.done(r, Cause::Memory);
                 }
                 Op::Pipe { pipe, n, parallel } => {
                     // The pipe's latency as the kernel exposes it is measured, part of the
-                    // issue runs (`calibrate.rs`); here only its occupancy is timed.
+                    // issue runs (`model/fast/calibrate.rs`); here only its occupancy is timed.
                     let r = tm.pipe(pipe, n, parallel, self.t);
                     stalls.pipeline_busy += r.busy;
                     self.t = r.next_issue;
@@ -161,7 +161,7 @@ impl Thread {
         let op = self.ops.get(self.pc).copied();
         let read = matches!(op, Some(Op::Load { .. })) as u64;
         match self.next.or(op) {
-            Some(Op::Load { word, .. }) => read ^ tm.touch(l2, WordAddr(word as u64)),
+            Some(Op::Load { word, .. }) => read ^ tm.touch(l2, WordAddr::new(word as u64)),
             _ => read,
         }
     }

@@ -1,6 +1,6 @@
 //! The one table of the ray-tracing instructions' encodings (`docs/isa.md`, "Encoding").
 //!
-//! The decoder reads it ([`super::decode`]); `kernels/rt.h` emits the same fields with
+//! The decoder reads it ([`mod@super::decode`]); `kernels/rt.h` emits the same fields with
 //! `.insn`, and `docs/isa.md` lists them: the test `rt_table_agrees_with_rt_h_and_isa_md`
 //! checks that all three say the same. Adding an instruction is one row here, one `.insn`
 //! in `rt.h`, one row in `isa.md`, and its [`Op`] in the executor (`docs/extending.md`).

@@ -161,41 +161,9 @@ pub fn elf_name(accel: SimAccel, workload: Workload) -> String {
     format!("{}-{}.elf", accel.name(), workload.name())
 }
 
-macro_rules! kernel {
-    ($name:literal) => {
-        include_bytes!(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../kernels/build/",
-            $name
-        ))
-    };
-}
-
-/// The 16 committed kernels, in [`SimAccel::ALL`] × [`Workload::ALL`] order.
-static ELFS: [&[u8]; 16] = [
-    kernel!("bvh2-cast.elf"),
-    kernel!("bvh2-path.elf"),
-    kernel!("bvh2+-cast.elf"),
-    kernel!("bvh2+-path.elf"),
-    kernel!("bvh4-cast.elf"),
-    kernel!("bvh4-path.elf"),
-    kernel!("bvh4+-cast.elf"),
-    kernel!("bvh4+-path.elf"),
-    kernel!("bvh8-cast.elf"),
-    kernel!("bvh8-path.elf"),
-    kernel!("bvh8+-cast.elf"),
-    kernel!("bvh8+-path.elf"),
-    kernel!("dst-sw-cast.elf"),
-    kernel!("dst-sw-path.elf"),
-    kernel!("dst-cast.elf"),
-    kernel!("dst-path.elf"),
-];
-
 /// The compiled kernel of configuration `accel` and `workload` (an RV32IMF ELF).
 pub fn elf(accel: SimAccel, workload: Workload) -> &'static [u8] {
-    let a = SimAccel::ALL.iter().position(|&a| a == accel).unwrap();
-    let w = Workload::ALL.iter().position(|&w| w == workload).unwrap();
-    ELFS[a * Workload::ALL.len() + w]
+    accel.kernel(workload == Workload::Path)
 }
 
 #[cfg(test)]

@@ -87,4 +87,4 @@ pub use memory::{
     FRAME_BUFFER_ADDR, FrameMemory, GLOBAL_REGISTERS, LOCAL_STORE_ADDR, MemFault, Memory,
     PARAMS_ADDR,
 };
-pub use run::{RunError, RunStats, run_fast, run_frame, run_to_halt};
+pub use run::{RunError, RunStats, run_counting, run_frame, run_to_halt};

@@ -63,7 +63,7 @@ pub fn run_to_halt<M: Memory>(
 
 /// Runs `hart` until `ebreak` counting instructions only (the fastest loop; for speed
 /// measurements and when the counts are not needed). Returns the instructions retired.
-pub fn run_fast<M: Memory>(
+pub fn run_counting<M: Memory>(
     hart: &mut Hart,
     prog: &Program,
     mem: &mut M,

@@ -13,8 +13,8 @@
 //!   datapath functional units (integer ALU, floating point add/sub/mult)") and its private
 //!   local store (the stack; `units.local_store_latency`).
 //! * **The TM's shared units**: the FP compare, min/max, conversion, branch and integer
-//!   multiply pools (`fu.rs`), the reciprocal/divide unit, the L1 and the ray-box,
-//!   ray-triangle and dual-split pipelines (`tm.rs`); the chip's atomic unit (`atomic.rs`).
+//!   multiply pools (`hw/fu.rs`), the reciprocal/divide unit, the L1 and the ray-box,
+//!   ray-triangle and dual-split pipelines (`hw/tm.rs`); the chip's atomic unit (`hw/atomic.rs`).
 //! * **Loads are non-blocking**: a load takes one L1 bank slot per word and the thread goes
 //!   on issuing; only an instruction that reads the loaded register waits.
 //! * **Ray-tracing instructions with a memory operand** (`rt.box`, `rt.boxn`, `rt.tri`,
