@@ -18,7 +18,15 @@ pub const SHARED_ENV: &str = "DUALSPLIT_SHARED_SCENES";
 
 /// The repository's folder of committed meshes, `<repository>/scenes`.
 pub fn repo_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+    checkout().join("scenes")
+}
+
+/// The repository's root: two folders above this crate's.
+fn checkout() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .nth(2)
+        .expect("crates/testkit lies two folders below the repository's root")
 }
 
 /// The folder of the large meshes: `DUALSPLIT_SHARED_SCENES` when set and not empty, else
@@ -26,7 +34,10 @@ pub fn repo_dir() -> PathBuf {
 pub fn shared_dir() -> PathBuf {
     match std::env::var_os(SHARED_ENV) {
         Some(v) if !v.is_empty() => PathBuf::from(v),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes"),
+        _ => checkout()
+            .parent()
+            .unwrap_or(Path::new("/"))
+            .join("shared/scenes"),
     }
 }
 
@@ -35,22 +46,22 @@ pub fn shared_dir() -> PathBuf {
 /// When neither holds it, prints `skipped: NAME not found in DIRS` and returns `None`.
 ///
 /// # Panics
-/// When neither folder holds it and the `CI` environment variable is set, with that reason.
+/// When neither folder holds it and the `CI` environment variable is set, naming both.
 pub fn shipped_path(name: &str) -> Option<PathBuf> {
     let dirs = [repo_dir(), shared_dir()];
     if let Some(p) = dirs.iter().map(|d| d.join(name)).find(|p| p.is_file()) {
         return Some(p);
     }
     let reason = format!(
-        "skipped: {name} not found in {} or {}",
+        "{name} not found in {} or {}",
         dirs[0].display(),
         dirs[1].display()
     );
     assert!(
         std::env::var_os("CI").is_none(),
-        "{reason} (required under CI)"
+        "{reason} (required when CI is set)"
     );
-    eprintln!("{reason}");
+    eprintln!("skipped: {reason}");
     None
 }
 
