@@ -11,15 +11,7 @@
 
 static int traverse(const struct Ray *ray, const struct RayPre *r, int any, struct Hit *best)
 {
-    const struct Params *P = PARAMS;
-    float t_min, t_max;
-    if (!dst_clip(ray, r, &t_min, &t_max))
-        return 0;
-    struct Entry stack[STACK_SIZE];
-    int sp = 0;
-    int have = 0;
-    float best_t = ray->t_max;
-    uint32_t node = P->root;
+    DST_TRAVERSE_BEGIN(ray, r);
     for (;;) {
         uint32_t out = rt_dst(WORD_ADDR(node), t_min, t_max);
         uint32_t code = out & 3u;
@@ -43,18 +35,6 @@ static int traverse(const struct Ray *ray, const struct RayPre *r, int any, stru
         }
         if (code == CODE_LEAF && test_run(offset, ray->t_min, any, &have, best, &best_t))
             return 1;
-        /* Pop the next entry that can still hold a closer hit, clamping its t_max. */
-        float limit = cull_limit(best_t);
-        for (;;) {
-            if (sp == 0)
-                return have;
-            struct Entry e = stack[--sp];
-            if (!(e.t_min > limit)) {
-                node = e.node;
-                t_min = e.t_min;
-                t_max = f_min(e.t_max, limit);
-                break;
-            }
-        }
+        DST_POP_OR_RETURN();
     }
 }

@@ -1,6 +1,6 @@
 /* What both DST traversals share (crates/accel/src/dst/traverse.rs, `Tracer`): the clip to
- * the scene box, the triangle runs, the stack and the pop rule. Included by dst_sw.h and
- * dst.h. Each stack entry carries its node and its interval [t_min, t_max]. */
+ * the scene box, the triangle runs, the stack, the loop's start and the pop rule. Included
+ * by dst_sw.h and dst.h. Each stack entry carries its node and its interval [t_min, t_max]. */
 
 struct Entry {
     uint32_t node;
@@ -71,3 +71,38 @@ static inline int test_run(uint32_t first, float t_lo, int any, int *have, struc
             return 0;
     }
 }
+
+/* The start of both traversals' `traverse` (return type int, parameters `ray` and `r`):
+ * returns 0 when there is nothing to traverse (dst_clip), else declares the loop's state:
+ * the current node (the root) and its interval t_min, t_max; the stack `stack` with `sp`
+ * entries; whether a hit was found (`have`) and the best hit's t (`best_t`, starting at the
+ * ray's t_max). A macro, so that both loops compile exactly as if written out. */
+#define DST_TRAVERSE_BEGIN(ray, r)                                                        \
+    float t_min, t_max;                                                                   \
+    if (!dst_clip((ray), (r), &t_min, &t_max))                                            \
+        return 0;                                                                         \
+    struct Entry stack[STACK_SIZE];                                                       \
+    int sp = 0;                                                                           \
+    int have = 0;                                                                         \
+    float best_t = (ray)->t_max;                                                          \
+    uint32_t node = PARAMS->root
+
+/* The end of a node that continues nowhere: pops the next entry that can still hold a
+ * closer hit (t_min not beyond cull_limit(best_t)) into node, t_min and t_max, clamping its
+ * t_max; returns `have` from `traverse` when the stack runs out. Uses the state declared by
+ * DST_TRAVERSE_BEGIN. */
+#define DST_POP_OR_RETURN()                                                               \
+    do {                                                                                  \
+        float limit = cull_limit(best_t);                                                 \
+        for (;;) {                                                                        \
+            if (sp == 0)                                                                  \
+                return have;                                                              \
+            struct Entry e = stack[--sp];                                                 \
+            if (!(e.t_min > limit)) {                                                     \
+                node = e.node;                                                            \
+                t_min = e.t_min;                                                          \
+                t_max = f_min(e.t_max, limit);                                            \
+                break;                                                                    \
+            }                                                                             \
+        }                                                                                 \
+    } while (0)

@@ -6,13 +6,13 @@
 
 use dualsplit_accel::{BuildConfig, Bvh2, CollapseConfig, Structures, WideBvh};
 use dualsplit_geometry::Aabb;
-use dualsplit_testkit::scenes::load_scene;
+use dualsplit_testkit::scenes::shipped;
 use std::sync::OnceLock;
 
 fn boxes() -> &'static Vec<Aabb> {
     static B: OnceLock<Vec<Aabb>> = OnceLock::new();
     B.get_or_init(|| {
-        let scene = load_scene("dragon_box.ply.gz");
+        let scene = shipped("dragon_box.ply.gz").expect("the benchmark needs this mesh");
         scene.triangles.iter().map(|t| t.bounds()).collect()
     })
 }
@@ -62,7 +62,7 @@ fn main() {
         cpu_seconds() - c,
         b.nodes.len()
     );
-    let scene = load_scene("dragon_box.ply.gz");
+    let scene = shipped("dragon_box.ply.gz").expect("the benchmark needs this mesh");
     let s = Structures::build(&scene.triangles, &BuildConfig::default());
     for st in s.stats() {
         eprintln!(

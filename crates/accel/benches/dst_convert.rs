@@ -7,7 +7,7 @@ use dualsplit_accel::dst::{Dst, DstConfig, Partitioning};
 use dualsplit_accel::image::Words;
 use dualsplit_accel::{BuildConfig, Bvh2, BvhImage, SharedTriangles, WideBvh};
 use dualsplit_geometry::Aabb;
-use dualsplit_testkit::scenes::load_shipped;
+use dualsplit_testkit::scenes::shipped_triangles;
 use std::sync::OnceLock;
 
 struct Input {
@@ -19,7 +19,9 @@ struct Input {
 fn input() -> &'static Input {
     static INPUT: OnceLock<Input> = OnceLock::new();
     INPUT.get_or_init(|| {
-        let tris: SharedTriangles = load_shipped(&scene_name()).into();
+        let tris: SharedTriangles = shipped_triangles(&scene_name())
+            .expect("the benchmark needs this mesh")
+            .into();
         let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
         let bvh = Bvh2::build(&boxes, &BuildConfig::default());
         Input { tris, boxes, bvh }

@@ -14,7 +14,7 @@ use dualsplit_geometry::Ray;
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::{LoadStats, Scene};
 use dualsplit_testkit::dst::{build, check_dst_ray};
-use dualsplit_testkit::scenes::load_shipped;
+use dualsplit_testkit::scenes::shipped_triangles;
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
 
@@ -44,7 +44,7 @@ struct Prepared {
 }
 
 fn prepare(name: &str) -> Prepared {
-    let tris = load_shipped(&format!("{name}.ply.gz"));
+    let tris = shipped_triangles(&format!("{name}.ply.gz")).expect("the benchmark needs this mesh");
     let scene = Scene::from_triangles(name, name, tris, LoadStats::default()).expect("scene");
     let b = build(&scene.triangles, &DstConfig::hardware());
     let side = side();

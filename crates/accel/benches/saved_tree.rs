@@ -9,7 +9,7 @@
 use dualsplit_accel::{
     AnyTree, BuildConfig, Bvh2Tree, BvhTree, DstConfig, DstTree, SharedTriangles, TreeKind,
 };
-use dualsplit_testkit::scenes::load_shipped;
+use dualsplit_testkit::scenes::shipped_triangles;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
@@ -40,7 +40,9 @@ fn build(tris: &SharedTriangles) -> DstTree {
 fn input() -> &'static Input {
     static INPUT: OnceLock<Input> = OnceLock::new();
     INPUT.get_or_init(|| {
-        let tris: SharedTriangles = load_shipped(&scene_name()).into();
+        let tris: SharedTriangles = shipped_triangles(&scene_name())
+            .expect("the benchmark needs this mesh")
+            .into();
         let dir = tempfile::tempdir().expect("tempdir");
         let file = dir.path().join("dst.dstree");
         let dst = AnyTree::from(build(&tris));

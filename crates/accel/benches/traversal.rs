@@ -10,7 +10,7 @@ use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
 use dualsplit_geometry::Ray;
 use dualsplit_testkit::oracle::key;
 use dualsplit_testkit::rays::record_rays;
-use dualsplit_testkit::scenes::load_scene;
+use dualsplit_testkit::scenes::shipped;
 use std::sync::OnceLock;
 
 /// Rays of each kind per set.
@@ -28,7 +28,7 @@ fn data(scene: &str) -> &'static Data {
     static SPONZA: OnceLock<Data> = OnceLock::new();
     let cell = if scene == "dragon_box" { &BOX } else { &SPONZA };
     cell.get_or_init(|| {
-        let sc = load_scene(&format!("{scene}.ply.gz"));
+        let sc = shipped(&format!("{scene}.ply.gz")).expect("the benchmark needs this mesh");
         let s = Structures::build(&sc.triangles, &BuildConfig::default());
         let r = record_rays(&sc, &s, 150, RAYS);
         let cut = |v: Vec<Ray>| v.into_iter().take(RAYS).collect::<Vec<_>>();

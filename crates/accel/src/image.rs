@@ -306,6 +306,71 @@ pub(crate) fn packed_kind(b: &[f32; 6], packed: u32, leaf_bit: u32) -> ChildKind
     }
 }
 
+/// Defines a packed node layout (BVH2, BVH4): `$arity` child boxes (words `6k..6k + 6`)
+/// followed by one word holding the child-block offset in its low `32 − $arity` bits and one
+/// leaf bit per slot, `leaf_bit(k)`. The layouts differ only in these constants, so the
+/// struct and its [`NodeLayout`] implementation are written once here; the doc comment given
+/// (the byte table and a worked example) goes on the struct.
+macro_rules! packed_node {
+    ($(#[$doc:meta])* $node:ident, name $name:literal, arity $arity:literal,
+     leaf_bit |$k:ident| $leaf_bit:expr) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+        #[repr(C)]
+        pub struct $node {
+            /// Child boxes.
+            pub boxes: [[f32; 6]; $arity],
+            /// The child-block offset (the low [`NodeLayout::OFFSET_BITS`] bits) and the
+            /// child-type bits (the table above).
+            pub packed: u32,
+        }
+
+        const _: () = assert!(size_of::<$node>() == 4 * <$node as NodeLayout>::WORDS);
+
+        impl $node {
+            /// The packed-word bit that marks child `k` a leaf.
+            #[inline(always)]
+            fn leaf_bit($k: usize) -> u32 {
+                $leaf_bit
+            }
+
+            const OFFSET_MASK: u32 = (1 << <$node as NodeLayout>::OFFSET_BITS) - 1;
+        }
+
+        impl NodeLayout for $node {
+            const NAME: &'static str = $name;
+            const ARITY: usize = $arity;
+            const WORDS: usize = 6 * $arity + 1;
+            const OFFSET_BITS: u32 = 32 - $arity;
+
+            fn encode(children: &[(Aabb, ChildKind)], offset: u32) -> Result<Self, ImageError> {
+                let (boxes, packed) = $crate::image::encode_packed::<$arity>(
+                    children,
+                    Self::check_offset(offset)?,
+                    Self::leaf_bit,
+                );
+                Ok($node { boxes, packed })
+            }
+
+            #[inline(always)]
+            fn offset(&self) -> u32 {
+                self.packed & Self::OFFSET_MASK
+            }
+
+            #[inline(always)]
+            fn kind(&self, k: usize) -> ChildKind {
+                $crate::image::packed_kind(&self.boxes[k], self.packed, Self::leaf_bit(k))
+            }
+
+            #[inline(always)]
+            fn box_words(&self, k: usize) -> &[f32; 6] {
+                &self.boxes[k]
+            }
+        }
+    };
+}
+pub(crate) use packed_node;
+
 #[cfg(test)]
 pub(crate) mod test_support {
     use super::*;

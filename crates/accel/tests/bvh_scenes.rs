@@ -12,7 +12,7 @@ use dualsplit_accel::wide::cpu::{CpuBvh, SimdLevel};
 use dualsplit_accel::{AccelKind, BuildConfig, CollapseConfig, NoObserver, Structures, WideBvh};
 use dualsplit_testkit::oracle::{hit_bits, key};
 use dualsplit_testkit::rays::record_rays;
-use dualsplit_testkit::scenes::load_scene;
+use dualsplit_testkit::scenes::shipped;
 use rayon::prelude::*;
 
 const RAYS: usize = if cfg!(debug_assertions) {
@@ -22,7 +22,9 @@ const RAYS: usize = if cfg!(debug_assertions) {
 };
 
 fn equivalence(name: &str) {
-    equivalence_on(name, &load_scene(name), RAYS);
+    if let Some(scene) = shipped(name) {
+        equivalence_on(name, &scene, RAYS);
+    }
 }
 
 /// Every builtin scene (reduced sizes), with its preset camera; a quarter of the shipped
@@ -164,7 +166,9 @@ fn equivalence_dragon_box() {
 #[test]
 fn identical_leaves_in_all_three() {
     for name in ["dragon_res4.ply.gz", "sponza_dabrovic.ply.gz"] {
-        let scene = load_scene(name);
+        let Some(scene) = shipped(name) else {
+            continue;
+        };
         let boxes: Vec<_> = scene.triangles.iter().map(|t| t.bounds()).collect();
         let bvh = dualsplit_accel::Bvh2::build(&boxes, &BuildConfig::default());
         let l2 = WideBvh::from_bvh2(&bvh).leaf_sets(&bvh.prim_ids);

@@ -7,7 +7,7 @@
 use dualsplit_accel::dst::{Dst, DstConfig, DstCosts, Partitioning};
 use dualsplit_accel::{BuildConfig, Bvh2, Bvh2Node, SharedTriangles};
 use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3};
-use dualsplit_testkit::scenes::load_shipped;
+use dualsplit_testkit::scenes::shipped_triangles;
 use proptest::prelude::*;
 use std::sync::OnceLock;
 
@@ -32,14 +32,16 @@ fn assert_same(bvh: &Bvh2, tris: &SharedTriangles, cfg: &DstConfig, what: &str) 
     }
 }
 
-/// A shipped scene's triangles and its BVH2 under the default build.
+/// A mesh committed in the repository's `scenes/` and its BVH2 under the default build.
 struct Shipped {
     tris: SharedTriangles,
     bvh: Bvh2,
 }
 
 fn shipped(name: &str) -> Shipped {
-    let tris: SharedTriangles = load_shipped(name).into();
+    let tris: SharedTriangles = shipped_triangles(name)
+        .expect("committed in scenes/")
+        .into();
     let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
     let bvh = Bvh2::build(&boxes, &BuildConfig::default());
     Shipped { tris, bvh }

@@ -11,7 +11,7 @@ use dualsplit_accel::{AccelKind, NoObserver};
 use dualsplit_render::{PixelJob, RayKind, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::{LoadStats, Scene};
 use dualsplit_testkit::dst::{build, check_dst_ray};
-use dualsplit_testkit::scenes::load_shipped;
+use dualsplit_testkit::scenes::shipped_triangles;
 
 /// Image side; pixels are visited in a scattered order until every ray kind has
 /// [`MIN_RAYS`] rays (the open meshes send many rays to the sky, so shadow rays are rarest).
@@ -25,7 +25,9 @@ const MIN_RAYS: u64 = if cfg!(debug_assertions) {
 const STRIDE: u32 = 7919;
 
 fn scene_case(name: &str, cfg: DstConfig) {
-    let tris = load_shipped(name);
+    let Some(tris) = shipped_triangles(name) else {
+        return;
+    };
     let scene = Scene::from_triangles(name, name, tris, LoadStats::default()).expect("scene");
     rays_case(&scene, name, cfg, MIN_RAYS);
 }
@@ -127,7 +129,9 @@ fn sponza_dabrovic_software_preset() {
 /// Prints both modes' sizes and per-ray work on the renderer's primary rays.
 #[test]
 fn similar_partitioning_effect() {
-    let tris = load_shipped("bunny.ply.gz");
+    let Some(tris) = shipped_triangles("bunny.ply.gz") else {
+        return;
+    };
     let scene = Scene::from_triangles("bunny", "bunny", tris, LoadStats::default()).expect("scene");
     let ident = build(&scene.triangles, &DstConfig::hardware());
     let similar = build(

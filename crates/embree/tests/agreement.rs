@@ -1,7 +1,7 @@
 //! Embree agrees with our structures on the renderer's rays: every difference is a tie, a
-//! grazing hit or a hit at an interval end, on shipped scenes (read from the scenes folder
-//! beside the repository) and on builtins. Skips with a note when the library or a scene
-//! file is missing.
+//! grazing hit or a hit at an interval end, on shipped scenes
+//! ([`dualsplit_testkit::scenes::shipped`]) and on builtins. Skips with a note when the
+//! library or a scene file is missing (fails under `CI`).
 
 use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
 use dualsplit_embree::{
@@ -41,15 +41,16 @@ fn agreement(scene: &Scene, peer: &EmbreeScene, s: &Structures) -> Vec<(RayKind,
         .collect()
 }
 
+/// [`check_scene`] on the shipped mesh `name` (skipped when missing, as
+/// [`dualsplit_testkit::scenes::shipped`] says).
+fn check_shipped(name: &str) {
+    if let Some(path) = dualsplit_testkit::scenes::shipped_path(name) {
+        check_scene(path.to_str().expect("scene paths are UTF-8"));
+    }
+}
+
 fn check_scene(spec: &str) {
-    let scene = match dualsplit_scene::load(spec) {
-        Ok(s) => s,
-        Err(e) if !spec.starts_with("builtin:") && !std::path::Path::new(spec).exists() => {
-            eprintln!("note: {spec} is missing ({e}); skipped");
-            return;
-        }
-        Err(e) => panic!("{spec}: {e}"),
-    };
+    let scene = dualsplit_scene::load(spec).unwrap_or_else(|e| panic!("{spec}: {e}"));
     let peer = match EmbreeScene::new(&scene.triangles) {
         Ok(p) => p,
         Err(EmbreeError::Missing(why)) => {
@@ -76,19 +77,17 @@ fn check_scene(spec: &str) {
 
 #[test]
 fn embree_agrees_on_the_shipped_bunny() {
-    check_scene(&dualsplit_testkit::scenes::scene_path("bunny.ply.gz"));
+    check_shipped("bunny.ply.gz");
 }
 
 #[test]
 fn embree_agrees_on_the_shipped_sponza() {
-    check_scene(&dualsplit_testkit::scenes::scene_path(
-        "sponza_dabrovic.ply.gz",
-    ));
+    check_shipped("sponza_dabrovic.ply.gz");
 }
 
 #[test]
 fn embree_agrees_on_the_shipped_small_dragon() {
-    check_scene(&dualsplit_testkit::scenes::scene_path("dragon_res4.ply.gz"));
+    check_shipped("dragon_res4.ply.gz");
 }
 
 #[test]

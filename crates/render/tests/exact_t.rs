@@ -1,7 +1,7 @@
 //! Hit distances on the renderer's own rays: on shipped scenes with large triangles
 //! (Sponza's floors and walls, Dragon Box's box), `t` is within 1e-6 of the f64 crossing of the ray and the
 //! hit triangle's plane for 99.9 % of the primary and diffuse hits. Skips with a note when
-//! the scenes folder is missing (fails under CI).
+//! a mesh is missing (fails under CI: [`dualsplit_testkit::scenes::shipped`]).
 
 use dualsplit_accel::{BuildConfig, Structures};
 use dualsplit_geometry::{Ray, Triangle, Vec3};
@@ -25,16 +25,9 @@ fn plane_t(tri: &Triangle, ray: &Ray) -> f64 {
 }
 
 fn check(name: &str) {
-    let path = dualsplit_testkit::scenes::scene_path(name);
-    if !std::path::Path::new(&path).exists() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "{path} is missing under CI"
-        );
-        eprintln!("note: {path} is missing; skipped");
+    let Some(scene) = dualsplit_testkit::scenes::shipped(name) else {
         return;
-    }
-    let scene = dualsplit_testkit::scenes::load_scene(name);
+    };
     let s = Structures::build(&scene.triangles, &BuildConfig::default());
     let sets = ray_sets(&scene, &s, &RenderSettings::new(256, 256, Workload::Path)).unwrap();
     for set in sets.iter().filter(|s| s.kind != RayKind::Shadow) {

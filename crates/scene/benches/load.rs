@@ -5,7 +5,7 @@
 //! `cargo bench -p dualsplit-scene --bench load`. The figures are in `docs/performance.md`.
 
 use dualsplit_scene::load::{self, Format};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn main() {
     divan::main();
@@ -13,11 +13,7 @@ fn main() {
 
 /// A shipped scene, by file name.
 fn scene(name: &str) -> PathBuf {
-    Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/scenes"
-    ))
-    .join(name)
+    dualsplit_testkit::scenes::shipped_path(name).expect("the benchmark needs this mesh")
 }
 
 const SCENES: &[&str] = &["dragon_box.ply.gz", "dragon_sponza.ply.gz"];

@@ -14,8 +14,8 @@
 //! `frame_atrium`: a whole 64×64 path-traced frame of the builtin architectural scene
 //! (`builtin:atrium`) in each of the eight configurations, counted the same way (a BVH8
 //! visit loads a 200-byte node and tests 8 boxes, a DST visit one 8–20-byte node).
-//! `frame_dragon`: a 128×128 path-traced frame of the shipped `dragon_box.ply.gz` (read from
-//! the scenes folder beside the repository; skipped with a note when the file is absent),
+//! `frame_dragon`: a 128×128 path-traced frame of the shipped `dragon_box.ply.gz` (found by
+//! `dualsplit_testkit::scenes::shipped`; skipped with a note when the file is absent),
 //! every configuration.
 //!
 //! The synthetic stream is a stress case, not a typical frame: 1.54 DRAM reads per visit
@@ -221,10 +221,7 @@ fn frame_dragon_rv32(b: divan::Bencher, accel: SimAccel) {
 fn dragon() -> Option<&'static Built> {
     static DRAGON: OnceLock<Prepared> = OnceLock::new();
     prepared(&DRAGON, || {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../../shared/scenes/dragon_box.ply.gz"
-        );
-        dualsplit_scene::load(path).map_err(|e| e.to_string())
+        dualsplit_testkit::scenes::shipped("dragon_box.ply.gz")
+            .ok_or_else(|| "dragon_box.ply.gz not found".to_string())
     })
 }

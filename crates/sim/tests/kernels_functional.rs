@@ -13,25 +13,13 @@ use dualsplit_sim::model::rv32::kernels::{
 };
 use dualsplit_sim::model::rv32::{Program, run_frame};
 
-/// Loads a scene spec; shipped meshes live in `shared/scenes` beside the repository. A
-/// missing mesh skips the test locally and fails it under CI (`CI=1`).
+/// Loads a scene spec; `shipped:NAME` is the shipped mesh NAME, which when missing skips
+/// the test locally and fails it under CI ([`dualsplit_testkit::scenes::shipped`]).
 fn load(spec: &str) -> Option<Scene> {
-    let path = match spec.strip_prefix("shipped:") {
-        Some(name) => format!(
-            "{}/../../../shared/scenes/{name}",
-            env!("CARGO_MANIFEST_DIR")
-        ),
-        None => spec.to_string(),
-    };
-    if spec.starts_with("shipped:") && !std::path::Path::new(&path).exists() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "{path} is missing (needed under CI)"
-        );
-        eprintln!("skipping {spec}: {path} not found");
-        return None;
+    match spec.strip_prefix("shipped:") {
+        Some(name) => dualsplit_testkit::scenes::shipped(name),
+        None => Some(dualsplit_scene::load(spec).unwrap_or_else(|e| panic!("{spec}: {e}"))),
     }
-    Some(dualsplit_scene::load(&path).unwrap_or_else(|e| panic!("{path}: {e}")))
 }
 
 /// Runs every configuration's kernel for `workload` and compares each pixel with the

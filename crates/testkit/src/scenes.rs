@@ -1,30 +1,84 @@
 //! Scenes for tests and benchmarks: the shipped meshes, and a room built in code (no
 //! loader needed).
+//!
+//! A shipped mesh is looked up by file name in the repository's `scenes/` folder (the small
+//! meshes committed with the code), then in the folder of the large meshes: the one named by
+//! the `DUALSPLIT_SHARED_SCENES` environment variable, else `shared/scenes` beside the
+//! checkout. [`shipped`] and [`shipped_path`] return `None` with a printed reason when
+//! neither folder holds the file, so a test needing a large mesh skips on a fresh clone; when
+//! the `CI` environment variable is set they panic with that reason instead.
 
 use dualsplit_geometry::{Triangle, Vec3};
 use dualsplit_scene::{Camera, Light, LoadStats, Scene};
+use std::path::{Path, PathBuf};
 
-/// Path of the shipped scene file `name` (in the `shared/scenes` folder beside the
-/// repository).
-pub fn scene_path(name: &str) -> String {
-    format!(
-        "{}/../../../shared/scenes/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    )
+/// The environment variable naming the folder of the large meshes (default: `shared/scenes`
+/// beside the checkout). Naming a missing folder hides the large meshes.
+pub const SHARED_ENV: &str = "DUALSPLIT_SHARED_SCENES";
+
+/// The repository's folder of committed meshes, `<repository>/scenes`.
+pub fn repo_dir() -> PathBuf {
+    checkout().join("scenes")
 }
 
-/// Loads the shipped scene `name` with `dualsplit_scene::load`.
+/// The repository's root: two folders above this crate's.
+fn checkout() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .nth(2)
+        .expect("crates/testkit lies two folders below the repository's root")
+}
+
+/// The folder of the large meshes: `DUALSPLIT_SHARED_SCENES` when set and not empty, else
+/// `shared/scenes` beside the checkout.
+pub fn shared_dir() -> PathBuf {
+    match std::env::var_os(SHARED_ENV) {
+        Some(v) if !v.is_empty() => PathBuf::from(v),
+        _ => checkout()
+            .parent()
+            .unwrap_or(Path::new("/"))
+            .join("shared/scenes"),
+    }
+}
+
+/// Path of the shipped mesh `name`: in [`repo_dir`] if there, else in [`shared_dir`].
+///
+/// When neither holds it, prints `skipped: NAME not found in DIRS` and returns `None`.
 ///
 /// # Panics
-/// When the file is missing or does not parse, naming the path.
-pub fn load_scene(name: &str) -> Scene {
-    let path = scene_path(name);
-    dualsplit_scene::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+/// When neither folder holds it and the `CI` environment variable is set, naming both.
+pub fn shipped_path(name: &str) -> Option<PathBuf> {
+    let dirs = [repo_dir(), shared_dir()];
+    if let Some(p) = dirs.iter().map(|d| d.join(name)).find(|p| p.is_file()) {
+        return Some(p);
+    }
+    let reason = format!(
+        "{name} not found in {} or {}",
+        dirs[0].display(),
+        dirs[1].display()
+    );
+    assert!(
+        std::env::var_os("CI").is_none(),
+        "{reason} (required when CI is set)"
+    );
+    eprintln!("skipped: {reason}");
+    None
 }
 
-/// The triangles of the shipped scene `name`.
-pub fn load_shipped(name: &str) -> Vec<Triangle> {
-    load_scene(name).triangles
+/// Loads the shipped mesh `name` found by [`shipped_path`] with `dualsplit_scene::load`;
+/// `None` (with the printed reason) when it is missing.
+///
+/// # Panics
+/// When it is missing under `CI`, or when the file does not load, naming the path.
+pub fn shipped(name: &str) -> Option<Scene> {
+    let path = shipped_path(name)?;
+    let spec = path.to_str().expect("scene paths are UTF-8");
+    Some(dualsplit_scene::load(spec).unwrap_or_else(|e| panic!("{spec}: {e}")))
+}
+
+/// The triangles of the shipped mesh `name`, as [`shipped`].
+pub fn shipped_triangles(name: &str) -> Option<Vec<Triangle>> {
+    shipped(name).map(|s| s.triangles)
 }
 
 /// Two triangles of the quad `a b c d` (counter-clockwise).

@@ -1,67 +1,26 @@
 //! The 52-byte BVH2 internal node (Lin et al. 2020, §4.2).
 
-use crate::image::{ChildKind, ImageError, NodeLayout, encode_packed, packed_kind};
+use crate::image::{ChildKind, ImageError, NodeLayout, packed_node};
 use dualsplit_geometry::Aabb;
 
-/// BVH2 internal node: two child boxes and one packed offset/type word, 52 bytes.
-///
-/// | bytes | words | field |
-/// |---|---|---|
-/// | 0–23 | 0–5 | child 0 box: min.x, min.y, min.z, max.x, max.y, max.z (f32) |
-/// | 24–47 | 6–11 | child 1 box, same order |
-/// | 48–51 | 12 | `packed`: bits 0–29 child-block offset (absolute word index), bit 30 child 1 is a leaf, bit 31 child 0 is a leaf |
-///
-/// A slot whose box is degenerate (`min.x > max.x`, [`Aabb::DEGENERATE`]) is empty; this
-/// only occurs in the root of a scene with zero or one leaf. Children are stored
-/// consecutively from the offset (internal child: 13 words, leaf child: one leaf word; see
-/// [`crate::image`]).
-///
-/// Worked example: child 0 an internal node, child 1 a leaf, child block at word 13 →
-/// `packed = 13 | 1 << 30 = 0x4000_000D`; child 0 is the node at word 13 and child 1's leaf
-/// word is word 13 + 13 = 26.
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-#[repr(C)]
-pub struct Node2 {
-    /// Child boxes.
-    pub boxes: [[f32; 6]; 2],
-    /// Offset (bits 0–29) and the two child-type bits (30: child 1 leaf, 31: child 0 leaf).
-    pub packed: u32,
-}
-
-const _: () = assert!(size_of::<Node2>() == 52);
-
-/// The packed-word bit that marks child `k` a leaf: bit 31 for child 0, bit 30 for child 1.
-fn leaf_bit(k: usize) -> u32 {
-    31 - k as u32
-}
-
-const OFFSET_MASK: u32 = (1 << 30) - 1;
-
-impl NodeLayout for Node2 {
-    const NAME: &'static str = "bvh2";
-    const ARITY: usize = 2;
-    const WORDS: usize = 13;
-    const OFFSET_BITS: u32 = 30;
-
-    fn encode(children: &[(Aabb, ChildKind)], offset: u32) -> Result<Self, ImageError> {
-        let (boxes, packed) = encode_packed::<2>(children, Self::check_offset(offset)?, leaf_bit);
-        Ok(Node2 { boxes, packed })
-    }
-
-    #[inline(always)]
-    fn offset(&self) -> u32 {
-        self.packed & OFFSET_MASK
-    }
-
-    #[inline(always)]
-    fn kind(&self, k: usize) -> ChildKind {
-        packed_kind(&self.boxes[k], self.packed, leaf_bit(k))
-    }
-
-    #[inline(always)]
-    fn box_words(&self, k: usize) -> &[f32; 6] {
-        &self.boxes[k]
-    }
+packed_node! {
+    /// BVH2 internal node: two child boxes and one packed offset/type word, 52 bytes.
+    ///
+    /// | bytes | words | field |
+    /// |---|---|---|
+    /// | 0–23 | 0–5 | child 0 box: min.x, min.y, min.z, max.x, max.y, max.z (f32) |
+    /// | 24–47 | 6–11 | child 1 box, same order |
+    /// | 48–51 | 12 | `packed`: bits 0–29 child-block offset (absolute word index), bit 30 child 1 is a leaf, bit 31 child 0 is a leaf |
+    ///
+    /// A slot whose box is degenerate (`min.x > max.x`, [`Aabb::DEGENERATE`]) is empty; this
+    /// only occurs in the root of a scene with zero or one leaf. Children are stored
+    /// consecutively from the offset (internal child: 13 words, leaf child: one leaf word; see
+    /// [`crate::image`]).
+    ///
+    /// Worked example: child 0 an internal node, child 1 a leaf, child block at word 13 →
+    /// `packed = 13 | 1 << 30 = 0x4000_000D`; child 0 is the node at word 13 and child 1's leaf
+    /// word is word 13 + 13 = 26.
+    Node2, name "bvh2", arity 2, leaf_bit |k| 31 - k as u32
 }
 
 #[cfg(test)]

@@ -1,65 +1,24 @@
 //! The 100-byte BVH4 internal node (Lin et al. 2020, §4.2).
 
-use crate::image::{ChildKind, ImageError, NodeLayout, encode_packed, packed_kind};
+use crate::image::{ChildKind, ImageError, NodeLayout, packed_node};
 use dualsplit_geometry::Aabb;
 
-/// BVH4 internal node: four child boxes and one packed offset/type word, 100 bytes.
-///
-/// | bytes | words | field |
-/// |---|---|---|
-/// | 0–95 | 0–23 | child boxes, slot `k` at words `6k..6k+6`: min.xyz, max.xyz (f32) |
-/// | 96–99 | 24 | `packed`: bits 0–27 child-block offset (absolute word index), bit `28 + k` child `k` is a leaf |
-///
-/// Children occupy slots `0..n` in order; the remaining slots hold [`Aabb::DEGENERATE`]
-/// (empty, `min.x > max.x`) and take no space in the child block. Internal children take 25
-/// words in the child block, leaf children one leaf word (see [`crate::image`]).
-///
-/// Worked example: slots = [leaf, internal, leaf, empty], child block at word 25 →
-/// `packed = 25 | 1 << 28 | 1 << 30 = 0x5000_0019`; slot 0's leaf word is word 25, slot 1's
-/// node is at word 26, slot 2's leaf word is word 51.
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-#[repr(C)]
-pub struct Node4 {
-    /// Child boxes.
-    pub boxes: [[f32; 6]; 4],
-    /// Offset (bits 0–27) and the four child-type bits (28–31).
-    pub packed: u32,
-}
-
-const _: () = assert!(size_of::<Node4>() == 100);
-
-/// The packed-word bit that marks child `k` a leaf: bits 28–31 for children 0–3.
-fn leaf_bit(k: usize) -> u32 {
-    28 + k as u32
-}
-
-const OFFSET_MASK: u32 = (1 << 28) - 1;
-
-impl NodeLayout for Node4 {
-    const NAME: &'static str = "bvh4";
-    const ARITY: usize = 4;
-    const WORDS: usize = 25;
-    const OFFSET_BITS: u32 = 28;
-
-    fn encode(children: &[(Aabb, ChildKind)], offset: u32) -> Result<Self, ImageError> {
-        let (boxes, packed) = encode_packed::<4>(children, Self::check_offset(offset)?, leaf_bit);
-        Ok(Node4 { boxes, packed })
-    }
-
-    #[inline(always)]
-    fn offset(&self) -> u32 {
-        self.packed & OFFSET_MASK
-    }
-
-    #[inline(always)]
-    fn kind(&self, k: usize) -> ChildKind {
-        packed_kind(&self.boxes[k], self.packed, leaf_bit(k))
-    }
-
-    #[inline(always)]
-    fn box_words(&self, k: usize) -> &[f32; 6] {
-        &self.boxes[k]
-    }
+packed_node! {
+    /// BVH4 internal node: four child boxes and one packed offset/type word, 100 bytes.
+    ///
+    /// | bytes | words | field |
+    /// |---|---|---|
+    /// | 0–95 | 0–23 | child boxes, slot `k` at words `6k..6k+6`: min.xyz, max.xyz (f32) |
+    /// | 96–99 | 24 | `packed`: bits 0–27 child-block offset (absolute word index), bit `28 + k` child `k` is a leaf |
+    ///
+    /// Children occupy slots `0..n` in order; the remaining slots hold [`Aabb::DEGENERATE`]
+    /// (empty, `min.x > max.x`) and take no space in the child block. Internal children take 25
+    /// words in the child block, leaf children one leaf word (see [`crate::image`]).
+    ///
+    /// Worked example: slots = [leaf, internal, leaf, empty], child block at word 25 →
+    /// `packed = 25 | 1 << 28 | 1 << 30 = 0x5000_0019`; slot 0's leaf word is word 25, slot 1's
+    /// node is at word 26, slot 2's leaf word is word 51.
+    Node4, name "bvh4", arity 4, leaf_bit |k| 28 + k as u32
 }
 
 #[cfg(test)]

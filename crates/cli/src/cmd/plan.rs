@@ -3,15 +3,12 @@
 //! --from` to assemble. Takes the report's scene, resolution, TM and model options, plus
 //! `--vary KEY=V1,V2,...` sweeps over any key of the hardware config TOML.
 
-use super::report::{
-    DEFAULT_RES, FULL_RES, SIM_RAYS_PER_SECOND, SIM_RAYS_PER_SECOND_RV32, resolve_specs,
-};
+use super::report::{Resolved, SIM_RAYS_PER_SECOND, SIM_RAYS_PER_SECOND_RV32};
 use crate::args::{SimAccelArg, parse_sim_accel, parse_workload, sim_accels};
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_render::Workload;
 use dualsplit_report::produce::SIM_WORKERS;
-use dualsplit_report::scenes::{self, SceneFiles};
 use dualsplit_report::study::plan::PlanScene;
 use dualsplit_report::study::{Plan, PlanOptions, Vary};
 use dualsplit_sim::{SimConfig, ThreadModel};
@@ -63,29 +60,8 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if keys.windows(2).any(|w| w[0] == w[1]) {
         anyhow::bail!("a key is swept by two --vary options; list its values in one");
     }
-    let res = args.scope.res.unwrap_or(if args.scope.full {
-        FULL_RES
-    } else {
-        DEFAULT_RES
-    });
-    let mut tms = args.scope.tms.clone();
-    tms.sort_unstable();
-    tms.dedup();
-    if tms.is_empty() {
-        anyhow::bail!("--tms needs positive TM counts, e.g. --tms 32,64,128");
-    }
-    let base_tms = if tms.contains(&64) {
-        64
-    } else {
-        tms[tms.len() / 2]
-    };
-    let model =
-        args.scope
-            .model
-            .as_deref()
-            .unwrap_or(if args.scope.full { "rv32" } else { "fast" });
-    let thread_model = ThreadModel::parse(model)
-        .ok_or_else(|| anyhow::anyhow!("unknown --model `{model}` (expected rv32 or fast)"))?;
+    let scope = Resolved::new(&args.scope)?;
+    let thread_model = scope.thread_model;
     let accels = if args.accel.is_empty() {
         dualsplit_sim::SimAccel::ALL.to_vec()
     } else {
@@ -97,11 +73,8 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         args.workload.clone()
     };
 
-    let dir = scenes::find_here(args.scope.scenes_dir.as_deref())?;
-    let scene_files = SceneFiles::scan(dir.as_ref());
-    let specs = resolve_specs(&args.scope.specs, args.scope.full, &scene_files);
     let mut plan_scenes = Vec::new();
-    for spec in &specs {
+    for spec in &scope.specs {
         let sp = ctx.spinner(format!("loading {spec}"));
         let scene = dualsplit_scene::load(spec).with_context(|| format!("loading scene {spec}"));
         sp.finish_and_clear();
@@ -124,10 +97,10 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
 
     let plan = Plan::build(&PlanOptions {
         scenes: plan_scenes,
-        width: res,
-        height: res,
-        tms,
-        base_tms,
+        width: scope.res,
+        height: scope.res,
+        tms: scope.tms,
+        base_tms: scope.base_tms,
         thread_model,
         accels,
         workloads,
@@ -146,14 +119,15 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         .map(|e| e.estimated_rays() / per_core)
         .fold(0.0f64, f64::max);
     println!(
-        "wrote {}: {} jobs ({} scenes at {res}×{res}, {} thread model, {} swept combinations); \
+        "wrote {}: {} jobs ({} scenes at {r}×{r}, {} thread model, {} swept combinations); \
          estimated {cpu_hours:.2} CPU-hours, the longest job about {} on one core",
         path.display(),
         plan.entries.len(),
-        specs.len(),
+        scope.specs.len(),
         thread_model.name(),
         dualsplit_report::study::vary::cross_product(&plan.vary).len(),
         duration(longest_s),
+        r = scope.res,
     );
     Ok(ExitCode::SUCCESS)
 }

@@ -105,50 +105,15 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let start = Instant::now();
     let out = args.out.take().unwrap_or_else(|| PathBuf::from("report"));
     crate::output::prepare_dir(&out, "--out")?;
-    let dir = scenes::find_here(args.scope.scenes_dir.as_deref())?;
-    let scene_files = SceneFiles::scan(dir.as_ref());
-    eprintln!("{}", scene_files.describe());
-    if args.scope.tms.is_empty() || args.scope.tms.contains(&0) {
-        anyhow::bail!("--tms needs positive TM counts, e.g. --tms 32,64,128");
-    }
-    let res = args.scope.res.unwrap_or(if args.scope.full {
-        FULL_RES
-    } else {
-        DEFAULT_RES
-    });
-    if res == 0 {
-        anyhow::bail!("--res must be positive");
-    }
-    // The simulated frames obey the renderer's frame limit.
-    if u64::from(res) * u64::from(res) > dualsplit_render::MAX_PIXELS {
-        anyhow::bail!(
-            "--res {res}: at most {} pixels in a frame (--res 16384)",
-            dualsplit_render::MAX_PIXELS
-        );
-    }
+    let scope = Resolved::new(&args.scope)?;
+    eprintln!("{}", scope.scene_files.describe());
     let user_scenes = !args.scope.specs.is_empty();
-    let specs = resolve_specs(&args.scope.specs, args.scope.full, &scene_files);
-    let mut tms = args.scope.tms.clone();
-    tms.sort_unstable();
-    tms.dedup();
-    let base_tms = if tms.contains(&64) {
-        64
-    } else {
-        tms[tms.len() / 2]
-    };
-    let model =
-        args.scope
-            .model
-            .as_deref()
-            .unwrap_or(if args.scope.full { "rv32" } else { "fast" });
-    let thread_model = ThreadModel::parse(model)
-        .ok_or_else(|| anyhow::anyhow!("unknown --model `{model}` (expected rv32 or fast)"))?;
     let plan = Plan {
-        specs: &specs,
-        res,
-        tms: &tms,
-        base_tms,
-        thread_model,
+        specs: &scope.specs,
+        res: scope.res,
+        tms: &scope.tms,
+        base_tms: scope.base_tms,
+        thread_model: scope.thread_model,
     };
     eprintln!("{}", plan.describe());
     if args.dry_run {
@@ -157,7 +122,7 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
 
     let mut scenes = Vec::new();
     let mut skipped = Vec::new();
-    for spec in &specs {
+    for spec in &scope.specs {
         let sp = ctx.spinner(format!("loading {spec}"));
         let loaded = dualsplit_scene::load_with(spec, &ctx.limits);
         sp.finish_and_clear();
@@ -185,22 +150,22 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         );
     }
     let settings = ReportSettings {
-        width: res,
-        height: res,
-        tms,
-        base_tms,
+        width: scope.res,
+        height: scope.res,
+        tms: scope.tms,
+        base_tms: scope.base_tms,
         cpu_res: CPU_RES,
         full: args.scope.full,
-        thread_model,
+        thread_model: scope.thread_model,
     };
-    let simulate = real_simulator(thread_model);
+    let simulate = real_simulator(scope.thread_model);
     let bars = Bars {
         ctx,
         bar: Mutex::new(None),
     };
     let producer = Producer::new(Cache::new(out.join("cache")), settings, &bars, &*simulate);
     let mut data = producer.run(&scenes, skipped)?;
-    data.scene_files = scene_files;
+    data.scene_files = scope.scene_files;
     let written = dualsplit_report::write_report(&data, &out)?;
     if let Some(e) = data.sim_error() {
         eprintln!("note: {e}; simulated sections say so");
@@ -217,6 +182,71 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         start.elapsed().as_secs_f64()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// A study's scope ([`crate::args::Scope`], shared by `report` and `plan`) resolved into
+/// what to simulate.
+pub struct Resolved {
+    /// The scenes folder found and the paper's meshes in it.
+    pub scene_files: SceneFiles,
+    /// The scenes, as [`resolve_specs`] picks them.
+    pub specs: Vec<String>,
+    /// Square resolution of the simulated frames.
+    pub res: u32,
+    /// TM counts of the scaling study, ascending, without repeats.
+    pub tms: Vec<u32>,
+    /// The TM count of Tables 4–6: 64 when listed, else the middle one.
+    pub base_tms: u32,
+    /// The thread model.
+    pub thread_model: ThreadModel,
+}
+
+impl Resolved {
+    /// Applies the defaults (plain or `--full`), checks the values, finds the scenes
+    /// folder and picks the scenes. Loads no scene.
+    pub fn new(scope: &crate::args::Scope) -> anyhow::Result<Self> {
+        let dir = scenes::find_here(scope.scenes_dir.as_deref())?;
+        let scene_files = SceneFiles::scan(dir.as_ref());
+        let mut tms = scope.tms.clone();
+        tms.sort_unstable();
+        tms.dedup();
+        if tms.is_empty() || tms.contains(&0) {
+            anyhow::bail!("--tms needs positive TM counts, e.g. --tms 32,64,128");
+        }
+        let res = scope
+            .res
+            .unwrap_or(if scope.full { FULL_RES } else { DEFAULT_RES });
+        if res == 0 {
+            anyhow::bail!("--res must be positive");
+        }
+        // The simulated frames obey the renderer's frame limit.
+        if u64::from(res) * u64::from(res) > dualsplit_render::MAX_PIXELS {
+            anyhow::bail!(
+                "--res {res}: at most {} pixels in a frame (--res 16384)",
+                dualsplit_render::MAX_PIXELS
+            );
+        }
+        let specs = resolve_specs(&scope.specs, scope.full, &scene_files);
+        let base_tms = if tms.contains(&64) {
+            64
+        } else {
+            tms[tms.len() / 2]
+        };
+        let model = scope
+            .model
+            .as_deref()
+            .unwrap_or(if scope.full { "rv32" } else { "fast" });
+        let thread_model = ThreadModel::parse(model)
+            .ok_or_else(|| anyhow::anyhow!("unknown --model `{model}` (expected rv32 or fast)"))?;
+        Ok(Self {
+            scene_files,
+            specs,
+            res,
+            tms,
+            base_tms,
+            thread_model,
+        })
+    }
 }
 
 /// The scenes of a report or study: those given, else the paper's meshes found in the

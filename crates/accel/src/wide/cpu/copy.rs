@@ -1,0 +1,103 @@
+//! Copying a BVH image into the CPU-side nodes and triangle packets.
+
+use super::layout::{EMPTY, EMPTY_PACKET, LANES, LEAF, Lanes, TriPacket};
+use super::merge::{MERGE_MAX, gather};
+use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
+use dualsplit_geometry::Triangle;
+
+/// What [`copy`] makes: nodes and packets.
+pub(super) struct Copied<N> {
+    pub(super) nodes: Vec<N>,
+    pub(super) packets: Vec<TriPacket>,
+}
+
+/// Copies the image of node layout `L` into nodes of type `N` (`N::W >= L::ARITY`).
+pub(super) fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage) -> Copied<N> {
+    let words = &img.words[..];
+    let triangles = img.triangle_slice();
+    let mut out = Copied {
+        nodes: vec![N::EMPTY],
+        packets: Vec::new(),
+    };
+    // (image word of a node, node index it is copied to)
+    let mut todo: Vec<(usize, usize)> = vec![(0, 0)];
+    // Triangle slots used (4 per packet).
+    let mut slots = 0usize;
+    while let Some((w, at)) = todo.pop() {
+        let node = L::read(words, w);
+        let mut addr = node.offset() as usize;
+        let mut lane = 0;
+        let mut internal = Vec::new();
+        for k in 0..L::ARITY {
+            let kind = node.kind(k);
+            if kind == ChildKind::Empty {
+                continue;
+            }
+            // A leaf's entries; an internal child whose subtree holds few triangles becomes
+            // one leaf of them.
+            let entries = match kind {
+                ChildKind::Leaf => {
+                    let run = words[addr] as usize;
+                    let len = words[run..]
+                        .iter()
+                        .position(|&e| e & RUN_END != 0)
+                        .map_or(0, |p| p + 1);
+                    Some(words[run..run + len].to_vec())
+                }
+                _ => gather::<L>(words, addr, MERGE_MAX),
+            };
+            let child = match entries {
+                // A subtree without triangles (only a forged saved tree has one) holds
+                // nothing to hit.
+                Some(e) if e.is_empty() => EMPTY,
+                Some(e) => {
+                    let first = slots as u32;
+                    assert!(first < LEAF, "too many triangle references");
+                    pack_entries(&mut out.packets, &mut slots, e, triangles);
+                    LEAF | first
+                }
+                None => {
+                    internal.push((addr, lane));
+                    EMPTY
+                }
+            };
+            out.nodes[at].set(lane, *node.box_words(k), child);
+            addr += L::child_words(kind) as usize;
+            lane += 1;
+        }
+        // Children of one node next to one another, then their subtrees depth-first.
+        let mut subtrees = Vec::with_capacity(internal.len());
+        for (cw, l) in internal {
+            let idx = out.nodes.len();
+            out.nodes.push(N::EMPTY);
+            out.nodes[at].set_child(l, idx as u32);
+            subtrees.push((cw, idx));
+        }
+        todo.extend(subtrees.into_iter().rev());
+    }
+    out
+}
+
+/// Appends the triangles of the index-run entries `entries` (ids with [`RUN_END`] on each
+/// run's last) to `packets`, slot after slot from `*slots`, padding nothing: the caller
+/// pads the last packet by starting from [`EMPTY_PACKET`]s.
+pub(crate) fn pack_entries(
+    packets: &mut Vec<TriPacket>,
+    slots: &mut usize,
+    entries: impl IntoIterator<Item = u32>,
+    triangles: &[Triangle],
+) {
+    for e in entries {
+        if *slots & (LANES - 1) == 0 {
+            packets.push(EMPTY_PACKET);
+        }
+        let pk = packets.last_mut().expect("pushed");
+        let tri = &triangles[(e & !RUN_END) as usize];
+        let l = *slots % LANES;
+        for (r, row) in pk.v.iter_mut().enumerate() {
+            row[l] = tri.v[r / 3][r % 3];
+        }
+        pk.prim[l] = e;
+        *slots += 1;
+    }
+}

@@ -1,0 +1,127 @@
+//! The copy's memory layout: nodes of four ([`Chunk`]) or eight ([`Chunk8`]) lanes, the
+//! child words, and triangle packets ([`TriPacket`]).
+
+use super::isa::Isa;
+use super::ray::RaySimd;
+use wide::f32x4;
+
+/// Lanes of one SSE register of `f32`: children per [`Chunk`], triangles per [`TriPacket`].
+pub const LANES: usize = 4;
+
+/// Child word of a leaf: bit 31 set, bits 0–30 the slot of its first triangle in
+/// [`CpuBvh::packets`](super::CpuBvh::packets) (`4 · packet + lane`).
+pub const LEAF: u32 = 1 << 31;
+
+/// Child word of an empty lane.
+pub const EMPTY: u32 = u32::MAX;
+
+/// A BVH2 or BVH4 node of the copy: its children's boxes plane by plane, then their child
+/// words.
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C, align(16))]
+pub struct Chunk {
+    /// `planes[p][lane]`: plane `p` of the lane's box, in the image's box-word order
+    /// (min.x, min.y, min.z, max.x, max.y, max.z). Empty lanes hold the degenerate box.
+    pub planes: [[f32; LANES]; 6],
+    /// Per lane: a node (its index), a leaf ([`LEAF`] | first triangle) or [`EMPTY`].
+    pub child: [u32; LANES],
+}
+
+/// A BVH8 node of the copy, laid out as [`Chunk`] with eight lanes, so that one AVX
+/// register holds a plane of all eight children (and two SSE registers one half each).
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C, align(32))]
+pub struct Chunk8 {
+    /// `planes[p][lane]`, as [`Chunk::planes`].
+    pub planes: [[f32; 8]; 6],
+    /// Per lane, as in [`Chunk`]: a node, a leaf or [`EMPTY`].
+    pub child: [u32; 8],
+}
+
+/// Four consecutive triangles of the leaf-ordered triangle list, vertex coordinates lane by
+/// lane, with their ids. Leaves follow one another without padding: a leaf starts at any
+/// lane (its child word names the slot `4 · packet + lane`) and ends at the first lane from
+/// there whose id has [`RUN_END`](crate::image::RUN_END) set; the last packet is padded
+/// with [`EMPTY`] lanes.
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C, align(16))]
+pub struct TriPacket {
+    /// `v[3 * vertex + axis][lane]`.
+    pub v: [[f32; LANES]; 9],
+    /// Triangle ids; [`RUN_END`](crate::image::RUN_END) on a leaf's last one, [`EMPTY`] on
+    /// padding lanes.
+    pub prim: [u32; LANES],
+}
+
+pub(crate) const EMPTY_PACKET: TriPacket = TriPacket {
+    v: [[0.0; LANES]; 9],
+    prim: [EMPTY; LANES],
+};
+
+/// A node of the copy with `W` lanes: [`Chunk`] (BVH2 and BVH4) or [`Chunk8`] (BVH8).
+pub(crate) trait Lanes: bytemuck::Pod + Send + Sync + std::fmt::Debug {
+    /// Children per node.
+    const W: usize;
+    /// A node with every lane empty (degenerate boxes, [`EMPTY`] words).
+    const EMPTY: Self;
+    /// Sets lane `l`'s box words (image order) and child word.
+    fn set(&mut self, l: usize, boxw: [f32; 6], child: u32);
+    /// Lane `l`'s child word.
+    fn child(&self, l: usize) -> u32;
+    /// Sets lane `l`'s child word.
+    fn set_child(&mut self, l: usize, child: u32);
+    /// Entry distances (lanes 0–3 in the first vector, 4–7 in the second) and the mask of
+    /// the non-empty lanes the ray meets on `[t_lo, t_hi]`.
+    fn test<I: Isa>(&self, isa: I, rs: &RaySimd, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32);
+}
+
+macro_rules! lanes_impl {
+    ($t:ty, $w:expr, |$n:ident, $isa:ident, $rs:ident, $lo:ident, $hi:ident| $test:expr) => {
+        impl Lanes for $t {
+            const W: usize = $w;
+            const EMPTY: Self = Self {
+                planes: [
+                    [f32::INFINITY; $w],
+                    [f32::INFINITY; $w],
+                    [f32::INFINITY; $w],
+                    [f32::NEG_INFINITY; $w],
+                    [f32::NEG_INFINITY; $w],
+                    [f32::NEG_INFINITY; $w],
+                ],
+                child: [EMPTY; $w],
+            };
+            #[inline]
+            fn set(&mut self, l: usize, boxw: [f32; 6], child: u32) {
+                for (p, v) in boxw.into_iter().enumerate() {
+                    self.planes[p][l] = v;
+                }
+                self.child[l] = child;
+            }
+            #[inline(always)]
+            fn child(&self, l: usize) -> u32 {
+                self.child[l]
+            }
+            #[inline]
+            fn set_child(&mut self, l: usize, child: u32) {
+                self.child[l] = child;
+            }
+            #[inline(always)]
+            fn test<I: Isa>(
+                &self,
+                $isa: I,
+                $rs: &RaySimd,
+                $lo: f32,
+                $hi: f32,
+            ) -> ([f32x4; 2], u32) {
+                let $n = self;
+                $test
+            }
+        }
+    };
+}
+lanes_impl!(Chunk, LANES, |n, _isa, rs, t_lo, t_hi| {
+    let (e, m) = rs.test(&n.planes, &n.child, t_lo, t_hi);
+    ([e, f32x4::splat(0.0)], m)
+});
+lanes_impl!(Chunk8, 8, |n, isa, rs, t_lo, t_hi| isa
+    .test8(rs, n, t_lo, t_hi));

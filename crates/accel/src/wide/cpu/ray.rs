@@ -1,0 +1,173 @@
+//! The ray's constants in SIMD registers and the 4-wide tests: the slab test of four boxes
+//! and the first stage of the watertight test on a packet of four triangles.
+
+use super::layout::{LANES, TriPacket};
+#[cfg(doc)]
+use dualsplit_geometry::Triangle;
+use dualsplit_geometry::{EXIT_WIDEN, RayPre};
+use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
+
+/// What [`RaySimd::triangle_edges`] finds for the four triangles of a packet.
+pub(super) struct Edges {
+    pub(super) u: [f32; LANES],
+    pub(super) v: [f32; LANES],
+    pub(super) w: [f32; LANES],
+    /// Lanes with an edge function equal to zero.
+    pub(super) zero: u32,
+    /// Lanes [`Triangle::intersect`] might accept.
+    pub(super) candidates: u32,
+}
+
+/// The ray's constants broadcast to all lanes, the plane rows its signs pick, and the
+/// watertight test's axes and shear.
+pub(crate) struct RaySimd {
+    pub(super) o: [f32x4; 3],
+    pub(super) inv: [f32x4; 3],
+    /// The origin and reciprocal direction as scalars.
+    pub(super) os: [f32; 3],
+    pub(super) invs: [f32; 3],
+    /// Plane rows of the near and far planes per axis.
+    pub(super) near: [usize; 3],
+    pub(super) far: [usize; 3],
+    pub(super) k: [usize; 3],
+    pub(super) sx: f32x4,
+    pub(super) sy: f32x4,
+}
+
+impl RaySimd {
+    /// The constants of the precomputed ray `r`.
+    #[inline(always)]
+    pub(crate) fn new(r: &RayPre) -> Self {
+        let o = r.ray.origin;
+        let inv = r.inv_dir;
+        let s = |a: usize| 3 * r.neg[a] as usize;
+        Self {
+            o: [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)],
+            inv: [
+                f32x4::splat(inv.x),
+                f32x4::splat(inv.y),
+                f32x4::splat(inv.z),
+            ],
+            os: [o.x, o.y, o.z],
+            invs: [inv.x, inv.y, inv.z],
+            near: [s(0), 1 + s(1), 2 + s(2)],
+            far: [3 - s(0), 4 - s(1), 5 - s(2)],
+            k: r.k,
+            sx: f32x4::splat(r.shear.x),
+            sy: f32x4::splat(r.shear.y),
+        }
+    }
+
+    /// The first stage of [`Triangle::intersect`] (shear, edge functions `u`, `v`, `w`, the
+    /// same IEEE operations in the same order) on the four triangles of `pk` at once: the
+    /// edge functions, the lanes where one of them is zero (the scalar test recomputes
+    /// those in f64), and the lanes the scalar test might accept: all but those where no
+    /// edge function is zero and their signs differ, which it rejects at that stage.
+    #[inline(always)]
+    pub(super) fn triangle_edges(&self, pk: &TriPacket) -> Edges {
+        let [kx, ky, kz] = self.k;
+        let rel = |vertex: usize, axis: usize| f32x4::new(pk.v[3 * vertex + axis]) - self.o[axis];
+        let (ax, ay, az) = (rel(0, kx), rel(0, ky), rel(0, kz));
+        let (bx, by, bz) = (rel(1, kx), rel(1, ky), rel(1, kz));
+        let (cx, cy, cz) = (rel(2, kx), rel(2, ky), rel(2, kz));
+        let ax = ax - self.sx * az;
+        let ay = ay - self.sy * az;
+        let bx = bx - self.sx * bz;
+        let by = by - self.sy * bz;
+        let cx = cx - self.sx * cz;
+        let cy = cy - self.sy * cz;
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let zero = f32x4::splat(0.0);
+        let any_zero = (u.cmp_eq(zero) | v.cmp_eq(zero) | w.cmp_eq(zero)).move_mask() as u32;
+        let neg = u.cmp_lt(zero) | v.cmp_lt(zero) | w.cmp_lt(zero);
+        let pos = u.cmp_gt(zero) | v.cmp_gt(zero) | w.cmp_gt(zero);
+        let reject = (neg & pos).move_mask() as u32 & !any_zero;
+        Edges {
+            u: u.to_array(),
+            v: v.to_array(),
+            w: w.to_array(),
+            zero: any_zero,
+            candidates: 0b1111 & !reject,
+        }
+    }
+
+    /// Entry distances of four boxes (`planes[p][lane]`) clipped to `[t_lo, t_hi]`, and the mask of
+    /// the non-empty lanes the ray meets (`entry <= exit`).
+    #[inline(always)]
+    pub(super) fn test(
+        &self,
+        planes: &[[f32; LANES]; 6],
+        child: &[u32; LANES],
+        t_lo: f32,
+        t_hi: f32,
+    ) -> (f32x4, u32) {
+        self.test_rows(|p| planes[p], *child, t_lo, t_hi)
+    }
+
+    /// [`RaySimd::test`] with plane `p`'s row given by `row(p)`.
+    #[inline(always)]
+    pub(super) fn test_rows(
+        &self,
+        row: impl Fn(usize) -> [f32; LANES],
+        child: [u32; LANES],
+        t_lo: f32,
+        t_hi: f32,
+    ) -> (f32x4, u32) {
+        let mut entry = f32x4::splat(t_lo);
+        let mut exit = f32x4::splat(t_hi);
+        let widen = f32x4::splat(EXIT_WIDEN);
+        for a in 0..3 {
+            let tn = (f32x4::new(row(self.near[a])) - self.o[a]) * self.inv[a];
+            let tf = (f32x4::new(row(self.far[a])) - self.o[a]) * self.inv[a] * widen;
+            entry = keep_max(tn, entry);
+            exit = keep_min(tf, exit);
+        }
+        let hit = entry.cmp_le(exit).move_mask() as u32;
+        let empty = i32x4::new(bytemuck::cast::<[u32; LANES], [i32; LANES]>(child))
+            .cmp_eq(i32x4::splat(-1))
+            .move_mask() as u32;
+        (entry, hit & !empty)
+    }
+}
+
+/// Whether SSE's `maxps`/`minps` are available: `maxps x, b` is exactly
+/// `x > b ? x : b` and `minps x, b` is `x < b ? x : b` (`wide`'s `fast_max`/`fast_min` use
+/// them where SSE is on), one instruction where the portable form takes a compare and a blend.
+const SSE: bool = cfg!(all(
+    any(target_arch = "x86", target_arch = "x86_64"),
+    target_feature = "sse"
+));
+
+/// `if x > bound { x } else { bound }` per lane: a NaN `x` keeps the bound.
+#[inline(always)]
+pub(super) fn keep_max(x: f32x4, bound: f32x4) -> f32x4 {
+    if SSE {
+        x.fast_max(bound)
+    } else {
+        keep_max_portable(x, bound)
+    }
+}
+
+/// [`keep_max`] by compare and blend, on any target.
+#[inline(always)]
+pub(super) fn keep_max_portable(x: f32x4, bound: f32x4) -> f32x4 {
+    x.cmp_gt(bound).blend(x, bound)
+}
+
+/// `if x < bound { x } else { bound }` per lane: a NaN `x` keeps the bound.
+#[inline(always)]
+pub(super) fn keep_min(x: f32x4, bound: f32x4) -> f32x4 {
+    if SSE {
+        x.fast_min(bound)
+    } else {
+        keep_min_portable(x, bound)
+    }
+}
+
+/// [`keep_min`] by compare and blend, on any target.
+#[inline(always)]
+pub(super) fn keep_min_portable(x: f32x4, bound: f32x4) -> f32x4 {
+    x.cmp_lt(bound).blend(x, bound)
+}

@@ -1,0 +1,229 @@
+//! The traversal of the copy: the node loop, the stack, and the leaf test.
+
+use super::isa::Isa;
+use super::layout::{EMPTY, LANES, LEAF, Lanes, TriPacket};
+use super::ray::RaySimd;
+use crate::image::RUN_END;
+use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, Triangle, Vec3, cull_limit};
+use std::cell::Cell;
+use wide::{CmpEq, CmpLt, f32x4};
+
+/// The traversal (see the [`super`] module docs) of `nodes` and `packets` with instructions `I`.
+#[inline(always)]
+pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
+    isa: I,
+    nodes: &[N],
+    packets: &[TriPacket],
+    ray: &Ray,
+    stack: &mut Vec<Entry>,
+) -> Option<Hit> {
+    let r = ray.precompute();
+    let rs = RaySimd::new(&r);
+    let mut best: Option<Hit> = None;
+    let mut best_t = ray.t_max;
+    let mut limit = cull_limit(best_t);
+    let mut cur = 0u32;
+    loop {
+        if cur & LEAF == 0 {
+            let node = &nodes[cur as usize];
+            let (dv, mask) = node.test(isa, &rs, ray.t_min, limit);
+            let dist: [[f32; LANES]; 2] = dv.map(|v| v.to_array());
+            let child = |i: usize| node.child(i);
+            let d = |i: usize| dist[i / LANES][i % LANES];
+            if mask != 0 {
+                let first = mask.trailing_zeros() as usize;
+                let rest = mask & (mask - 1);
+                if rest == 0 {
+                    cur = child(first);
+                    continue;
+                }
+                if ANY {
+                    // Any hit ends the ray: no order is better than another, so the
+                    // first hit child is next and the others are pushed unsorted.
+                    let mut m = rest;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let c = child(i);
+                        prefetch_child(nodes, packets, c);
+                        stack.push(Entry { t: d(i), child: c });
+                    }
+                    cur = child(first);
+                    continue;
+                }
+                let second = rest.trailing_zeros() as usize;
+                if rest & (rest - 1) == 0 {
+                    // Two hits: the nearer next, the other on the stack.
+                    let (near, far) = if d(second) < d(first) {
+                        (second, first)
+                    } else {
+                        (first, second)
+                    };
+                    let c = child(far);
+                    prefetch_child(nodes, packets, c);
+                    stack.push(Entry {
+                        t: d(far),
+                        child: c,
+                    });
+                    cur = child(near);
+                    continue;
+                }
+                // Three or more: each goes to the stack slot of its rank (the number of
+                // hit children before it by entry distance, ties by slot), nearest on
+                // top; then the nearest is taken.
+                let count = ones(mask);
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    prefetch_child(nodes, packets, child(i));
+                }
+                let base = stack.len();
+                stack.resize(
+                    base + count,
+                    Entry {
+                        t: 0.0,
+                        child: EMPTY,
+                    },
+                );
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let di = d(i);
+                    // The hit lanes nearer than `i`, or as near and in an earlier slot,
+                    // from one comparison per four lanes.
+                    let splat = f32x4::splat(di);
+                    let mut before = 0u32;
+                    for (c, v) in dv.iter().enumerate().take(N::W.div_ceil(LANES)) {
+                        let lt = v.cmp_lt(splat).move_mask() as u32;
+                        let eq = v.cmp_eq(splat).move_mask() as u32;
+                        let earlier = ((1u32 << i) - 1) >> (LANES * c);
+                        before |= (lt | (eq & earlier)) << (LANES * c);
+                    }
+                    let rank = ones(before & mask);
+                    stack[base + count - 1 - rank] = Entry {
+                        t: di,
+                        child: child(i),
+                    };
+                }
+                cur = stack.pop().map_or(EMPTY, |e| e.child);
+                continue;
+            }
+        } else {
+            let slot = (cur & !LEAF) as usize;
+            if test_leaf::<ANY>(packets, slot, &rs, &r, &mut best, &mut best_t) {
+                return best;
+            }
+            limit = cull_limit(best_t);
+        }
+        // Next: the nearest stacked entry not beyond the limit.
+        loop {
+            let Some(e) = stack.pop() else {
+                return best;
+            };
+            if e.t <= limit {
+                cur = e.child;
+                break;
+            }
+        }
+    }
+}
+
+/// Set bits of an 8-bit mask: the x86-64 baseline has no `popcnt`, and `count_ones` becomes
+/// a dozen instructions there; a 256-byte table is one load.
+#[inline(always)]
+fn ones(mask: u32) -> usize {
+    const TABLE: [u8; 256] = {
+        let mut t = [0u8; 256];
+        let mut i = 0;
+        while i < 256 {
+            t[i] = (i as u32).count_ones() as u8;
+            i += 1;
+        }
+        t
+    };
+    TABLE[(mask & 0xff) as usize] as usize
+}
+
+/// Prefetches the first line of child word `c`'s node or the first packet of its leaf.
+#[inline(always)]
+fn prefetch_child<N>(nodes: &[N], packets: &[TriPacket], c: u32) {
+    if c & LEAF == 0 {
+        crate::wide::simd::prefetch(&nodes[c as usize]);
+    } else {
+        crate::wide::simd::prefetch(&packets[(c & !LEAF) as usize / LANES]);
+    }
+}
+
+/// Tests the leaf whose first triangle is at `slot` of `packets` (it ends at the first id
+/// from there with [`RUN_END`]) on `[ray.t_min, best_t]`, keeping the closest hit by
+/// [`Hit::closer_than`] in `best` and `best_t`. Returns true when `ANY` and a hit was
+/// accepted.
+#[inline(always)]
+pub(crate) fn test_leaf<const ANY: bool>(
+    packets: &[TriPacket],
+    slot: usize,
+    rs: &RaySimd,
+    r: &RayPre,
+    best: &mut Option<Hit>,
+    best_t: &mut f32,
+) -> bool {
+    let mut i = slot / LANES;
+    // Lanes at or after the leaf's first.
+    let mut from = (0b1111 << (slot % LANES)) & 0b1111;
+    loop {
+        let pk = &packets[i];
+        // Lanes up to the leaf's last (the first id from `from` on with bit 31 set:
+        // RUN_END or padding).
+        let ends = f32x4::new(bytemuck::cast(pk.prim)).move_mask() as u32 & from;
+        let lanes = if ends == 0 {
+            from
+        } else {
+            from & ((ends & ends.wrapping_neg()) << 1).wrapping_sub(1)
+        };
+        // Lanes the scalar test could accept; it decides each of them, from the edge
+        // functions computed here unless one is zero (then it recomputes them in f64).
+        let e = rs.triangle_edges(pk);
+        let mut m = e.candidates & lanes;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let p = PrimId(pk.prim[l] & !RUN_END);
+            // The triangle's own words, from the packet (already in cache).
+            let vertex =
+                |k: usize| Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l]);
+            let tri = Triangle::new(vertex(0), vertex(1), vertex(2));
+            let h = if e.zero & (1 << l) != 0 {
+                tri.intersect(r, r.ray.t_min, *best_t)
+            } else {
+                tri.intersect_from_edges(r, [e.u[l], e.v[l], e.w[l]], r.ray.t_min, *best_t)
+            };
+            if let Some(h) = h
+                && Hit::keep_closest(best, p, h)
+            {
+                if ANY {
+                    return true;
+                }
+                *best_t = h.t;
+            }
+        }
+        if ends != 0 {
+            return false;
+        }
+        i += 1;
+        from = 0b1111;
+    }
+}
+
+/// A stacked child: its entry distance and child word.
+#[derive(Clone, Copy)]
+pub(super) struct Entry {
+    pub(super) t: f32,
+    pub(super) child: u32,
+}
+
+thread_local! {
+    /// The traversal stack's buffer, one per thread, reused from ray to ray.
+    pub(super) static STACK: Cell<Vec<Entry>> = const { Cell::new(Vec::new()) };
+}
