@@ -63,8 +63,8 @@ fn scene_budgets_are_flags() {
 #[test]
 fn simulate_obeys_the_renderer_limits() {
     let dir = tempfile::tempdir().unwrap();
-    // Coordinates near 1e38 put the fitted camera at infinity: render refuses it, and so
-    // must simulate.
+    // Coordinates near 1e38 would put the fitted camera at infinity: loading refuses the
+    // scene for its extent, in render and simulate alike.
     std::fs::write(
         dir.path().join("big.obj"),
         "v 1e38 1e38 1e38\nv -1e38 -1e38 -1e38\nv 1e38 -1e38 0\nf 1 2 3\n",
@@ -72,9 +72,12 @@ fn simulate_obeys_the_renderer_limits() {
     .unwrap();
     let args = ["big.obj", "--res", "8", "--workload", "cast"];
     let render = [&["render"][..], &args, &["-o", "x.png"]].concat();
-    fails_with(&dualsplit(&render, dir.path()), "invalid camera");
+    fails_with(&dualsplit(&render, dir.path()), "extent (2e38, 2e38, 2e38)");
     let simulate = [&["simulate"][..], &args, &["--model", "fast"]].concat();
-    fails_with(&dualsplit(&simulate, dir.path()), "invalid camera");
+    fails_with(
+        &dualsplit(&simulate, dir.path()),
+        "extent (2e38, 2e38, 2e38)",
+    );
     // A frame far beyond the pixel limit is refused before anything is built or allocated.
     let out = dualsplit(
         &[
@@ -100,6 +103,62 @@ fn simulate_obeys_the_renderer_limits() {
         dir.path(),
     );
     fails_with(&out, "268435456");
+}
+
+/// The extreme-coordinate reproducer (coordinates at ±3e38, whose extent overflows to +∞)
+/// and a scene at the extent limit, 2^60 wide.
+#[test]
+fn scenes_wider_than_the_extent_limit_are_refused_at_load() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("huge.obj"),
+        "v -3e38 -3e38 -3e38\nv 3e38 -3e38 -3e38\nv 0 3e38 3e38\n\
+         v -3e38 3e38 -3e38\nv 3e38 3e38 3e38\nv 0 -3e38 3e38\n\
+         v 1 2 3\nv 2 3 4\nv 1 3 3\nf 1 2 3\nf 4 5 6\nf 7 8 9\n",
+    )
+    .unwrap();
+    let refused = "huge.obj: the scene's extent (inf, inf, inf) exceeds 1.1529215e18 on some axis";
+    for cmd in [
+        &["info", "huge.obj"][..],
+        &["build", "huge.obj", "--accel", "dst", "-o", "huge.dst"],
+        &["check", "huge.obj"],
+        &["stats", "huge.obj"],
+        &["render", "huge.obj", "--res", "8", "-o", "x.png"],
+        &["simulate", "huge.obj", "--res", "8", "--model", "fast"],
+    ] {
+        fails_with(&dualsplit(cmd, dir.path()), refused);
+    }
+    assert!(!dir.path().join("huge.dst").exists(), "no tree is saved");
+    // At the limit (±2^59, 2^60 wide) every command works, and the saved DST checks.
+    let c = (1u64 << 59) as f32;
+    let mut obj = String::new();
+    for i in 0..24 {
+        let s = [c, c / 1e6, 1.0][i % 3] * (1.0 - i as f32 / 48.0);
+        obj += &format!(
+            "v {} 0 {}\nv 0 {} {}\nv {} {} {}\n",
+            -s,
+            s,
+            s,
+            -s,
+            s / 2.0,
+            -s / 3.0,
+            s
+        );
+        obj += &format!("f {} {} {}\n", 3 * i + 1, 3 * i + 2, 3 * i + 3);
+    }
+    std::fs::write(dir.path().join("wide.obj"), obj).unwrap();
+    for cmd in [
+        &["build", "wide.obj", "--accel", "dst", "-o", "wide.dst"][..],
+        &["check", "wide.obj", "--tree", "wide.dst", "--rays", "2000"],
+        &["check", "wide.obj", "--rays", "2000"],
+        &["render", "wide.obj", "--res", "16", "-o", "wide.png"],
+        &["simulate", "wide.obj", "--res", "8", "--model", "fast"],
+    ] {
+        let out = dualsplit(cmd, dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{cmd:?}: {err}\n{stdout}");
+    }
 }
 
 #[test]

@@ -67,15 +67,23 @@ fn frames_past_the_limits_are_refused_with_the_limit() {
 
 #[test]
 fn cameras_that_overflow_are_refused() {
-    // A scene near f32::MAX fits its camera at infinity.
+    // Loading refuses a scene near f32::MAX (its fitted camera would be at infinity); a
+    // caller may still set such a camera on a scene of its own.
     use dualsplit_geometry::{Triangle, Vec3};
     let t = Triangle::new(
         Vec3::splat(1e38),
         Vec3::splat(-1e38),
         Vec3::new(1e38, -1e38, 0.0),
     );
-    let scene =
-        dualsplit_scene::Scene::from_triangles("big", "big", vec![t], Default::default()).unwrap();
+    let big = dualsplit_scene::Scene::from_triangles("big", "big", vec![t], Default::default());
+    assert!(
+        matches!(big, Err(dualsplit_scene::SceneError::Extent { .. })),
+        "{big:?}"
+    );
+    let small = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
+    let mut scene =
+        dualsplit_scene::Scene::from_triangles("s", "s", vec![small], Default::default()).unwrap();
+    scene.camera.eye = Vec3::new(1.0, 1.0, f32::INFINITY);
     let r = validate(&scene, &RenderSettings::new(8, 8, Workload::Cast));
     assert!(matches!(r, Err(RenderError::Camera { .. })), "{r:?}");
 }

@@ -65,6 +65,24 @@ pub enum SceneError {
         /// Why it is refused.
         reason: String,
     },
+    /// The scene's bounds are wider than [`Scene::MAX_EXTENT`](crate::Scene::MAX_EXTENT) on
+    /// some axis (the extent of coordinates near ±3.4e38 overflows to +∞).
+    #[error(
+        "{spec}: the scene's extent ({:e}, {:e}, {:e}) exceeds {:e} on some axis (bounds ({:e}, {:e}, {:e}) to ({:e}, {:e}, {:e})); f32 areas, cameras and ray tests overflow beyond it: scale the scene down",
+        extent[0], extent[1], extent[2], limit, min[0], min[1], min[2], max[0], max[1], max[2]
+    )]
+    Extent {
+        /// The spec.
+        spec: String,
+        /// Lower corner of the bounds.
+        min: [f32; 3],
+        /// Upper corner of the bounds.
+        max: [f32; 3],
+        /// `max − min` per axis (+∞ where the difference overflows).
+        extent: [f32; 3],
+        /// [`Scene::MAX_EXTENT`](crate::Scene::MAX_EXTENT).
+        limit: f32,
+    },
     /// A builtin name or parameter is wrong.
     #[error("builtin scene `{spec}`: {message}")]
     Builtin {

@@ -23,6 +23,15 @@
 //! (they are real input and never hit by the watertight test) and counted in
 //! [`LoadStats::degenerate`]. A scene with no triangle left is an error ([`SceneError::Empty`]).
 //!
+//! ## Extent
+//!
+//! A scene wider than [`Scene::MAX_EXTENT`] (2^60 ≈ 1.15e18) on some axis is refused with
+//! [`SceneError::Extent`], which names the extent and the bounds. Coordinates up to ±3.4e38
+//! are valid f32, but their differences overflow: a box from −3e38 to 3e38 has an infinite
+//! extent, its surface area overflows from about 1.8e19 across, the fitted camera sits
+//! about 2.3 extents from the scene's centre, and a ray test multiplies two vertex offsets
+//! from the ray's origin. Up to 2^60 every one of these stays finite.
+//!
 //! Triangle ids follow the file: the loaders emit triangles in face order of the file, each
 //! polygon fan-triangulated in place (see [`load`](mod@load)), and dropping keeps that order.
 //! So a triangle's id is its face index in the file after triangulation, minus the number of
@@ -77,8 +86,13 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Widest extent (`max − min` of the bounds) a scene may have on any axis: 2^60 ≈
+    /// 1.15e18 (see the crate docs, "Extent").
+    pub const MAX_EXTENT: f32 = (1u64 << 60) as f32;
+
     /// Builds a scene from triangles, dropping non-finite ones (counted), counting degenerate
-    /// ones, and fitting a default camera and light to the bounds.
+    /// ones, and fitting a default camera and light to the bounds. A scene wider than
+    /// [`Scene::MAX_EXTENT`] is [`SceneError::Extent`].
     pub fn from_triangles(
         name: impl Into<String>,
         spec: impl Into<String>,
@@ -121,6 +135,16 @@ impl Scene {
         stats.degenerate = degenerate;
         if triangles.is_empty() {
             return Err(SceneError::Empty { spec });
+        }
+        let extent = bounds.max - bounds.min;
+        if !extent.cmple(glam::Vec3::splat(Self::MAX_EXTENT)).all() {
+            return Err(SceneError::Extent {
+                spec,
+                min: bounds.min.to_array(),
+                max: bounds.max.to_array(),
+                extent: extent.to_array(),
+                limit: Self::MAX_EXTENT,
+            });
         }
         let camera = Camera::fit(&bounds);
         let light = Light::fit(&bounds);

@@ -409,5 +409,25 @@ fn the_fuzz_seeds_are_valid_scenes() {
             n += 1;
         }
     }
-    assert_eq!(n, 9);
+    assert_eq!(n, 11);
+}
+
+#[test]
+fn the_extreme_coordinate_seeds_load_or_name_their_extent() {
+    let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds/obj");
+    // Coordinates at ±3e38: the extent overflows to +∞.
+    let e = dualsplit_scene::load(seeds.join("extreme.obj").to_str().unwrap()).unwrap_err();
+    assert!(
+        matches!(&e, SceneError::Extent { extent, .. } if extent.iter().all(|x| x.is_infinite())),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string()
+            .contains("extent (inf, inf, inf) exceeds 1.1529215e18"),
+        "{e}"
+    );
+    // ±5.7e17: just under the limit, with a finite fitted camera.
+    let s = dualsplit_scene::load(seeds.join("at_extent_limit.obj").to_str().unwrap()).unwrap();
+    assert!((s.bounds.max - s.bounds.min).max_element() <= dualsplit_scene::Scene::MAX_EXTENT);
+    assert!(s.camera.eye.is_finite() && s.light.position.is_finite());
 }

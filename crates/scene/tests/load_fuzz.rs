@@ -1,7 +1,10 @@
 //! No input panics: random bytes, random truncations and random byte flips of valid files,
-//! fed to every parser. Each case must return `Ok` or a `SceneError`.
+//! fed to every parser. Each case must return `Ok` or a `SceneError`. Scenes with
+//! coordinates anywhere in the finite f32 range either load with finite cameras and lights
+//! or are refused for their extent.
 
 use dualsplit_scene::load::{self, Format};
+use dualsplit_scene::{Camera, Light, Scene, SceneError};
 use proptest::prelude::*;
 use std::path::Path;
 
@@ -101,5 +104,83 @@ proptest! {
         let mut b = vec![0x1f, 0x8b];
         b.extend(bytes);
         let _ = load::maybe_gunzip(Path::new("x.ply.gz"), b);
+    }
+}
+
+/// A coordinate for the extreme-range scenes. With `wide`: anywhere in the finite f32 range
+/// (any sign, exponent and mantissa, zero and subnormals included), the ends of the range,
+/// values around the extent limit, or an ordinary small value. Without: the same kinds of
+/// values held within ±`Scene::MAX_EXTENT / 2`, so the scene is at most the limit wide.
+fn extreme_coordinate(wide: bool) -> BoxedStrategy<f32> {
+    let half = Scene::MAX_EXTENT / 2.0;
+    // Exponent fields up to 185 give magnitudes below 2^59 = half.
+    let top = if wide { 255 } else { 186 };
+    let ends = if wide {
+        vec![f32::MAX, -f32::MAX, 3e38, -3e38, half, -half]
+    } else {
+        vec![half, -half, f32::MIN_POSITIVE, 0.0]
+    };
+    let reach = if wide { 1.01f32 } else { 1.0 };
+    prop_oneof![
+        (any::<bool>(), 0u32..top, 0u32..1 << 23)
+            .prop_map(|(neg, e, m)| f32::from_bits(u32::from(neg) << 31 | e << 23 | m)),
+        prop::sample::select(ends),
+        (-reach..reach).prop_map(move |f| f * half),
+        -4.0f32..4.0,
+    ]
+    .boxed()
+}
+
+/// The extreme-range scene generator: whether it may be wider than the limit, and an OBJ
+/// file of 1 to 12 triangles whose vertices come from [`extreme_coordinate`], written in
+/// shortest round-trip form.
+fn extreme_obj() -> impl Strategy<Value = (bool, String)> {
+    any::<bool>().prop_flat_map(|wide| {
+        let c = || extreme_coordinate(wide);
+        prop::collection::vec([c(), c(), c()], 3..36).prop_map(move |vs| {
+            let mut obj = String::new();
+            for [x, y, z] in &vs {
+                obj += &format!("v {x} {y} {z}\n");
+            }
+            for i in 0..vs.len() / 3 {
+                obj += &format!("f {} {} {}\n", 3 * i + 1, 3 * i + 2, 3 * i + 3);
+            }
+            (wide, obj)
+        })
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]
+
+    /// A scene at most [`Scene::MAX_EXTENT`] wide loads, and every camera and light placed
+    /// on it (the fit and each file preset) is finite; a wider one is
+    /// [`SceneError::Extent`], naming an extent beyond the limit.
+    #[test]
+    fn extreme_coordinates_load_with_finite_views_or_name_the_extent((may_be_wide, obj) in extreme_obj()) {
+        let mesh = load::parse_bytes(Path::new("x.obj"), Format::Obj, obj.as_bytes()).unwrap();
+        let bounds = mesh
+            .triangles
+            .iter()
+            .fold(dualsplit_geometry::Aabb::EMPTY, |b, t| b.union(t.bounds()));
+        let wide = !(bounds.max - bounds.min).cmple(dualsplit_geometry::Vec3::splat(Scene::MAX_EXTENT)).all();
+        prop_assert!(may_be_wide || !wide, "{bounds:?}");
+        match Scene::from_triangles("x", "x.obj", mesh.triangles, mesh.stats) {
+            Ok(scene) => {
+                prop_assert!(!wide, "{:?} loaded", scene.bounds);
+                for stem in ["x", "dragon", "bunny", "dragon_box", "sponza_dabrovic", "dragon_sponza"] {
+                    let c = Camera::preset_for(stem, &scene.bounds);
+                    prop_assert!(c.eye.is_finite() && c.target.is_finite(), "{stem}: {c:?}");
+                    prop_assert!((c.target - c.eye).length().is_finite(), "{stem}: {c:?}");
+                    let l = Light::preset_for(stem, &scene.bounds);
+                    prop_assert!(l.position.is_finite() && l.radius.is_finite(), "{stem}: {l:?}");
+                }
+            }
+            Err(SceneError::Extent { extent, limit, .. }) => {
+                prop_assert!(wide);
+                prop_assert!(extent.iter().any(|&e| e > limit), "{extent:?}");
+            }
+            Err(e) => prop_assert!(false, "{e}"),
+        }
     }
 }

@@ -15,6 +15,12 @@
 //! or two (two on one axis = single-axis carving node, on two axes = dual-axis carving
 //! node); a lone face is carved by the cheaper node type with a ±∞ no-op partner plane.
 //!
+//! Costs are f32 areas: for boxes more than about 1.8e19 across they overflow to +∞ (or
+//! NaN, as 0 · ∞), and no option is then strictly cheaper than +∞. A chain that must reach
+//! its child's box (every chain but a similar-partitioning leaf's, which may stop) then
+//! takes the first option of its state, so every face is still carved and the tree stays
+//! valid for any finite boxes; only the SAH choice among overflowed costs is arbitrary.
+//!
 //! This is the plain DP of [`super::reference`] made fast: each state's options come from
 //! a table built at compile time ([`OPTIONS`]) in the reference's loop order, and the
 //! cheapest is selected without branches, with the same strict `<` and the same float
@@ -591,8 +597,11 @@ impl ChainDp {
                 let c = d.weight[t as usize] * sa + cost[s | t as usize];
                 let allowed = PAIRS_CHEAP || rem & d.cheap_partner[t as usize] == 0;
                 let better = (c < best_c) & allowed;
+                // A chain that may not stop takes its first allowed option when no cost is
+                // below +∞ (costs overflowed or are NaN), so it still carves every face.
+                let first = !STOP & (best_t == 0) & allowed;
                 best_c = if better { c } else { best_c };
-                best_t = if better { t } else { best_t };
+                best_t = if better | first { t } else { best_t };
             }
             cost[s] = best_c;
             choice[s] = best_t;

@@ -136,6 +136,10 @@ impl ChainSolution {
                 if c < best {
                     best = c;
                     choice = Some(t);
+                } else if choice.is_none() && tri.is_none() {
+                    // No cost below +∞ so far (overflowed or NaN): a chain that may not stop
+                    // keeps its first option, so it still carves every face.
+                    choice = Some(t);
                 }
             };
             let remaining: Vec<usize> = (0..k).filter(|i| s & 1 << i == 0).collect();

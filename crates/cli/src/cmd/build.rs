@@ -1,7 +1,8 @@
 //! `dualsplit build SCENE --accel dst|bvh2|bvh4|bvh8 -o FILE [--json]`: builds exactly one
 //! structure (a DST, BVH4 or BVH8 is derived from the scene's BVH2) and saves it in the
 //! saved-tree format (`docs/tree-format.md`), so later runs can load it instead of
-//! building.
+//! building. The structure is validated before it is written (a DST against its BVH2, as
+//! `check --tree` does): one that does not validate is an error and no file is written.
 //!
 //! JSON schema (`--json`), one object: `{"scene", "spec", "triangles", "accel", "file",
 //! "file_bytes", "bvh2_ms", "build_ms", "save_ms", "stats"}`: `build_ms` is the wall time of
@@ -13,6 +14,7 @@ use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::{
     AnyTree, BuildConfig, BuildStats, Bvh2Tree, BvhTree, DstConfig, DstTree, TreeKind,
+    ValidationReport,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -67,13 +69,30 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let bvh2 = Bvh2Tree::build(&scene.triangles[..], &BuildConfig::default())
         .with_context(|| format!("building the BVH2 of {}", args.scene))?;
     let bvh2_ms = bvh2.stats().build_ms;
-    let tree: AnyTree = match args.accel {
-        TreeKind::Dst => DstTree::from_bvh2(&bvh2, &DstConfig::hardware())?.into(),
-        TreeKind::Bvh2 => bvh2.into_tree().into(),
-        TreeKind::Bvh4 => BvhTree::bvh4_from(&bvh2)?.into(),
-        TreeKind::Bvh8 => BvhTree::bvh8_from(&bvh2)?.into(),
+    let tree: Option<AnyTree> = match args.accel {
+        TreeKind::Dst => Some(DstTree::from_bvh2(&bvh2, &DstConfig::hardware())?.into()),
+        TreeKind::Bvh2 => None,
+        TreeKind::Bvh4 => Some(BvhTree::bvh4_from(&bvh2)?.into()),
+        TreeKind::Bvh8 => Some(BvhTree::bvh8_from(&bvh2)?.into()),
     };
     let build_ms = t0.elapsed().as_secs_f64() * 1e3;
+    sp.set_message(format!("validating {}", args.accel));
+    let report = match &tree {
+        None => bvh2.tree().encoded().validate(),
+        Some(AnyTree::Bvh(b)) => b.encoded().validate(),
+        Some(AnyTree::Dst(d)) => ValidationReport::of_dst(d.dst(), bvh2.logical()),
+    };
+    let tree = tree.unwrap_or_else(|| bvh2.into_tree().into());
+    if !report.is_ok() {
+        anyhow::bail!(
+            "the {} built from {} does not validate ({} errors: {}); {} was not written",
+            args.accel,
+            args.scene,
+            report.error_count,
+            report.errors.join("; "),
+            args.output.display()
+        );
+    }
     sp.set_message(format!("saving {}", args.output.display()));
     let t0 = Instant::now();
     tree.save(&args.output)?;
