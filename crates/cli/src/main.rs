@@ -56,6 +56,8 @@ enum Command {
     RunJob(cmd::run_job::Args),
     /// Measure the fast thread model's per-event costs from the compiled kernels.
     Calibrate(cmd::calibrate::Args),
+    /// Answer a file of rays (closest hits or shadow rays) with one traversal.
+    Trace(cmd::trace::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -92,6 +94,7 @@ fn main() -> std::process::ExitCode {
         Command::Plan(a) => cmd::plan::run(a, &ctx),
         Command::RunJob(a) => cmd::run_job::run(a, &ctx),
         Command::Calibrate(a) => cmd::calibrate::run(a, &ctx),
+        Command::Trace(a) => cmd::trace::run(a, &ctx),
     };
     match result {
         Ok(code) => code,

@@ -12,6 +12,7 @@ pub mod run_job;
 pub mod simulate;
 pub mod stats;
 pub mod study_report;
+pub mod trace;
 
 use crate::progress::Ctx;
 use anyhow::Context;
