@@ -9,6 +9,7 @@ pub mod rays;
 pub mod render;
 pub mod report;
 pub mod run_job;
+pub mod scene;
 pub mod simulate;
 pub mod stats;
 pub mod study_report;
