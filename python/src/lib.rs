@@ -590,6 +590,28 @@ fn parse_res(res: &Bound<'_, PyAny>) -> PyResult<(u32, u32)> {
     Ok((w, h))
 }
 
+/// Largest configuration file read, as the command line's `--config`: 1 MiB.
+const MAX_CONFIG_BYTES: u64 = 1 << 20;
+
+/// The text of a configuration file: a regular file of at most [`MAX_CONFIG_BYTES`].
+fn read_config(p: &std::path::Path) -> PyResult<String> {
+    let io = |e: std::io::Error| py_err(&format!("reading {}", p.display()), &e);
+    let meta = std::fs::metadata(p).map_err(io)?;
+    if !meta.is_file() {
+        return Err(DualsplitError::new_err(format!(
+            "{}: not a regular file; only regular files are read",
+            p.display()
+        )));
+    }
+    if meta.len() > MAX_CONFIG_BYTES {
+        return Err(DualsplitError::new_err(format!(
+            "{}: larger than {MAX_CONFIG_BYTES} bytes",
+            p.display()
+        )));
+    }
+    std::fs::read_to_string(p).map_err(io)
+}
+
 /// Simulates one frame per configuration on the TRaX-style many-core model and returns the
 /// document `dualsplit simulate --json` prints, as a dict.
 #[pyfunction]
@@ -628,8 +650,7 @@ fn simulate<'py>(
     }
     let mut cfg = match &config_file {
         Some(p) => {
-            let text = std::fs::read_to_string(p)
-                .map_err(|e| py_err(&format!("reading {}", p.display()), &e))?;
+            let text = read_config(p)?;
             SimConfig::from_toml(&text).map_err(|e| py_err(&format!("in {}", p.display()), &e))?
         }
         None => SimConfig::lin2020(),

@@ -224,6 +224,19 @@ def test_config_range_errors_carry_the_cli_message(cli, tmp_path, scene, key, va
     assert reason in str(e.value)
 
 
+def test_config_files_are_read_like_the_cli(cli, tmp_path, scene):
+    base = tmp_path / "base.toml"
+    base.write_text("[l2]\nsize_bytes = 65536\n")
+    got = dualsplit.simulate(scene, config_file=base, config={"l2.banks": 16}, **SIM)
+    both = tmp_path / "both.toml"
+    both.write_text("[l2]\nsize_bytes = 65536\nbanks = 16\n")
+    assert got == sim_cli(cli, "--config", both)
+    with pytest.raises(dualsplit.DualsplitError, match="not a regular file"):
+        dualsplit.simulate(scene, config_file=tmp_path, res=8)
+    with pytest.raises(dualsplit.DualsplitError, match="nope.toml"):
+        dualsplit.simulate(scene, config_file=tmp_path / "nope.toml", res=8)
+
+
 def test_unknown_config_keys_are_refused(scene):
     with pytest.raises(dualsplit.DualsplitError, match="`l2.nope` is not a key of the config TOML"):
         dualsplit.simulate(scene, res=8, config={"l2.nope": 1})
