@@ -61,6 +61,11 @@ enum Command {
     RunJob(cmd::run_job::Args),
     /// Measure the fast thread model's per-event costs from the compiled kernels.
     Calibrate(cmd::calibrate::Args),
+    /// Make a scene file: `scene dragon-box DRAGON.ply -o dragon_box.ply.gz`.
+    #[command(subcommand)]
+    Scene(cmd::scene::Command),
+    /// Answer a file of rays (closest hits or shadow rays) with one traversal.
+    Trace(cmd::trace::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -100,6 +105,8 @@ fn main() -> std::process::ExitCode {
         Command::Plan(a) => cmd::plan::run(a, &ctx),
         Command::RunJob(a) => cmd::run_job::run(a, &ctx),
         Command::Calibrate(a) => cmd::calibrate::run(a, &ctx),
+        Command::Trace(a) => cmd::trace::run(a, &ctx),
+        Command::Scene(c) => cmd::scene::run(c, &ctx),
     };
     match result {
         Ok(code) => code,

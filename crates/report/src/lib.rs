@@ -31,6 +31,7 @@ pub mod paper;
 mod plain;
 pub mod produce;
 pub mod scenes;
+pub mod simulate;
 pub mod study;
 pub mod summary;
 pub mod tables;

@@ -89,7 +89,8 @@ pub struct PaperMatch {
 
 impl PaperMatch {
     /// Finds the paper scene a scene name or spec corresponds to: `dragon_box` is the
-    /// paper's Dragon Box; `dragon_sponza`, `atrium`/`sponza` (↔ Crytek Sponza), `forest`
+    /// paper's Dragon Box and `crytek` (the file `crytek_sponza.gltf`) its Crytek Sponza;
+    /// `dragon_sponza`, `atrium`/`sponza` (↔ Crytek Sponza), `forest`
     /// (↔ Vegetation) and `hairball` are stand-ins.
     pub fn for_scene(name: &str, spec: &str) -> Option<Self> {
         let s = format!("{name} {spec}").to_ascii_lowercase();
@@ -98,6 +99,8 @@ impl PaperMatch {
             m(PaperScene::DragonBox, true)
         } else if s.contains("dragon_sponza") || s.contains("dragon-sponza") {
             m(PaperScene::DragonSponza, false)
+        } else if s.contains("crytek") {
+            m(PaperScene::CrytekSponza, true)
         } else if s.contains("hairball") {
             m(PaperScene::Hairball, false)
         } else if s.contains("forest") || s.contains("vegetation") {
@@ -404,5 +407,11 @@ mod tests {
         assert_eq!(m.scene, PaperScene::Vegetation);
         assert!(!m.same_mesh);
         assert_eq!(PaperMatch::for_scene("bunny", "bunny.ply"), None);
+        // The real Crytek Sponza is the paper's mesh; the Dabrovic atrium a stand-in.
+        let m = PaperMatch::for_scene("crytek_sponza", "scenes/crytek_sponza.gltf").unwrap();
+        assert_eq!((m.scene, m.same_mesh), (PaperScene::CrytekSponza, true));
+        assert_eq!(m.describe(), "Crytek Sponza (same mesh)");
+        let m = PaperMatch::for_scene("sponza_dabrovic", "s/sponza_dabrovic.ply.gz").unwrap();
+        assert_eq!((m.scene, m.same_mesh), (PaperScene::CrytekSponza, false));
     }
 }

@@ -75,7 +75,7 @@ pub type SimulateFn<'a> = dyn Fn(
     + Sync
     + 'a;
 
-/// The real simulator with thread model `model` ([`dualsplit_sim::simulate_model`]),
+/// The real simulator with thread model `model` ([`dualsplit_sim::simulate`]),
 /// errors as "simulator unavailable: …".
 pub fn real_simulator(model: ThreadModel) -> Box<SimulateFn<'static>> {
     Box::new(move |scene, structures, accel, settings, cfg, progress| {

@@ -13,11 +13,13 @@ use std::path::{Path, PathBuf};
 /// The environment variable naming the scenes folder.
 pub const ENV_VAR: &str = "DUALSPLIT_SCENES";
 
-/// The shipped meshes that stand for scenes of the paper: file name, paper scene, and
-/// whether it is the paper's own mesh.
-pub const PAPER_FILES: [(&str, PaperScene, bool); 2] = [
+/// The meshes that stand for scenes of the paper: file name, paper scene, and whether it is
+/// the paper's own mesh. `crytek_sponza.gltf` (with its `Sponza.bin`) is the Khronos glTF
+/// sample's Crytek Sponza as `scripts/get-scenes.sh` saves it.
+pub const PAPER_FILES: [(&str, PaperScene, bool); 3] = [
     ("dragon_box.ply.gz", PaperScene::DragonBox, true),
     ("dragon_sponza.ply.gz", PaperScene::DragonSponza, false),
+    ("crytek_sponza.gltf", PaperScene::CrytekSponza, true),
 ];
 
 /// How the scenes folder was found.
@@ -283,6 +285,11 @@ mod tests {
             text.contains(
                 "found: Dragon Box (dragon_box.ply.gz, the paper's mesh). Not found: Dragon Sponza"
             ),
+            "{text}"
+        );
+        assert_eq!(files.path_of(PaperScene::CrytekSponza), None);
+        assert!(
+            text.contains("Crytek Sponza (crytek_sponza.gltf, the paper's mesh)"),
             "{text}"
         );
         let none = SceneFiles::scan(None).describe();

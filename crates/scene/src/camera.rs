@@ -173,6 +173,16 @@ fn preset_view(stem: &str) -> Option<View> {
             zoom: 1.0,
             fov: 60.0,
         },
+        // The paper's Crytek Sponza (the glTF sample, scaled to metres): from inside the
+        // atrium at its east end, a quarter of its height up, looking west down the nave,
+        // slightly up toward the arcades (the paper shows only a thumbnail of this view).
+        "crytek_sponza" => View {
+            target: [0.08, 0.3, 0.5],
+            eye: Some([0.9, 0.22, 0.5]),
+            dir: Vec3::X,
+            zoom: 1.0,
+            fov: 60.0,
+        },
         // The row of dragons on the courtyard floor, seen diagonally from a corner.
         "dragon_sponza" => View {
             target: [0.5, 0.11, 0.487],
@@ -269,7 +279,7 @@ impl Light {
                 intensity: 1.0,
             },
             // High over the open courtyard: sun-like light falling into the atrium.
-            "sponza_dabrovic" | "dragon_sponza" => Self {
+            "sponza_dabrovic" | "dragon_sponza" | "crytek_sponza" => Self {
                 position: at([0.4, 0.95, 0.5]),
                 radius: r * 0.01,
                 intensity: 1.0,

@@ -43,6 +43,7 @@ mod camera;
 mod error;
 pub mod limits;
 pub mod load;
+pub mod make;
 
 pub use camera::{Camera, CameraError, Light, parse_vec3};
 pub use error::SceneError;

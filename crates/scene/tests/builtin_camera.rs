@@ -44,6 +44,7 @@ fn every_shipped_stem_has_a_preset() {
         "dragon_box",
         "dragon_sponza",
         "sponza_dabrovic",
+        "crytek_sponza",
         "bunny",
     ] {
         assert!(Camera::has_preset(stem), "{stem}");
@@ -72,6 +73,23 @@ fn sponza_views_are_inside_the_atrium() {
         assert!(inside(&b, c.eye), "{stem}: eye {:?}", c.eye);
         assert!(inside(&b, c.target), "{stem}");
     }
+}
+
+#[test]
+fn crytek_sponza_is_seen_down_its_nave() {
+    // The Khronos sample's bounds (its accessors' min/max) after the root node's 0.008.
+    let b = Aabb::new(
+        Vec3::new(-1432.2, -2.46, -645.43) * 0.008,
+        Vec3::new(1302.2, 1296.7, 574.9) * 0.008,
+    );
+    let c = Camera::preset_for("crytek_sponza", &b);
+    assert!(inside(&b, c.eye) && inside(&b, c.target), "{c:?}");
+    let d = (c.target - c.eye).normalize();
+    // Along the long (x) axis, toward -x, slightly up, from the nave's middle.
+    assert!(d.x < -0.95 && d.y > 0.0, "{d:?}");
+    assert!((c.eye.z - b.center().z).abs() < 0.05 * b.extent().z);
+    let l = Light::preset_for("crytek_sponza", &b);
+    assert!(l.position.y > b.min.y + 0.9 * b.extent().y);
 }
 
 #[test]

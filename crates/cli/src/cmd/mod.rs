@@ -9,9 +9,11 @@ pub mod rays;
 pub mod render;
 pub mod report;
 pub mod run_job;
+pub mod scene;
 pub mod simulate;
 pub mod stats;
 pub mod study_report;
+pub mod trace;
 
 use crate::progress::Ctx;
 use anyhow::Context;

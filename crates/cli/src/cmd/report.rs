@@ -250,20 +250,32 @@ impl Resolved {
 }
 
 /// The scenes of a report or study: those given, else the paper's meshes found in the
-/// scenes folder (all with `full`; Dragon Box, the paper's own, by default), then the
-/// builtins.
+/// scenes folder (all with `full`; by default the paper's own, Dragon Box and Crytek
+/// Sponza), then the builtins, less the stand-in of a paper scene whose own mesh was found
+/// (the atrium when `crytek_sponza.gltf` is there).
 pub fn resolve_specs(given: &[String], full: bool, scene_files: &SceneFiles) -> Vec<String> {
     if !given.is_empty() {
         return given.to_vec();
     }
-    let files = scene_files
+    let found: Vec<_> = scene_files
         .files
         .iter()
-        .filter(|f| full || f.scene == PaperScene::DragonBox)
-        .filter_map(|f| f.path.clone());
+        .filter(|f| f.path.is_some() && (full || f.same_mesh))
+        .collect();
+    let has_own = |scene: PaperScene| found.iter().any(|f| f.same_mesh && f.scene == scene);
     let builtins: &[&str] = if full { &FULL_SCENES } else { &DEFAULT_SCENES };
-    files
-        .chain(builtins.iter().map(|s| s.to_string()))
+    found
+        .iter()
+        .filter_map(|f| f.path.clone())
+        .chain(
+            builtins
+                .iter()
+                .filter(|b| {
+                    dualsplit_report::paper::PaperMatch::for_scene("", b)
+                        .is_none_or(|m| !has_own(m.scene))
+                })
+                .map(|s| s.to_string()),
+        )
         .collect()
 }
 
@@ -323,5 +335,49 @@ impl Plan<'_> {
             self.tms,
             r = self.res,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dualsplit_report::scenes::{ScenesDir, Source};
+
+    fn files(names: &[&str]) -> (tempfile::TempDir, SceneFiles) {
+        let dir = tempfile::tempdir().unwrap();
+        for n in names {
+            std::fs::write(dir.path().join(n), "").unwrap();
+        }
+        let sd = ScenesDir {
+            path: dir.path().to_path_buf(),
+            source: Source::Flag,
+        };
+        let f = SceneFiles::scan(Some(&sd));
+        (dir, f)
+    }
+
+    #[test]
+    fn the_real_crytek_sponza_replaces_the_atrium() {
+        let (_d, none) = files(&[]);
+        assert_eq!(resolve_specs(&[], false, &none), DEFAULT_SCENES.to_vec());
+
+        let (_d, f) = files(&[
+            "dragon_box.ply.gz",
+            "crytek_sponza.gltf",
+            "dragon_sponza.ply.gz",
+        ]);
+        let specs = resolve_specs(&[], false, &f);
+        assert!(specs[0].ends_with("dragon_box.ply.gz"), "{specs:?}");
+        assert!(specs[1].ends_with("crytek_sponza.gltf"), "{specs:?}");
+        assert!(specs.iter().all(|s| !s.contains("atrium")), "{specs:?}");
+        assert_eq!(&specs[2..], &DEFAULT_SCENES[1..]);
+        // --full adds the stand-in Dragon Sponza, still without the atrium.
+        let full = resolve_specs(&[], true, &f);
+        assert_eq!(full.len(), 5, "{full:?}");
+        assert!(full.iter().any(|s| s.ends_with("dragon_sponza.ply.gz")));
+        assert!(full.iter().all(|s| !s.contains("atrium")), "{full:?}");
+        // Scenes given on the command line are taken as they are.
+        let given = vec!["builtin:atrium".to_string()];
+        assert_eq!(resolve_specs(&given, false, &f), given);
     }
 }

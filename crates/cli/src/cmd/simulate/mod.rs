@@ -1,11 +1,12 @@
 //! `dualsplit simulate`: one frame per configuration on the TRaX-style many-core model
-//! (Lin et al. 2020, §4), each printed in full, then compared side by side
-//! ([`summary`]).
+//! (Lin et al. 2020, §4), each printed in full, then compared side by side.
 //!
 //! With `--tree FILE` the saved structure is simulated instead of building: only the
 //! configurations of its traversals (DST\* and DST for a DST; BVH4 and BVH4+ for a BVH4),
 //! by default all of them. The JSON is the same as when the structure is built.
-mod summary;
+//!
+//! The checks, the runs and the JSON document are [`dualsplit_report::simulate`]'s, which
+//! the Python package's `simulate` calls too.
 
 use crate::args::{
     SimAccelArg, View, parse_positive, parse_res, parse_sim_accel, parse_workload, sim_accels,
@@ -16,11 +17,11 @@ use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::TraversalSet;
 use dualsplit_render::{RenderSettings, Workload};
+use dualsplit_report::simulate::{self as frames, SimulateJson};
 use dualsplit_report::units;
-use dualsplit_sim::{FrameRequest, SimAccel, SimConfig, SimResult, ThreadModel, simulate};
+use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel};
 use std::process::ExitCode;
-use std::time::{Duration, Instant};
-use summary::{Summary, summarize};
+use std::time::Duration;
 
 /// Arguments of `dualsplit simulate`.
 #[derive(clap::Args)]
@@ -73,24 +74,6 @@ fn parse_model(s: &str) -> Result<ThreadModel, String> {
 /// Idle-at-end share of thread-cycles above which the chip is called not busy.
 const IDLE_WARN: f64 = 0.10;
 
-/// `--json`: what was simulated and every number of the tables (host timings aside: they
-/// are measurements of this machine, not results).
-#[derive(serde::Serialize)]
-struct JsonReport<'a> {
-    scene: &'a str,
-    spec: &'a str,
-    triangles: usize,
-    width: u32,
-    height: u32,
-    workload: Workload,
-    thread_model: ThreadModel,
-    camera: &'a dualsplit_scene::Camera,
-    light: &'a dualsplit_scene::Light,
-    config: &'a SimConfig,
-    results: Vec<&'a SimResult>,
-    summary: Summary,
-}
-
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let json = JsonOut::from_arg(args.json.as_deref())?;
@@ -105,15 +88,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if let Some(t) = args.tms {
         cfg.tms = t;
     }
-    cfg.validate()?;
-    // The frame obeys the renderer's limits, and the chip and frame fit the simulator's
-    // memory bound for every configuration, before the scene is loaded.
+    // The configuration and the frame are checked before the scene is loaded.
     let settings = RenderSettings::new(args.res.0, args.res.1, workload);
-    dualsplit_render::validate_frame(&settings)?;
-    for accel in SimAccel::ALL {
-        let pixels = args.res.0 as u64 * args.res.1 as u64;
-        dualsplit_sim::footprint::check(&cfg, accel, model, pixels)?;
-    }
+    frames::check_frame(&cfg, &settings, model)?;
 
     let mut scene = super::load(&args.scene, ctx)?;
     args.view.apply(&mut scene)?;
@@ -123,67 +100,38 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let structures = Loaded::get(&scene, args.tree.as_deref(), ctx)?;
     let accels = configurations(&args.accel, &structures)?;
 
-    // Each run's host time, for the table's `host` line only: a host measurement is never
-    // part of a result (the JSON is the same on every machine).
-    let sim_one = |accel: SimAccel| -> anyhow::Result<(SimResult, Duration)> {
-        let total = settings.width as u64 * settings.height as u64;
-        let bar = ctx.bar(total, format!("{} {}", accel.label(), workload.name()));
-        let t0 = Instant::now();
-        let r = simulate(
-            &FrameRequest {
-                scene: &scene,
-                structures: &structures,
-                accel,
-                settings: &settings,
-                cfg: &cfg,
-                model,
-            },
-            &|done, _| bar.set_position(done),
-        )
-        .with_context(|| format!("simulating {}", accel.label()))?;
-        let host = t0.elapsed();
+    let total = settings.width as u64 * settings.height as u64;
+    let bars: Vec<_> = accels
+        .iter()
+        .map(|a| {
+            (
+                *a,
+                ctx.bar(total, format!("{} {}", a.label(), workload.name())),
+            )
+        })
+        .collect();
+    let results = frames::simulate_frames(
+        model,
+        &scene,
+        &structures,
+        &accels,
+        &settings,
+        &cfg,
+        &|accel, done, _| {
+            if let Some((_, bar)) = bars.iter().find(|(a, _)| *a == accel) {
+                bar.set_position(done);
+            }
+        },
+    )?;
+    for (_, bar) in &bars {
         bar.finish_and_clear();
-        Ok((r, host))
-    };
-    // Two configurations at a time: each run is single-threaded and deterministic.
-    let mut results = Vec::with_capacity(accels.len());
-    for pair in accels.chunks(2) {
-        let out: Vec<anyhow::Result<(SimResult, Duration)>> = std::thread::scope(|s| {
-            let handles: Vec<_> = pair
-                .iter()
-                .map(|&a| {
-                    let f = &sim_one;
-                    s.spawn(move || f(a))
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().expect("simulation thread panicked"))
-                .collect()
-        });
-        for r in out {
-            results.push(r?);
-        }
     }
     let plain: Vec<&SimResult> = results.iter().map(|(r, _)| r).collect();
-    let summary = summarize(&plain);
+    let report = SimulateJson::new(&scene, &settings, model, &cfg, plain);
+    let summary = &report.summary;
 
     if let Some(out) = json {
-        let report = JsonReport {
-            scene: &scene.name,
-            spec: &scene.spec,
-            triangles: scene.triangles.len(),
-            width: settings.width,
-            height: settings.height,
-            workload,
-            thread_model: model,
-            camera: &scene.camera,
-            light: &scene.light,
-            config: &cfg,
-            results: plain,
-            summary,
-        };
-        out.emit(&serde_json::to_string_pretty(&report)?)?;
+        out.emit(&report.to_json()?)?;
     } else {
         println!(
             "scene {} ({} triangles), {}×{} {}, {} TMs × {} TPs, {} thread model",
@@ -204,7 +152,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                 "\ncomparison (frame time, energy and DRAM lines as % of {}; stalls and idle as shares of all thread-cycles)",
                 summary.baseline.map_or("?", |a| a.label())
             );
-            print!("{}", summary::table(&summary));
+            print!("{}", frames::table(summary));
         }
         let idle = summary
             .rows
