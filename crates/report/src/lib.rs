@@ -27,6 +27,7 @@ pub mod charts;
 pub mod data;
 mod error;
 pub mod html;
+pub mod memory;
 pub mod paper;
 mod plain;
 pub mod produce;

@@ -9,7 +9,9 @@ use crate::units;
 use dualsplit_accel::TraversalSet;
 use dualsplit_render::{RenderError, RenderSettings, Workload};
 use dualsplit_scene::Scene;
-use dualsplit_sim::{SimAccel, SimConfig, SimError, SimResult, StallShares, ThreadModel};
+use dualsplit_sim::{
+    MemoryFigures, SimAccel, SimConfig, SimError, SimResult, StallShares, ThreadModel,
+};
 use serde::Serialize;
 use std::time::{Duration, Instant};
 
@@ -193,6 +195,8 @@ pub struct Row {
     pub thread_cycles_per_ray: f64,
     /// Where the thread-cycles went.
     pub stalls: StallShares,
+    /// The memory system's figures.
+    pub memory: MemoryFigures,
 }
 
 /// The comparison: the baseline and one row per configuration, in the order simulated.
@@ -231,6 +235,7 @@ pub fn summarize(results: &[&SimResult]) -> Summary {
                 instructions_per_ray: r.instructions.total() as f64 / rays,
                 thread_cycles_per_ray: r.cycles as f64 * f64::from(r.threads) / rays,
                 stalls: StallShares::of(r),
+                memory: r.memory,
             }
         })
         .collect();
@@ -258,6 +263,13 @@ pub fn table(s: &Summary) -> String {
         "memory stall".into(),
         "unit stall".into(),
         "idle at end".into(),
+        "L1 hit".into(),
+        "L2 hit".into(),
+        "row hit".into(),
+        "DRAM lat. mean/p95".into(),
+        "GB/s".into(),
+        "lines/px".into(),
+        "rays/px".into(),
     ];
     let mut rows = vec![header.to_vec()];
     for r in &s.rows {
@@ -272,6 +284,16 @@ pub fn table(s: &Summary) -> String {
             pct(Some(r.stalls.memory)),
             pct(Some(r.stalls.units())),
             pct(Some(r.stalls.idle_at_end)),
+            pct(Some(r.memory.l1_hit_rate)),
+            pct(Some(r.memory.l2_hit_rate)),
+            pct(Some(r.memory.dram_row_hit_rate)),
+            format!(
+                "{:.0}/{}",
+                r.memory.dram_latency_mean_cycles, r.memory.dram_latency_p95_cycles
+            ),
+            format!("{:.1}", r.memory.dram_gbps),
+            format!("{:.2}", r.memory.lines_per_pixel),
+            format!("{:.2}", r.memory.rays_per_pixel),
         ]);
     }
     let widths: Vec<usize> = (0..rows[0].len())

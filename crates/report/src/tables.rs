@@ -721,6 +721,7 @@ pub fn sections(data: &ReportData) -> Vec<Section> {
         table3(data),
         table45(data, Workload::Cast),
         table45(data, Workload::Path),
+        crate::memory::section(data),
         table6(data),
         table7(data),
         cpu(data),

@@ -69,5 +69,5 @@ pub use hw::energy::EnergySplit;
 pub use hw::memory::{CacheStats, DramStats};
 pub use hw::{ChipStats, Cycle, Stalls, Tick};
 pub use model::ThreadModel;
-pub use result::{SimResult, Utilisation};
+pub use result::{MemoryFigures, SimResult, Utilisation};
 pub use shares::StallShares;

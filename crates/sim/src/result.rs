@@ -23,6 +23,31 @@ pub struct Utilisation {
     pub issue: f64,
 }
 
+/// The memory system's figures of a frame: what explains where a frame sits between the
+/// compute and the bandwidth regime.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MemoryFigures {
+    /// L1 hit rate (hits on filled lines / accesses).
+    pub l1_hit_rate: f64,
+    /// L2 hit rate (hits on filled lines / accesses).
+    pub l2_hit_rate: f64,
+    /// Cycles L2 requests waited for a busy L2 bank, summed over requests.
+    pub l2_bank_conflict_cycles: u64,
+    /// Row-buffer hit rate of DRAM reads.
+    pub dram_row_hit_rate: f64,
+    /// Mean DRAM read latency (arrival at the DRAM to data), core cycles.
+    pub dram_latency_mean_cycles: f64,
+    /// 95th percentile of the DRAM read latency, core cycles.
+    pub dram_latency_p95_cycles: u64,
+    /// DRAM bandwidth achieved over the frame: lines read × line size / frame time, GB/s
+    /// (10^9 bytes per second).
+    pub dram_gbps: f64,
+    /// DRAM lines read per pixel.
+    pub lines_per_pixel: f64,
+    /// Rays traced per pixel.
+    pub rays_per_pixel: f64,
+}
+
 /// What one simulated frame reports.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct SimResult {
@@ -67,6 +92,9 @@ pub struct SimResult {
     pub utilisation: Utilisation,
     /// Stall breakdown in thread-cycles.
     pub stalls: Stalls,
+    /// The memory system's figures.
+    #[serde(default)]
+    pub memory: MemoryFigures,
     /// Per-pixel radiance in scanline order, as the renderer computes it from the same hits.
     #[serde(skip)]
     pub radiance: Vec<f32>,
@@ -119,6 +147,21 @@ impl SimResult {
             units: stats.units,
             utilisation,
             stalls: stats.stalls,
+            memory: MemoryFigures {
+                l1_hit_rate: ratio(c.l1_hits, c.l1_accesses),
+                l2_hit_rate: ratio(c.l2_hits, c.l2_accesses),
+                l2_bank_conflict_cycles: c.l2_bank_wait,
+                dram_row_hit_rate: ratio(dram.row_hits, dram.reads),
+                dram_latency_mean_cycles: ratio(dram.latency_cycles, dram.reads),
+                dram_latency_p95_cycles: dram.latency_p95_cycles,
+                dram_gbps: if frame_ms > 0.0 {
+                    dram.reads as f64 * cfg.l2.line_bytes as f64 / (frame_ms * 1e-3) / 1e9
+                } else {
+                    0.0
+                },
+                lines_per_pixel: ratio(dram.reads, pixels),
+                rays_per_pixel: ratio(rays, pixels),
+            },
             radiance,
         }
     }

@@ -227,11 +227,21 @@ fn print_result(r: &SimResult, host: Duration) {
         100.0 * r.row_hit_rate
     );
     println!(
-        "  caches         L1 hit {:.1} % ({} accesses), L2 hit {:.1} % ({} accesses)",
+        "  caches         L1 hit {:.1} % ({} accesses), L2 hit {:.1} % ({} accesses), L2 bank conflicts {} cycles",
         100.0 * r.l1_hit_rate,
         r.caches.l1_accesses,
         100.0 * r.l2_hit_rate,
-        r.caches.l2_accesses
+        r.caches.l2_accesses,
+        r.memory.l2_bank_conflict_cycles
+    );
+    let m = &r.memory;
+    println!(
+        "  memory         DRAM {:.1} GB/s, read latency mean {:.1} / p95 {} cycles, {:.2} lines and {:.2} rays per pixel",
+        m.dram_gbps,
+        m.dram_latency_mean_cycles,
+        m.dram_latency_p95_cycles,
+        m.lines_per_pixel,
+        m.rays_per_pixel
     );
     println!(
         "  instructions   {} total: int {}, fpadd {}, fpmul {}, fpcmp {}, fpinv {}, local {}, loads {}, box issues {}, tri {}, dual-split {}, atomics {}",

@@ -77,7 +77,15 @@ pub struct DramStats {
     pub latency_cycles: u64,
     /// Core cycle of the last completion.
     pub last_done: Cycle,
+    /// The 95th percentile of (completion − arrival) over reads, in core cycles (the
+    /// smallest latency that at least 95 % of reads do not exceed).
+    #[serde(default)]
+    pub latency_p95_cycles: u64,
 }
+
+/// Read latencies counted one bucket per core cycle up to this many cycles; longer ones
+/// share the last bucket (the percentile then reports this bound).
+const LATENCY_BUCKETS: usize = 4096;
 
 /// A row's time open in a bank's schedule. Its `close` (the last tick a column command
 /// may read it) is the next epoch's activate − t_RP − t_RTP, open-ended for the last
@@ -262,6 +270,8 @@ pub struct Dram {
     burst: Divisor,
     tpc: Divisor,
     stats: DramStats,
+    /// Reads by latency in core cycles ([`LATENCY_BUCKETS`]).
+    latency_histogram: Vec<u64>,
 }
 
 /// Division by a timing constant: a shift when it is a power of two (t_burst = 4 and
@@ -314,6 +324,7 @@ impl Dram {
             burst: Divisor::new(cfg.t_burst),
             tpc: Divisor::new(cfg.ticks_per_cycle),
             stats: DramStats::default(),
+            latency_histogram: vec![0; LATENCY_BUCKETS],
         }
     }
 
@@ -452,8 +463,10 @@ impl Dram {
             DramAccess::Closed => s.row_closed += 1,
             DramAccess::Conflict => s.row_conflicts += 1,
         }
-        s.latency_cycles += done_cycle - arrive;
+        let latency = done_cycle - arrive;
+        s.latency_cycles += latency;
         s.last_done = s.last_done.max(done_cycle);
+        self.latency_histogram[(latency as usize).min(LATENCY_BUCKETS - 1)] += 1;
         (done_cycle, kind)
     }
 
@@ -462,17 +475,45 @@ impl Dram {
         // Every read is a row hit, a closed bank or a conflict, and activates a row unless
         // it is a row hit: the two sums are not counted on the way.
         let s = self.stats;
+        let reads = s.row_hits + s.row_closed + s.row_conflicts;
         DramStats {
-            reads: s.row_hits + s.row_closed + s.row_conflicts,
+            reads,
             activations: s.row_closed + s.row_conflicts,
+            latency_p95_cycles: percentile(&self.latency_histogram, reads, 95),
             ..s
         }
     }
 }
 
+/// The smallest bucket index at or below which at least `pct` % of the `total` counts lie.
+fn percentile(histogram: &[u64], total: u64, pct: u64) -> u64 {
+    let need = (total * pct).div_ceil(100);
+    let mut seen = 0;
+    for (i, &n) in histogram.iter().enumerate() {
+        seen += n;
+        if seen >= need && need > 0 {
+            return i as u64;
+        }
+    }
+    0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_percentile_is_the_smallest_latency_covering_the_share() {
+        // 100 reads: 90 of 10 cycles, 5 of 20, 5 of 30.
+        let mut h = vec![0; 64];
+        h[10] = 90;
+        h[20] = 5;
+        h[30] = 5;
+        assert_eq!(percentile(&h, 100, 95), 20);
+        assert_eq!(percentile(&h, 100, 96), 30);
+        assert_eq!(percentile(&h, 100, 90), 10);
+        assert_eq!(percentile(&h, 0, 95), 0);
+    }
     use crate::SimConfig;
     use dualsplit_geometry::Pcg32;
 
