@@ -197,15 +197,45 @@ fn subcommand(argv: &[String]) -> Option<&str> {
         .find(|a| !a.starts_with('-'))
 }
 
-/// The flags `dualsplit SUB --help` lists (long and short), or the error it gave.
-fn flags_of(sub: &str) -> Result<BTreeSet<String>, String> {
+/// The `--help` text of `dualsplit PATH…`, or the error it gave.
+fn help_of(path: &[&str]) -> Result<String, String> {
     let dir = tempfile::tempdir().unwrap();
-    let out = common::dualsplit(&[sub, "--help"], dir.path());
+    let mut args = path.to_vec();
+    args.push("--help");
+    let out = common::dualsplit(&args, dir.path());
     if !out.status.success() {
         return Err(common::stderr(&out));
     }
+    Ok(common::stdout(&out))
+}
+
+/// The subcommand path of an argument list: its first word that is not a flag, then each
+/// following word that its parent's `--help` lists under "Commands:" (`scene convert`).
+fn command_path(argv: &[String]) -> Option<Vec<&str>> {
+    let first = subcommand(argv)?;
+    let mut path = vec![first];
+    let mut rest = argv.iter().skip_while(|a| a.as_str() != first).skip(1);
+    while let Some(next) = rest.next().filter(|a| !a.starts_with('-')) {
+        let Ok(help) = help_of(&path) else { break };
+        let nested = help
+            .lines()
+            .skip_while(|l| !l.starts_with("Commands:"))
+            .skip(1)
+            .take_while(|l| l.starts_with("  "))
+            .any(|l| l.split_whitespace().next() == Some(next.as_str()));
+        if !nested {
+            break;
+        }
+        path.push(next.as_str());
+    }
+    Some(path)
+}
+
+/// The flags `dualsplit PATH… --help` lists (long and short), or the error it gave.
+fn flags_of(path: &[&str]) -> Result<BTreeSet<String>, String> {
+    let help = help_of(path)?;
     let mut flags = BTreeSet::new();
-    for line in common::stdout(&out).lines() {
+    for line in help.lines() {
         let line = line.trim_start();
         if !line.starts_with('-') {
             continue;
@@ -241,10 +271,11 @@ fn flag_names(word: &str) -> Vec<String> {
 
 /// Problems with a synopsis: an unknown subcommand, or flags it does not have.
 fn check_synopsis(c: &DocCommand) -> Option<String> {
-    let Some(sub) = subcommand(&c.argv) else {
+    let Some(path) = command_path(&c.argv) else {
         return Some("no subcommand".into());
     };
-    let flags = match flags_of(sub) {
+    let sub = path.join(" ");
+    let flags = match flags_of(&path) {
         Ok(f) => f,
         Err(e) => return Some(format!("subcommand `{sub}`: {}", e.trim())),
     };

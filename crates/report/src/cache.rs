@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 /// Bump when the meaning or layout of a cached value changes. Simulator model changes are
 /// tracked separately by [`dualsplit_sim::MODEL_VERSION`], which is also part of every key
 /// (all crates share one version number, so the crate version alone does not tell).
-pub const SCHEMA: u32 = 4;
+pub const SCHEMA: u32 = 5;
 
 /// Largest cache entry [`Cache::get`] reads (a render's base64 PNG is the largest piece,
 /// a few MB).
