@@ -741,7 +741,12 @@ mod tests {
                 let got = d.rd_at(line, arrive, now);
                 assert_eq!(got, r.read(line, arrive), "seed {seed}, read {i}");
             }
-            assert_eq!(d.stats(), r.stats, "seed {seed}");
+            // The reference model keeps no latency histogram.
+            let got = DramStats {
+                latency_p95_cycles: 0,
+                ..d.stats()
+            };
+            assert_eq!(got, r.stats, "seed {seed}");
             if !light {
                 assert!(
                     d.stats().queue_wait_cycles > 0,
