@@ -45,17 +45,17 @@ pub struct CacheConfig {
     pub banks: u32,
     /// Ways per set (1 = direct-mapped, as in SimTRaX).
     pub associativity: u32,
-    /// Hit latency in core cycles (for L2: on top of the L1 latency).
+    /// Hit latency in core cycles (for L2: on top of the L1 latency). The L2's 3 cycles in
+    /// lin2020 come from SimTRaX's 512 KB sample configurations, not a 4 MB, 128-bank L2
+    /// (`docs/sources.md`).
     pub hit_latency: u64,
     /// L2 only: bank = line address mod banks (`true`, the default and lin2020) or word
-    /// address mod banks (`false`, SimTRaX's `L2Cache.cc`; a sensitivity option).
-    /// An L2 access moves a whole 64-byte line, which a real banked cache keeps in one bank
-    /// (sequential interleaving by block address, Hennessy & Patterson, *Computer
-    /// Architecture*, 5th ed., §2.2 "multibanked caches"); SimTRaX's word rule sends an L1
-    /// miss to the bank of whichever word missed first, which for depth-first node layouts is
-    /// mostly word 0 of a line, so the 8 banks ≡ 0 mod 16 took 35–45 % of the L2 traffic
-    /// (`docs/simulator.md`, "TM scaling"). Ignored for the L1, which word loads make
-    /// word-interleaved.
+    /// address mod banks (`false`; a sensitivity option).
+    /// The default is not sourced: the paper does not say how its L2 banks are interleaved,
+    /// and SimTRaX banks the L2 by word address and refuses a conflicting access, so the
+    /// thread retries next cycle (`sim/L2Cache.cc`); `false` here takes SimTRaX's bank but
+    /// only delays a conflicting access. Differs from SimTRaX: see `docs/sources.md`.
+    /// Ignored for the L1, which word loads make word-interleaved.
     #[serde(default = "line_interleaved_default")]
     pub line_interleaved: bool,
 }
@@ -100,6 +100,9 @@ fn l2_partial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<CacheConfig, D::
 }
 
 /// GDDR5 main memory; timings in DRAM clock ticks (`ticks_per_cycle` per core cycle).
+/// lin2020's timings are those SimTRaX ships for its "GDDR5" (USIMM's `1Gb_x16_amd2GHz.vi`):
+/// DDR3-1600 values rescaled to a 2 GHz controller, and its organisation (8 KB rows,
+/// 16 GB addressed) is not the paper's 2 GB (`docs/sources.md`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct DramConfig {
@@ -148,7 +151,7 @@ pub struct UnitConfig {
     pub box_pipes: u32,
     /// Ray-box pipeline latency (cycles, initiation interval 1).
     pub box_latency: u64,
-    /// Ray-triangle pipelines.
+    /// Ray-triangle pipelines (the paper gives no count; lin2020 assumes one per TM).
     pub tri_pipes: u32,
     /// Ray-triangle pipeline latency.
     pub tri_latency: u64,
