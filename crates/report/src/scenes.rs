@@ -14,7 +14,8 @@ use std::path::{Path, PathBuf};
 pub const ENV_VAR: &str = "DUALSPLIT_SCENES";
 
 /// The meshes that stand for scenes of the paper: file name, paper scene, and whether it is
-/// the paper's own mesh. `crytek_sponza.gltf` (with its `Sponza.bin`) is the Khronos glTF
+/// the paper's own scene (the Dragon Box is reconstructed: the paper's dragon in a box the
+/// paper does not describe). `crytek_sponza.gltf` (with its `Sponza.bin`) is the Khronos glTF
 /// sample's Crytek Sponza as `scripts/get-scenes.sh` saves it.
 pub const PAPER_FILES: [(&str, PaperScene, bool); 3] = [
     ("dragon_box.ply.gz", PaperScene::DragonBox, true),
@@ -127,7 +128,7 @@ pub struct PaperFile {
     pub file: String,
     /// The paper scene it stands for.
     pub scene: PaperScene,
-    /// Whether it is the paper's own mesh (else a stand-in).
+    /// Whether it is the paper's own scene, as far as it can be had (else a stand-in).
     pub same_mesh: bool,
     /// Its path when found.
     pub path: Option<String>,

@@ -120,7 +120,7 @@ fn cornell_path_two_samples() {
     check(&scene, &structures, &settings);
 }
 
-/// The paper's own mesh (871K triangles: the deepest trees, so the kernels' fixed-size
+/// The reconstructed Dragon Box (871K triangles: the deepest trees, so the kernels' fixed-size
 /// traversal stacks are exercised), both workloads on one build.
 #[test]
 fn dragon_box() {

@@ -21,7 +21,7 @@ use std::time::Instant;
 
 /// Default stand-ins: the builtins at reduced sizes, keeping the paper's scene characters
 /// (hairball ↔ Hairball, forest ↔ Vegetation, atrium ↔ Crytek Sponza). The default report
-/// also takes the paper's own Dragon Box from the scenes folder when it is there.
+/// also takes the reconstructed Dragon Box from the scenes folder when it is there.
 pub const DEFAULT_SCENES: [&str; 3] = [
     "builtin:atrium?triangles=30000",
     "builtin:forest?triangles=40000",
@@ -250,9 +250,9 @@ impl Resolved {
 }
 
 /// The scenes of a report or study: those given, else the paper's meshes found in the
-/// scenes folder (all with `full`; by default the paper's own, Dragon Box and Crytek
-/// Sponza), then the builtins, less the stand-in of a paper scene whose own mesh was found
-/// (the atrium when `crytek_sponza.gltf` is there).
+/// scenes folder (all with `full`; by default the paper's scenes: the reconstructed Dragon
+/// Box and Crytek Sponza), then the builtins, less the stand-in of a paper scene whose own
+/// mesh was found (the atrium when `crytek_sponza.gltf` is there).
 pub fn resolve_specs(given: &[String], full: bool, scene_files: &SceneFiles) -> Vec<String> {
     if !given.is_empty() {
         return given.to_vec();

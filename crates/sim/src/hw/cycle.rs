@@ -1,8 +1,8 @@
 //! Simulated time: the core clock ([`Cycle`]) and the DRAM clock ([`Tick`]).
 //!
 //! The chip runs at `clock_ghz` (1 GHz in Lin et al. 2020, Table 1); the GDDR5 model counts
-//! in ticks of `dram.ticks_per_cycle` per core cycle (0.5 ns: USIMM's memory clock in
-//! SimTRaX's `gddr5_8ch.cfg`). A point in time and a duration are different things: a
+//! in ticks of `dram.ticks_per_cycle` per core cycle (0.5 ns: the 2 GHz memory clock of the
+//! USIMM device file SimTRaX uses, `1Gb_x16_amd2GHz.vi`; `docs/sources.md`). A point in time and a duration are different things: a
 //! point plus a duration (`u64` cycles or ticks) is a point, two points differ by a
 //! duration.
 

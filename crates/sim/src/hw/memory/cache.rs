@@ -18,8 +18,8 @@
 //! Writing the tag at request time instead would make the replaced line vanish for the
 //! whole miss latency and request an in-flight line again once a conflicting miss took its
 //! tag; under load the two feed each other (longer latencies, more re-requests of the
-//! top-of-tree lines, hotter L2 banks) and TM scaling breaks down at 128 TMs
-//! (`docs/simulator.md`, "TM scaling").
+//! top-of-tree lines, hotter L2 banks) and TM scaling breaks down at 128 TMs (an analysis
+//! of model 4, in the git history only).
 
 use crate::hw::Cycle;
 use crate::hw::addr::LineAddr;
