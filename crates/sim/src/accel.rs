@@ -1,6 +1,6 @@
 //! The simulated configurations: which structure, traversed how, on which units.
 //!
-//! Every configuration is registered once, in the [`sim_accels!`] invocation below: its
+//! Every configuration is registered once, in the `sim_accels!` invocation below: its
 //! variant, command-line name, the paper's label, the traversal it runs, its ray-box pipes
 //! for the "+" configurations, its chart colour, and its two compiled kernels
 //! (`kernels/build/<name>-{cast,path}.elf`, which `kernels/Makefile`'s `CONFIGS` builds; a
