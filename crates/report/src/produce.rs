@@ -80,14 +80,8 @@ pub type SimulateFn<'a> = dyn Fn(
 pub fn real_simulator(model: ThreadModel) -> Box<SimulateFn<'static>> {
     Box::new(move |scene, structures, accel, settings, cfg, progress| {
         dualsplit_sim::simulate(
-            &dualsplit_sim::FrameRequest {
-                scene,
-                structures,
-                accel,
-                settings,
-                cfg,
-                model,
-            },
+            &dualsplit_sim::FrameRequest::new(scene, structures, accel, settings, cfg)
+                .with_model(model),
             progress,
         )
         .map_err(|e| format!("simulator unavailable: {e}"))

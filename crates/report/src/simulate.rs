@@ -71,14 +71,8 @@ pub fn simulate_frames<S: TraversalSet + Sync>(
     let sim_one = |accel: SimAccel| -> Result<(SimResult, Duration), SimulateError> {
         let t0 = Instant::now();
         let r = dualsplit_sim::simulate(
-            &dualsplit_sim::FrameRequest {
-                scene,
-                structures,
-                accel,
-                settings,
-                cfg,
-                model,
-            },
+            &dualsplit_sim::FrameRequest::new(scene, structures, accel, settings, cfg)
+                .with_model(model),
             &|done, total| progress(accel, done, total),
         )
         .map_err(|source| SimulateError::Frame {

@@ -761,14 +761,8 @@ mod tests {
         cfg.tms = 2;
         for model in dualsplit_sim::ThreadModel::ALL {
             let r = dualsplit_sim::simulate(
-                &dualsplit_sim::FrameRequest {
-                    scene: &scene,
-                    structures: &s,
-                    accel: SimAccel::Dst,
-                    settings: &settings,
-                    cfg: &cfg,
-                    model,
-                },
+                &dualsplit_sim::FrameRequest::new(&scene, &s, SimAccel::Dst, &settings, &cfg)
+                    .with_model(model),
                 &|_, _| {},
             )
             .unwrap();

@@ -156,14 +156,7 @@ fn bench_model(
     let cfg = SimConfig::lin2020();
     let sim = || {
         simulate(
-            &FrameRequest {
-                scene,
-                structures: s,
-                accel,
-                settings: &settings,
-                cfg: &cfg,
-                model,
-            },
+            &FrameRequest::new(scene, s, accel, &settings, &cfg).with_model(model),
             &|_, _| {},
         )
         .unwrap()

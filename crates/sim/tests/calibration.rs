@@ -63,14 +63,7 @@ fn run(model: ThreadModel, spec: &str, accel: SimAccel, wl: Workload) -> SimResu
     cfg.tms = 8;
     let settings = RenderSettings::new(64, 64, wl);
     simulate(
-        &FrameRequest {
-            scene: &scene,
-            structures: &s,
-            accel,
-            settings: &settings,
-            cfg: &cfg,
-            model,
-        },
+        &FrameRequest::new(&scene, &s, accel, &settings, &cfg).with_model(model),
         &|_, _| {},
     )
     .unwrap()

@@ -19,14 +19,7 @@ fn compiled_kernels_give_the_renderers_pixels() {
         for accel in SimAccel::ALL {
             let run = |m| {
                 simulate(
-                    &FrameRequest {
-                        scene: &scene,
-                        structures: &s,
-                        accel,
-                        settings: &settings,
-                        cfg: &cfg,
-                        model: m,
-                    },
+                    &FrameRequest::new(&scene, &s, accel, &settings, &cfg).with_model(m),
                     &|_, _| {},
                 )
                 .unwrap()
@@ -62,14 +55,8 @@ fn a_frame_beyond_the_memory_map_is_a_typed_error() {
     // 4096² pixels × 12 bytes is beyond the 128 MiB between the frame buffer and the program.
     let settings = RenderSettings::new(4096, 4096, Workload::Cast);
     let e = simulate(
-        &FrameRequest {
-            scene: &scene,
-            structures: &s,
-            accel: SimAccel::Dst,
-            settings: &settings,
-            cfg: &tiny(),
-            model: ThreadModel::Rv32,
-        },
+        &FrameRequest::new(&scene, &s, SimAccel::Dst, &settings, &tiny())
+            .with_model(ThreadModel::Rv32),
         &|_, _| {},
     )
     .unwrap_err();

@@ -129,14 +129,7 @@ fn chips_at_the_ends_of_the_ranges_simulate() {
         for toml in [small, slow.as_str()] {
             let cfg = SimConfig::from_toml(toml).unwrap();
             let r = simulate(
-                &FrameRequest {
-                    scene: &scene,
-                    structures: &s,
-                    accel: SimAccel::Dst,
-                    settings: &settings,
-                    cfg: &cfg,
-                    model,
-                },
+                &FrameRequest::new(&scene, &s, SimAccel::Dst, &settings, &cfg).with_model(model),
                 &|_, _| {},
             )
             .unwrap_or_else(|e| panic!("{model:?} {toml}: {e}"));
@@ -170,14 +163,7 @@ fn chips_too_large_for_the_host_are_refused_before_allocating() {
     ] {
         let cfg = SimConfig::from_toml(toml).unwrap();
         match simulate(
-            &FrameRequest {
-                scene: &scene,
-                structures: &s,
-                accel: SimAccel::Bvh2,
-                settings: &settings,
-                cfg: &cfg,
-                model,
-            },
+            &FrameRequest::new(&scene, &s, SimAccel::Bvh2, &settings, &cfg).with_model(model),
             &|_, _| {},
         ) {
             Err(e @ SimError::Memory(_)) => {

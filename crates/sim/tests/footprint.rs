@@ -52,14 +52,7 @@ fn simulations_stay_within_their_estimate() {
         let (before, max_before) = (ALLOC.allocated(), ALLOC.max_allocated());
         ALLOC.set_limit(before + est as usize).unwrap();
         let r = simulate(
-            &FrameRequest {
-                scene: &scene,
-                structures: &s,
-                accel,
-                settings: &settings,
-                cfg: &cfg,
-                model,
-            },
+            &FrameRequest::new(&scene, &s, accel, &settings, &cfg).with_model(model),
             &|_, _| {},
         )
         .unwrap();

@@ -159,14 +159,8 @@ fn run_all(missing: &mut Vec<String>) -> Vec<Golden> {
             for model in ThreadModel::ALL {
                 for accel in SimAccel::ALL {
                     let r = simulate(
-                        &FrameRequest {
-                            scene: &scene,
-                            structures: &structures,
-                            accel,
-                            settings: &settings,
-                            cfg: &cfg,
-                            model,
-                        },
+                        &FrameRequest::new(&scene, &structures, accel, &settings, &cfg)
+                            .with_model(model),
                         &|_, _| {},
                     )
                     .unwrap_or_else(|e| panic!("{short} {wl_name} {}: {e}", accel.name()));

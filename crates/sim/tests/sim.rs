@@ -63,14 +63,7 @@ fn run_model(
 ) -> SimResult {
     let settings = RenderSettings::new(24, 16, wl);
     simulate(
-        &FrameRequest {
-            scene,
-            structures: s,
-            accel,
-            settings: &settings,
-            cfg,
-            model,
-        },
+        &FrameRequest::new(scene, s, accel, &settings, cfg).with_model(model),
         &|_, _| {},
     )
     .unwrap()
@@ -200,14 +193,7 @@ fn dst_and_dst_sw_pixels_equal_the_renderers_and_use_their_units() {
         let settings = RenderSettings::new(24, 16, wl);
         let sim = |m, a| {
             simulate(
-                &FrameRequest {
-                    scene: &scene,
-                    structures: &s,
-                    accel: a,
-                    settings: &settings,
-                    cfg: &cfg,
-                    model: m,
-                },
+                &FrameRequest::new(&scene, &s, a, &settings, &cfg).with_model(m),
                 &|_, _| {},
             )
             .unwrap()
@@ -425,27 +411,13 @@ fn one_tree_simulates_as_every_structure() {
             };
             let want = go(&|| {
                 simulate(
-                    &FrameRequest {
-                        scene: &scene,
-                        structures: &s,
-                        accel,
-                        settings: &settings,
-                        cfg: &cfg,
-                        model,
-                    },
+                    &FrameRequest::new(&scene, &s, accel, &settings, &cfg).with_model(model),
                     &|_, _| {},
                 )
             });
             let got = go(&|| {
                 simulate(
-                    &FrameRequest {
-                        scene: &scene,
-                        structures: &dst,
-                        accel,
-                        settings: &settings,
-                        cfg: &cfg,
-                        model,
-                    },
+                    &FrameRequest::new(&scene, &dst, accel, &settings, &cfg).with_model(model),
                     &|_, _| {},
                 )
             });

@@ -98,14 +98,14 @@ pub fn simulate_entry(
     }
     let settings = RenderSettings::new(entry.width, entry.height, entry.workload);
     dualsplit_sim::simulate(
-        &dualsplit_sim::FrameRequest {
-            scene: &scene,
-            structures: &structures,
-            accel: entry.accel,
-            settings: &settings,
-            cfg: &entry.config,
-            model: entry.thread_model,
-        },
+        &dualsplit_sim::FrameRequest::new(
+            &scene,
+            &structures,
+            entry.accel,
+            &settings,
+            &entry.config,
+        )
+        .with_model(entry.thread_model),
         progress,
     )
     .map_err(|e| fail(format!("simulating: {e}")))

@@ -81,13 +81,6 @@ impl Chip {
         self.stalls.idle = idle;
     }
 
-    /// Adds stall cycles a thread model accounts for itself (the `fast` model's measured
-    /// dependency and pipeline-latency stalls).
-    pub fn add_stalls(&mut self, dependency: u64, pipeline_latency: u64) {
-        self.stalls.dependency += dependency;
-        self.stalls.pipeline_latency += pipeline_latency;
-    }
-
     /// The counters so far.
     pub fn stats(&self) -> ChipStats {
         let mut s = ChipStats {
