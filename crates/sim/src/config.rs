@@ -45,23 +45,20 @@ pub struct CacheConfig {
     pub banks: u32,
     /// Ways per set (1 = direct-mapped, as in SimTRaX).
     pub associativity: u32,
-    /// Hit latency in core cycles (for L2: on top of the L1 latency). The L2's 3 cycles in
-    /// lin2020 come from SimTRaX's 512 KB sample configurations, not a 4 MB, 128-bank L2
-    /// (`docs/sources.md`).
+    /// Hit latency in core cycles (for L2: on top of the L1 latency). lin2020's L2 takes 5:
+    /// a CACTI 7 access time of 4.98 ns for 4 MB, 128 banks at 65 nm (`docs/sources.md`).
     pub hit_latency: u64,
-    /// L2 only: bank = line address mod banks (`true`, the default and lin2020) or word
-    /// address mod banks (`false`; a sensitivity option).
-    /// The default is not sourced: the paper does not say how its L2 banks are interleaved,
-    /// and SimTRaX banks the L2 by word address and refuses a conflicting access, so the
-    /// thread retries next cycle (`sim/L2Cache.cc`); `false` here takes SimTRaX's bank but
-    /// only delays a conflicting access. Differs from SimTRaX: see `docs/sources.md`.
-    /// Ignored for the L1, which word loads make word-interleaved.
-    #[serde(default = "line_interleaved_default")]
+    /// L2 only: bank = line address mod banks (`true`) or word address mod banks (`false`,
+    /// the default and lin2020: SimTRaX `sim/L2Cache.cc:170`). Ignored for the L1, which
+    /// word loads make word-interleaved.
+    #[serde(default)]
     pub line_interleaved: bool,
-}
-
-fn line_interleaved_default() -> bool {
-    true
+    /// L2 only: a request that finds its bank taken in its cycle is refused and the thread
+    /// issues nothing until the bank accepts it (`true`, SimTRaX `sim/L2Cache.cc:180-185`,
+    /// retry `sim/IssueUnit.cc:769-787`), or only the request waits for its bank (`false`).
+    /// Ignored for the L1.
+    #[serde(default)]
+    pub refuse_conflicts: bool,
 }
 
 /// A `[l1]` or `[l2]` table as written: the keys it leaves out keep that cache's
@@ -76,6 +73,7 @@ struct PartialCache {
     associativity: Option<u32>,
     hit_latency: Option<u64>,
     line_interleaved: Option<bool>,
+    refuse_conflicts: Option<bool>,
 }
 
 impl PartialCache {
@@ -87,6 +85,7 @@ impl PartialCache {
             associativity: self.associativity.unwrap_or(d.associativity),
             hit_latency: self.hit_latency.unwrap_or(d.hit_latency),
             line_interleaved: self.line_interleaved.unwrap_or(d.line_interleaved),
+            refuse_conflicts: self.refuse_conflicts.unwrap_or(d.refuse_conflicts),
         }
     }
 }
@@ -132,6 +131,14 @@ pub struct DramConfig {
     pub t_ccd: u64,
     /// Data-bus occupancy of one 64-byte line.
     pub t_burst: u64,
+    /// Four-activate window: at most four activations in any `t_faw` ticks of one channel
+    /// (its one rank); 0 = no limit.
+    pub t_faw: u64,
+    /// Refresh cycle time: every `t_refi` ticks, all banks of a channel are refreshed for
+    /// `t_rfc` ticks, in which no command issues; the refresh closes every open row.
+    pub t_rfc: u64,
+    /// Refresh interval; 0 = no refresh.
+    pub t_refi: u64,
     /// Read-queue entries per channel; a full queue stalls the request (back-pressure).
     pub read_queue: u32,
     /// Energy of one 64-byte read burst, nJ.
@@ -267,20 +274,22 @@ impl SimConfig {
                 banks: 16,
                 associativity: 1,
                 hit_latency: 1,
-                line_interleaved: true, // ignored: the L1 is word-interleaved
+                line_interleaved: false, // ignored: the L1 is word-interleaved
+                refuse_conflicts: false, // ignored: an L1 conflict stalls the thread's issue
             },
             l2: CacheConfig {
                 size_bytes: 4 * 1024 * 1024,
                 line_bytes: 64,
                 banks: 128,
                 associativity: 1,
-                hit_latency: 3,
-                line_interleaved: true,
+                hit_latency: 5,
+                line_interleaved: false,
+                refuse_conflicts: true,
             },
             dram: DramConfig {
                 channels: 16,
                 banks_per_channel: 16,
-                row_bytes: 8192,
+                row_bytes: 2048,
                 ticks_per_cycle: 2,
                 t_cas: 28,
                 t_rcd: 28,
@@ -291,7 +300,10 @@ impl SimConfig {
                 t_rtp: 15,
                 t_ccd: 4,
                 t_burst: 4,
-                read_queue: 64,
+                t_faw: 80,
+                t_rfc: 220,
+                t_refi: 15600,
+                read_queue: 80,
                 e_read_nj: 9.8,
                 e_activate_nj: 61.3,
                 background_w: 26.7,
@@ -377,6 +389,17 @@ impl SimConfig {
                 });
             }
         }
+        let d = &self.dram;
+        if d.t_refi != 0 && d.t_refi <= d.t_rfc {
+            return Err(ConfigError::Invalid {
+                field: "dram.t_refi",
+                value: d.t_refi.to_string(),
+                reason: format!(
+                    "the refresh interval must exceed t_rfc ({} ticks), or be 0 for no refresh",
+                    d.t_rfc
+                ),
+            });
+        }
         if self.l1.line_bytes != self.l2.line_bytes {
             return Err(ConfigError::Invalid {
                 field: "l2.line_bytes",
@@ -402,12 +425,14 @@ impl SimConfig {
             ("l1.associativity", int(l1.associativity)),
             ("l1.hit_latency", Int(l1.hit_latency)),
             ("l1.line_interleaved", Flag(l1.line_interleaved)),
+            ("l1.refuse_conflicts", Flag(l1.refuse_conflicts)),
             ("l2.size_bytes", Int(l2.size_bytes)),
             ("l2.line_bytes", Int(l2.line_bytes)),
             ("l2.banks", int(l2.banks)),
             ("l2.associativity", int(l2.associativity)),
             ("l2.hit_latency", Int(l2.hit_latency)),
             ("l2.line_interleaved", Flag(l2.line_interleaved)),
+            ("l2.refuse_conflicts", Flag(l2.refuse_conflicts)),
             ("dram.channels", int(d.channels)),
             ("dram.banks_per_channel", int(d.banks_per_channel)),
             ("dram.row_bytes", Int(d.row_bytes)),
@@ -421,6 +446,9 @@ impl SimConfig {
             ("dram.t_rtp", Int(d.t_rtp)),
             ("dram.t_ccd", Int(d.t_ccd)),
             ("dram.t_burst", Int(d.t_burst)),
+            ("dram.t_faw", Int(d.t_faw)),
+            ("dram.t_rfc", Int(d.t_rfc)),
+            ("dram.t_refi", Int(d.t_refi)),
             ("dram.read_queue", int(d.read_queue)),
             ("dram.e_read_nj", Real(d.e_read_nj)),
             ("dram.e_activate_nj", Real(d.e_activate_nj)),

@@ -3,7 +3,11 @@
 //! one access per bank per cycle); a hit returns its word `l1.hit_latency` cycles after its
 //! bank slot, a miss goes to the shared [`L2`] and the line is installed when its fill
 //! arrives; a miss to a line in flight waits for that fill (no second L2 access). Stores
-//! are write-around.
+//! are write-around. When the L2 refuses a miss (its bank taken, `l2.refuse_conflicts`),
+//! the load is retried until the L2 accepts it, as SimTRaX's issue unit retries a refused
+//! instruction (`sim/L1Cache.cc:318-322`, `sim/IssueUnit.cc:769-787`): modelled as the
+//! thread issuing nothing before the cycle after the L2 bank's first free cycle (the cycle
+//! a retry succeeds when no other request takes the bank first).
 
 use crate::config::CacheConfig;
 use crate::hw::Cycle;
@@ -24,6 +28,8 @@ pub struct L1 {
     accesses: u64,
     hits: u64,
     merged: u64,
+    /// The latest cycle an L2 bank accepted a refused miss of the load being placed.
+    accepted: Cycle,
 }
 
 impl L1 {
@@ -38,6 +44,7 @@ impl L1 {
             accesses: 0,
             hits: 0,
             merged: 0,
+            accepted: Cycle::ZERO,
         }
     }
 
@@ -80,6 +87,11 @@ impl L1 {
             ready = ready.max(r).max(last + self.latency);
             c = last + 1;
             w = seg_end;
+        }
+        let accepted = std::mem::replace(&mut self.accepted, Cycle::ZERO);
+        if accepted >= c {
+            busy += accepted + 1 - c;
+            c = accepted + 1;
         }
         Issued {
             next_issue: c,
@@ -149,7 +161,10 @@ impl L1 {
 
     #[inline(never)]
     fn miss(&mut self, l2: &mut L2, line: u64, w: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
-        let ready = l2.read(LineAddr::new(line), WordAddr::new(w), slot, now);
+        let (ready, refused) = l2.read(LineAddr::new(line), WordAddr::new(w), slot, now);
+        if let Some(accepted) = refused {
+            self.accepted = self.accepted.max(accepted);
+        }
         self.cache.install(LineAddr::new(line), ready, slot);
         (ready, ready)
     }

@@ -515,6 +515,13 @@ impl<const P: usize> SparseSlots<P> {
         self.find(c.max(self.lo), 1)
     }
 
+    /// The first start at or after `c` where a span of `len` cycles (`1 ≤ len ≤ 64`)
+    /// overlaps no other span, without reserving it.
+    pub fn peek_span(&self, c: Slot, len: u64) -> Slot {
+        debug_assert!(c >= self.floor && (1..=64).contains(&len));
+        self.find(c.max(self.lo), len)
+    }
+
     /// Reserves the first free cycle at or after `c` and returns it.
     #[inline]
     pub fn reserve(&mut self, c: Slot) -> Slot {

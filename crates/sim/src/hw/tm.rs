@@ -115,6 +115,25 @@ impl Tm {
 mod tests {
     use super::*;
 
+    /// SimTRaX refuses an L2 request whose bank is taken in its cycle and the thread retries
+    /// (`sim/L2Cache.cc:180-185`): the load's issue is held until the bank accepts it.
+    #[test]
+    fn a_refused_l2_request_holds_the_threads_issue() {
+        let c = Cycle;
+        for (refuse, next, busy) in [(true, c(12), 1), (false, c(11), 0)] {
+            let mut cfg = SimConfig::lin2020();
+            cfg.l2.refuse_conflicts = refuse;
+            let mut l2 = L2::new(&cfg);
+            let (mut a, mut b) = (Tm::new(&cfg, 1), Tm::new(&cfg, 1));
+            // Words 0 and 128 miss in two TMs in cycle 10: both on L2 bank 0 (word
+            // address mod 128), so the second request gets the bank in cycle 11.
+            let first = a.load(&mut l2, WordAddr::new(0), 1, c(10), c(10));
+            assert_eq!(first.next_issue, c(11));
+            let r = b.load(&mut l2, WordAddr::new(128), 1, c(10), c(10));
+            assert_eq!((r.next_issue, r.busy), (next, busy), "refuse = {refuse}");
+        }
+    }
+
     /// The TM's interface as a thread model other than the macro-op replay drives it:
     /// typed requests at a cycle, the cycle the result is ready.
     #[test]
@@ -122,10 +141,10 @@ mod tests {
         let cfg = SimConfig::lin2020();
         let mut l2 = L2::new(&cfg);
         let mut tm = Tm::new(&cfg, 1);
-        // A cold 3-word load at byte 0: L1 1 + L2 3 + closed row 30; words at 0, 1, 2.
+        // A cold 3-word load at byte 0: L1 1 + L2 5 + closed row 30; words at 0, 1, 2.
         let c = Cycle;
         let r = tm.load(&mut l2, WordAddr::from_byte(0), 3, c(0), c(0));
-        assert_eq!((r.next_issue, r.ready, r.busy), (c(3), c(34), 0));
+        assert_eq!((r.next_issue, r.ready, r.busy), (c(3), c(36), 0));
         // The same words again: L1 hits, the last at cycle 102, data at 103.
         let r = tm.load(&mut l2, WordAddr::new(0), 3, c(100), c(100));
         assert_eq!((r.next_issue, r.ready), (c(103), c(103)));

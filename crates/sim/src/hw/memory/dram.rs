@@ -15,6 +15,16 @@
 //!
 //! then the data leaves t_CAS later in the channel bus's first free burst slot (slots are
 //! t_burst long; a later-reserved row hit may fill a gap before an earlier conflict's data).
+//!
+//! An activation also keeps the channel's (one rank's) **four-activate window**: at most
+//! four activations in any t_FAW ticks (USIMM `memory_controller.cc:134-170`). **Refresh**:
+//! every t_REFI ticks each channel is refreshed for t_RFC ticks (window k ≥ 1 is
+//! `[k·t_REFI, k·t_REFI + t_RFC)`, the same for every channel), in which no activation
+//! issues, and which closes every open row: a read after a refresh finds its bank closed.
+//! USIMM forces a refresh at such deadlines (`memory_controller.cc:215-218`); its refresh
+//! times are per rank and follow the controller's state, ours are a fixed grid, and a column
+//! command already placed is not moved out of a window (a simplification: a window is
+//! t_RFC = 220 of t_REFI = 15,600 ticks).
 //! A full read queue delays the request until the first of its channel's in-flight reads
 //! completes (back-pressure). The queue is kept on the bus table itself: each in-flight
 //! read is marked *pending* on its data-bus slot, which is also its completion time.
@@ -254,6 +264,64 @@ struct Channel {
     bus: SparseSlots<2>,
     /// Activations, each holding t_RRD ticks (minimum spacing between activations).
     acts: SparseSlots,
+    /// Ticks of the activations that may still share a t_FAW window with a later one,
+    /// ascending.
+    faw: Vec<u64>,
+}
+
+/// The refresh schedule: window k ≥ 1 is `[k·refi, k·refi + rfc)`; `refi = 0`: none.
+#[derive(Clone, Copy, Debug)]
+struct Refresh {
+    refi: u64,
+    rfc: u64,
+}
+
+impl Refresh {
+    /// How many refreshes have started by tick `t`.
+    #[inline]
+    fn count(self, t: Tick) -> u64 {
+        if self.refi == 0 {
+            0
+        } else {
+            t.get() / self.refi
+        }
+    }
+
+    /// The first tick at or after `t` outside every refresh window.
+    #[inline]
+    fn free(self, t: Tick) -> Tick {
+        if self.refi == 0 {
+            return t;
+        }
+        let (k, off) = (t.get() / self.refi, t.get() % self.refi);
+        if k >= 1 && off < self.rfc {
+            Tick(k * self.refi + self.rfc)
+        } else {
+            t
+        }
+    }
+}
+
+/// Whether an activation at tick `s` keeps every `faw`-tick window of a channel at four
+/// activations or fewer, given the channel's activations `acts` (ascending; they keep the
+/// rule among themselves, so a window that breaks it holds `s`).
+fn faw_allows(acts: &[u64], s: u64, faw: u64) -> bool {
+    if faw == 0 {
+        return true;
+    }
+    let lo = acts.partition_point(|&t| t + faw <= s);
+    let hi = acts.partition_point(|&t| t < s + faw);
+    let near = &acts[lo..hi];
+    let at = near.partition_point(|&t| t <= s);
+    // Windows holding `s`: any five consecutive of near[..at] + s + near[at..] spanning
+    // less than `faw`.
+    let v: Vec<u64> = near[..at]
+        .iter()
+        .copied()
+        .chain([s])
+        .chain(near[at..].iter().copied())
+        .collect();
+    v.windows(5).all(|w| w[4] - w[0] >= faw)
 }
 
 /// The DRAM system.
@@ -269,6 +337,7 @@ pub struct Dram {
     /// Divisions by t_burst and by ticks_per_cycle.
     burst: Divisor,
     tpc: Divisor,
+    refresh: Refresh,
     stats: DramStats,
     /// Reads by latency in core cycles ([`LATENCY_BUCKETS`]).
     latency_histogram: Vec<u64>,
@@ -323,6 +392,10 @@ impl Dram {
             bank_bits: cfg.banks_per_channel.trailing_zeros(),
             burst: Divisor::new(cfg.t_burst),
             tpc: Divisor::new(cfg.ticks_per_cycle),
+            refresh: Refresh {
+                refi: cfg.t_refi,
+                rfc: cfg.t_rfc,
+            },
             stats: DramStats::default(),
             latency_histogram: vec![0; LATENCY_BUCKETS],
         }
@@ -371,6 +444,10 @@ impl Dram {
         let floor = now.to_ticks(tpc).get();
         ch.bus.forget_before(self.burst.div(floor));
         ch.acts.forget_before(floor);
+        let old = ch.faw.partition_point(|&t| t + c.t_faw < floor);
+        if old > 0 {
+            ch.faw.drain(..old);
+        }
         // The read's tick; the schedule below is in ticks.
         let mut a = arrive.to_ticks(tpc);
         // Reads complete by `a` leave the queue: slot `s` completes at (s + 1) · t_burst ≤ a,
@@ -386,6 +463,7 @@ impl Dram {
         }
         let bank = &mut self.banks[b];
         let gap = c.t_rp + c.t_rtp;
+        let refresh = self.refresh;
         let epochs = &mut self.epochs;
         epochs.expire(b, bank, a, gap);
         // Row-hit-first: an earlier epoch of this row still ahead of the read serves it
@@ -406,7 +484,8 @@ impl Dram {
                 }
                 // The column command waits for its data-bus slot (t_CAS before it).
                 let slot = ch.bus.peek(self.burst.div_ceil((col + c.t_cas).get()));
-                if Tick(slot * c.t_burst) - c.t_cas <= close {
+                let col = Tick(slot * c.t_burst) - c.t_cas;
+                if col <= close && refresh.count(col) == refresh.count(e.act) {
                     hit = Some(slot);
                     break;
                 }
@@ -420,7 +499,13 @@ impl Dram {
                 return self.finish(arrive, done, DramAccess::RowHit);
             }
         }
-        let (col, kind) = match bank.open_row {
+        // A refresh since the bank's last activation closed its row.
+        let open = if refresh.count(a.max(bank.col_ready)) == refresh.count(bank.act) {
+            bank.open_row
+        } else {
+            NO_ROW
+        };
+        let (col, kind) = match open {
             r if r == row => (a.max(bank.col_ready), DramAccess::RowHit),
             open => {
                 let mut act = a;
@@ -434,7 +519,28 @@ impl Dram {
                 if open != NO_ROW || bank.act > Tick(0) {
                     act = act.max(bank.act + c.t_rc);
                 }
-                act = Tick(ch.acts.reserve_span(act.get(), c.t_rrd.max(1)));
+                // The first start free of other activations' t_RRD spans, of refresh
+                // windows and of a fifth activation in a t_FAW window.
+                let rrd = c.t_rrd.max(1);
+                let mut s = act.get();
+                loop {
+                    s = ch.acts.peek_span(s, rrd);
+                    let f = refresh.free(Tick(s)).get();
+                    if f != s {
+                        s = f;
+                    } else if faw_allows(&ch.faw, s, c.t_faw) {
+                        break;
+                    } else {
+                        s += 1;
+                    }
+                }
+                let placed = ch.acts.reserve_span(s, rrd);
+                debug_assert_eq!(placed, s);
+                if c.t_faw > 0 {
+                    let i = ch.faw.partition_point(|&t| t <= s);
+                    ch.faw.insert(i, s);
+                }
+                act = Tick(s);
                 epochs.push(b, bank, row, act, gap);
                 bank.act = act;
                 bank.open_row = row;
@@ -515,6 +621,7 @@ mod tests {
         assert_eq!(percentile(&h, 0, 95), 0);
     }
     use crate::SimConfig;
+    use crate::config::DramConfig;
     use dualsplit_geometry::Pcg32;
 
     impl Dram {
@@ -531,17 +638,71 @@ mod tests {
         }
     }
 
+    /// lin2020's timings with 8 KB rows and no t_FAW or refresh: the organisation the
+    /// hand-computed latencies below are written for (128 lines per row, 16 channels, 16
+    /// banks).
+    fn plain() -> DramConfig {
+        DramConfig {
+            row_bytes: 8192,
+            t_faw: 0,
+            t_rfc: 0,
+            t_refi: 0,
+            ..SimConfig::lin2020().dram
+        }
+    }
+
     fn dram() -> Dram {
-        Dram::new(&SimConfig::lin2020().dram)
+        Dram::new(&plain())
+    }
+
+    #[test]
+    fn a_fifth_activation_waits_for_the_four_activate_window() {
+        let cfg = DramConfig {
+            t_faw: 80,
+            ..plain()
+        };
+        let mut d = Dram::new(&cfg);
+        // Five closed banks of channel 0 at cycle 0: activations at ticks 0, 13, 26, 39
+        // (t_RRD), the fifth at 80 (t_FAW after the first), column 108, data at 136: done
+        // at tick 140 = cycle 70.
+        let bank = 128 * 16;
+        let done: Vec<_> = (0..5).map(|b| d.rd(b * bank, 0).0).collect();
+        assert_eq!(done[3], 50);
+        assert_eq!(done[4], 70);
+        // Without the window the fifth follows t_RRD: act 52, data at 108 rounded to the
+        // burst grid 108, done 112 = cycle 56.
+        let mut d = dram();
+        assert_eq!((0..5).map(|b| d.rd(b * bank, 0).0).last(), Some(56));
+    }
+
+    #[test]
+    fn refresh_blocks_activations_and_closes_rows() {
+        let cfg = DramConfig {
+            t_rfc: 220,
+            t_refi: 15600,
+            ..plain()
+        };
+        let mut d = Dram::new(&cfg);
+        // Row 0 opened at cycle 0; a read of it at cycle 7800 (tick 15600) falls in the
+        // first refresh window [15600, 15820): the refresh closed the row, so it is a
+        // closed-bank read activated at tick 15820: column 15848, data 15876, done 15880 =
+        // cycle 7940.
+        assert_eq!(d.rd(0, 0), (30, DramAccess::Closed));
+        assert_eq!(d.rd(1, 7800), (7940, DramAccess::Closed));
+        // Before the window the row was still open.
+        let mut d = Dram::new(&cfg);
+        d.rd(0, 0);
+        assert_eq!(d.rd(1, 7000), (7016, DramAccess::RowHit));
     }
 
     /// The same DRAM model (Lin et al. 2020 §5's GDDR5 memory) written for clarity, not
     /// host speed: reservations in plain sets of taken ticks,
     /// the read queue a min-heap of completion ticks, each bank's epochs a `VecDeque`.
     mod reference {
-        use super::super::{DramAccess, DramStats, EPOCH_KEEP};
+        use super::super::{DramAccess, DramStats, EPOCH_KEEP, Refresh, faw_allows};
         use crate::Cycle;
         use crate::config::DramConfig;
+        use crate::hw::Tick;
         use std::cmp::Reverse;
         use std::collections::{BTreeSet, BinaryHeap, VecDeque};
 
@@ -585,6 +746,8 @@ mod tests {
         struct Channel {
             bus: Taken,
             acts: Taken,
+            /// Every activation tick, ascending.
+            faw: Vec<u64>,
             inflight: BinaryHeap<Reverse<u64>>,
         }
 
@@ -633,6 +796,11 @@ mod tests {
                 {
                     bank.epochs.pop_front();
                 }
+                let refresh = Refresh {
+                    refi: c.t_refi,
+                    rfc: c.t_rfc,
+                };
+                let n = |t: u64| refresh.count(Tick(t));
                 let mut result = None;
                 if bank.open_row != Some(row) {
                     for e in bank.epochs.iter().filter(|e| e.row == row) {
@@ -641,7 +809,8 @@ mod tests {
                             continue;
                         }
                         let slot = ch.bus.find((col + c.t_cas).div_ceil(c.t_burst), 1);
-                        if slot * c.t_burst - c.t_cas <= e.close {
+                        let col = slot * c.t_burst - c.t_cas;
+                        if col <= e.close && n(col) == n(e.act) {
                             ch.bus.reserve_span(slot, 1);
                             result = Some((slot * c.t_burst + c.t_burst, DramAccess::RowHit));
                             break;
@@ -651,7 +820,12 @@ mod tests {
                 let (done, kind) = match result {
                     Some(r) => r,
                     None => {
-                        let (col, kind) = match bank.open_row {
+                        let open = if n(a.max(bank.col_ready)) == n(bank.act) {
+                            bank.open_row
+                        } else {
+                            None
+                        };
+                        let (col, kind) = match open {
                             Some(r) if r == row => (a.max(bank.col_ready), DramAccess::RowHit),
                             open => {
                                 let mut act = a;
@@ -666,7 +840,21 @@ mod tests {
                                 if open.is_some() || bank.act > 0 {
                                     act = act.max(bank.act + c.t_rc);
                                 }
-                                act = ch.acts.reserve_span(act, c.t_rrd.max(1));
+                                let rrd = c.t_rrd.max(1);
+                                loop {
+                                    act = ch.acts.find(act, rrd);
+                                    let f = refresh.free(Tick(act)).get();
+                                    if f != act {
+                                        act = f;
+                                    } else if faw_allows(&ch.faw, act, c.t_faw) {
+                                        break;
+                                    } else {
+                                        act += 1;
+                                    }
+                                }
+                                ch.acts.reserve_span(act, rrd);
+                                let i = ch.faw.partition_point(|&t| t <= act);
+                                ch.faw.insert(i, act);
                                 if let Some(last) = bank.epochs.back_mut() {
                                     last.close = act - c.t_rp - c.t_rtp;
                                 }
@@ -719,6 +907,13 @@ mod tests {
             let light = seed % 6 == 4;
             if seed % 4 == 3 {
                 (cfg.ticks_per_cycle, cfg.t_burst, cfg.t_rrd) = (3, 3, 7);
+            }
+            // Frequent refreshes and a wide four-activate window, so both bind often.
+            if seed % 5 == 1 {
+                (cfg.t_refi, cfg.t_rfc, cfg.t_faw) = (700, 60, 120);
+            }
+            if seed % 7 == 2 {
+                (cfg.t_refi, cfg.t_faw) = (0, 0);
             }
             let mut d = Dram::new(&cfg);
             let mut r = reference::RefDram::new(&cfg);

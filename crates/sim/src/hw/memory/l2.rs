@@ -2,10 +2,12 @@
 //!
 //! Hardware (Lin et al. 2020, §4, Table 1; SimTRaX `L2Cache.cc`): one L2 for all TMs,
 //! `l2.banks` banks that each accept one access per cycle, direct-mapped by default, with
-//! `l2.hit_latency` cycles from the bank slot to the data. The bank of an access is its
-//! line address mod the bank count (`l2.line_interleaved = true`: a banked cache keeps a
-//! line in one bank and interleaves by block address, Hennessy & Patterson, *Computer
-//! Architecture*, 5th ed., §2.2) or, as SimTRaX does, its word address mod the bank count.
+//! `l2.hit_latency` cycles from the bank slot to the data. The bank of an access is, as
+//! SimTRaX has it (`sim/L2Cache.cc:170`), its word address mod the bank count, or its line
+//! address mod the bank count (`l2.line_interleaved = true`, an option). A request that
+//! finds its bank taken is refused (`l2.refuse_conflicts`, SimTRaX `sim/L2Cache.cc:180-185`)
+//! and the thread retries each cycle; it is accepted in the bank's first free cycle, which
+//! [`L2::read`] reports so the L1 can hold the thread's issue until then.
 //! A miss goes to DRAM ([`Dram`]) when the tag lookup is done and the line is installed
 //! when the DRAM's data arrives; a miss to a line already in flight waits for that fill.
 
@@ -22,6 +24,7 @@ pub struct L2 {
     /// `banks − 1` (a power of two).
     bank_mask: u64,
     line_interleaved: bool,
+    refuse_conflicts: bool,
     /// L1 hit latency + L2 hit latency: from the L2 bank slot to the data in the register.
     hit_latency: u64,
     dram: Dram,
@@ -39,6 +42,7 @@ impl L2 {
             banks: vec![Slots::default(); cfg.l2.banks as usize],
             bank_mask: cfg.l2.banks as u64 - 1,
             line_interleaved: cfg.l2.line_interleaved,
+            refuse_conflicts: cfg.l2.refuse_conflicts,
             hit_latency: cfg.l1.hit_latency + cfg.l2.hit_latency,
             dram: Dram::new(&cfg.dram),
             accesses: 0,
@@ -49,9 +53,17 @@ impl L2 {
     }
 
     /// Reads `line` for an L1 miss of word `word` whose L1 slot was `at`; returns the cycle
-    /// the data is in the requesting thread's register. `now` (≤ `at`) is the current event
-    /// time: no later request starts before it.
-    pub fn read(&mut self, line: LineAddr, word: WordAddr, at: Cycle, now: Cycle) -> Cycle {
+    /// the data is in the requesting thread's register and, when the bank was taken at `at`
+    /// and conflicts are refused, the cycle the bank accepted the retried request (the
+    /// thread issues nothing before it). `now` (≤ `at`) is the current event time: no later
+    /// request starts before it.
+    pub fn read(
+        &mut self,
+        line: LineAddr,
+        word: WordAddr,
+        at: Cycle,
+        now: Cycle,
+    ) -> (Cycle, Option<Cycle>) {
         let bank_addr = if self.line_interleaved {
             line.get()
         } else {
@@ -61,8 +73,9 @@ impl L2 {
         let slot = Cycle(self.banks[b].reserve(at.get()));
         self.bank_wait += slot - at;
         self.accesses += 1;
+        let refused = (self.refuse_conflicts && slot > at).then_some(slot);
         let data = slot + self.hit_latency;
-        match self.tags.lookup(line, slot) {
+        let ready = match self.tags.lookup(line, slot) {
             Lookup::Present { fill } if fill <= slot => {
                 self.hits += 1;
                 data
@@ -76,7 +89,8 @@ impl L2 {
                 self.tags.install(line, done, slot);
                 done
             }
-        }
+        };
+        (ready, refused)
     }
 
     /// The tag word of `line`'s first way, read without effect: lets the event loop bring

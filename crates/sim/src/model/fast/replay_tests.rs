@@ -117,12 +117,12 @@ fn l1_hit_takes_one_cycle() {
 fn cold_load_is_a_closed_row_read_and_reload_hits_l2() {
     let cfg = SimConfig::lin2020();
     let mut chip = Chip::new(&cfg, 1);
-    // L1 1 + L2 3 + closed row (tRCD 14 + tCAS 14 + burst 2) = 34.
-    assert_eq!(chip.load_word(0, 0, 100), 134);
-    // Another TM: L1 miss, L2 hit: 1 + 3.
-    assert_eq!(chip.load_word(1, 0, 200), 204);
-    // Same TM, another line in the same DRAM row: row hit, 1 + 3 + 14 + 2 = 20.
-    assert_eq!(chip.load_word(0, 16, 300), 320);
+    // L1 1 + L2 5 + closed row (tRCD 14 + tCAS 14 + burst 2) = 36.
+    assert_eq!(chip.load_word(0, 0, 100), 136);
+    // Another TM: L1 miss, L2 hit: 1 + 5.
+    assert_eq!(chip.load_word(1, 0, 200), 206);
+    // Same TM, another line in the same DRAM row: row hit, 1 + 5 + 14 + 2 = 22.
+    assert_eq!(chip.load_word(0, 16, 300), 322);
     assert_eq!(chip.stats().caches.l2_hits, 1);
     assert_eq!(chip.stats().dram.row_hits, 1);
 }
@@ -132,10 +132,10 @@ fn row_conflict_load() {
     let cfg = SimConfig::lin2020();
     let mut chip = Chip::new(&cfg, 1);
     chip.load_word(0, 0, 0);
-    // Same channel and bank, next row: 128 lines × 16 channels × 16 banks × 16 words.
-    let w = 128 * 16 * 16 * 16;
-    // 1 + 3 + tRP 14 + tRCD 14 + tCAS 14 + burst 2 = 48.
-    assert_eq!(chip.load_word(0, w, 1000), 1048);
+    // Same channel and bank, next row: 32 lines × 16 channels × 16 banks × 16 words.
+    let w = 32 * 16 * 16 * 16;
+    // 1 + 5 + tRP 14 + tRCD 14 + tCAS 14 + burst 2 = 50.
+    assert_eq!(chip.load_word(0, w, 1000), 1050);
     assert_eq!(chip.stats().dram.row_conflicts, 1);
 }
 
@@ -164,23 +164,24 @@ fn a_conflicting_miss_replaces_a_line_only_when_its_fill_arrives() {
     // lines in flight on its pending lists.
     let cfg = SimConfig::lin2020();
     let mut chip = Chip::new(&cfg, 1);
-    // Line 0 cold: 134 (L1 1 + L2 3 + closed row 30).
-    assert_eq!(chip.load_word(0, 0, 100), 134);
+    // Line 0 cold: 136 (L1 1 + L2 5 + closed row 30).
+    assert_eq!(chip.load_word(0, 0, 100), 136);
     // Line 1024 (word 16384) maps to the same L1 set (64 KB direct-mapped): a closed-row
-    // read on channel 8, 34 cycles.
-    assert_eq!(chip.load_word(0, 16384, 200), 234);
-    // Line 0 is still in the L1 until 234: a 1-cycle hit, no L2 access.
+    // read on channel 0, bank 2 (32 lines per row), 36 cycles.
+    assert_eq!(chip.load_word(0, 16384, 200), 236);
+    // Line 0 is still in the L1 until 236: a 1-cycle hit, no L2 access.
     assert_eq!(chip.load_word(0, 1, 202), 203);
     assert_eq!(chip.stats().caches.l2_accesses, 2);
-    // Line 2048 (same set, channel 0 bank 1, closed row: data at tick 470, rounded up to
-    // the 2 ns burst grid, 472 + 4 = 476 ticks) takes the set's tag while 1024 is still in
-    // flight; 1024 stays on the in-flight list and a miss to it merges.
-    assert_eq!(chip.load_word(0, 32768, 203), 238);
-    assert_eq!(chip.load_word(0, 16385, 205), 234);
+    // Line 2048 (same set; channel 0, bank 4, closed; its activation t_RRD after line
+    // 1024's at tick 412: act 425, column 453, data at 481 rounded up to the 2 ns burst grid,
+    // 484 + 4 = 488 ticks) takes the set's tag while 1024 is still in flight; 1024 stays on
+    // the in-flight list and a miss to it merges.
+    assert_eq!(chip.load_word(0, 32768, 203), 244);
+    assert_eq!(chip.load_word(0, 16385, 205), 236);
     assert_eq!(chip.stats().caches.l2_accesses, 3);
     assert_eq!(chip.stats().caches.l1_merged, 1);
-    // Once 2048 has arrived, line 0 is gone: an L1 miss, L2 hit (1 + 3).
-    assert_eq!(chip.load_word(0, 2, 240), 244);
+    // Once 2048 has arrived, line 0 is gone: an L1 miss, L2 hit (1 + 5).
+    assert_eq!(chip.load_word(0, 2, 250), 256);
     assert_eq!(chip.stats().caches.l2_accesses, 4);
     assert_eq!(chip.stats().dram.reads, 3);
 }
@@ -200,10 +201,10 @@ fn miss_to_line_in_flight_merges() {
 #[test]
 fn thread_load_then_use_waits_for_data() {
     let cfg = SimConfig::lin2020();
-    // Load at cycle 0 (cold: 34), use at 34, one issue: finish 35.
+    // Load at cycle 0 (cold: 36), use at 36, one issue: finish 37.
     let (end, chip) = one_thread(&cfg, 1, vec![Op::Load { word: 0, words: 1 }, use_data()]);
-    assert_eq!(end, 35);
-    assert_eq!(chip.stats().stalls.memory, 33);
+    assert_eq!(end, 37);
+    assert_eq!(chip.stats().stalls.memory, 35);
 }
 
 #[test]
