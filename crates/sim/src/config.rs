@@ -202,6 +202,13 @@ pub struct UnitConfig {
     pub local_store_latency: u64,
     /// Compiled kernels: bytes of each TP's local store.
     pub local_store_bytes: u32,
+    /// Compiled kernels: instruction caches per TM; thread `i` fetches from cache
+    /// `i mod icaches`.
+    pub icaches: u32,
+    /// Banks of each instruction cache (bank = instruction index mod banks; a power of two).
+    pub icache_banks: u32,
+    /// Fetches one bank serves per cycle (0 = no limit).
+    pub icache_fetches: u32,
 }
 
 /// Energy per event in nanojoules (65 nm).
@@ -333,6 +340,9 @@ impl SimConfig {
                 intmul_latency: 1,
                 local_store_latency: 1,
                 local_store_bytes: 4096,
+                icaches: 2,
+                icache_banks: 16,
+                icache_fetches: 2,
             },
             energy: EnergyConfig {
                 int_nj: 0.000572,
@@ -477,6 +487,9 @@ impl SimConfig {
             ("units.intmul_latency", Int(u.intmul_latency)),
             ("units.local_store_latency", Int(u.local_store_latency)),
             ("units.local_store_bytes", int(u.local_store_bytes)),
+            ("units.icaches", int(u.icaches)),
+            ("units.icache_banks", int(u.icache_banks)),
+            ("units.icache_fetches", int(u.icache_fetches)),
             ("energy.int_nj", Real(e.int_nj)),
             ("energy.fpadd_nj", Real(e.fpadd_nj)),
             ("energy.fpmul_nj", Real(e.fpmul_nj)),

@@ -164,6 +164,9 @@ pub const RANGES: &[KeyRange] = &[
         multiple: 16,
         ..int("units.local_store_bytes", 1024, 1 << 20, "bytes")
     },
+    int("units.icaches", 1, MAX_UNITS, "caches"),
+    pow2("units.icache_banks", 1, 1024, "banks"),
+    int("units.icache_fetches", 0, MAX_UNITS, "fetches per cycle"),
     real("energy.int_nj", 0.0, MAX_NJ, "nJ"),
     real("energy.fpadd_nj", 0.0, MAX_NJ, "nJ"),
     real("energy.fpmul_nj", 0.0, MAX_NJ, "nJ"),

@@ -18,8 +18,10 @@ pub struct StallShares {
     pub fu_busy: f64,
     /// Waiting for the reciprocal unit.
     pub fpinv: f64,
-    /// L1 bank conflicts.
+    /// L1 bank conflicts and refused L2 requests.
     pub l1_bank: f64,
+    /// Instruction-cache bank conflicts (compiled kernels).
+    pub icache: f64,
     /// Waiting for the global atomic unit.
     pub atomic: f64,
     /// Finished while other threads still ran (the frame's tail).
@@ -40,6 +42,7 @@ impl StallShares {
             fu_busy: f(s.fu_busy),
             fpinv: f(s.fpinv),
             l1_bank: f(s.l1_bank),
+            icache: f(s.icache),
             atomic: f(s.atomic),
             idle_at_end: f(s.idle),
         }
@@ -53,6 +56,7 @@ impl StallShares {
             + self.fu_busy
             + self.fpinv
             + self.l1_bank
+            + self.icache
             + self.atomic
     }
 }

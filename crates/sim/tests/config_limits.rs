@@ -77,10 +77,16 @@ fn both_ends_of_every_range_are_accepted_and_one_past_them_refused() {
                 format!("[{section}]\n{name} = {v}")
             }
         };
-        // Cache sizes and line counts are tied to each other: keep the ends where they fit.
+        // Cache sizes and line counts are tied to each other, and the refresh interval to
+        // t_RFC: keep the ends where they fit.
         let tied = matches!(
             r.key,
-            "l1.size_bytes" | "l2.size_bytes" | "l1.associativity" | "l2.associativity"
+            "l1.size_bytes"
+                | "l2.size_bytes"
+                | "l1.associativity"
+                | "l2.associativity"
+                | "dram.t_rfc"
+                | "dram.t_refi"
         );
         for v in [r.min as u64, r.max as u64] {
             if !tied {
@@ -96,6 +102,11 @@ fn both_ends_of_every_range_are_accepted_and_one_past_them_refused() {
     SimConfig::from_toml("[l1]\nsize_bytes = 1073741824\n[l2]\nsize_bytes = 1073741824").unwrap();
     SimConfig::from_toml("[l1]\nsize_bytes = 64\n[l2]\nsize_bytes = 64").unwrap();
     SimConfig::from_toml("[l1]\nassociativity = 64\n[l2]\nassociativity = 64").unwrap();
+    SimConfig::from_toml("[dram]\nt_rfc = 65536\nt_refi = 16777216").unwrap();
+    SimConfig::from_toml("[dram]\nt_rfc = 0\nt_refi = 0").unwrap();
+    SimConfig::from_toml("[dram]\nt_rfc = 0\nt_refi = 1").unwrap();
+    // A refresh interval no longer than t_RFC would leave no tick to activate in.
+    refused("[dram]\nt_rfc = 220\nt_refi = 220", "`dram.t_refi`");
 }
 
 /// A 50-triangle soup in front of the camera.

@@ -6,7 +6,7 @@
 //! * [`chip`]: the units of the whole chip and the handle a thread drives them through;
 //! * [`tm`]: a thread multiprocessor: [`l1`] (L1 data cache controller), [`pipe`] (ray-box,
 //!   ray-triangle and dual-split pipelines), the reciprocal unit, [`fu`] (functional-unit
-//!   pools and classes);
+//!   pools and classes), [`icache`] (instruction-cache fetch slots);
 //! * [`atomic`]: the global atomic unit;
 //! * [`memory`]: the L2 and GDDR5 DRAM behind the L1s;
 //! * [`slots`]: the reservation tables the units are made of;
@@ -21,6 +21,7 @@ pub mod counts;
 pub mod cycle;
 pub mod energy;
 pub mod fu;
+pub mod icache;
 pub mod issued;
 pub mod l1;
 pub mod memory;

@@ -13,7 +13,8 @@ pub struct Stalls {
     pub pipeline_busy: u64,
     /// Waiting for the shared reciprocal unit's result or a free slot on it.
     pub fpinv: u64,
-    /// An L1 bank already used this cycle (bank conflict).
+    /// A bank already used this cycle: an L1 bank conflict, or an L2 bank refusing a miss
+    /// (the thread retries until it is accepted).
     pub l1_bank: u64,
     /// Waiting for the global atomic unit (pixel hand-out).
     pub atomic: u64,
@@ -26,4 +27,7 @@ pub struct Stalls {
     /// Compiled kernels: waiting for a free unit of a shared pool or the reciprocal unit.
     #[serde(default)]
     pub fu_busy: u64,
+    /// Compiled kernels: an instruction-cache bank already served its fetches this cycle.
+    #[serde(default)]
+    pub icache: u64,
 }

@@ -20,6 +20,7 @@ use crate::hw::Cycle;
 use crate::hw::addr::WordAddr;
 use crate::hw::counts::UnitStats;
 use crate::hw::fu::Pools;
+use crate::hw::icache::ICaches;
 use crate::hw::issued::Issued;
 use crate::hw::l1::L1;
 use crate::hw::memory::{CacheStats, L2};
@@ -34,6 +35,8 @@ pub struct Tm {
     fpinv_latency: u64,
     /// The shared pools of the compiled kernels' threads.
     pub pools: Pools,
+    /// The instruction caches' fetch slots (compiled kernels).
+    pub icache: ICaches,
     units: UnitStats,
 }
 
@@ -47,6 +50,7 @@ impl Tm {
             fpinv: vec![Slots::default(); cfg.units.fpinv_units as usize],
             fpinv_latency: cfg.units.fpinv_latency,
             pools: Pools::new(&cfg.units),
+            icache: ICaches::new(&cfg.units),
             units: UnitStats::default(),
         }
     }

@@ -268,7 +268,7 @@ fn print_result(r: &SimResult, host: Duration) {
     let tot = (r.cycles as f64 * r.threads as f64).max(1.0);
     let pct = |x: u64| 100.0 * x as f64 / tot;
     println!(
-        "  stalls (% of thread-cycles)  memory {:.1}, pipeline latency {:.1}, pipeline busy {:.1}, dependency {:.1}, busy unit {:.1}, fpinv {:.1}, L1 bank {:.1}, atomic {:.1}, idle at end {:.1}",
+        "  stalls (% of thread-cycles)  memory {:.1}, pipeline latency {:.1}, pipeline busy {:.1}, dependency {:.1}, busy unit {:.1}, fpinv {:.1}, L1/L2 bank {:.1}, icache {:.1}, atomic {:.1}, idle at end {:.1}",
         pct(s.memory),
         pct(s.pipeline_latency),
         pct(s.pipeline_busy),
@@ -276,6 +276,7 @@ fn print_result(r: &SimResult, host: Duration) {
         pct(s.fu_busy),
         pct(s.fpinv),
         pct(s.l1_bank),
+        pct(s.icache),
         pct(s.atomic),
         pct(s.idle)
     );

@@ -112,6 +112,7 @@ pub(crate) fn run<S: TraversalSet>(
                 Tp::new(
                     &prog,
                     (i / cfg.tps_per_tm) as usize,
+                    ((i % cfg.tps_per_tm) % cfg.units.icaches) as usize,
                     cfg.units.local_store_bytes,
                 )
             })

@@ -75,6 +75,8 @@ struct Waiting {
 pub struct Tp {
     hart: Hart,
     tm: u32,
+    /// The instruction cache it fetches from.
+    icache: u32,
     /// The cycle of its next issue slot.
     t: Cycle,
     /// Scoreboard: the cycle each register's pending result arrives (`x0..x31`,
@@ -93,11 +95,13 @@ pub struct Tp {
 }
 
 impl Tp {
-    /// A TP on TM `tm` about to run `prog` from its entry point.
-    pub fn new(prog: &Program, tm: usize, local_store_bytes: u32) -> Self {
+    /// A TP on TM `tm`, fetching from that TM's instruction cache `icache`, about to run
+    /// `prog` from its entry point.
+    pub fn new(prog: &Program, tm: usize, icache: usize, local_store_bytes: u32) -> Self {
         Self {
             hart: Hart::new(prog, local_store_bytes),
             tm: tm as u32,
+            icache: icache as u32,
             t: Cycle::ZERO,
             ready: [Cycle::ZERO; 64],
             producer: [Producer::Unit; 64],
@@ -155,6 +159,9 @@ impl Tp {
                     .expect_err("fetch outside the text"));
             };
             let info = ins.info;
+            // The instruction is fetched when the previous one has issued (SimTRaX holds a
+            // fetched instruction until it issues).
+            let fetch_from = self.t;
             // Operands.
             let (mut at, mut why) = (self.t, Producer::Unit);
             for r in info.src {
@@ -192,6 +199,12 @@ impl Tp {
                 }
                 self.t = at;
             }
+            let pc = self.hart.pc;
+            let fetched = tm.icache.peek(self.icache as usize, pc, fetch_from);
+            if fetched > self.t {
+                stalls.icache += fetched - self.t;
+                self.t = fetched;
+            }
             let shared = match info.fu {
                 // A load or store is the L1's unless it addresses the local store.
                 FuClass::Load | FuClass::Store => {
@@ -203,6 +216,7 @@ impl Tp {
             if (shared && self.t > now) || self.t > now + LOOKAHEAD {
                 return Ok(Wake::At(self.t));
             }
+            tm.icache.take(self.icache as usize, pc, fetched);
             let r = self.hart.step(prog, mem)?;
             // The executed class (a load or store whose address is the local store's).
             let info = r.info;
@@ -393,7 +407,7 @@ mod tests {
         let placement =
             crate::model::rv32::placement::Placement::new(0, 4 * w.len() as u64, 64, 64);
         let mut threads = Compiled {
-            tps: (0..threads).map(|_| Tp::new(&prog, 0, 4096)).collect(),
+            tps: (0..threads).map(|_| Tp::new(&prog, 0, 0, 4096)).collect(),
             prog: &prog,
             mem: &mut mem,
             placement: &placement,

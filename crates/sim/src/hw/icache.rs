@@ -1,0 +1,199 @@
+//! A TM's instruction caches as SimTRaX's issue unit has them (`sim/IssueUnit.cc:790-847`):
+//! `units.icaches` caches per TM (the paper's §4: two), thread `i` of the TM fetching from
+//! cache `i mod icaches`; each cache has `units.icache_banks` banks, the bank of an
+//! instruction is its index (pc / 4) mod the bank count, and a bank serves at most
+//! `units.icache_fetches` fetches per cycle (`fetch_per_cycle = 2`, `sim/IssueUnit.h:148`).
+//! A thread whose bank is full retries its fetch the next cycle. Every fetch hits (SimTRaX
+//! reads the decoded program; there are no misses). `icache_fetches = 0` removes the limit.
+
+use crate::config::UnitConfig;
+use crate::hw::Cycle;
+
+/// Cycles of fetch counts a bank remembers: twice the `rv32` model's run-ahead
+/// (`tp::LOOKAHEAD`, 256 cycles), so the fetches of threads running ahead and of threads at
+/// the event clock share one count per cycle.
+const HISTORY: u64 = 1024;
+
+/// One bank's fetches per cycle over a sliding window of [`HISTORY`] cycles
+/// (`[base, base + HISTORY)`, a ring). A cycle before the window is not counted: no thread
+/// fetches that far behind another's run-ahead.
+#[derive(Clone, Debug)]
+struct Bank {
+    base: u64,
+    counts: Box<[u8; HISTORY as usize]>,
+}
+
+impl Bank {
+    fn new() -> Self {
+        Self {
+            base: 0,
+            counts: Box::new([0; HISTORY as usize]),
+        }
+    }
+
+    #[inline]
+    fn count(&self, c: u64) -> u8 {
+        if c < self.base || c >= self.base + HISTORY {
+            0
+        } else {
+            self.counts[(c % HISTORY) as usize]
+        }
+    }
+
+    /// The first cycle at or after `c` with fewer than `limit` fetches.
+    #[inline]
+    fn first_free(&self, c: u64, limit: u8) -> u64 {
+        let mut s = c;
+        while self.count(s) >= limit {
+            s += 1;
+        }
+        s
+    }
+
+    /// Counts a fetch in cycle `s`, sliding the window forward when `s` lies past it.
+    fn take(&mut self, s: u64) {
+        if s < self.base {
+            return;
+        }
+        if s >= self.base + HISTORY {
+            let base = s + 1 - HISTORY / 2;
+            let fresh = base.max(self.base + HISTORY);
+            // The cycles [fresh, base + HISTORY) reuse ring entries of forgotten cycles.
+            if base + HISTORY - fresh >= HISTORY {
+                self.counts.fill(0);
+            } else {
+                for x in fresh..base + HISTORY {
+                    self.counts[(x % HISTORY) as usize] = 0;
+                }
+            }
+            self.base = base;
+        }
+        self.counts[(s % HISTORY) as usize] += 1;
+    }
+}
+
+/// The fetch counts of one TM's instruction caches.
+#[derive(Clone, Debug)]
+pub struct ICaches {
+    /// Banks of cache 0 first.
+    banks: Vec<Bank>,
+    caches: usize,
+    bank_mask: u32,
+    /// Fetches per bank per cycle; 0 = no limit.
+    limit: u8,
+}
+
+impl ICaches {
+    /// Idle caches as `units` configures them.
+    pub fn new(units: &UnitConfig) -> Self {
+        let limit = units.icache_fetches.min(u8::MAX as u32) as u8;
+        let n = if limit == 0 {
+            0
+        } else {
+            (units.icaches * units.icache_banks) as usize
+        };
+        Self {
+            banks: (0..n).map(|_| Bank::new()).collect(),
+            caches: units.icaches as usize,
+            bank_mask: units.icache_banks - 1,
+            limit,
+        }
+    }
+
+    /// The cache thread `thread` of its TM fetches from.
+    pub fn cache_of(&self, thread: usize) -> usize {
+        thread % self.caches
+    }
+
+    /// The bank of cache `cache` holding the instruction at byte address `pc`.
+    #[inline]
+    fn bank(&self, cache: usize, pc: u32) -> usize {
+        cache * (self.bank_mask as usize + 1) + ((pc >> 2) & self.bank_mask) as usize
+    }
+
+    /// The first cycle at or after `c` at which cache `cache` could fetch the instruction at
+    /// `pc`, without taking it.
+    #[inline]
+    pub fn peek(&self, cache: usize, pc: u32, c: Cycle) -> Cycle {
+        if self.limit == 0 {
+            return c;
+        }
+        Cycle(self.banks[self.bank(cache, pc)].first_free(c.get(), self.limit))
+    }
+
+    /// Fetches the instruction at `pc` from cache `cache` in cycle `s`, which [`Self::peek`]
+    /// returned (nothing was fetched from the bank since).
+    #[inline]
+    pub fn take(&mut self, cache: usize, pc: u32, s: Cycle) {
+        if self.limit != 0 {
+            let b = self.bank(cache, pc);
+            debug_assert!(self.banks[b].count(s.get()) < self.limit);
+            self.banks[b].take(s.get());
+        }
+    }
+
+    /// Fetches the instruction at `pc` from cache `cache` in the first cycle at or after `c`
+    /// its bank has a fetch left, and returns that cycle.
+    #[inline]
+    pub fn fetch(&mut self, cache: usize, pc: u32, c: Cycle) -> Cycle {
+        if self.limit == 0 {
+            return c;
+        }
+        let (b, limit) = (self.bank(cache, pc), self.limit);
+        let bank = &mut self.banks[b];
+        let s = bank.first_free(c.get(), limit);
+        bank.take(s);
+        Cycle(s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::SimConfig;
+
+    #[test]
+    fn a_bank_serves_two_fetches_a_cycle() {
+        let mut ic = ICaches::new(&SimConfig::lin2020().units);
+        let c = Cycle;
+        // Three threads of cache 0 fetching pc 0 (bank 0) in cycle 5: the third waits.
+        assert_eq!(ic.fetch(0, 0, c(5)), c(5));
+        assert_eq!(ic.peek(0, 0, c(5)), c(5));
+        assert_eq!(ic.fetch(0, 0, c(5)), c(5));
+        assert_eq!(ic.peek(0, 0, c(5)), c(6));
+        assert_eq!(ic.fetch(0, 0, c(5)), c(6));
+        // Another bank (pc 4), the same bank of the other cache, and pc 64 (bank 0 again,
+        // 16 banks) of cache 0.
+        assert_eq!(ic.fetch(0, 4, c(5)), c(5));
+        assert_eq!(ic.fetch(1, 0, c(5)), c(5));
+        assert_eq!(ic.fetch(0, 64, c(5)), c(6));
+        assert_eq!((ic.cache_of(0), ic.cache_of(1), ic.cache_of(2)), (0, 1, 0));
+    }
+
+    #[test]
+    fn counts_survive_run_ahead_and_slide() {
+        let mut ic = ICaches::new(&SimConfig::lin2020().units);
+        let c = Cycle;
+        // A thread 300 cycles ahead, then two at the clock: all three counted.
+        assert_eq!(ic.fetch(0, 0, c(1300)), c(1300));
+        assert_eq!(ic.fetch(0, 0, c(1000)), c(1000));
+        assert_eq!(ic.fetch(0, 0, c(1000)), c(1000));
+        assert_eq!(ic.fetch(0, 0, c(1000)), c(1001));
+        assert_eq!(ic.fetch(0, 0, c(1300)), c(1300));
+        assert_eq!(ic.fetch(0, 0, c(1300)), c(1301));
+        // Far ahead: the window slides and the old counts are forgotten, not reused.
+        assert_eq!(ic.fetch(0, 0, c(1000 + 5 * HISTORY)), c(1000 + 5 * HISTORY));
+        assert_eq!(ic.peek(0, 0, c(1001 + 5 * HISTORY)), c(1001 + 5 * HISTORY));
+        assert_eq!(ic.peek(0, 0, c(1000 + 5 * HISTORY)), c(1000 + 5 * HISTORY));
+    }
+
+    #[test]
+    fn no_limit_when_fetches_are_zero() {
+        let mut units = SimConfig::lin2020().units;
+        units.icache_fetches = 0;
+        let mut ic = ICaches::new(&units);
+        for _ in 0..10 {
+            assert_eq!(ic.fetch(0, 0, Cycle(3)), Cycle(3));
+        }
+    }
+}
