@@ -280,11 +280,7 @@ impl Refresh {
     /// How many refreshes have started by tick `t`.
     #[inline]
     fn count(self, t: Tick) -> u64 {
-        if self.refi == 0 {
-            0
-        } else {
-            t.get() / self.refi
-        }
+        t.get().checked_div(self.refi).unwrap_or(0)
     }
 
     /// The first tick at or after `t` outside every refresh window.
