@@ -10,6 +10,8 @@
 //!             fsynced and renamed, so a half-written file is never read as a result
 //!   page.rs   the assembled study: table, missing entries, results.json / results.csv
 //!   sweep.rs  one chart per swept key: frame time, energy, DRAM lines against its value
+//!   variants.rs  one row per combination of swept values: DST ÷ BVH2, the order of the
+//!             configurations, BVH2's memory stalls and bandwidth (variants.md)
 //! ```
 //!
 //! Nothing here schedules anything: `run-job DIR INDEX` is the unit a scheduler (Slurm job
@@ -20,6 +22,7 @@ pub mod page;
 pub mod plan;
 pub mod store;
 pub mod sweep;
+pub mod variants;
 pub mod vary;
 
 pub use plan::{Plan, PlanEntry, PlanOptions};

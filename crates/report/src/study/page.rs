@@ -13,7 +13,7 @@ use crate::html::esc;
 use crate::paper::Metric;
 use crate::tables::metric;
 use dualsplit_render::Workload;
-use dualsplit_sim::{SimAccel, ThreadModel};
+use dualsplit_sim::{SimAccel, StallShares, ThreadModel};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -45,6 +45,18 @@ pub struct StudyRow {
     pub dram_lines: u64,
     /// Rays traced.
     pub rays: u64,
+    /// Share of thread-cycles spent waiting for memory.
+    #[serde(default)]
+    pub memory_stall_share: f64,
+    /// Achieved DRAM read bandwidth, GB/s.
+    #[serde(default)]
+    pub dram_gbps: f64,
+    /// DRAM lines per pixel.
+    #[serde(default)]
+    pub lines_per_pixel: f64,
+    /// Rays per pixel.
+    #[serde(default)]
+    pub rays_per_pixel: f64,
 }
 
 /// Where and when a result was computed (host facts: on the page, not in `results.json`).
@@ -122,6 +134,10 @@ pub fn assemble(dir: &Path) -> Result<StudyData, StudyError> {
                     energy_j: metric(&r.result, Metric::EnergyJ),
                     dram_lines: r.result.dram_lines,
                     rays: r.result.rays,
+                    memory_stall_share: StallShares::of(&r.result).memory,
+                    dram_gbps: r.result.memory.dram_gbps,
+                    lines_per_pixel: r.result.memory.lines_per_pixel,
+                    rays_per_pixel: r.result.memory.rays_per_pixel,
                 });
                 data.provenance.push(Provenance {
                     index: e.index,
@@ -233,6 +249,11 @@ pub fn write_study(data: &StudyData, out: &Path) -> Result<Vec<PathBuf>, StudyEr
         &out.join("results.csv"),
         results_csv(data).as_bytes(),
     )?);
+    let vs = super::variants::variants(data);
+    files.push(write(
+        &out.join("variants.md"),
+        super::variants::markdown(&vs).as_bytes(),
+    )?);
     let charts = sweep::charts(data)?;
     for (i, c) in charts.iter().enumerate() {
         files.push(write(
@@ -287,6 +308,24 @@ fn page_html(data: &StudyData, charts: &[sweep::SweepChart]) -> String {
     for c in charts {
         let _ = writeln!(h, "<h2>{}</h2>\n{}", esc(&c.title), c.svg);
     }
+    h.push_str("<h2>Variants</h2>\n<table><tr><th>scene</th><th>workload</th><th>TMs</th><th>variant</th><th>DST % of BVH2</th><th>order, fastest first (% of BVH2)</th><th>BVH2 memory stalls</th><th>BVH2 GB/s</th><th>BVH2 lines/px</th><th>rays/px</th></tr>\n");
+    for v in super::variants::variants(data) {
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1} %</td><td>{:.0}</td><td>{:.2}</td><td>{:.2}</td></tr>",
+            esc(&v.scene),
+            v.workload,
+            v.tms,
+            esc(&v.varied),
+            v.dst_text(),
+            esc(&v.order_text()),
+            100.0 * v.base.memory_stall_share,
+            v.base.dram_gbps,
+            v.base.lines_per_pixel,
+            v.base.rays_per_pixel
+        );
+    }
+    h.push_str("</table>\n");
     h.push_str("<h2>Results</h2>\n<table><tr><th>#</th><th>scene</th><th>configuration</th><th>workload</th><th>TMs</th><th>swept</th><th>frame (ms)</th><th>energy (J)</th><th>DRAM lines</th><th>host</th></tr>\n");
     for (r, p) in data.rows.iter().zip(&data.provenance) {
         let _ = writeln!(
