@@ -57,6 +57,42 @@ fn dragon_box_rebuilt_from_the_shipped_dragon_is_the_shipped_dragon_box() {
 }
 
 #[test]
+fn the_closed_dragon_box_adds_ten_triangles_to_the_open_one() {
+    let Some(dragon) = shipped_path("dragon_res4.ply.gz") else {
+        return;
+    };
+    let dragon = dragon.to_str().unwrap().to_string();
+    let dir = tempfile::tempdir().unwrap();
+    let (open, closed) = (
+        dir.path().join("dragon_box.ply.gz"),
+        dir.path().join("dragon_box_closed.ply.gz"),
+    );
+    for (out, extra) in [(&open, &[][..]), (&closed, &["--closed"][..])] {
+        let mut args = vec![
+            "-q",
+            "scene",
+            "dragon-box",
+            &dragon,
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = dualsplit(&args, dir.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let open = dualsplit_scene::load(open.to_str().unwrap()).unwrap();
+    let closed = dualsplit_scene::load(closed.to_str().unwrap()).unwrap();
+    assert_eq!(closed.triangles.len(), open.triangles.len() + 10);
+    assert_eq!(
+        bits(&closed.triangles[..open.triangles.len()]),
+        bits(&open.triangles)
+    );
+    // The closed file's stem gets the open box's camera.
+    assert_eq!(closed.camera.eye, open.camera.eye);
+    assert_eq!(closed.camera.target, open.camera.target);
+}
+
+#[test]
 fn dragon_box_input_errors_exit_nonzero_with_the_reason() {
     let dir = tempfile::tempdir().unwrap();
     let o = dualsplit(

@@ -99,6 +99,20 @@ fn check_range(what: &'static str, value: f32, min: f32, max: f32) -> Result<f32
     }
 }
 
+/// The closed Dragon Box (`dragon_box_closed`, [`crate::make::closed_dragon_box`]) is seen
+/// and lit exactly as the open one: its presets are the open box's, placed in the open box's
+/// bounds, which are the closed box's cut back to a cube (the open box is a cube; the
+/// closed one only extends it along +z).
+fn open_box_view<'a>(stem: &'a str, b: &Aabb) -> (&'a str, Aabb) {
+    if stem == "dragon_box_closed" {
+        let mut open = *b;
+        open.max.z = open.min.z + b.extent().y;
+        ("dragon_box", open)
+    } else {
+        (stem, *b)
+    }
+}
+
 /// A view relative to the bounds: looks at `target` (fractions of the box, 0 = min, 1 = max)
 /// from `eye` (same fractions), or, when `eye` is `None`, from direction `dir` at the distance
 /// that fits the box's bounding sphere scaled by `zoom`.
@@ -214,7 +228,8 @@ impl Camera {
     /// …; see `docs/scenes.md`), placed relative to `bounds`; [`Camera::fit`] for any other
     /// stem.
     pub fn preset_for(stem: &str, bounds: &Aabb) -> Self {
-        preset_view(stem).map_or_else(|| Self::fit(bounds), |v| v.camera(bounds))
+        let (stem, bounds) = open_box_view(stem, bounds);
+        preset_view(stem).map_or_else(|| Self::fit(&bounds), |v| v.camera(&bounds))
     }
 
     /// True when `stem` has a preset view.
@@ -268,6 +283,8 @@ impl Light {
     /// The preset light of a shipped scene file by its stem, relative to `bounds`;
     /// [`Light::fit`] for any other stem.
     pub fn preset_for(stem: &str, b: &Aabb) -> Self {
+        let (stem, b) = open_box_view(stem, b);
+        let b = &b;
         let at = |f: [f32; 3]| b.min + b.extent() * Vec3::from_array(f);
         let r = (b.extent().length() * 0.5).max(1e-3);
         match stem {

@@ -62,6 +62,47 @@ pub fn open_box(bounds: &Aabb) -> [Triangle; BOX_TRIANGLES] {
     faces.map(|[a, b, d]| Triangle::new(c[a], c[b], c[d]))
 }
 
+/// Triangles [`closed_dragon_box`] adds to the open box: the floor, top and side walls
+/// carried on past the open side, and a front wall behind the camera.
+pub const CLOSING_TRIANGLES: usize = 10;
+
+/// How far behind the preset camera the front wall of the closed box stands, as a fraction
+/// of the box's side.
+pub const CLOSING_WALL_BEHIND_EYE: f64 = 0.1;
+
+/// The Dragon Box closed behind the camera: [`dragon_box`], then [`CLOSING_TRIANGLES`]
+/// that carry the floor, top and side walls on along +z from the open side to a front wall
+/// standing [`CLOSING_WALL_BEHIND_EYE`] × the side behind the preset camera of
+/// `dragon_box`. Saved as `dragon_box_closed`, it is seen and lit as the open box is (its
+/// camera and light presets are the open box's), so rays that leave through the open side
+/// stay in the scene.
+pub fn closed_dragon_box(dragon: &[Triangle]) -> Vec<Triangle> {
+    let mut out = dragon_box(dragon);
+    let open = out[dragon.len()..]
+        .iter()
+        .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+    let eye = crate::Camera::preset_for("dragon_box", &open).eye;
+    let (lo, hi) = (open.min, open.max);
+    let side = f64::from(hi.y - lo.y);
+    let zw = (f64::from(eye.z) + CLOSING_WALL_BEHIND_EYE * side) as f32;
+    let (x0, x1, y0, y1, z1) = (lo.x, hi.x, lo.y, hi.y, hi.z);
+    let p = Vec3::new;
+    let quad =
+        |a: Vec3, b: Vec3, c: Vec3, d: Vec3| [Triangle::new(a, b, c), Triangle::new(a, c, d)];
+    out.extend(
+        [
+            quad(p(x0, y0, z1), p(x0, y0, zw), p(x1, y0, zw), p(x1, y0, z1)), // floor
+            quad(p(x0, y1, z1), p(x1, y1, z1), p(x1, y1, zw), p(x0, y1, zw)), // top
+            quad(p(x0, y0, z1), p(x0, y1, z1), p(x0, y1, zw), p(x0, y0, zw)), // left
+            quad(p(x1, y0, z1), p(x1, y0, zw), p(x1, y1, zw), p(x1, y1, z1)), // right
+            quad(p(x0, y0, zw), p(x0, y1, zw), p(x1, y1, zw), p(x1, y0, zw)), // front
+        ]
+        .into_iter()
+        .flatten(),
+    );
+    out
+}
+
 /// The Dragon Box of `dragon`: its triangles, then [`open_box`] of their bounds.
 pub fn dragon_box(dragon: &[Triangle]) -> Vec<Triangle> {
     let bounds = dragon.iter().fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
@@ -212,5 +253,42 @@ mod tests {
         assert!(text.contains("element face 12\n"), "{text}");
         let header = text.find("end_header\n").unwrap() + "end_header\n".len();
         assert_eq!(bytes.len(), header + 12 * 12 + 12 * 13);
+    }
+}
+
+#[cfg(test)]
+mod closed_box_tests {
+    use super::*;
+    use crate::{Camera, Light};
+
+    #[test]
+    fn the_closed_box_is_seen_and_lit_as_the_open_one_from_inside() {
+        let dragon = vec![
+            Triangle::new(Vec3::ZERO, Vec3::X, Vec3::new(0.0, 2.0, 0.5)),
+            Triangle::new(Vec3::new(0.3, 0.1, -0.4), Vec3::X, Vec3::new(0.7, 1.0, 0.2)),
+        ];
+        let open = dragon_box(&dragon);
+        let closed = closed_dragon_box(&dragon);
+        assert_eq!(closed.len(), open.len() + CLOSING_TRIANGLES);
+        assert_eq!(&closed[..open.len()], &open[..]);
+        let bounds = |t: &[Triangle]| t.iter().fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+        let (ob, cb) = (bounds(&open), bounds(&closed));
+        let (oc, cc) = (
+            Camera::preset_for("dragon_box", &ob),
+            Camera::preset_for("dragon_box_closed", &cb),
+        );
+        assert_eq!(
+            (oc.eye, oc.target, oc.fov_y_deg),
+            (cc.eye, cc.target, cc.fov_y_deg)
+        );
+        let (ol, cl) = (
+            Light::preset_for("dragon_box", &ob),
+            Light::preset_for("dragon_box_closed", &cb),
+        );
+        assert_eq!((ol.position, ol.radius), (cl.position, cl.radius));
+        // The eye is inside the closed box, in front of the open side, behind the front wall.
+        let inside = (cc.eye.cmpgt(cb.min) & cc.eye.cmplt(cb.max)).all();
+        assert!(inside, "{:?} outside {cb:?}", cc.eye);
+        assert!(cc.eye.z > ob.max.z && cc.eye.z < cb.max.z);
     }
 }

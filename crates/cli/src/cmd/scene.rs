@@ -48,6 +48,11 @@ pub struct DragonBoxArgs {
     /// The Dragon Box file to write (gzipped binary PLY).
     #[arg(short, long)]
     output: PathBuf,
+    /// Close the box behind the camera (10 more triangles: the walls carried on past the
+    /// open side to a front wall behind the preset camera). Name the file
+    /// `dragon_box_closed.ply.gz`: that stem gets the open box's camera and light.
+    #[arg(long)]
+    closed: bool,
 }
 
 /// Runs the subcommand.
@@ -56,7 +61,11 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         Command::DragonBox(args) => {
             crate::output::check_file(&args.output, "-o")?;
             let dragon = super::load(&args.dragon, ctx)?;
-            let tris = make::dragon_box(&dragon.triangles);
+            let tris = if args.closed {
+                make::closed_dragon_box(&dragon.triangles)
+            } else {
+                make::dragon_box(&dragon.triangles)
+            };
             let n = dragon.triangles.len();
             let comments = [
                 format!(
@@ -64,18 +73,24 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                     dragon.name,
                     n.saturating_sub(1)
                 ),
-                "plus an open-front (+z) box of 10 triangles appended as the last faces"
-                    .to_string(),
+                if args.closed {
+                    "plus an open-front (+z) box of 10 triangles, then 10 closing it behind the \
+                     camera, appended as the last faces"
+                } else {
+                    "plus an open-front (+z) box of 10 triangles appended as the last faces"
+                }
+                .to_string(),
                 "made by dualsplit scene dragon-box".to_string(),
             ];
             let comments: Vec<&str> = comments.iter().map(String::as_str).collect();
             make::write_ply_gz(&args.output, &tris, &comments)
                 .with_context(|| format!("writing {}", args.output.display()))?;
             println!(
-                "wrote {}: {} triangles ({n} of {}, 10 of the box), triangles sha256 {}",
+                "wrote {}: {} triangles ({n} of {}, {} of the box), triangles sha256 {}",
                 args.output.display(),
                 tris.len(),
                 dragon.spec,
+                tris.len() - n,
                 make::triangles_sha256(&tris)
             );
             Ok(ExitCode::SUCCESS)
