@@ -76,13 +76,21 @@ static inline float rt_box(const void *box, float t_lo, float t_hi)
         mask_;                                                                       \
     })
 
-/* Entry distance of box k of the last rt_boxn (k a constant 0-7). */
+/* Entry distance of box k of the last rt_boxn (k a constant 0-7; rt_boxexit is k = 8). */
 #define rt_boxget(k)                                                                 \
     ({                                                                               \
         float entry_;                                                                \
         __asm__ volatile(".insn r 0x2B, 2, %1, %0, x0, x0" : "=f"(entry_) : "i"(k)); \
         entry_;                                                                      \
     })
+
+/* The exit distance of the last rt_box (its slab interval's far end, hit or miss). */
+static inline float rt_boxexit(void)
+{
+    float r;
+    __asm__ volatile(".insn r 0x2B, 2, 8, %0, x0, x0" : "=f"(r));
+    return r;
+}
 
 /* Watertight test of the triangle at `tri` (v0, v1, v2) on [t_lo, t_hi]: t of the hit, else
  * NaN. */

@@ -30,6 +30,8 @@ pub struct SimConfig {
     pub units: UnitConfig,
     /// Energy per event.
     pub energy: EnergyConfig,
+    /// Which variant of the compiled kernels the `rv32` model runs.
+    pub kernels: KernelsConfig,
 }
 
 /// A cache: size, line, banks, associativity and hit latency.
@@ -229,6 +231,36 @@ pub struct EnergyConfig {
     pub dst_pipe_nj: f64,
 }
 
+/// The variant of the compiled kernels (`kernels/`): the `[kernels]` table.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct KernelsConfig {
+    /// `true`: the traversals as Lin et al. 2020 describe them (§4: "ray-box intersection
+    /// tests are executed serially for each box in a BVH node", empty slots holding
+    /// degenerate boxes, §4.2, then the hits are ordered, §4.4; the DST ray is clipped to
+    /// the scene box by one `rt.box`); `false`: the serial BVH kernels test only the present
+    /// children and the DST kernels clip in software.
+    pub parity: bool,
+}
+
+impl KernelsConfig {
+    /// The variant's index among [`KernelsConfig::ALL`].
+    pub fn index(self) -> usize {
+        self.parity as usize
+    }
+
+    /// Every variant, in the order of [`KernelsConfig::index`].
+    pub const ALL: [KernelsConfig; 2] = [
+        KernelsConfig { parity: false },
+        KernelsConfig { parity: true },
+    ];
+
+    /// The suffix of its kernels' file names (`kernels/Makefile`): `""` or `-parity`.
+    pub fn suffix(self) -> &'static str {
+        ["", "-parity"][self.index()]
+    }
+}
+
 impl Default for SimConfig {
     fn default() -> Self {
         Self::lin2020()
@@ -337,6 +369,7 @@ impl SimConfig {
                 tri_pipe_nj: 0.71,
                 dst_pipe_nj: 0.0610,
             },
+            kernels: KernelsConfig { parity: false },
         }
     }
 
@@ -462,6 +495,7 @@ impl SimConfig {
             ("energy.box_pipe_nj", Real(e.box_pipe_nj)),
             ("energy.tri_pipe_nj", Real(e.tri_pipe_nj)),
             ("energy.dst_pipe_nj", Real(e.dst_pipe_nj)),
+            ("kernels.parity", Flag(self.kernels.parity)),
         ]
     }
 

@@ -1,7 +1,7 @@
 //! One simulated frame: the request and the entry point.
 
 use crate::accel::SimAccel;
-use crate::config::SimConfig;
+use crate::config::{KernelsConfig, SimConfig};
 use crate::error::SimError;
 use crate::footprint;
 use crate::model::{ThreadModel, fast, rv32};
@@ -85,6 +85,11 @@ pub fn simulate<S: TraversalSet>(
         });
     }
     footprint::check(cfg, accel, model, frame.pixels())?;
+    if model == ThreadModel::Fast && cfg.kernels != KernelsConfig::default() {
+        return Err(SimError::FastKernelVariant {
+            variant: format!("parity = {}", cfg.kernels.parity),
+        });
+    }
     match model {
         ThreadModel::Rv32 => rv32::frame::run(frame, progress),
         ThreadModel::Fast => fast::frame::run(frame, progress),

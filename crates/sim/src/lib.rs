@@ -60,7 +60,9 @@ mod shares;
 pub const MODEL_VERSION: u32 = 8;
 
 pub use accel::SimAccel;
-pub use config::{CacheConfig, ConfigError, DramConfig, EnergyConfig, SimConfig, UnitConfig};
+pub use config::{
+    CacheConfig, ConfigError, DramConfig, EnergyConfig, KernelsConfig, SimConfig, UnitConfig,
+};
 pub use error::SimError;
 pub use frame::{FrameRequest, simulate};
 pub use hw::counts::UnitStats;

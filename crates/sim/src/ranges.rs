@@ -172,6 +172,7 @@ pub const RANGES: &[KeyRange] = &[
     real("energy.box_pipe_nj", 0.0, MAX_NJ, "nJ"),
     real("energy.tri_pipe_nj", 0.0, MAX_NJ, "nJ"),
     real("energy.dst_pipe_nj", 0.0, MAX_NJ, "nJ"),
+    flag("kernels.parity"),
 ];
 
 impl KeyRange {

@@ -229,11 +229,11 @@ pub enum Op {
     RtRcp,
     /// `rt.atominc`: `x[rd] = G[x[rs1]]++`.
     RtAtomInc,
-    /// `rt.box`: `f[rd]` = entry distance or NaN.
+    /// `rt.box`: `f[rd]` = entry distance or NaN; the exit distance to `B.exit`.
     RtBox,
     /// `rt.boxn` (`imm` = N = 2, 4, 8): `x[rd]` = hit mask, entries to `B`.
     RtBoxN,
-    /// `rt.boxget` (`imm` = k): `f[rd] = B[k]`.
+    /// `rt.boxget` (`imm` = k): `f[rd] = B[k]` (k = 0–7), `B.exit` (k = 8).
     RtBoxGet,
     /// `rt.tri`: `f[rd]` = `t` or NaN.
     RtTri,
@@ -333,7 +333,7 @@ fn shape(op: Op, imm: i32) -> (K, K, K, K, FuClass, u8) {
         RtSetK => (N, X, N, N, U::IntAlu, Latches::WRITES_RAY),
         RtRcp => (F, F, N, N, U::Rcp, 0),
         RtAtomInc => (X, X, N, N, U::Atomic, 0),
-        RtBox => (F, X, F, F, U::BoxPipe(1), r),
+        RtBox => (F, X, F, F, U::BoxPipe(1), r | Latches::WRITES_BOX),
         RtBoxN => (X, X, F, F, U::BoxPipe(imm as u8), r | Latches::WRITES_BOX),
         RtBoxGet => (F, N, N, N, U::IntAlu, Latches::READS_BOX),
         RtTri => (F, X, F, F, U::TriPipe, r),

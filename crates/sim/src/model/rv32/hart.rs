@@ -163,6 +163,8 @@ pub struct Hart {
     pub ray: RayPre,
     /// The box latch `B`.
     pub box_latch: [f32; 8],
+    /// The exit distance of the last `rt.box` (`B.exit`, read by `rt.boxget 8`).
+    pub box_exit: f32,
     /// The DST latch `D`.
     pub dst_latch: DstLatch,
     /// The TP's private local store, at [`LOCAL_STORE_ADDR`].
@@ -289,6 +291,7 @@ impl Hart {
             pc: prog.entry,
             ray: initial_ray(),
             box_latch: [0.0; 8],
+            box_exit: 0.0,
             dst_latch: DstLatch::default(),
             local: vec![0; local_store_bytes as usize].into_boxed_slice(),
             halted: false,
@@ -310,6 +313,7 @@ impl Hart {
         self.pc = prog.entry;
         self.ray = initial_ray();
         self.box_latch = [0.0; 8];
+        self.box_exit = 0.0;
         self.dst_latch = DstLatch::default();
         self.halted = false;
     }
@@ -448,7 +452,7 @@ impl Hart {
     /// The box test of `rt.box`/`rt.boxn` on the six words `b` (min xyz, max xyz): the
     /// entry distance on a hit, else the canonical NaN.
     #[inline(always)]
-    fn box_test(&self, b: &[u32], t_lo: f32, t_hi: f32) -> (bool, u32) {
+    fn box_test(&self, b: &[u32], t_lo: f32, t_hi: f32) -> (bool, u32, f32) {
         let v = |k: usize| f32::from_bits(b[k]);
         let (entry, exit) = self.ray.slab(
             Vec3::new(v(0), v(1), v(2)),
@@ -457,9 +461,9 @@ impl Hart {
             t_hi,
         );
         if entry <= exit {
-            (true, entry.to_bits())
+            (true, entry.to_bits(), exit)
         } else {
-            (false, CANONICAL_NAN)
+            (false, CANONICAL_NAN, exit)
         }
     }
 
@@ -705,7 +709,9 @@ impl Hart {
             RtBox => {
                 let mut w = [0u32; 6];
                 self.operand_words(prog, mem, a!(), &mut w, &mut acc)?;
-                wf!(self.box_test(&w, fb!(), fc!()).1);
+                let (_, entry, exit) = self.box_test(&w, fb!(), fc!());
+                self.box_exit = exit;
+                wf!(entry);
             }
             RtBoxN => {
                 let n = imm as usize;
@@ -713,13 +719,17 @@ impl Hart {
                 self.operand_words(prog, mem, a!(), &mut w[..6 * n], &mut acc)?;
                 let mut mask = 0;
                 for k in 0..n {
-                    let (hit, entry) = self.box_test(&w[6 * k..6 * k + 6], fb!(), fc!());
+                    let (hit, entry, _) = self.box_test(&w[6 * k..6 * k + 6], fb!(), fc!());
                     mask |= (hit as u32) << k;
                     self.box_latch[k] = f32::from_bits(entry);
                 }
                 wx!(mask);
             }
-            RtBoxGet => wf!(self.box_latch[imm as usize & 7].to_bits()),
+            RtBoxGet => wf!(match imm {
+                0..=7 => self.box_latch[imm as usize],
+                _ => self.box_exit,
+            }
+            .to_bits()),
             RtTri => {
                 let mut w = [0u32; 9];
                 self.operand_words(prog, mem, a!(), &mut w, &mut acc)?;

@@ -153,7 +153,7 @@ pub const RT_INSTRUCTIONS: [RtEncoding; 12] = [
         Op::RtBoxGet,
         OPCODE_CUSTOM1,
         2,
-        Format::R { funct7_max: 7 },
+        Format::R { funct7_max: 8 },
         GET,
         Imm::Field,
     ),

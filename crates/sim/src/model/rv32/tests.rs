@@ -551,7 +551,7 @@ fn decode_errors_and_rounding_modes() {
     assert!(decode(i(0x13, 1, 1, 1, 0x420)).is_err());
     // Custom instructions with bad function fields.
     assert!(decode(r4(0x2B, 1, 3, 1, 2, 3, 4)).is_err()); // boxn N = 16
-    assert!(decode(r(0x2B, 2, 8, 1, 0, 0)).is_err()); // boxget k = 8
+    assert!(decode(r(0x2B, 2, 9, 1, 0, 0)).is_err()); // boxget k = 9
     assert!(decode(r(0x2B, 5, 3, 1, 0, 0)).is_err()); // dstget field 3
     assert!(decode(r(0x0B, 6, 0, 1, 0, 0)).is_err());
     // CSRs read 0; writing frm = RNE is fine, another mode is an error.
@@ -733,7 +733,7 @@ mod custom {
             )
     }
 
-    /// The program: set R, rt.box, rt.boxn, 8 × rt.boxget, rt.tri, rt.dst, 3 × rt.dstget,
+    /// The program: set R, rt.box, rt.boxn, 8 × rt.boxget, rt.boxget 8 (B.exit), rt.tri, rt.dst, 3 × rt.dstget,
     /// rt.rcp, 2 × rt.atominc.
     fn program(f2: u32) -> Program {
         let mut w = vec![
@@ -746,6 +746,7 @@ mod custom {
         ];
         w.extend((0..8).map(|k| r(0x2B, 2, k, 20 + k, 0, 0))); // f20+k = B[k]
         w.extend([
+            r(0x2B, 2, 8, 19, 0, 0),       // f19 = B.exit (rt.box's, not rt.boxn's)
             r4(0x2B, 3, 0, 14, 8, 11, 12), // f14 = rt.tri (x8), f11, f12
             r4(0x2B, 4, 0, 9, 10, 28, 29), // x9 = rt.dst (x10), f28, f29
             r(0x2B, 5, 0, 15, 0, 0),       // f15 = D.t_min_out
@@ -825,6 +826,8 @@ mod custom {
             }
         };
         prop_assert_eq!(h.f[10], slab(c.boxes[0]).1);
+        let exit = pre.slab(c.boxes[0].0, c.boxes[0].1, c.t_lo, c.t_hi).1;
+        prop_assert_eq!(h.f[19], exit.to_bits());
         let mut mask = 0;
         for k in 0..n {
             let (hit, entry) = slab(c.boxes[k]);
@@ -874,10 +877,10 @@ mod custom {
         prop_assert_eq!(retired[4].fu(), FuClass::BoxPipe(1));
         prop_assert_eq!(retired[5].mem, acc(0, 6 * n as u8, false));
         prop_assert_eq!(retired[5].fu(), FuClass::BoxPipe(n as u8));
-        prop_assert_eq!(retired[14].mem, acc(TRI_ADDR, 9, false));
-        prop_assert_eq!(retired[14].fu(), FuClass::TriPipe);
-        prop_assert_eq!(retired[15].mem, acc(LOCAL_STORE_ADDR, 3, true));
-        prop_assert_eq!(retired[15].fu(), FuClass::DstPipe);
+        prop_assert_eq!(retired[15].mem, acc(TRI_ADDR, 9, false));
+        prop_assert_eq!(retired[15].fu(), FuClass::TriPipe);
+        prop_assert_eq!(retired[16].mem, acc(LOCAL_STORE_ADDR, 3, true));
+        prop_assert_eq!(retired[16].fu(), FuClass::DstPipe);
         Ok(())
     }
 
