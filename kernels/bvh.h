@@ -114,7 +114,7 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
             for (const uint32_t *idx = WORD_ADDR(run);; idx++) {
                 uint32_t entry = *idx;
                 uint32_t prim = entry & ~LAST_IN_RUN;
-                float t = rt_tri(triangle(prim), t_min, best_t);
+                float t = RT_TRI(triangle(prim), t_min, best_t);
                 if (t == t && (!have || !closer_than(best, t, prim))) {
                     best->t = t;
                     best->prim = prim;
@@ -137,12 +137,12 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
         int base = sp;
         uint32_t addr = node_offset(node);
 #if BVH_WIDE_BOX
-        uint32_t mask = rt_boxn(BVH_ARITY, node->box, t_min, limit);
+        uint32_t mask = RT_BOXN(BVH_ARITY, node->box, t_min, limit);
 #endif
 #if BVH_WIDE_BOX
 #define BOX_ENTRY(k) ((mask >> (k)) & 1u ? rt_boxget(k) : __builtin_nanf(""))
 #else
-#define BOX_ENTRY(k) rt_box(&node->box[k], t_min, limit)
+#define BOX_ENTRY(k) RT_BOX(&node->box[k], t_min, limit)
 #endif
 #if KERNEL_PARITY
 /* Every slot's box is tested, empty slots included (Lin et al. 2020, §4: a BVH node's boxes

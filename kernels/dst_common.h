@@ -47,7 +47,7 @@ static inline int dst_clip(const struct Ray *ray, const struct RayPre *r, float 
         return 0;
 #if KERNEL_PARITY
     (void)r;
-    float entry = rt_box(P->scene_min, ray->t_min, cull_limit(ray->t_max));
+    float entry = RT_BOX(P->scene_min, ray->t_min, cull_limit(ray->t_max));
     if (entry != entry)
         return 0;
     *t_min = entry;
@@ -67,7 +67,7 @@ static inline int test_run(uint32_t first, float t_lo, int any, int *have, struc
     for (const uint32_t *idx = WORD_ADDR(PARAMS->indices_start + first);; idx++) {
         uint32_t entry = *idx;
         uint32_t prim = entry & ~LAST_IN_RUN;
-        float t = rt_tri(triangle(prim), t_lo, *best_t);
+        float t = RT_TRI(triangle(prim), t_lo, *best_t);
         if (t == t) {
             if (any) {
                 best->t = t;

@@ -3,7 +3,7 @@
 //! Every configuration is registered once, in the `sim_accels!` invocation below: its
 //! variant, command-line name, the paper's label, the traversal it runs, its ray-box pipes
 //! for the "+" configurations, its chart colour, and its compiled kernels, one per workload
-//! and variant (`kernels/build/<name>-{cast,path}{,-parity}.elf`, which `kernels/Makefile`'s
+//! and variant (`kernels/build/<name>-{cast,path}{,-parity,-loads,-parity-loads}.elf`, which `kernels/Makefile`'s
 //! `CONFIGS` builds; a test checks the two lists agree). The CLI, the simulator, the kernel table, the
 //! calibration and the charts read it from here (`docs/extending.md`).
 
@@ -53,8 +53,18 @@ macro_rules! sim_accels {
                 parallel: $par,
                 color: $rgb,
                 kernels: [
-                    [kernel!(concat!($name, "-cast.elf")), kernel!(concat!($name, "-cast-parity.elf"))],
-                    [kernel!(concat!($name, "-path.elf")), kernel!(concat!($name, "-path-parity.elf"))],
+                    [
+                        kernel!(concat!($name, "-cast.elf")),
+                        kernel!(concat!($name, "-cast-parity.elf")),
+                        kernel!(concat!($name, "-cast-loads.elf")),
+                        kernel!(concat!($name, "-cast-parity-loads.elf")),
+                    ],
+                    [
+                        kernel!(concat!($name, "-path.elf")),
+                        kernel!(concat!($name, "-path-parity.elf")),
+                        kernel!(concat!($name, "-path-loads.elf")),
+                        kernel!(concat!($name, "-path-parity-loads.elf")),
+                    ],
                 ],
             },
         )*];

@@ -241,23 +241,64 @@ pub struct KernelsConfig {
     /// the scene box by one `rt.box`); `false`: the serial BVH kernels test only the present
     /// children and the DST kernels clip in software.
     pub parity: bool,
+    /// How the ray-tracing instructions get their node words.
+    pub node_fetch: NodeFetch,
+}
+
+/// How the kernels hand node words to the ray-box, ray-triangle and dual-split pipelines
+/// (`docs/isa.md`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum NodeFetch {
+    /// `rt.box`, `rt.boxn`, `rt.tri`, `rt.dst` read their words through a memory operand,
+    /// all in one issue.
+    #[default]
+    Operand,
+    /// One `rt.ldp` per word into the pipeline input registers, then the register form:
+    /// SimTRaX's `LOADPIPEGLB` form (`sim/Instruction.h`, lines 110–111).
+    Loads,
+}
+
+impl NodeFetch {
+    /// Its TOML spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            NodeFetch::Operand => "operand",
+            NodeFetch::Loads => "loads",
+        }
+    }
 }
 
 impl KernelsConfig {
     /// The variant's index among [`KernelsConfig::ALL`].
     pub fn index(self) -> usize {
-        self.parity as usize
+        self.parity as usize | ((self.node_fetch == NodeFetch::Loads) as usize) << 1
     }
 
     /// Every variant, in the order of [`KernelsConfig::index`].
-    pub const ALL: [KernelsConfig; 2] = [
-        KernelsConfig { parity: false },
-        KernelsConfig { parity: true },
+    pub const ALL: [KernelsConfig; 4] = [
+        KernelsConfig {
+            parity: false,
+            node_fetch: NodeFetch::Operand,
+        },
+        KernelsConfig {
+            parity: true,
+            node_fetch: NodeFetch::Operand,
+        },
+        KernelsConfig {
+            parity: false,
+            node_fetch: NodeFetch::Loads,
+        },
+        KernelsConfig {
+            parity: true,
+            node_fetch: NodeFetch::Loads,
+        },
     ];
 
-    /// The suffix of its kernels' file names (`kernels/Makefile`): `""` or `-parity`.
+    /// The suffix of its kernels' file names (`kernels/Makefile`): `""`, `-parity`,
+    /// `-loads` or `-parity-loads`.
     pub fn suffix(self) -> &'static str {
-        ["", "-parity"][self.index()]
+        ["", "-parity", "-loads", "-parity-loads"][self.index()]
     }
 }
 
@@ -369,7 +410,10 @@ impl SimConfig {
                 tri_pipe_nj: 0.71,
                 dst_pipe_nj: 0.0610,
             },
-            kernels: KernelsConfig { parity: false },
+            kernels: KernelsConfig {
+                parity: false,
+                node_fetch: NodeFetch::Operand,
+            },
         }
     }
 
@@ -496,6 +540,10 @@ impl SimConfig {
             ("energy.tri_pipe_nj", Real(e.tri_pipe_nj)),
             ("energy.dst_pipe_nj", Real(e.dst_pipe_nj)),
             ("kernels.parity", Flag(self.kernels.parity)),
+            (
+                "kernels.node_fetch",
+                Value::Choice(self.kernels.node_fetch.name()),
+            ),
         ]
     }
 

@@ -87,7 +87,11 @@ pub fn simulate<S: TraversalSet>(
     footprint::check(cfg, accel, model, frame.pixels())?;
     if model == ThreadModel::Fast && cfg.kernels != KernelsConfig::default() {
         return Err(SimError::FastKernelVariant {
-            variant: format!("parity = {}", cfg.kernels.parity),
+            variant: format!(
+                "parity = {}, node_fetch = \"{}\"",
+                cfg.kernels.parity,
+                cfg.kernels.node_fetch.name()
+            ),
         });
     }
     match model {

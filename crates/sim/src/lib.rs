@@ -61,7 +61,8 @@ pub const MODEL_VERSION: u32 = 8;
 
 pub use accel::SimAccel;
 pub use config::{
-    CacheConfig, ConfigError, DramConfig, EnergyConfig, KernelsConfig, SimConfig, UnitConfig,
+    CacheConfig, ConfigError, DramConfig, EnergyConfig, KernelsConfig, NodeFetch, SimConfig,
+    UnitConfig,
 };
 pub use error::SimError;
 pub use frame::{FrameRequest, simulate};
