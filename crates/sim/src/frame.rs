@@ -58,6 +58,21 @@ impl<'a, S: TraversalSet> FrameRequest<'a, S> {
     }
 }
 
+/// Whether `model` runs `cfg`'s kernel variant (`[kernels]`): the `fast` model replays costs
+/// measured on the default kernels only ([`SimError::FastKernelVariant`] otherwise).
+pub fn check_model(cfg: &SimConfig, model: ThreadModel) -> Result<(), SimError> {
+    if model == ThreadModel::Fast && cfg.kernels != KernelsConfig::default() {
+        return Err(SimError::FastKernelVariant {
+            variant: format!(
+                "parity = {}, node_fetch = \"{}\"",
+                cfg.kernels.parity,
+                cfg.kernels.node_fetch.name()
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// Simulates one frame; `progress` is called with (pixels done, pixels total).
 pub fn simulate<S: TraversalSet>(
     frame: &FrameRequest<'_, S>,
@@ -85,15 +100,7 @@ pub fn simulate<S: TraversalSet>(
         });
     }
     footprint::check(cfg, accel, model, frame.pixels())?;
-    if model == ThreadModel::Fast && cfg.kernels != KernelsConfig::default() {
-        return Err(SimError::FastKernelVariant {
-            variant: format!(
-                "parity = {}, node_fetch = \"{}\"",
-                cfg.kernels.parity,
-                cfg.kernels.node_fetch.name()
-            ),
-        });
-    }
+    check_model(cfg, model)?;
     match model {
         ThreadModel::Rv32 => rv32::frame::run(frame, progress),
         ThreadModel::Fast => fast::frame::run(frame, progress),

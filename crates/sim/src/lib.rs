@@ -65,7 +65,7 @@ pub use config::{
     UnitConfig,
 };
 pub use error::SimError;
-pub use frame::{FrameRequest, simulate};
+pub use frame::{FrameRequest, check_model, simulate};
 pub use hw::counts::UnitStats;
 pub use hw::counts::{InstrCounts, Mix};
 pub use hw::energy::EnergySplit;
