@@ -63,6 +63,26 @@ static inline int child_kind(const Node *n, int k)
 #endif
 }
 
+#if KERNEL_PARITY
+/* The kind of slot k without looking at its box: the box test decides whether the slot is
+ * hit (an empty slot's degenerate box misses). In BVH2/4 an empty slot reads as internal
+ * here; empty slots follow the children (the builders fill slots 0..n), so no child lies
+ * after one and the size taken for it never moves a child's address. */
+static inline int child_kind_no_box(const Node *n, int k)
+{
+#if BVH_ARITY == 8
+    return child_kind(n, k);
+#else
+#if BVH_ARITY == 2
+    uint32_t bit = 31 - k;
+#else
+    uint32_t bit = 28 + k;
+#endif
+    return (n->packed >> bit) & 1u ? CHILD_LEAF : CHILD_INTERNAL;
+#endif
+}
+#endif
+
 static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, struct Hit *best)
 {
     (void)pre;
@@ -94,7 +114,7 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
             for (const uint32_t *idx = WORD_ADDR(run);; idx++) {
                 uint32_t entry = *idx;
                 uint32_t prim = entry & ~LAST_IN_RUN;
-                float t = rt_tri(triangle(prim), t_min, best_t);
+                float t = RT_TRI(triangle(prim), t_min, best_t);
                 if (t == t && (!have || !closer_than(best, t, prim))) {
                     best->t = t;
                     best->prim = prim;
@@ -117,13 +137,42 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
         int base = sp;
         uint32_t addr = node_offset(node);
 #if BVH_WIDE_BOX
-        uint32_t mask = rt_boxn(BVH_ARITY, node->box, t_min, limit);
+        uint32_t mask = RT_BOXN(BVH_ARITY, node->box, t_min, limit);
 #endif
 #if BVH_WIDE_BOX
 #define BOX_ENTRY(k) ((mask >> (k)) & 1u ? rt_boxget(k) : __builtin_nanf(""))
 #else
-#define BOX_ENTRY(k) rt_box(&node->box[k], t_min, limit)
+#define BOX_ENTRY(k) RT_BOX(&node->box[k], t_min, limit)
 #endif
+#if KERNEL_PARITY
+/* Every slot's box is tested, empty slots included (Lin et al. 2020, §4: a BVH node's boxes
+ * are all tested, then the hit children are ordered). */
+#define CHILD(k)                                                                       \
+    do {                                                                               \
+        int kind = child_kind_no_box(node, k);                                         \
+        float entry = BOX_ENTRY(k);                                                    \
+        if (entry == entry) {                                                          \
+            struct Entry c = {entry, kind == CHILD_LEAF ? addr | ENTRY_LEAF : addr};   \
+            if (!have_cur) {                                                           \
+                cur = c;                                                               \
+                have_cur = 1;                                                          \
+            } else if (entry < cur.t) {                                                \
+                /* A later slot is nearer only when strictly nearer. */                \
+                stack[sp++] = cur;                                                     \
+                cur = c;                                                               \
+            } else {                                                                   \
+                /* Below the stacked entries that are nearer or equally near. */       \
+                int j = sp++;                                                          \
+                while (j > base && stack[j - 1].t <= entry) {                          \
+                    stack[j] = stack[j - 1];                                           \
+                    j--;                                                               \
+                }                                                                      \
+                stack[j] = c;                                                          \
+            }                                                                          \
+        }                                                                              \
+        addr += kind == CHILD_INTERNAL ? NODE_WORDS : kind == CHILD_LEAF ? 1u : 0u;    \
+    } while (0)
+#else
 #define CHILD(k)                                                                       \
     do {                                                                               \
         int kind = child_kind(node, k);                                                \
@@ -151,6 +200,7 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
         }                                                                              \
         addr += kind == CHILD_INTERNAL ? NODE_WORDS : kind == CHILD_LEAF ? 1u : 0u;    \
     } while (0)
+#endif
         CHILD(0);
         CHILD(1);
 #if BVH_ARITY >= 4

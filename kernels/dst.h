@@ -13,7 +13,7 @@ static int traverse(const struct Ray *ray, const struct RayPre *r, int any, stru
 {
     DST_TRAVERSE_BEGIN(ray, r);
     for (;;) {
-        uint32_t out = rt_dst(WORD_ADDR(node), t_min, t_max);
+        uint32_t out = RT_DST(WORD_ADDR(node), t_min, t_max);
         uint32_t code = out & 3u;
         uint32_t offset = out >> 2;
         if (code == CODE_ONE_CHILD) {

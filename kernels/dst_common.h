@@ -15,6 +15,7 @@ _Static_assert(STACK_SIZE * sizeof(struct Entry) <= LOCAL_STORE_BYTES * 5 / 8,
 /* RayPre::slab of the scene box on [t_lo, t_hi]: the clipped interval, non-empty when the
  * ray meets the box. Near and far planes by the ray's signs; far planes widened; NaN plane
  * distances ignored (f_max/f_min return the other operand). */
+#if !KERNEL_PARITY
 static void scene_slab(const struct RayPre *r, float t_lo, float t_hi, float *entry,
                        float *exit)
 {
@@ -31,17 +32,31 @@ static void scene_slab(const struct RayPre *r, float t_lo, float t_hi, float *en
     *entry = lo;
     *exit = hi;
 }
+#endif
 
 /* The start of both traversals: the ray's interval clipped to the scene box in *t_min,
- * *t_max; 0 when the tree is empty or the ray misses the box (nothing to traverse). */
+ * *t_max; 0 when the tree is empty or the ray misses the box (nothing to traverse). With
+ * KERNEL_PARITY the ray-box pipeline clips (one rt.box on the scene box, whose 6 words
+ * scene_min, scene_max follow each other in the parameter block; rt.boxexit reads the exit
+ * distance), else the slab test runs in software. */
 static inline int dst_clip(const struct Ray *ray, const struct RayPre *r, float *t_min,
                            float *t_max)
 {
     const struct Params *P = PARAMS;
     if (P->nodes_end == P->nodes_start)
         return 0;
+#if KERNEL_PARITY
+    (void)r;
+    float entry = RT_BOX(P->scene_min, ray->t_min, cull_limit(ray->t_max));
+    if (entry != entry)
+        return 0;
+    *t_min = entry;
+    *t_max = rt_boxexit();
+    return 1;
+#else
     scene_slab(r, ray->t_min, cull_limit(ray->t_max), t_min, t_max);
     return !(*t_min > *t_max);
+#endif
 }
 
 /* Intersects the triangle run starting at index entry `first` on [ray.t_min, best_t];
@@ -52,7 +67,7 @@ static inline int test_run(uint32_t first, float t_lo, int any, int *have, struc
     for (const uint32_t *idx = WORD_ADDR(PARAMS->indices_start + first);; idx++) {
         uint32_t entry = *idx;
         uint32_t prim = entry & ~LAST_IN_RUN;
-        float t = rt_tri(triangle(prim), t_lo, *best_t);
+        float t = RT_TRI(triangle(prim), t_lo, *best_t);
         if (t == t) {
             if (any) {
                 best->t = t;

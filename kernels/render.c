@@ -8,8 +8,19 @@
  *   -DACCEL_BVH -DBVH_ARITY=N   BVH2/4/8 ... -DBVH_WIDE_BOX=1 for the "+" configurations
  *   -DACCEL_DST_SW              DST* (software decoder)
  *   -DACCEL_DST                 DST (the dual-split instruction)
+ *   -DKERNEL_PARITY=0|1         1: the traversals as the paper describes them (bvh.h: every
+ *                               box slot tested; dst_common.h: the scene-box clip on rt.box)
+ *   -DPIPE_LOADS=0|1            1: node words reach the pipelines through rt.ldp and the
+ *                               register forms (rt.h), else through the memory operand
  *
  * A thread takes pixels from global register 0 until they run out. */
+#ifndef KERNEL_PARITY
+#define KERNEL_PARITY 0
+#endif
+#ifndef PIPE_LOADS
+#define PIPE_LOADS 0
+#endif
+
 #include "dualsplit.h"
 #include "fmath.h"
 #include "rt.h"

@@ -44,6 +44,7 @@ pub fn check_frame(
     model: ThreadModel,
 ) -> Result<(), SimulateError> {
     cfg.validate().map_err(SimError::from)?;
+    dualsplit_sim::check_model(cfg, model)?;
     dualsplit_render::validate_frame(settings)?;
     let pixels = settings.width as u64 * settings.height as u64;
     for accel in SimAccel::ALL {

@@ -88,7 +88,7 @@ fn kernel_frame(bencher: divan::Bencher, accel: SimAccel) {
     let scene = dualsplit_scene::load("builtin:cornell").unwrap();
     let structures = Structures::build(&scene.triangles, &Default::default());
     let settings = RenderSettings::new(32, 32, Workload::Path);
-    let prog = Program::from_elf(elf(accel, settings.workload)).unwrap();
+    let prog = Program::from_elf(elf(accel, settings.workload, Default::default())).unwrap();
     let params = Params::new(&scene, &structures, accel, &settings);
     let image = structures.image(accel.kind());
     let run = || {

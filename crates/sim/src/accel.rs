@@ -2,12 +2,12 @@
 //!
 //! Every configuration is registered once, in the `sim_accels!` invocation below: its
 //! variant, command-line name, the paper's label, the traversal it runs, its ray-box pipes
-//! for the "+" configurations, its chart colour, and its two compiled kernels
-//! (`kernels/build/<name>-{cast,path}.elf`, which `kernels/Makefile`'s `CONFIGS` builds; a
-//! test checks the two lists agree). The CLI, the simulator, the kernel table, the
+//! for the "+" configurations, its chart colour, and its compiled kernels, one per workload
+//! and variant (`kernels/build/<name>-{cast,path}{,-parity,-loads,-parity-loads}.elf`, which `kernels/Makefile`'s
+//! `CONFIGS` builds; a test checks the two lists agree). The CLI, the simulator, the kernel table, the
 //! calibration and the charts read it from here (`docs/extending.md`).
 
-use crate::config::SimConfig;
+use crate::config::{KernelsConfig, SimConfig};
 use dualsplit_accel::AccelKind;
 use serde::{Deserialize, Serialize};
 
@@ -52,7 +52,20 @@ macro_rules! sim_accels {
                 kind: AccelKind::$kind,
                 parallel: $par,
                 color: $rgb,
-                kernels: [kernel!(concat!($name, "-cast.elf")), kernel!(concat!($name, "-path.elf"))],
+                kernels: [
+                    [
+                        kernel!(concat!($name, "-cast.elf")),
+                        kernel!(concat!($name, "-cast-parity.elf")),
+                        kernel!(concat!($name, "-cast-loads.elf")),
+                        kernel!(concat!($name, "-cast-parity-loads.elf")),
+                    ],
+                    [
+                        kernel!(concat!($name, "-path.elf")),
+                        kernel!(concat!($name, "-path-parity.elf")),
+                        kernel!(concat!($name, "-path-loads.elf")),
+                        kernel!(concat!($name, "-path-parity-loads.elf")),
+                    ],
+                ],
             },
         )*];
     };
@@ -67,8 +80,8 @@ struct Info {
     /// configurations), if any.
     parallel: Option<u32>,
     color: [u8; 3],
-    /// The compiled kernels, cast then path.
-    kernels: [&'static [u8]; 2],
+    /// The compiled kernels, cast then path, each in the order of [`KernelsConfig::ALL`].
+    kernels: [[&'static [u8]; KernelsConfig::ALL.len()]; 2],
 }
 
 sim_accels! {
@@ -126,8 +139,9 @@ impl SimAccel {
     pub fn color(self) -> [u8; 3] {
         self.info().color
     }
-    /// Its compiled kernel for workload `cast` (`path == false`) or `path`: an RV32IMF ELF.
-    pub fn kernel(self, path: bool) -> &'static [u8] {
-        self.info().kernels[path as usize]
+    /// Its compiled kernel for workload `cast` (`path == false`) or `path` in `variant`: an
+    /// RV32IMF ELF.
+    pub fn kernel(self, path: bool, variant: KernelsConfig) -> &'static [u8] {
+        self.info().kernels[path as usize][variant.index()]
     }
 }

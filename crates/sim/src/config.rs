@@ -30,6 +30,8 @@ pub struct SimConfig {
     pub units: UnitConfig,
     /// Energy per event.
     pub energy: EnergyConfig,
+    /// Which variant of the compiled kernels the `rv32` model runs.
+    pub kernels: KernelsConfig,
 }
 
 /// A cache: size, line, banks, associativity and hit latency.
@@ -243,6 +245,77 @@ pub struct EnergyConfig {
     pub dst_pipe_nj: f64,
 }
 
+/// The variant of the compiled kernels (`kernels/`): the `[kernels]` table.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct KernelsConfig {
+    /// `true`: the traversals as Lin et al. 2020 describe them (§4: "ray-box intersection
+    /// tests are executed serially for each box in a BVH node", empty slots holding
+    /// degenerate boxes, §4.2, then the hits are ordered, §4.4; the DST ray is clipped to
+    /// the scene box by one `rt.box`); `false`: the serial BVH kernels test only the present
+    /// children and the DST kernels clip in software.
+    pub parity: bool,
+    /// How the ray-tracing instructions get their node words.
+    pub node_fetch: NodeFetch,
+}
+
+/// How the kernels hand node words to the ray-box, ray-triangle and dual-split pipelines
+/// (`docs/isa.md`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum NodeFetch {
+    /// `rt.box`, `rt.boxn`, `rt.tri`, `rt.dst` read their words through a memory operand,
+    /// all in one issue.
+    #[default]
+    Operand,
+    /// One `rt.ldp` per word into the pipeline input registers, then the register form:
+    /// SimTRaX's `LOADPIPEGLB` form (`sim/Instruction.h`, lines 110–111).
+    Loads,
+}
+
+impl NodeFetch {
+    /// Its TOML spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            NodeFetch::Operand => "operand",
+            NodeFetch::Loads => "loads",
+        }
+    }
+}
+
+impl KernelsConfig {
+    /// The variant's index among [`KernelsConfig::ALL`].
+    pub fn index(self) -> usize {
+        self.parity as usize | ((self.node_fetch == NodeFetch::Loads) as usize) << 1
+    }
+
+    /// Every variant, in the order of [`KernelsConfig::index`].
+    pub const ALL: [KernelsConfig; 4] = [
+        KernelsConfig {
+            parity: false,
+            node_fetch: NodeFetch::Operand,
+        },
+        KernelsConfig {
+            parity: true,
+            node_fetch: NodeFetch::Operand,
+        },
+        KernelsConfig {
+            parity: false,
+            node_fetch: NodeFetch::Loads,
+        },
+        KernelsConfig {
+            parity: true,
+            node_fetch: NodeFetch::Loads,
+        },
+    ];
+
+    /// The suffix of its kernels' file names (`kernels/Makefile`): `""`, `-parity`,
+    /// `-loads` or `-parity-loads`.
+    pub fn suffix(self) -> &'static str {
+        ["", "-parity", "-loads", "-parity-loads"][self.index()]
+    }
+}
+
 impl Default for SimConfig {
     fn default() -> Self {
         Self::lin2020()
@@ -358,6 +431,10 @@ impl SimConfig {
                 box_pipe_nj: 0.1377,
                 tri_pipe_nj: 0.71,
                 dst_pipe_nj: 0.0610,
+            },
+            kernels: KernelsConfig {
+                parity: false,
+                node_fetch: NodeFetch::Operand,
             },
         }
     }
@@ -503,6 +580,11 @@ impl SimConfig {
             ("energy.box_pipe_nj", Real(e.box_pipe_nj)),
             ("energy.tri_pipe_nj", Real(e.tri_pipe_nj)),
             ("energy.dst_pipe_nj", Real(e.dst_pipe_nj)),
+            ("kernels.parity", Flag(self.kernels.parity)),
+            (
+                "kernels.node_fetch",
+                Value::Choice(self.kernels.node_fetch.name()),
+            ),
         ]
     }
 

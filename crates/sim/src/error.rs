@@ -52,6 +52,14 @@ pub enum SimError {
         /// The traversals there are, comma-separated.
         available: String,
     },
+    /// The `fast` model replays costs measured on the default kernels only.
+    #[error(
+        "the fast model is calibrated on the default kernels ([kernels] parity = false, node_fetch = \"operand\"); kernels with {variant} need --model rv32"
+    )]
+    FastKernelVariant {
+        /// The variant asked for, as its `[kernels]` keys.
+        variant: String,
+    },
     /// The `fast` model's measured costs are missing or unreadable.
     #[error("fast model: {0}")]
     Calibration(#[from] CalibrationError),

@@ -1,7 +1,7 @@
 //! One simulated frame: the request and the entry point.
 
 use crate::accel::SimAccel;
-use crate::config::SimConfig;
+use crate::config::{KernelsConfig, SimConfig};
 use crate::error::SimError;
 use crate::footprint;
 use crate::model::{ThreadModel, fast, rv32};
@@ -58,6 +58,21 @@ impl<'a, S: TraversalSet> FrameRequest<'a, S> {
     }
 }
 
+/// Whether `model` runs `cfg`'s kernel variant (`[kernels]`): the `fast` model replays costs
+/// measured on the default kernels only ([`SimError::FastKernelVariant`] otherwise).
+pub fn check_model(cfg: &SimConfig, model: ThreadModel) -> Result<(), SimError> {
+    if model == ThreadModel::Fast && cfg.kernels != KernelsConfig::default() {
+        return Err(SimError::FastKernelVariant {
+            variant: format!(
+                "parity = {}, node_fetch = \"{}\"",
+                cfg.kernels.parity,
+                cfg.kernels.node_fetch.name()
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// Simulates one frame; `progress` is called with (pixels done, pixels total).
 pub fn simulate<S: TraversalSet>(
     frame: &FrameRequest<'_, S>,
@@ -85,6 +100,7 @@ pub fn simulate<S: TraversalSet>(
         });
     }
     footprint::check(cfg, accel, model, frame.pixels())?;
+    check_model(cfg, model)?;
     match model {
         ThreadModel::Rv32 => rv32::frame::run(frame, progress),
         ThreadModel::Fast => fast::frame::run(frame, progress),

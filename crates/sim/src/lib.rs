@@ -60,9 +60,12 @@ mod shares;
 pub const MODEL_VERSION: u32 = 9;
 
 pub use accel::SimAccel;
-pub use config::{CacheConfig, ConfigError, DramConfig, EnergyConfig, SimConfig, UnitConfig};
+pub use config::{
+    CacheConfig, ConfigError, DramConfig, EnergyConfig, KernelsConfig, NodeFetch, SimConfig,
+    UnitConfig,
+};
 pub use error::SimError;
-pub use frame::{FrameRequest, simulate};
+pub use frame::{FrameRequest, check_model, simulate};
 pub use hw::counts::UnitStats;
 pub use hw::counts::{InstrCounts, Mix};
 pub use hw::energy::EnergySplit;

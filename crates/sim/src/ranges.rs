@@ -37,6 +37,8 @@ pub enum Value {
     Real(f64),
     /// A switch (any value is valid).
     Flag(bool),
+    /// One of a key's named choices.
+    Choice(&'static str),
 }
 
 /// The valid values of one key.
@@ -54,6 +56,8 @@ pub struct KeyRange {
     pub multiple: u64,
     /// The unit, for messages and the documentation.
     pub unit: &'static str,
+    /// The valid names of a [`Value::Choice`] key (empty for the others).
+    pub choices: &'static [&'static str],
 }
 
 const fn int(key: &'static str, min: u64, max: u64, unit: &'static str) -> KeyRange {
@@ -64,6 +68,7 @@ const fn int(key: &'static str, min: u64, max: u64, unit: &'static str) -> KeyRa
         pow2: false,
         multiple: 1,
         unit,
+        choices: &[],
     }
 }
 
@@ -82,11 +87,19 @@ const fn real(key: &'static str, min: f64, max: f64, unit: &'static str) -> KeyR
         pow2: false,
         multiple: 1,
         unit,
+        choices: &[],
     }
 }
 
 const fn flag(key: &'static str) -> KeyRange {
     real(key, 0.0, 1.0, "true or false")
+}
+
+const fn choice(key: &'static str, choices: &'static [&'static str]) -> KeyRange {
+    KeyRange {
+        choices,
+        ..real(key, 0.0, 0.0, "")
+    }
 }
 
 /// The longest latency of any unit, cache or DRAM timing (cycles or ticks).
@@ -180,6 +193,8 @@ pub const RANGES: &[KeyRange] = &[
     real("energy.box_pipe_nj", 0.0, MAX_NJ, "nJ"),
     real("energy.tri_pipe_nj", 0.0, MAX_NJ, "nJ"),
     real("energy.dst_pipe_nj", 0.0, MAX_NJ, "nJ"),
+    flag("kernels.parity"),
+    choice("kernels.node_fetch", &["operand", "loads"]),
 ];
 
 impl KeyRange {
@@ -187,6 +202,10 @@ impl KeyRange {
     pub fn describe(&self) -> String {
         if self.unit == "true or false" {
             return "true or false".into();
+        }
+        if !self.choices.is_empty() {
+            let quoted: Vec<String> = self.choices.iter().map(|c| format!("\"{c}\"")).collect();
+            return quoted.join(" or ");
         }
         let num = |v: f64| {
             if v.fract() == 0.0 && v.abs() < 1e15 {
@@ -219,6 +238,7 @@ impl KeyRange {
     pub fn check(&self, value: Value) -> Result<(), ConfigError> {
         let (ok, shown) = match value {
             Value::Flag(b) => (true, b.to_string()),
+            Value::Choice(c) => (self.choices.contains(&c), format!("\"{c}\"")),
             Value::Int(v) => (
                 (v as f64) >= self.min
                     && (v as f64) <= self.max

@@ -209,3 +209,39 @@ fn docs_list_every_range() {
         "docs/robustness.md must hold this table:\n{table}"
     );
 }
+
+/// `[kernels]` takes only its keys with their types; the rv32 model runs every variant, and
+/// the fast model, calibrated on the default kernels, refuses another with a typed error.
+#[test]
+fn kernel_variants_are_checked_and_fast_runs_only_the_default() {
+    for (toml, key) in [
+        ("[kernels]\nparity = 1", "parity"),
+        ("[kernels]\nparity = \"yes\"", "parity"),
+        ("[kernels]\nnode_fetch = \"memory\"", "node_fetch"),
+        ("[kernels]\nnode_fetch = true", "node_fetch"),
+    ] {
+        let e = SimConfig::from_toml(toml).expect_err(toml);
+        assert!(
+            matches!(e, dualsplit_sim::ConfigError::Parse(_)),
+            "{toml}: {e}"
+        );
+        assert!(e.to_string().contains(key), "{toml}: {e}");
+    }
+    let e = SimConfig::from_toml("[kernels]\nnode_fetch = \"memory\"").unwrap_err();
+    assert!(e.to_string().contains("loads"), "the valid names: {e}");
+    refused("[kernels]\nvariant = \"paper\"", "variant");
+    let (scene, s) = scene();
+    let settings = RenderSettings::new(4, 4, Workload::Cast);
+    for toml in ["parity = true", "node_fetch = \"loads\""] {
+        let cfg =
+            SimConfig::from_toml(&format!("tms = 1\ntps_per_tm = 2\n[kernels]\n{toml}")).unwrap();
+        assert_ne!(cfg.kernels, dualsplit_sim::KernelsConfig::default());
+        let frame =
+            |model| FrameRequest::new(&scene, &s, SimAccel::Dst, &settings, &cfg).with_model(model);
+        let r = simulate(&frame(ThreadModel::Rv32), &|_, _| {}).unwrap();
+        assert_eq!(r.pixels, 16);
+        let e = simulate(&frame(ThreadModel::Fast), &|_, _| {}).unwrap_err();
+        assert!(matches!(e, SimError::FastKernelVariant { .. }), "{e}");
+        assert!(e.to_string().contains("--model rv32"), "{e}");
+    }
+}

@@ -13,9 +13,10 @@ fn repo_file(path: &str) -> String {
 }
 
 /// (opcode, funct3, format letter, largest function field) per mnemonic, from `rt.h`'s
-/// `.insn` lines: `.insn r4 OPC, F3, F2, …` or `.insn r OPC, F3, F7, …`, the function
-/// field a number or `%N` (an operand: its range is given by the function's comment as
-/// `N = 2, 4, 8 -> funct2 = 0, 1, 2` or `k a constant 0-7`, checked through the decoder).
+/// `.insn` lines: `.insn r4 OPC, F3, F2, …`, `.insn r OPC, F3, F7, …` or `.insn i OPC, F3,
+/// x%N, …` (the `P` index in the rd field), the function field a number or `%N` (an operand:
+/// its range is given by the function's comment as `N = 2, 4, 8 -> funct2 = 0, 1, 2` or
+/// `k a constant 0-7`, checked through the decoder).
 fn from_rt_h() -> BTreeMap<String, (u32, u32, char, Option<u32>)> {
     let src = repo_file("kernels/rt.h");
     let mut out = BTreeMap::new();
@@ -53,9 +54,14 @@ fn from_rt_h() -> BTreeMap<String, (u32, u32, char, Option<u32>)> {
             .expect(".insn without a function name before it");
         let mnemonic = match n.as_str() {
             "rt_dst_tmin" | "rt_dst_tmax" | "rt_dst_offset_stack" => "rt.dstget".to_string(),
+            "rt_boxexit" => "rt.boxget".to_string(),
             other => other.replacen("rt_", "rt.", 1),
         };
-        let letter = if fmt == "r4" { '4' } else { 'r' };
+        let letter = match fmt {
+            "r4" => '4',
+            "i" => 'i',
+            _ => 'r',
+        };
         let f = num(fields[2]);
         let e = out.entry(mnemonic).or_insert((
             num(fields[0]).unwrap(),
@@ -87,7 +93,13 @@ fn from_isa_md() -> BTreeMap<String, (u32, u32, char)> {
             .and_then(|h| u32::from_str_radix(h.trim_start_matches("0x"), 16).ok())
             .unwrap_or_else(|| panic!("isa.md: opcode of {mnemonic}: {:?}", cells[2]));
         let funct3 = cells[3].parse().unwrap();
-        let letter = if cells[4].starts_with("f2") { '4' } else { 'r' };
+        let letter = if cells[4].starts_with("f2") {
+            '4'
+        } else if cells[4].starts_with("rd") {
+            'i'
+        } else {
+            'r'
+        };
         out.insert(mnemonic, (opcode, funct3, letter));
     }
     out
@@ -116,6 +128,7 @@ fn rt_table_agrees_with_rt_h_and_isa_md() {
         let (letter, max) = match e.format {
             Format::R4 { funct2_max } => ('4', funct2_max),
             Format::R { funct7_max } => ('r', funct7_max),
+            Format::I { rd_max, .. } => ('i', rd_max),
         };
         let h = rt_h[e.mnemonic];
         assert_eq!(
@@ -143,10 +156,16 @@ fn rt_table_agrees_with_rt_h_and_isa_md() {
 #[test]
 fn the_decoder_accepts_exactly_the_tables_function_fields() {
     for e in &RT_INSTRUCTIONS {
-        let base = e.opcode | e.funct3 << 12 | 5 << 7 | 6 << 15 | 7 << 20;
+        let rd = if matches!(e.format, Format::I { .. }) {
+            0
+        } else {
+            5 << 7
+        };
+        let base = e.opcode | e.funct3 << 12 | rd | 6 << 15 | 7 << 20;
         let (shift, width, max) = match e.format {
             Format::R4 { funct2_max } => (25, 4, funct2_max),
             Format::R { funct7_max } => (25, 128, funct7_max),
+            Format::I { rd_max, .. } => (7, 32, rd_max),
         };
         for f in 0..width {
             let w = base | f << shift | if width == 4 { 8 << 27 } else { 0 };
@@ -154,6 +173,12 @@ fn the_decoder_accepts_exactly_the_tables_function_fields() {
             if f <= max {
                 let i = d.unwrap_or_else(|err| panic!("{} field {f}: {err}", e.mnemonic));
                 assert_eq!(i.op, e.op, "{} field {f}", e.mnemonic);
+                if let Format::I { p_base, .. } = e.format {
+                    // The P index, and the byte offset from bits 20-31.
+                    let k = u32::from(i.rd) + 32 * u32::from(i.rs2);
+                    assert_eq!(k, p_base + f, "{}", e.mnemonic);
+                    assert_eq!((i.rs1, i.imm), (6, 7), "{}", e.mnemonic);
+                }
             } else {
                 assert!(d.is_err(), "{} field {f} decoded", e.mnemonic);
             }

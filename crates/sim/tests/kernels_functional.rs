@@ -7,11 +7,11 @@
 use dualsplit_accel::Structures;
 use dualsplit_render::{RenderSettings, Workload, render};
 use dualsplit_scene::Scene;
-use dualsplit_sim::SimAccel;
 use dualsplit_sim::model::rv32::kernels::{
     FRAME_FLOATS_PER_PIXEL, LOCAL_STORE_BYTES, Params, elf, elf_name,
 };
 use dualsplit_sim::model::rv32::{Program, run_frame};
+use dualsplit_sim::{KernelsConfig, SimAccel};
 
 /// Loads a scene spec; `shipped:NAME` is the shipped mesh NAME, which when missing skips
 /// the test locally and fails it under CI ([`dualsplit_testkit::scenes::shipped`]).
@@ -22,13 +22,28 @@ fn load(spec: &str) -> Option<Scene> {
     }
 }
 
-/// Runs every configuration's kernel for `workload` and compares each pixel with the
-/// renderer's.
+/// Runs every configuration's kernel for `workload`, in every variant, and compares each
+/// pixel with the renderer's.
 fn check(scene: &Scene, structures: &Structures, settings: &RenderSettings) {
     for accel in SimAccel::ALL {
-        let name = elf_name(accel, settings.workload);
         let want = render(scene, structures, accel.kind(), settings, &|| {}).unwrap();
-        let prog = Program::from_elf(elf(accel, settings.workload))
+        for variant in KernelsConfig::ALL {
+            check_variant(scene, structures, settings, accel, variant, &want.image);
+        }
+    }
+}
+
+fn check_variant(
+    scene: &Scene,
+    structures: &Structures,
+    settings: &RenderSettings,
+    accel: SimAccel,
+    variant: KernelsConfig,
+    want: &dualsplit_render::Image,
+) {
+    {
+        let name = elf_name(accel, settings.workload, variant);
+        let prog = Program::from_elf(elf(accel, settings.workload, variant))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         let params = Params::new(scene, structures, accel, settings);
         let (frame, stats) = run_frame(
@@ -47,7 +62,7 @@ fn check(scene: &Scene, structures: &Structures, settings: &RenderSettings) {
         for y in 0..settings.height {
             for x in 0..settings.width {
                 let i = (y * settings.width + x) as usize * FRAME_FLOATS_PER_PIXEL;
-                let w = want.image.get(x, y);
+                let w = want.get(x, y);
                 for (c, g) in got[i..i + FRAME_FLOATS_PER_PIXEL].iter().enumerate() {
                     assert_eq!(
                         g.to_bits(),
@@ -141,7 +156,12 @@ fn a_kernel_given_the_other_workload_faults() {
     let structures = Structures::build(&scene.triangles, &Default::default());
     let settings = RenderSettings::new(4, 4, Workload::Cast);
     let params = Params::new(&scene, &structures, SimAccel::Bvh2, &settings);
-    let prog = Program::from_elf(elf(SimAccel::Bvh2, Workload::Path)).unwrap();
+    let prog = Program::from_elf(elf(
+        SimAccel::Bvh2,
+        Workload::Path,
+        KernelsConfig::default(),
+    ))
+    .unwrap();
     let run = run_frame(
         &prog,
         structures.image(SimAccel::Bvh2.kind()),

@@ -206,6 +206,12 @@ impl Plan {
             let mut base = opts.base_config.clone();
             base.tms = opts.base_tms;
             let swept = vary::apply(&base, &combo)?;
+            dualsplit_sim::check_model(&swept, opts.thread_model).map_err(|e| {
+                StudyError::Vary {
+                    arg: vary::describe(&combo),
+                    reason: e.to_string(),
+                }
+            })?;
             // A swept `tms` replaces the TM scaling study: one TM count per combination.
             let (base_tms, all_tms) = if varies_tms {
                 (swept.tms, vec![swept.tms])
@@ -395,6 +401,30 @@ mod tests {
             (16, 16),
         );
         assert_eq!(e.cache_key, report_key.file_name());
+    }
+
+    #[test]
+    fn kernel_variants_sweep_on_rv32_and_are_refused_on_fast() {
+        let base = SimConfig::lin2020();
+        let v = || Vary::parse("kernels.node_fetch=operand,loads", &base).unwrap();
+        let e = Plan::build(&opts(vec![v()])).unwrap_err();
+        assert!(e.to_string().contains("--model rv32"), "{e}");
+        let mut o = opts(vec![v()]);
+        o.thread_model = ThreadModel::Rv32;
+        let plan = Plan::build(&o).unwrap();
+        assert_eq!(plan.entries.len(), 2 * (4 + 2));
+        assert!(
+            plan.entries
+                .iter()
+                .any(|e| e.config.kernels.node_fetch == dualsplit_sim::NodeFetch::Loads)
+        );
+        // A name that is not a choice: refused when parsed or when planned.
+        let bad = Vary::parse("kernels.node_fetch=memory", &base).and_then(|v| {
+            let mut o = opts(vec![v]);
+            o.thread_model = ThreadModel::Rv32;
+            Plan::build(&o)
+        });
+        assert!(bad.is_err());
     }
 
     #[test]

@@ -37,7 +37,7 @@
 //! total instructions per class (up to the fixed-point rounding).
 
 use crate::accel::SimAccel;
-use crate::config::UnitConfig;
+use crate::config::{KernelsConfig, UnitConfig};
 use crate::hw::counts::InstrCounts;
 use crate::hw::fu::{FU_CLASSES, FuClass, fu_index};
 use crate::model::fast::costs::Costs;
@@ -356,7 +356,7 @@ fn measure(
     workload: Workload,
     units: &UnitConfig,
 ) -> Result<Table, CalibrationError> {
-    let prog = Program::from_elf(elf(accel, workload))?;
+    let prog = Program::from_elf(elf(accel, workload, KernelsConfig::default()))?;
     let mut normal = Normal::new();
     let (mut seen, mut instructions) = ([false; EVENTS], 0);
     let (mut measured, mut counts) = ([0i128; TARGETS], [0u64; EVENTS]);

@@ -4,6 +4,7 @@
 //! replaying the recorded ops is exact.
 
 use crate::accel::SimAccel;
+use crate::config::KernelsConfig;
 use crate::error::SimError;
 use crate::frame::FrameRequest;
 use crate::hw::Chip;
@@ -150,7 +151,7 @@ pub(crate) fn run<S: TraversalSet>(
     let params = Params::new(scene, structures, accel, settings);
     let placement = placement(
         &params,
-        &Program::from_elf(elf(accel, settings.workload))?,
+        &Program::from_elf(elf(accel, settings.workload, KernelsConfig::default()))?,
         structures.image(accel.kind()),
         cfg.l1.line_bytes,
     );

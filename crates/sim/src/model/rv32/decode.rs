@@ -17,7 +17,7 @@
 //! [`DecodeError`]. The float-to-integer conversions `fcvt.w.s`/`fcvt.wu.s` accept every
 //! valid mode (0–4, 7), because C's `(int)x` compiles to `fcvt.w.s …, rtz`.
 
-use super::isa::{OPCODE_CUSTOM0, OPCODE_CUSTOM1};
+use super::isa::{OPCODE_CUSTOM0, OPCODE_CUSTOM1, OPCODE_CUSTOM2, OPCODE_CUSTOM3};
 use crate::hw::fu::FuClass;
 use std::fmt;
 
@@ -91,6 +91,10 @@ impl Latches {
     pub const READS_DST: u8 = 16;
     /// Writes `D`.
     pub const WRITES_DST: u8 = 32;
+    /// Reads the pipeline input registers `P`.
+    pub const READS_PIPE: u8 = 64;
+    /// Writes `P`.
+    pub const WRITES_PIPE: u8 = 128;
     /// The raw bits.
     #[inline]
     pub const fn bits(self) -> u8 {
@@ -229,11 +233,11 @@ pub enum Op {
     RtRcp,
     /// `rt.atominc`: `x[rd] = G[x[rs1]]++`.
     RtAtomInc,
-    /// `rt.box`: `f[rd]` = entry distance or NaN.
+    /// `rt.box`: `f[rd]` = entry distance or NaN; the exit distance to `B.exit`.
     RtBox,
     /// `rt.boxn` (`imm` = N = 2, 4, 8): `x[rd]` = hit mask, entries to `B`.
     RtBoxN,
-    /// `rt.boxget` (`imm` = k): `f[rd] = B[k]`.
+    /// `rt.boxget` (`imm` = k): `f[rd] = B[k]` (k = 0–7), `B.exit` (k = 8).
     RtBoxGet,
     /// `rt.tri`: `f[rd]` = `t` or NaN.
     RtTri,
@@ -241,6 +245,17 @@ pub enum Op {
     RtDst,
     /// `rt.dstget` (`imm` = field 0, 1, 2).
     RtDstGet,
+    /// `rt.ldp` / `rt.ldph`: `P[k] = mem[x[rs1] + imm]`, `k = rd + 32 · rs2` (0–47; the
+    /// two fields name no register).
+    RtLdp,
+    /// `rt.boxp`: `rt.box` on the box in `P[0..6]`.
+    RtBoxP,
+    /// `rt.boxnp` (`imm` = N): `rt.boxn` on the N boxes in `P[0..6N]`.
+    RtBoxNP,
+    /// `rt.trip`: `rt.tri` on the triangle in `P[0..9]`.
+    RtTriP,
+    /// `rt.dstp`: `rt.dst` on the node in `P[0..3]`.
+    RtDstP,
     /// A word that does not decode (`imm` = the word); executing it is an error.
     Illegal,
 }
@@ -299,6 +314,7 @@ fn shape(op: Op, imm: i32) -> (K, K, K, K, FuClass, u8) {
     use K::*;
     use Op::*;
     let r = Latches::READS_RAY;
+    let p = r | Latches::READS_PIPE;
     match op {
         Lui | Auipc => (X, N, N, N, U::IntAlu, 0),
         Jal => (X, N, N, N, U::Branch, 0),
@@ -333,7 +349,7 @@ fn shape(op: Op, imm: i32) -> (K, K, K, K, FuClass, u8) {
         RtSetK => (N, X, N, N, U::IntAlu, Latches::WRITES_RAY),
         RtRcp => (F, F, N, N, U::Rcp, 0),
         RtAtomInc => (X, X, N, N, U::Atomic, 0),
-        RtBox => (F, X, F, F, U::BoxPipe(1), r),
+        RtBox => (F, X, F, F, U::BoxPipe(1), r | Latches::WRITES_BOX),
         RtBoxN => (X, X, F, F, U::BoxPipe(imm as u8), r | Latches::WRITES_BOX),
         RtBoxGet => (F, N, N, N, U::IntAlu, Latches::READS_BOX),
         RtTri => (F, X, F, F, U::TriPipe, r),
@@ -342,6 +358,11 @@ fn shape(op: Op, imm: i32) -> (K, K, K, K, FuClass, u8) {
             let rd = if imm == 2 { X } else { F };
             (rd, N, N, N, U::IntAlu, Latches::READS_DST)
         }
+        RtLdp => (N, X, N, N, U::Load, Latches::WRITES_PIPE),
+        RtBoxP => (F, N, F, F, U::BoxPipe(1), p | Latches::WRITES_BOX),
+        RtBoxNP => (X, N, F, F, U::BoxPipe(imm as u8), p | Latches::WRITES_BOX),
+        RtTriP => (F, N, F, F, U::TriPipe, p),
+        RtDstP => (X, N, F, F, U::DstPipe, p | Latches::WRITES_DST),
     }
 }
 
@@ -356,7 +377,13 @@ pub fn make(op: Op, rd: u8, rs1: u8, rs2: u8, rs3: u8, imm: i32) -> Instr {
     } else {
         keep(k1, rs1)
     };
-    let (rd, rs2, rs3) = (keep(krd, rd), keep(k2, rs2), keep(k3, rs3));
+    // rt.ldp: rd and rs2 hold the P index, not registers; keep them.
+    let (rd, rs2) = if op == Op::RtLdp {
+        (rd & 31, rs2 & 31)
+    } else {
+        (keep(krd, rd), keep(k2, rs2))
+    };
+    let rs3 = keep(k3, rs3);
     Instr {
         op,
         rd,
@@ -562,20 +589,22 @@ pub fn decode(w: u32) -> Result<Instr, DecodeError> {
             0x78 if rs2 == 0 && f3 == 0 => r(FmvWX),
             _ => Err(err("OP-FP funct7 (only single precision is supported)")),
         },
-        OPCODE_CUSTOM0 | OPCODE_CUSTOM1 => match super::isa::lookup(w) {
-            Some((e, imm)) => {
-                let used = |k: usize, r: u8| if e.regs[k] { r } else { 0 };
-                Ok(make(
-                    e.op,
-                    used(0, rd),
-                    used(1, rs1),
-                    used(2, rs2),
-                    used(3, rs3),
-                    imm,
-                ))
+        OPCODE_CUSTOM0 | OPCODE_CUSTOM1 | OPCODE_CUSTOM2 | OPCODE_CUSTOM3 => {
+            match super::isa::lookup(w) {
+                Some((e, imm)) => {
+                    let used = |k: usize, r: u8| if e.regs[k] { r } else { 0 };
+                    // rt.ldp names no register but P[k]: k & 31 in rd, k >> 5 in rs2.
+                    let (rd, rs2) = if e.op == Op::RtLdp {
+                        let k = super::isa::pipe_index(e, w);
+                        (k & 31, k >> 5)
+                    } else {
+                        (used(0, rd), used(2, rs2))
+                    };
+                    Ok(make(e.op, rd, used(1, rs1), rs2, used(3, rs3), imm))
+                }
+                None => Err(err("custom opcode funct3/funct2/funct7")),
             }
-            None => Err(err("custom opcode funct3/funct2/funct7")),
-        },
+        }
         _ => Err(err(
             "unknown opcode (compressed, A, D and other extensions are not supported)",
         )),

@@ -78,7 +78,7 @@ pub(crate) fn run<S: TraversalSet>(
         cfg,
         ..
     } = *frame;
-    let prog = Program::from_elf(elf(accel, settings.workload))?;
+    let prog = Program::from_elf(elf(accel, settings.workload, cfg.kernels))?;
     let image = structures.image(accel.kind());
     // The memory map of docs/isa.md: the image below the parameter block, the frame
     // buffer below the program.

@@ -2,6 +2,7 @@
 
 use super::decode::{CSR_FCSR, CSR_FRM, Info, Op, decode};
 use super::elf::Program;
+use super::isa::PIPE_INPUT_WORDS;
 use super::memory::{LOCAL_STORE_ADDR, MemFault, Memory};
 use crate::hw::fu::FuClass;
 use dualsplit_accel::dst::HeaderOffset;
@@ -163,6 +164,10 @@ pub struct Hart {
     pub ray: RayPre,
     /// The box latch `B`.
     pub box_latch: [f32; 8],
+    /// The exit distance of the last `rt.box` (`B.exit`, read by `rt.boxget 8`).
+    pub box_exit: f32,
+    /// The pipeline input registers `P` (written by `rt.ldp`, read by the register forms).
+    pub pipe_in: [u32; PIPE_INPUT_WORDS],
     /// The DST latch `D`.
     pub dst_latch: DstLatch,
     /// The TP's private local store, at [`LOCAL_STORE_ADDR`].
@@ -289,6 +294,8 @@ impl Hart {
             pc: prog.entry,
             ray: initial_ray(),
             box_latch: [0.0; 8],
+            box_exit: 0.0,
+            pipe_in: [0; PIPE_INPUT_WORDS],
             dst_latch: DstLatch::default(),
             local: vec![0; local_store_bytes as usize].into_boxed_slice(),
             halted: false,
@@ -310,6 +317,8 @@ impl Hart {
         self.pc = prog.entry;
         self.ray = initial_ray();
         self.box_latch = [0.0; 8];
+        self.box_exit = 0.0;
+        self.pipe_in = [0; PIPE_INPUT_WORDS];
         self.dst_latch = DstLatch::default();
         self.halted = false;
     }
@@ -445,10 +454,30 @@ impl Hart {
         Ok(())
     }
 
+    /// The node words of a ray-tracing instruction: from `P` for a register form
+    /// (`from_pipe`), else the memory operand at `addr`.
+    #[inline(always)]
+    fn node_words<M: Memory>(
+        &self,
+        from_pipe: bool,
+        prog: &Program,
+        mem: &mut M,
+        addr: u32,
+        out: &mut [u32],
+        acc: &mut MemAccess,
+    ) -> Result<(), ExecError> {
+        if from_pipe {
+            out.copy_from_slice(&self.pipe_in[..out.len()]);
+            Ok(())
+        } else {
+            self.operand_words(prog, mem, addr, out, acc)
+        }
+    }
+
     /// The box test of `rt.box`/`rt.boxn` on the six words `b` (min xyz, max xyz): the
     /// entry distance on a hit, else the canonical NaN.
     #[inline(always)]
-    fn box_test(&self, b: &[u32], t_lo: f32, t_hi: f32) -> (bool, u32) {
+    fn box_test(&self, b: &[u32], t_lo: f32, t_hi: f32) -> (bool, u32, f32) {
         let v = |k: usize| f32::from_bits(b[k]);
         let (entry, exit) = self.ray.slab(
             Vec3::new(v(0), v(1), v(2)),
@@ -457,9 +486,9 @@ impl Hart {
             t_hi,
         );
         if entry <= exit {
-            (true, entry.to_bits())
+            (true, entry.to_bits(), exit)
         } else {
-            (false, CANONICAL_NAN)
+            (false, CANONICAL_NAN, exit)
         }
     }
 
@@ -702,27 +731,33 @@ impl Hart {
                 let old = mem.atominc(a!()).map_err(|f| self.fault(f, 0, a!()))?;
                 wx!(old);
             }
-            RtBox => {
+            RtBox | RtBoxP => {
                 let mut w = [0u32; 6];
-                self.operand_words(prog, mem, a!(), &mut w, &mut acc)?;
-                wf!(self.box_test(&w, fb!(), fc!()).1);
+                self.node_words(op == RtBoxP, prog, mem, a!(), &mut w, &mut acc)?;
+                let (_, entry, exit) = self.box_test(&w, fb!(), fc!());
+                self.box_exit = exit;
+                wf!(entry);
             }
-            RtBoxN => {
+            RtBoxN | RtBoxNP => {
                 let n = imm as usize;
                 let mut w = [0u32; 48];
-                self.operand_words(prog, mem, a!(), &mut w[..6 * n], &mut acc)?;
+                self.node_words(op == RtBoxNP, prog, mem, a!(), &mut w[..6 * n], &mut acc)?;
                 let mut mask = 0;
                 for k in 0..n {
-                    let (hit, entry) = self.box_test(&w[6 * k..6 * k + 6], fb!(), fc!());
+                    let (hit, entry, _) = self.box_test(&w[6 * k..6 * k + 6], fb!(), fc!());
                     mask |= (hit as u32) << k;
                     self.box_latch[k] = f32::from_bits(entry);
                 }
                 wx!(mask);
             }
-            RtBoxGet => wf!(self.box_latch[imm as usize & 7].to_bits()),
-            RtTri => {
+            RtBoxGet => wf!(match imm {
+                0..=7 => self.box_latch[imm as usize],
+                _ => self.box_exit,
+            }
+            .to_bits()),
+            RtTri | RtTriP => {
                 let mut w = [0u32; 9];
-                self.operand_words(prog, mem, a!(), &mut w, &mut acc)?;
+                self.node_words(op == RtTriP, prog, mem, a!(), &mut w, &mut acc)?;
                 let v = |k: usize| {
                     Vec3::new(
                         f32::from_bits(w[3 * k]),
@@ -738,9 +773,9 @@ impl Hart {
                     None => CANONICAL_NAN,
                 });
             }
-            RtDst => {
+            RtDst | RtDstP => {
                 let mut w = [0u32; 3];
-                self.operand_words(prog, mem, a!(), &mut w, &mut acc)?;
+                self.node_words(op == RtDstP, prog, mem, a!(), &mut w, &mut acc)?;
                 let out = dst_step(&PipelineInput {
                     word: HeaderOffset::from_bits(w[0]),
                     p0: f32::from_bits(w[1]),
@@ -756,6 +791,10 @@ impl Hart {
                     offset_stack: out.offset_stack,
                 };
                 wx!(out.code as u32 | (out.offset << 2));
+            }
+            RtLdp => {
+                let v = u32::from_le_bytes(self.load::<4, M>(prog, mem, ea!(), &mut acc)?);
+                self.pipe_in[(rd!() + 32 * rs2!()) % PIPE_INPUT_WORDS] = v;
             }
             RtDstGet => match imm {
                 0 => wf!(self.dst_latch.t_min_out.to_bits()),

@@ -12,6 +12,14 @@ pub const OPCODE_CUSTOM0: u32 = 0x0B;
 /// Opcode of the custom-1 space (`rt.box`, `rt.boxn`, `rt.boxget`, `rt.tri`, `rt.dst`,
 /// `rt.dstget`).
 pub const OPCODE_CUSTOM1: u32 = 0x2B;
+/// Opcode of the custom-2 space (`rt.ldp`, `rt.ldph`: loads into the pipeline input
+/// registers `P`).
+pub const OPCODE_CUSTOM2: u32 = 0x5B;
+/// Opcode of the custom-3 space (`rt.boxp`, `rt.boxnp`, `rt.trip`, `rt.dstp`: the register
+/// forms, reading their node words from `P`; `funct3` and `funct2` as the memory forms').
+pub const OPCODE_CUSTOM3: u32 = 0x7B;
+/// Words of the pipeline input registers `P` (the largest reader: `rt.boxnp` with 8 boxes).
+pub const PIPE_INPUT_WORDS: usize = 48;
 
 /// The instruction format (`.insn r4` or `.insn r`) and the function field checked beside
 /// `funct3`, with its largest valid value.
@@ -27,6 +35,14 @@ pub enum Format {
         /// Largest valid `funct7`.
         funct7_max: u32,
     },
+    /// I (`.insn i`, a load's form): the 12-bit signed byte offset in bits 20–31; the `rd`
+    /// field names no register but `P[p_base + rd]`, `rd` at most `rd_max`.
+    I {
+        /// Largest valid `rd` field.
+        rd_max: u32,
+        /// The first `P` word the row reaches.
+        p_base: u32,
+    },
 }
 
 /// What the function field (`funct2` or `funct7`) becomes in the decoded immediate.
@@ -38,6 +54,8 @@ pub enum Imm {
     BoxCount,
     /// The field itself (the latch index of `rt.boxget`, `rt.dstget`).
     Field,
+    /// The sign-extended 12-bit byte offset of the I format (`rt.ldp`).
+    Offset,
 }
 
 /// One ray-tracing instruction's encoding and operands.
@@ -47,7 +65,7 @@ pub struct RtEncoding {
     pub mnemonic: &'static str,
     /// The decoded operation.
     pub op: Op,
-    /// [`OPCODE_CUSTOM0`] or [`OPCODE_CUSTOM1`].
+    /// [`OPCODE_CUSTOM0`] … [`OPCODE_CUSTOM3`].
     pub opcode: u32,
     /// `funct3`.
     pub funct3: u32,
@@ -89,9 +107,13 @@ const UNARY: [bool; 4] = [true, true, false, false];
 const MEM: [bool; 4] = [true, true, true, true];
 /// `rd` only (a latch read).
 const GET: [bool; 4] = [true, false, false, false];
+/// `rd` from `P` and the interval `rs2`, `rs3` (a register form).
+const PIPE: [bool; 4] = [true, false, true, true];
+/// A load into `P`: the address register `rs1` (the `rd` field is the `P` index).
+const LDP: [bool; 4] = [false, true, false, false];
 
 /// Every ray-tracing instruction (Lin et al. 2020, §2.3, §3; `docs/isa.md`).
-pub const RT_INSTRUCTIONS: [RtEncoding; 12] = [
+pub const RT_INSTRUCTIONS: [RtEncoding; 18] = [
     row(
         "rt.setorg",
         Op::RtSetOrg,
@@ -153,7 +175,7 @@ pub const RT_INSTRUCTIONS: [RtEncoding; 12] = [
         Op::RtBoxGet,
         OPCODE_CUSTOM1,
         2,
-        Format::R { funct7_max: 7 },
+        Format::R { funct7_max: 8 },
         GET,
         Imm::Field,
     ),
@@ -168,7 +190,75 @@ pub const RT_INSTRUCTIONS: [RtEncoding; 12] = [
         GET,
         Imm::Field,
     ),
+    row(
+        "rt.ldp",
+        Op::RtLdp,
+        OPCODE_CUSTOM2,
+        0,
+        Format::I {
+            rd_max: 31,
+            p_base: 0,
+        },
+        LDP,
+        Imm::Offset,
+    ),
+    row(
+        "rt.ldph",
+        Op::RtLdp,
+        OPCODE_CUSTOM2,
+        1,
+        Format::I {
+            rd_max: PIPE_INPUT_WORDS as u32 - 33,
+            p_base: 32,
+        },
+        LDP,
+        Imm::Offset,
+    ),
+    row(
+        "rt.boxp",
+        Op::RtBoxP,
+        OPCODE_CUSTOM3,
+        0,
+        R4,
+        PIPE,
+        Imm::None,
+    ),
+    row(
+        "rt.boxnp",
+        Op::RtBoxNP,
+        OPCODE_CUSTOM3,
+        1,
+        Format::R4 { funct2_max: 2 },
+        PIPE,
+        Imm::BoxCount,
+    ),
+    row(
+        "rt.trip",
+        Op::RtTriP,
+        OPCODE_CUSTOM3,
+        3,
+        R4,
+        PIPE,
+        Imm::None,
+    ),
+    row(
+        "rt.dstp",
+        Op::RtDstP,
+        OPCODE_CUSTOM3,
+        4,
+        R4,
+        PIPE,
+        Imm::None,
+    ),
 ];
+
+/// The `P` index an [`Format::I`] word `w` of row `e` loads (`p_base + rd`); 0 for other rows.
+pub fn pipe_index(e: &RtEncoding, w: u32) -> u8 {
+    match e.format {
+        Format::I { p_base, .. } => (p_base + ((w >> 7) & 31)) as u8,
+        _ => 0,
+    }
+}
 
 /// The table row of the custom instruction word `w`, with its decoded immediate; `None`
 /// when its opcode, `funct3` or function field names no instruction.
@@ -180,11 +270,13 @@ pub fn lookup(w: u32) -> Option<(&'static RtEncoding, i32)> {
     let field = match e.format {
         Format::R4 { funct2_max } => Some((w >> 25) & 3).filter(|&f| f <= funct2_max),
         Format::R { funct7_max } => Some(w >> 25).filter(|&f| f <= funct7_max),
+        Format::I { rd_max, .. } => Some((w >> 7) & 31).filter(|&f| f <= rd_max),
     }?;
     let imm = match e.imm {
         Imm::None => 0,
         Imm::BoxCount => 2 << field,
         Imm::Field => field as i32,
+        Imm::Offset => w as i32 >> 20,
     };
     Some((e, imm))
 }

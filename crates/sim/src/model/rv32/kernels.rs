@@ -9,6 +9,7 @@
 //! image's regions are.
 
 use crate::accel::SimAccel;
+use crate::config::KernelsConfig;
 use crate::model::rv32::placement::Placement;
 pub use crate::model::rv32::{FRAME_BUFFER_ADDR, LOCAL_STORE_ADDR, PARAMS_ADDR};
 use crate::model::rv32::{PROGRAM_BASE, Program};
@@ -156,14 +157,21 @@ pub fn placement(
     )
 }
 
-/// The file name of a kernel: `<config>-<workload>.elf`, as `kernels/Makefile` names it.
-pub fn elf_name(accel: SimAccel, workload: Workload) -> String {
-    format!("{}-{}.elf", accel.name(), workload.name())
+/// The file name of a kernel: `<config>-<workload><variant>.elf` (variant suffix `""`,
+/// `-parity`, `-loads` or `-parity-loads`, [`KernelsConfig::suffix`]), as `kernels/Makefile`
+/// names it.
+pub fn elf_name(accel: SimAccel, workload: Workload, variant: KernelsConfig) -> String {
+    format!(
+        "{}-{}{}.elf",
+        accel.name(),
+        workload.name(),
+        variant.suffix()
+    )
 }
 
-/// The compiled kernel of configuration `accel` and `workload` (an RV32IMF ELF).
-pub fn elf(accel: SimAccel, workload: Workload) -> &'static [u8] {
-    accel.kernel(workload == Workload::Path)
+/// The compiled kernel of configuration `accel`, `workload` and `variant` (an RV32IMF ELF).
+pub fn elf(accel: SimAccel, workload: Workload, variant: KernelsConfig) -> &'static [u8] {
+    accel.kernel(workload == Workload::Path, variant)
 }
 
 #[cfg(test)]
@@ -189,10 +197,12 @@ mod tests {
         let mut ours = Vec::new();
         for a in SimAccel::ALL {
             for w in Workload::ALL {
-                let name = elf_name(a, w);
-                let bytes = std::fs::read(format!("{dir}/{name}")).unwrap();
-                assert_eq!(elf(a, w), &bytes[..], "{name}");
-                ours.push(name);
+                for v in KernelsConfig::ALL {
+                    let name = elf_name(a, w, v);
+                    let bytes = std::fs::read(format!("{dir}/{name}")).unwrap();
+                    assert_eq!(elf(a, w, v), &bytes[..], "{name}");
+                    ours.push(name);
+                }
             }
         }
         ours.sort();
@@ -200,6 +210,7 @@ mod tests {
         let mk = kernels_file("Makefile");
         assert!(mk.contains("CONFIGS := bvh2 bvh2+ bvh4 bvh4+ bvh8 bvh8+ dst-sw dst"));
         assert!(mk.contains("WORKLOADS := cast path"));
+        assert!(mk.contains("VARIANTS := base parity loads parity-loads"));
     }
 
     /// The C header spells the constants the Rust side uses.

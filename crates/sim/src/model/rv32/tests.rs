@@ -551,7 +551,7 @@ fn decode_errors_and_rounding_modes() {
     assert!(decode(i(0x13, 1, 1, 1, 0x420)).is_err());
     // Custom instructions with bad function fields.
     assert!(decode(r4(0x2B, 1, 3, 1, 2, 3, 4)).is_err()); // boxn N = 16
-    assert!(decode(r(0x2B, 2, 8, 1, 0, 0)).is_err()); // boxget k = 8
+    assert!(decode(r(0x2B, 2, 9, 1, 0, 0)).is_err()); // boxget k = 9
     assert!(decode(r(0x2B, 5, 3, 1, 0, 0)).is_err()); // dstget field 3
     assert!(decode(r(0x0B, 6, 0, 1, 0, 0)).is_err());
     // CSRs read 0; writing frm = RNE is fine, another mode is an error.
@@ -733,7 +733,7 @@ mod custom {
             )
     }
 
-    /// The program: set R, rt.box, rt.boxn, 8 × rt.boxget, rt.tri, rt.dst, 3 × rt.dstget,
+    /// The program: set R, rt.box, rt.boxn, 8 × rt.boxget, rt.boxget 8 (B.exit), rt.tri, rt.dst, 3 × rt.dstget,
     /// rt.rcp, 2 × rt.atominc.
     fn program(f2: u32) -> Program {
         let mut w = vec![
@@ -746,6 +746,7 @@ mod custom {
         ];
         w.extend((0..8).map(|k| r(0x2B, 2, k, 20 + k, 0, 0))); // f20+k = B[k]
         w.extend([
+            r(0x2B, 2, 8, 19, 0, 0),       // f19 = B.exit (rt.box's, not rt.boxn's)
             r4(0x2B, 3, 0, 14, 8, 11, 12), // f14 = rt.tri (x8), f11, f12
             r4(0x2B, 4, 0, 9, 10, 28, 29), // x9 = rt.dst (x10), f28, f29
             r(0x2B, 5, 0, 15, 0, 0),       // f15 = D.t_min_out
@@ -754,6 +755,42 @@ mod custom {
             r(0x0B, 4, 0, 17, 1, 0),       // f17 = rt.rcp f1
             r(0x0B, 5, 0, 12, 0, 0),       // x12 = rt.atominc G[x0]
             r(0x0B, 5, 0, 13, 0, 0),       // x13 = rt.atominc G[x0]
+            EBREAK,
+        ]);
+        Program::from_words(BASE, &w)
+    }
+
+    /// `program(f2)` with each memory form replaced by its `rt.ldp` loads (`rt.ldph` from
+    /// `P[32]`) and the register form: the same registers and latches result.
+    fn program_loads(f2: u32) -> Program {
+        let ldp = |k: u32, base: u32, word: u32| {
+            let (f3, rd) = if k < 32 { (0, k) } else { (1, k - 32) };
+            i(0x5B, f3, rd, base, 4 * word as i32)
+        };
+        let n = 2u32 << f2;
+        let mut w = vec![
+            r4(0x0B, 0, 0, 0, 1, 2, 3),
+            r4(0x0B, 1, 0, 0, 4, 5, 6),
+            r4(0x0B, 2, 0, 0, 7, 8, 9),
+            r(0x0B, 3, 0, 0, 5, 0),
+        ];
+        w.extend((0..6).map(|k| ldp(k, 6, k)));
+        w.push(r4(0x7B, 0, 0, 10, 0, 11, 12)); // f10 = rt.boxp f11, f12
+        w.extend((0..6 * n).map(|k| ldp(k, 6, k)));
+        w.push(r4(0x7B, 1, f2, 7, 0, 11, 12)); // x7 = rt.boxnp
+        w.extend((0..8).map(|k| r(0x2B, 2, k, 20 + k, 0, 0)));
+        w.push(r(0x2B, 2, 8, 19, 0, 0));
+        w.extend((0..9).map(|k| ldp(k, 8, k)));
+        w.push(r4(0x7B, 3, 0, 14, 0, 11, 12)); // f14 = rt.trip
+        w.extend((0..3).map(|k| ldp(k, 10, k)));
+        w.extend([
+            r4(0x7B, 4, 0, 9, 0, 28, 29), // x9 = rt.dstp f28, f29
+            r(0x2B, 5, 0, 15, 0, 0),
+            r(0x2B, 5, 1, 16, 0, 0),
+            r(0x2B, 5, 2, 11, 0, 0),
+            r(0x0B, 4, 0, 17, 1, 0),
+            r(0x0B, 5, 0, 12, 0, 0),
+            r(0x0B, 5, 0, 13, 0, 0),
             EBREAK,
         ]);
         Program::from_words(BASE, &w)
@@ -799,6 +836,17 @@ mod custom {
         h.f[12] = f(c.t_hi);
         h.f[28] = f(c.t_min);
         h.f[29] = f(c.t_max);
+        // The load form from the same state.
+        let mut hp = h.clone();
+        let prog_p = program_loads(c.log2n);
+        let mut mem_p = FrameMemory::new(&image, &[], 0);
+        let mut retired_p = Vec::new();
+        while !hp.halted {
+            retired_p.push(
+                hp.step(&prog_p, &mut mem_p)
+                    .map_err(|e| TestCaseError::fail(e.to_string()))?,
+            );
+        }
         let mut retired = Vec::new();
         while !h.halted {
             retired.push(
@@ -825,6 +873,8 @@ mod custom {
             }
         };
         prop_assert_eq!(h.f[10], slab(c.boxes[0]).1);
+        let exit = pre.slab(c.boxes[0].0, c.boxes[0].1, c.t_lo, c.t_hi).1;
+        prop_assert_eq!(h.f[19], exit.to_bits());
         let mut mask = 0;
         for k in 0..n {
             let (hit, entry) = slab(c.boxes[k]);
@@ -874,10 +924,32 @@ mod custom {
         prop_assert_eq!(retired[4].fu(), FuClass::BoxPipe(1));
         prop_assert_eq!(retired[5].mem, acc(0, 6 * n as u8, false));
         prop_assert_eq!(retired[5].fu(), FuClass::BoxPipe(n as u8));
-        prop_assert_eq!(retired[14].mem, acc(TRI_ADDR, 9, false));
-        prop_assert_eq!(retired[14].fu(), FuClass::TriPipe);
-        prop_assert_eq!(retired[15].mem, acc(LOCAL_STORE_ADDR, 3, true));
-        prop_assert_eq!(retired[15].fu(), FuClass::DstPipe);
+        prop_assert_eq!(retired[15].mem, acc(TRI_ADDR, 9, false));
+        prop_assert_eq!(retired[15].fu(), FuClass::TriPipe);
+        prop_assert_eq!(retired[16].mem, acc(LOCAL_STORE_ADDR, 3, true));
+        prop_assert_eq!(retired[16].fu(), FuClass::DstPipe);
+        // The load form: the same registers and latches; rt.ldp is a one-word load into P,
+        // the register forms read no memory.
+        prop_assert_eq!(hp.x, h.x);
+        prop_assert_eq!(hp.f, h.f);
+        prop_assert_eq!(hp.box_latch.map(f), h.box_latch.map(f));
+        prop_assert_eq!(hp.box_exit.to_bits(), h.box_exit.to_bits());
+        prop_assert_eq!(hp.dst_latch.offset_stack, h.dst_latch.offset_stack);
+        for r in &retired_p {
+            match r.fu() {
+                FuClass::Load => {
+                    prop_assert_eq!(r.mem.words, 1);
+                    prop_assert!(r.info.latches.has(Latches::WRITES_PIPE));
+                }
+                FuClass::LocalLoad => prop_assert_eq!((r.mem.words, r.mem.local), (1, true)),
+                FuClass::BoxPipe(_) | FuClass::TriPipe | FuClass::DstPipe => {
+                    prop_assert_eq!(r.mem, MemAccess::NONE);
+                    prop_assert!(r.info.latches.has(Latches::READS_PIPE));
+                }
+                _ => {}
+            }
+        }
+        prop_assert_eq!(&hp.pipe_in[..3], &c.node[..]);
         Ok(())
     }
 

@@ -83,10 +83,12 @@ pub struct Tp {
     /// `f0..f31`), and what produces it.
     ready: [Cycle; 64],
     producer: [Producer; 64],
-    /// The same for the ray registers `R`, the box latch `B` and the DST latch `D`.
+    /// The same for the ray registers `R`, the box latch `B`, the DST latch `D` and the
+    /// pipeline input registers `P` (the latest of the loads that wrote them).
     ray_ready: Cycle,
     box_ready: Cycle,
     dst_ready: Cycle,
+    pipe_ready: Cycle,
     /// The latest result of any instruction so far.
     last: Cycle,
     waiting: Option<Waiting>,
@@ -108,6 +110,7 @@ impl Tp {
             ray_ready: Cycle::ZERO,
             box_ready: Cycle::ZERO,
             dst_ready: Cycle::ZERO,
+            pipe_ready: Cycle::ZERO,
             last: Cycle::ZERO,
             waiting: None,
             rays: 0,
@@ -184,6 +187,11 @@ impl Tp {
                     self.dst_ready,
                     Producer::Pipeline,
                 ),
+                (
+                    l.has(Latches::READS_PIPE),
+                    self.pipe_ready,
+                    Producer::Memory,
+                ),
             ] {
                 if reads && ready > at {
                     (at, why) = (ready, p);
@@ -251,6 +259,9 @@ impl Tp {
                     let i = l1_load(tm, l2, placement, &r, t, now, stalls);
                     self.t = i.next_issue;
                     self.write(dst, i.ready, Producer::Memory);
+                    if l.has(Latches::WRITES_PIPE) {
+                        self.pipe_ready = self.pipe_ready.max(i.ready);
+                    }
                     continue;
                 }
                 FuClass::Store => {
@@ -278,6 +289,13 @@ impl Tp {
                         dst,
                         latches: l,
                     };
+                    if l.has(Latches::READS_PIPE) {
+                        // A register form: its words are in P (waited for above).
+                        let p = tm.pipe(pipe, n, n > 1, t);
+                        stalls.pipeline_busy += p.busy;
+                        self.finish_pipe(p, w);
+                        continue;
+                    }
                     // The words are in the unit's operand latches at `i.ready`; the
                     // instruction holds the issue stage until then.
                     let arrive = i.ready.max(i.next_issue);
@@ -301,6 +319,10 @@ impl Tp {
             self.write(dst, slot + lat, p);
             if l.has(Latches::WRITES_RAY) {
                 self.ray_ready = slot + lat;
+            }
+            if l.has(Latches::WRITES_PIPE) {
+                // rt.ldp from the local store.
+                self.pipe_ready = self.pipe_ready.max(slot + lat);
             }
         }
     }
@@ -457,6 +479,25 @@ mod tests {
         let (end, s) = run(&cfg, &[mul], 2);
         assert_eq!(s.fu_busy, 1);
         assert_eq!(end, 2);
+    }
+
+    #[test]
+    fn a_register_form_waits_for_the_loads_into_p_like_a_load_use() {
+        let cfg = SimConfig::lin2020();
+        let boxp = r4(0x7B, 0, 0, 1, 0, 0, 0); // f1 = rt.boxp f0, f0
+        // With P ready, rt.boxp issues at 0 on the ray-box pipeline; its result is in at 8.
+        let (end, s) = run(&cfg, &[boxp], 1);
+        assert_eq!((end, s.memory), (cfg.units.box_latency, 0));
+        // lw x1, 0(x0); addi x2, x1, 1: the addi waits for the miss.
+        let (end_lw, s_lw) = run(&cfg, &[i(0x03, 2, 1, 0, 0), addi(2, 1, 1)], 1);
+        // rt.ldp P[0], 0(x0); rt.boxp: the same wait, then the pipeline's latency.
+        let (end_p, s_p) = run(&cfg, &[i(0x5B, 0, 0, 0, 0), boxp], 1);
+        assert!(s_lw.memory >= 28, "{s_lw:?}");
+        assert_eq!(s_p.memory, s_lw.memory);
+        assert_eq!(
+            end_p - end_lw,
+            cfg.units.box_latency - cfg.units.int_latency
+        );
     }
 
     #[test]
