@@ -245,8 +245,10 @@ pub struct EnergyConfig {
     pub dst_pipe_nj: f64,
 }
 
-/// The variant of the compiled kernels (`kernels/`): the `[kernels]` table.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+/// The variant of the compiled kernels (`kernels/`): the `[kernels]` table. The default
+/// (lin2020) is the one the sources describe: the paper's traversals (`parity = true`) and
+/// SimTRaX's pipeline input registers (`node_fetch = "loads"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct KernelsConfig {
     /// `true`: the traversals as Lin et al. 2020 describe them (§4: "ray-box intersection
@@ -259,6 +261,15 @@ pub struct KernelsConfig {
     pub node_fetch: NodeFetch,
 }
 
+impl Default for KernelsConfig {
+    fn default() -> Self {
+        Self {
+            parity: true,
+            node_fetch: NodeFetch::Loads,
+        }
+    }
+}
+
 /// How the kernels hand node words to the ray-box, ray-triangle and dual-split pipelines
 /// (`docs/isa.md`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -266,10 +277,10 @@ pub struct KernelsConfig {
 pub enum NodeFetch {
     /// `rt.box`, `rt.boxn`, `rt.tri`, `rt.dst` read their words through a memory operand,
     /// all in one issue.
-    #[default]
     Operand,
     /// One `rt.ldp` per word into the pipeline input registers, then the register form:
     /// SimTRaX's `LOADPIPEGLB` form (`sim/Instruction.h`, lines 110–111).
+    #[default]
     Loads,
 }
 
@@ -433,8 +444,8 @@ impl SimConfig {
                 dst_pipe_nj: 0.0610,
             },
             kernels: KernelsConfig {
-                parity: false,
-                node_fetch: NodeFetch::Operand,
+                parity: true,
+                node_fetch: NodeFetch::Loads,
             },
         }
     }

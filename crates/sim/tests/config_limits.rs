@@ -228,11 +228,11 @@ fn kernel_variants_are_checked_and_fast_runs_only_the_default() {
         assert!(e.to_string().contains(key), "{toml}: {e}");
     }
     let e = SimConfig::from_toml("[kernels]\nnode_fetch = \"memory\"").unwrap_err();
-    assert!(e.to_string().contains("loads"), "the valid names: {e}");
+    assert!(e.to_string().contains("operand"), "the valid names: {e}");
     refused("[kernels]\nvariant = \"paper\"", "variant");
     let (scene, s) = scene();
     let settings = RenderSettings::new(4, 4, Workload::Cast);
-    for toml in ["parity = true", "node_fetch = \"loads\""] {
+    for toml in ["parity = false", "node_fetch = \"operand\""] {
         let cfg =
             SimConfig::from_toml(&format!("tms = 1\ntps_per_tm = 2\n[kernels]\n{toml}")).unwrap();
         assert_ne!(cfg.kernels, dualsplit_sim::KernelsConfig::default());
