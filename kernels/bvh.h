@@ -145,8 +145,9 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
 #define BOX_ENTRY(k) RT_BOX(&node->box[k], t_min, limit)
 #endif
 #if KERNEL_PARITY
-/* Every slot's box is tested, empty slots included (Lin et al. 2020, §4: a BVH node's boxes
- * are all tested, then the hit children are ordered). */
+/* Every slot's box is tested, empty slots included ("ray-box intersection tests are executed
+ * serially for each box in a BVH node", Lin et al. 2020, §4), and the hits are ordered
+ * ("additional operations for child node ordering", §4.4). */
 #define CHILD(k)                                                                       \
     do {                                                                               \
         int kind = child_kind_no_box(node, k);                                         \

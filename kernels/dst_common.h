@@ -12,10 +12,10 @@ struct Entry {
 _Static_assert(STACK_SIZE * sizeof(struct Entry) <= LOCAL_STORE_BYTES * 5 / 8,
                "the traversal stack leaves room for the renderer's frames");
 
+#if !KERNEL_PARITY
 /* RayPre::slab of the scene box on [t_lo, t_hi]: the clipped interval, non-empty when the
  * ray meets the box. Near and far planes by the ray's signs; far planes widened; NaN plane
  * distances ignored (f_max/f_min return the other operand). */
-#if !KERNEL_PARITY
 static void scene_slab(const struct RayPre *r, float t_lo, float t_hi, float *entry,
                        float *exit)
 {
@@ -37,8 +37,8 @@ static void scene_slab(const struct RayPre *r, float t_lo, float t_hi, float *en
 /* The start of both traversals: the ray's interval clipped to the scene box in *t_min,
  * *t_max; 0 when the tree is empty or the ray misses the box (nothing to traverse). With
  * KERNEL_PARITY the ray-box pipeline clips (one rt.box on the scene box, whose 6 words
- * scene_min, scene_max follow each other in the parameter block; rt.boxexit reads the exit
- * distance), else the slab test runs in software. */
+ * scene_min, scene_max follow each other in the parameter block; rt_boxexit, rt.boxget 8,
+ * reads the exit distance), else the slab test runs in software. */
 static inline int dst_clip(const struct Ray *ray, const struct RayPre *r, float *t_min,
                            float *t_max)
 {

@@ -6,7 +6,9 @@
 #   scripts/validation-study.sh [OUT]       (default OUT: validation-study)
 #
 # Needs target/release/dualsplit (cargo build --release) and the shipped meshes
-# (DUALSPLIT_SCENES, default ../shared/scenes; scripts/get-scenes.sh). Runs JOBS jobs at a
+# (DUALSPLIT_SCENES, default ../shared/scenes; scripts/get-scenes.sh). RES (default 256) is
+# the studies' frame size; the paper-frame study runs at 1024x1024 (SKIP_PAPER_FRAME=1 leaves
+# it out: about an hour of one core). Runs JOBS jobs at a
 # time (default: the number of cores); every study shares one result cache, so an entry two
 # studies have in common runs once. Rerunning skips what is done. Each study's table ends up
 # in OUT/<study>/report/variants.md; docs/validation.md quotes them.
@@ -22,31 +24,33 @@ BOX=$S/dragon_box.ply.gz
 CLOSED=$OUT/scenes/dragon_box_closed.ply.gz
 [ -f "$CLOSED" ] || $D -q scene dragon-box "$S/dragon.ply.gz" --closed -o "$CLOSED"
 
-# study NAME [plan arguments...]: plan the study with the shared cache.
+# study NAME RES [plan arguments...]: plan the study at RES x RES with the shared cache.
 study() {
-  local name=$1
-  shift
+  local name=$1 res=$2
+  shift 2
   rm -rf "${OUT:?}/$name"
-  $D -q plan --model rv32 --tms 64 --res "$RES" --out "$OUT/$name" "$@" >/dev/null
+  $D -q plan --model rv32 --tms 64 --res "$res" --out "$OUT/$name" "$@" >/dev/null
   rm -rf "${OUT:?}/$name/cache"
   ln -s ../cache "$OUT/$name/cache"
   echo "$name"
 }
 
 {
-  study base "$BOX" --workload cast,path
-  study l2-banking "$BOX" --workload path --vary l2.line_interleaved=false,true \
+  study base "$RES" "$BOX" --workload cast,path
+  # The paper's frame size for its ray casting (Table 4 states 1024x1024), both workloads.
+  [ -n "${SKIP_PAPER_FRAME:-}" ] || study paper-frame 1024 "$BOX" --workload cast,path
+  study l2-banking "$RES" "$BOX" --workload path --vary l2.line_interleaved=false,true \
     --vary l2.refuse_conflicts=true,false
-  study l2-latency "$BOX" --workload path --vary l2.hit_latency=5,3
-  study dram-rows "$BOX" --workload path --vary dram.row_bytes=2048,8192
-  study dram-faw "$BOX" --workload path --vary dram.t_faw=80,0
-  study dram-refresh "$BOX" --workload path --vary dram.t_refi=15600,0
-  study dram-queue "$BOX" --workload path --vary dram.read_queue=80,64
-  study icache "$BOX" --workload path --vary units.icache_fetches=2,0
-  study kernel-parity "$BOX" --workload cast,path --vary kernels.parity=true,false
-  study instruction-form "$BOX" --workload cast,path --vary kernels.node_fetch=loads,operand
-  study enclosure "$BOX" "$CLOSED" --workload path
-  study previous-model "$BOX" --workload cast,path --config configs/model8.toml
+  study l2-latency "$RES" "$BOX" --workload path --vary l2.hit_latency=5,3
+  study dram-rows "$RES" "$BOX" --workload path --vary dram.row_bytes=2048,8192
+  study dram-faw "$RES" "$BOX" --workload path --vary dram.t_faw=80,0
+  study dram-refresh "$RES" "$BOX" --workload path --vary dram.t_refi=15600,0
+  study dram-queue "$RES" "$BOX" --workload path --vary dram.read_queue=80,64
+  study icache "$RES" "$BOX" --workload path --vary units.icache_fetches=2,0
+  study kernel-parity "$RES" "$BOX" --workload cast,path --vary kernels.parity=true,false
+  study instruction-form "$RES" "$BOX" --workload cast,path --vary kernels.node_fetch=loads,operand
+  study enclosure "$RES" "$BOX" "$CLOSED" --workload path
+  study previous-model "$RES" "$BOX" --workload cast,path --config configs/model8.toml
 } >"$OUT/studies.txt"
 
 # Every entry of every study, run JOBS at a time (run-job skips entries already done).

@@ -7,7 +7,7 @@ use crate::produce::CPU_RAYS;
 use crate::tables::{dram_split, metric};
 use dualsplit_accel::AccelKind;
 use dualsplit_render::{RayKind, Workload};
-use dualsplit_sim::{SimAccel, StallShares};
+use dualsplit_sim::{SimAccel, StallShares, ThreadModel};
 
 fn range(v: &[f64]) -> Option<(f64, f64)> {
     let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
@@ -132,12 +132,12 @@ pub fn table45(data: &ReportData, workload: Workload) -> String {
                 }
             }
         }
-        let best = SimAccel::ALL
+        let times: Vec<(SimAccel, f64)> = SimAccel::ALL
             .iter()
             .filter_map(|&a| Some((a, s.sim(a, workload, tms)?.frame_ms)))
-            .min_by(|x, y| x.1.total_cmp(&y.1));
-        if let Some((a, _)) = best {
-            fastest.push(format!("{} on {}", a.label(), s.name));
+            .collect();
+        if let Some(f) = fastest_text(&times, data.settings.thread_model) {
+            fastest.push(format!("{f} on {}", s.name));
         }
     }
     if ours[0].is_empty() && !fastest.is_empty() {
@@ -195,6 +195,34 @@ pub fn table45(data: &ReportData, workload: Workload) -> String {
         out.push(why_frame_time(data, workload));
     }
     out.join(" ")
+}
+
+/// The fastest of `times` (configuration, frame time) as text. With the `fast` thread model,
+/// every configuration within its measured frame-time error of the fastest
+/// ([`dualsplit_sim::model::fast::FRAME_TIME_ERROR`]) is named with it, their order
+/// unresolved.
+fn fastest_text(times: &[(SimAccel, f64)], model: ThreadModel) -> Option<String> {
+    let best = times.iter().min_by(|x, y| x.1.total_cmp(&y.1))?;
+    if model != ThreadModel::Fast {
+        return Some(best.0.label().to_string());
+    }
+    let err = dualsplit_sim::model::fast::FRAME_TIME_ERROR;
+    let mut close: Vec<&(SimAccel, f64)> = times
+        .iter()
+        .filter(|t| t.0 != best.0 && t.1 < best.1 * (1.0 + err))
+        .collect();
+    close.sort_by(|x, y| x.1.total_cmp(&y.1));
+    if close.is_empty() {
+        return Some(best.0.label().to_string());
+    }
+    let others: Vec<&str> = close.iter().map(|t| t.0.label()).collect();
+    Some(format!(
+        "{} (order unresolved against {}: within the fast model's measured {:.0} % \
+         frame-time error)",
+        best.0.label(),
+        others.join(", "),
+        100.0 * err
+    ))
 }
 
 /// Where DST's frame time differs from the paper's: what the threads spent their cycles on,
@@ -468,6 +496,24 @@ mod tests {
             scene_files: Default::default(),
             paper: PaperValues::published(),
         }
+    }
+
+    #[test]
+    fn a_fastest_within_the_fast_models_error_is_unresolved() {
+        let t = [
+            (SimAccel::Bvh2, 1.0),
+            (SimAccel::Dst, 0.80),
+            (SimAccel::Bvh8Plus, 0.82),
+            (SimAccel::Bvh4, 0.95),
+        ];
+        let fast = fastest_text(&t, ThreadModel::Fast).unwrap();
+        assert!(
+            fast.starts_with("DST (order unresolved against BVH8+:"),
+            "{fast}"
+        );
+        assert_eq!(fastest_text(&t, ThreadModel::Rv32).unwrap(), "DST");
+        let apart = [(SimAccel::Bvh2, 1.0), (SimAccel::Dst, 0.8)];
+        assert_eq!(fastest_text(&apart, ThreadModel::Fast).unwrap(), "DST");
     }
 
     #[test]
