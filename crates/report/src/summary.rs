@@ -228,10 +228,11 @@ fn why_frame_time(data: &ReportData, workload: Workload) -> String {
         return String::new();
     }
     format!(
-        "Why DST's frame time differs, measured: {}. DST saves memory traffic, so it saves \
-         time in the measure that the frame waits for memory; where the threads mostly issue \
-         instructions, its savings are small (docs/simulator.md, \"The paper's Dragon Box on \
-         the compiled kernels\", shows the same with more TMs).",
+        "Why DST's frame time differs, measured: {}. Our reading (an inference from these \
+         shares, not a measurement): DST saves memory traffic, so it can save time only as far \
+         as the frame waits for memory; where the threads mostly issue instructions, its \
+         savings are small (docs/simulator.md, \"The reconstructed Dragon Box on the compiled \
+         kernels\", gives the shares at 128 TMs).",
         per_scene.join("; ")
     )
 }
