@@ -212,7 +212,8 @@ pub struct Scope {
     /// Square resolution of the simulated frames (default 384, 1024 with --full).
     #[arg(long, value_parser = crate::args::parse_positive)]
     pub res: Option<u32>,
-    /// The paper's setup: 1024×1024, full-size scenes, 32/64/128 TMs.
+    /// The paper's setup: 1024×1024 (the resolution it states for Table 4; it states none
+    /// for the other tables), full-size scenes, 32/64/128 TMs.
     #[arg(long)]
     pub full: bool,
     /// Folder of the shipped meshes (Dragon Box, Dragon Sponza). Default: the
