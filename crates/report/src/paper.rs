@@ -83,7 +83,8 @@ impl PaperScene {
 pub struct PaperMatch {
     /// The paper's scene.
     pub scene: PaperScene,
-    /// True when it is the same mesh (Dragon Box), false for a stand-in.
+    /// True for the paper's scene or our reconstruction of it (Crytek Sponza, the
+    /// reconstructed Dragon Box), false for a stand-in.
     pub same_mesh: bool,
 }
 
