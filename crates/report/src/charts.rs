@@ -272,7 +272,7 @@ pub fn fig9(data: &ReportData, s: &SceneReport) -> Result<Option<String>, Report
                 .collect();
             fps_panel(
                 &right,
-                &format!("paper: {} (1024², published)", m.scene.label()),
+                &format!("paper: {} (published)", m.scene.label()),
                 &paper::TABLE7_TMS,
                 &paper_series,
                 true,

@@ -179,7 +179,8 @@ impl SceneReport {
             .and_then(|s| s.bytes.as_ref().ok().copied())
     }
 
-    /// "Name (stand-in for X)" or "Name (same mesh as Dragon Box)" or "Name".
+    /// "Name (stand-in for X)" or "Name (Dragon Box (paper's scene or our reconstruction))" or
+    /// "Name".
     pub fn label(&self) -> String {
         match &self.paper {
             Some(m) => format!("{} ({})", self.name, m.describe()),

@@ -74,8 +74,9 @@ pub fn section(data: &ReportData) -> Section {
         title: "Memory system — caches and DRAM per configuration".into(),
         summary: "Hit rates, L2 bank-conflict cycles, the DRAM's row-hit rate, read latency \
                   (arrival at the DRAM to data) and achieved bandwidth over the frame, and DRAM \
-                  lines and rays per pixel. A frame near the DRAM's sustainable bandwidth with \
-                  a large memory-stall share is bandwidth-bound: there the structure that \
+                  lines and rays per pixel. A reading of them (an inference, not a measurement): a \
+                  frame near the DRAM's sustainable bandwidth with a large memory-stall share is \
+                  bandwidth-bound: there the structure that \
                   moves the fewest lines wins; a frame far from it is bound by latency and \
                   issue."
             .into(),

@@ -83,7 +83,8 @@ impl PaperScene {
 pub struct PaperMatch {
     /// The paper's scene.
     pub scene: PaperScene,
-    /// True when it is the same mesh (Dragon Box), false for a stand-in.
+    /// True for the paper's scene or our reconstruction of it (Crytek Sponza, the
+    /// reconstructed Dragon Box), false for a stand-in.
     pub same_mesh: bool,
 }
 
@@ -112,10 +113,13 @@ impl PaperMatch {
         }
     }
 
-    /// "Dragon Box (same mesh)" or "stand-in for Hairball".
+    /// "Dragon Box (paper's scene or our reconstruction)" or "stand-in for Hairball".
     pub fn describe(&self) -> String {
         if self.same_mesh {
-            format!("{} (same mesh)", self.scene.label())
+            format!(
+                "{} (paper's scene or our reconstruction)",
+                self.scene.label()
+            )
         } else {
             format!("stand-in for {}", self.scene.label())
         }
@@ -410,7 +414,10 @@ mod tests {
         // The real Crytek Sponza is the paper's mesh; the Dabrovic atrium a stand-in.
         let m = PaperMatch::for_scene("crytek_sponza", "scenes/crytek_sponza.gltf").unwrap();
         assert_eq!((m.scene, m.same_mesh), (PaperScene::CrytekSponza, true));
-        assert_eq!(m.describe(), "Crytek Sponza (same mesh)");
+        assert_eq!(
+            m.describe(),
+            "Crytek Sponza (paper's scene or our reconstruction)"
+        );
         let m = PaperMatch::for_scene("sponza_dabrovic", "s/sponza_dabrovic.ply.gz").unwrap();
         assert_eq!((m.scene, m.same_mesh), (PaperScene::CrytekSponza, false));
     }

@@ -135,10 +135,10 @@ pub struct PaperFile {
 }
 
 impl PaperFile {
-    /// "Dragon Box (dragon_box.ply.gz, the paper's mesh)".
+    /// "Dragon Box (dragon_box.ply.gz, the paper's scene, or for Dragon Box our reconstruction of it)".
     pub fn describe(&self) -> String {
         let kind = if self.same_mesh {
-            "the paper's mesh"
+            "the paper's scene, or for Dragon Box our reconstruction of it"
         } else {
             "a stand-in"
         };
@@ -284,13 +284,13 @@ mod tests {
         let text = files.describe();
         assert!(
             text.contains(
-                "found: Dragon Box (dragon_box.ply.gz, the paper's mesh). Not found: Dragon Sponza"
+                "found: Dragon Box (dragon_box.ply.gz, the paper's scene, or for Dragon Box our reconstruction of it). Not found: Dragon Sponza"
             ),
             "{text}"
         );
         assert_eq!(files.path_of(PaperScene::CrytekSponza), None);
         assert!(
-            text.contains("Crytek Sponza (crytek_sponza.gltf, the paper's mesh)"),
+            text.contains("Crytek Sponza (crytek_sponza.gltf, the paper's scene, or for Dragon Box our reconstruction of it)"),
             "{text}"
         );
         let none = SceneFiles::scan(None).describe();

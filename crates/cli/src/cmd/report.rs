@@ -36,7 +36,8 @@ pub const DEFAULT_RES: u32 = 384;
 /// The paper's scenes for `--full`: full-size builtins, plus the shipped meshes of
 /// `dualsplit_report::scenes::PAPER_FILES` found in the scenes folder.
 pub const FULL_SCENES: [&str; 3] = ["builtin:atrium", "builtin:forest", "builtin:hairball"];
-/// The paper's resolution (§4.3).
+/// 1024×1024: the resolution the paper states for Table 4 (ray casting); it states none
+/// for path tracing (Table 5) or the other tables.
 pub const FULL_RES: u32 = 1024;
 /// Square resolution of the CPU ray sets (path workload rays).
 pub const CPU_RES: u32 = 320;

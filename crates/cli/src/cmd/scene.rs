@@ -1,6 +1,6 @@
 //! `dualsplit scene`: scene files made from public meshes.
 //!
-//! `dualsplit scene dragon-box DRAGON -o dragon_box.ply.gz` builds the paper's Dragon Box
+//! `dualsplit scene dragon-box DRAGON -o dragon_box.ply.gz` builds the reconstructed Dragon Box
 //! from the Stanford dragon exactly as the shipped `dragon_box.ply.gz` was made
 //! ([`dualsplit_scene::make`]): the dragon's triangles in file order, then an open box
 //! of 10 triangles. DRAGON is any scene file (the Stanford `dragon_vrip.ply`, or the
@@ -20,7 +20,7 @@ use std::process::ExitCode;
 /// The scene files `dualsplit scene` makes.
 #[derive(clap::Subcommand)]
 pub enum Command {
-    /// The paper's Dragon Box from the Stanford dragon: the dragon, then an axis-aligned
+    /// The reconstructed Dragon Box from the Stanford dragon: the dragon, then an axis-aligned
     /// cube (side 1.5 × the dragon's largest extent) open on +z, the dragon on its floor.
     DragonBox(DragonBoxArgs),
     /// Any scene file (.obj, .ply, .gltf, .glb, optionally .gz) as a gzipped binary PLY of
