@@ -179,7 +179,7 @@ impl SceneReport {
             .and_then(|s| s.bytes.as_ref().ok().copied())
     }
 
-    /// "Name (stand-in for X)" or "Name (Dragon Box (paper's scene or our reconstruction))" or
+    /// "Name (stand-in for X)" or "Name (Dragon Box, reconstructed)" or
     /// "Name".
     pub fn label(&self) -> String {
         match &self.paper {

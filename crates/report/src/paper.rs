@@ -113,13 +113,13 @@ impl PaperMatch {
         }
     }
 
-    /// "Dragon Box (paper's scene or our reconstruction)" or "stand-in for Hairball".
+    /// "Dragon Box, reconstructed", "Crytek Sponza, the paper's mesh" or "stand-in for
+    /// Hairball".
     pub fn describe(&self) -> String {
-        if self.same_mesh {
-            format!(
-                "{} (paper's scene or our reconstruction)",
-                self.scene.label()
-            )
+        if self.same_mesh && self.scene == PaperScene::DragonBox {
+            "Dragon Box, reconstructed".to_string()
+        } else if self.same_mesh {
+            format!("{}, the paper's mesh", self.scene.label())
         } else {
             format!("stand-in for {}", self.scene.label())
         }
@@ -414,10 +414,7 @@ mod tests {
         // The real Crytek Sponza is the paper's mesh; the Dabrovic atrium a stand-in.
         let m = PaperMatch::for_scene("crytek_sponza", "scenes/crytek_sponza.gltf").unwrap();
         assert_eq!((m.scene, m.same_mesh), (PaperScene::CrytekSponza, true));
-        assert_eq!(
-            m.describe(),
-            "Crytek Sponza (paper's scene or our reconstruction)"
-        );
+        assert_eq!(m.describe(), "Crytek Sponza, the paper's mesh");
         let m = PaperMatch::for_scene("sponza_dabrovic", "s/sponza_dabrovic.ply.gz").unwrap();
         assert_eq!((m.scene, m.same_mesh), (PaperScene::CrytekSponza, false));
     }
