@@ -144,6 +144,28 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
 #else
 #define BOX_ENTRY(k) RT_BOX(&node->box[k], t_min, limit)
 #endif
+/* A hit child (entry distance `entry`, slot kind `kind`, first word `addr`) joins the
+ * traversal order: the nearest in `cur`, the others on the stack, nearest on top. */
+#define ORDER_HIT(entry, kind)                                                         \
+    do {                                                                               \
+        struct Entry c = {entry, kind == CHILD_LEAF ? addr | ENTRY_LEAF : addr};       \
+        if (!have_cur) {                                                               \
+            cur = c;                                                                   \
+            have_cur = 1;                                                              \
+        } else if (entry < cur.t) {                                                    \
+            /* A later slot is nearer only when strictly nearer. */                    \
+            stack[sp++] = cur;                                                         \
+            cur = c;                                                                   \
+        } else {                                                                       \
+            /* Below the stacked entries that are nearer or equally near. */           \
+            int j = sp++;                                                              \
+            while (j > base && stack[j - 1].t <= entry) {                              \
+                stack[j] = stack[j - 1];                                               \
+                j--;                                                                   \
+            }                                                                          \
+            stack[j] = c;                                                              \
+        }                                                                              \
+    } while (0)
 #if KERNEL_PARITY
 /* Every slot's box is tested, empty slots included ("ray-box intersection tests are executed
  * serially for each box in a BVH node", Lin et al. 2020, §4), and the hits are ordered
@@ -153,23 +175,7 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
         int kind = child_kind_no_box(node, k);                                         \
         float entry = BOX_ENTRY(k);                                                    \
         if (entry == entry) {                                                          \
-            struct Entry c = {entry, kind == CHILD_LEAF ? addr | ENTRY_LEAF : addr};   \
-            if (!have_cur) {                                                           \
-                cur = c;                                                               \
-                have_cur = 1;                                                          \
-            } else if (entry < cur.t) {                                                \
-                /* A later slot is nearer only when strictly nearer. */                \
-                stack[sp++] = cur;                                                     \
-                cur = c;                                                               \
-            } else {                                                                   \
-                /* Below the stacked entries that are nearer or equally near. */       \
-                int j = sp++;                                                          \
-                while (j > base && stack[j - 1].t <= entry) {                          \
-                    stack[j] = stack[j - 1];                                           \
-                    j--;                                                               \
-                }                                                                      \
-                stack[j] = c;                                                          \
-            }                                                                          \
+            ORDER_HIT(entry, kind);                                                    \
         }                                                                              \
         addr += kind == CHILD_INTERNAL ? NODE_WORDS : kind == CHILD_LEAF ? 1u : 0u;    \
     } while (0)
@@ -180,23 +186,7 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
         if (kind != CHILD_EMPTY) {                                                     \
             float entry = BOX_ENTRY(k);                                                \
             if (entry == entry) {                                                      \
-                struct Entry c = {entry, kind == CHILD_LEAF ? addr | ENTRY_LEAF : addr}; \
-                if (!have_cur) {                                                       \
-                    cur = c;                                                           \
-                    have_cur = 1;                                                      \
-                } else if (entry < cur.t) {                                            \
-                    /* A later slot is nearer only when strictly nearer. */            \
-                    stack[sp++] = cur;                                                 \
-                    cur = c;                                                           \
-                } else {                                                               \
-                    /* Below the stacked entries that are nearer or equally near. */   \
-                    int j = sp++;                                                      \
-                    while (j > base && stack[j - 1].t <= entry) {                      \
-                        stack[j] = stack[j - 1];                                       \
-                        j--;                                                           \
-                    }                                                                  \
-                    stack[j] = c;                                                      \
-                }                                                                      \
+                ORDER_HIT(entry, kind);                                                \
             }                                                                          \
         }                                                                              \
         addr += kind == CHILD_INTERNAL ? NODE_WORDS : kind == CHILD_LEAF ? 1u : 0u;    \
