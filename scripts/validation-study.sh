@@ -51,6 +51,13 @@ study() {
   study instruction-form "$RES" "$BOX" --workload cast,path --vary kernels.node_fetch=loads,operand
   study enclosure "$RES" "$BOX" "$CLOSED" --workload path
   study previous-model "$RES" "$BOX" --workload cast,path --config configs/model8.toml
+  # More TMs: the paper's Table 7 goes to 128.
+  study tms-128 "$RES" "$BOX" --workload path --vary tms=128
+  # A mesh the model was not developed on: the Dragon Sponza stand-in (the Stanford dragon in
+  # the Dabrovic Sponza atrium), lin2020 and model 8.
+  study holdout "$RES" "$S/dragon_sponza.ply.gz" --workload path
+  study holdout-previous "$RES" "$S/dragon_sponza.ply.gz" --workload path \
+    --config configs/model8.toml
 } >"$OUT/studies.txt"
 
 # Every entry of every study, run JOBS at a time (run-job skips entries already done).
