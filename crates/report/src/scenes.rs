@@ -135,12 +135,15 @@ pub struct PaperFile {
 }
 
 impl PaperFile {
-    /// "Dragon Box (dragon_box.ply.gz, the paper's scene, or for Dragon Box our reconstruction of it)".
+    /// "Dragon Box (dragon_box.ply.gz, our reconstruction of the paper's scene)",
+    /// "Crytek Sponza (crytek_sponza.gltf, the paper's mesh)" or "… (…, a stand-in)".
     pub fn describe(&self) -> String {
-        let kind = if self.same_mesh {
-            "the paper's scene, or for Dragon Box our reconstruction of it"
-        } else {
+        let kind = if !self.same_mesh {
             "a stand-in"
+        } else if self.scene == PaperScene::DragonBox {
+            "our reconstruction of the paper's scene"
+        } else {
+            "the paper's mesh"
         };
         format!("{} ({}, {kind})", self.scene.label(), self.file)
     }
@@ -284,13 +287,13 @@ mod tests {
         let text = files.describe();
         assert!(
             text.contains(
-                "found: Dragon Box (dragon_box.ply.gz, the paper's scene, or for Dragon Box our reconstruction of it). Not found: Dragon Sponza"
+                "found: Dragon Box (dragon_box.ply.gz, our reconstruction of the paper's scene). Not found: Dragon Sponza"
             ),
             "{text}"
         );
         assert_eq!(files.path_of(PaperScene::CrytekSponza), None);
         assert!(
-            text.contains("Crytek Sponza (crytek_sponza.gltf, the paper's scene, or for Dragon Box our reconstruction of it)"),
+            text.contains("Crytek Sponza (crytek_sponza.gltf, the paper's mesh)"),
             "{text}"
         );
         let none = SceneFiles::scan(None).describe();
