@@ -221,7 +221,9 @@ impl L1 {
     /// register.
     #[cfg(test)]
     pub(crate) fn load_word(&mut self, l2: &mut L2, word: u64, slot: Cycle) -> Cycle {
-        self.first_word(l2, word, slot, Cycle::ZERO).0
+        let ready = self.first_word(l2, word, slot, Cycle::ZERO).0;
+        self.accepted = Cycle::ZERO;
+        ready
     }
     /// Adds the L1's counters to `caches`.
     pub fn add_stats(&self, caches: &mut CacheStats) {
