@@ -45,6 +45,20 @@ static inline uint32_t node_offset(const Node *n)
 #endif
 }
 
+#if BVH_ARITY != 8
+/* The kind the packed word gives slot k of a BVH2/4 node: leaf or internal (an empty slot
+ * reads as internal). */
+static inline int packed_kind(const Node *n, int k)
+{
+#if BVH_ARITY == 2
+    uint32_t bit = 31 - k;
+#else
+    uint32_t bit = 28 + k;
+#endif
+    return (n->packed >> bit) & 1u ? CHILD_LEAF : CHILD_INTERNAL;
+}
+#endif
+
 /* The kind of slot k: empty (degenerate box, min.x > max.x), leaf or internal. */
 static inline int child_kind(const Node *n, int k)
 {
@@ -54,12 +68,7 @@ static inline int child_kind(const Node *n, int k)
 #else
     if (n->box[k].lo[0] > n->box[k].hi[0])
         return CHILD_EMPTY;
-#if BVH_ARITY == 2
-    uint32_t bit = 31 - k;
-#else
-    uint32_t bit = 28 + k;
-#endif
-    return (n->packed >> bit) & 1u ? CHILD_LEAF : CHILD_INTERNAL;
+    return packed_kind(n, k);
 #endif
 }
 
@@ -73,12 +82,7 @@ static inline int child_kind_no_box(const Node *n, int k)
 #if BVH_ARITY == 8
     return child_kind(n, k);
 #else
-#if BVH_ARITY == 2
-    uint32_t bit = 31 - k;
-#else
-    uint32_t bit = 28 + k;
-#endif
-    return (n->packed >> bit) & 1u ? CHILD_LEAF : CHILD_INTERNAL;
+    return packed_kind(n, k);
 #endif
 }
 #endif
