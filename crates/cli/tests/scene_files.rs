@@ -6,6 +6,27 @@ use common::{dualsplit, stderr};
 use dualsplit_geometry::Triangle;
 use dualsplit_testkit::scenes::{shipped_path, shipped_triangles};
 
+/// Runs `dualsplit -q scene dragon-box DRAGON -o OUT EXTRA…` in `dir`; it must succeed.
+fn make_dragon_box(
+    dragon: &str,
+    out: &std::path::Path,
+    extra: &[&str],
+    dir: &std::path::Path,
+) -> std::process::Output {
+    let mut args = vec![
+        "-q",
+        "scene",
+        "dragon-box",
+        dragon,
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = dualsplit(&args, dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    o
+}
+
 /// Every coordinate's bits.
 fn bits(tris: &[Triangle]) -> Vec<[u32; 9]> {
     tris.iter()
@@ -28,18 +49,7 @@ fn dragon_box_rebuilt_from_the_shipped_dragon_is_the_shipped_dragon_box() {
     let dragon = dragon.to_str().unwrap().to_string();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("dragon_box.ply.gz");
-    let o = dualsplit(
-        &[
-            "-q",
-            "scene",
-            "dragon-box",
-            &dragon,
-            "-o",
-            out.to_str().unwrap(),
-        ],
-        dir.path(),
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = make_dragon_box(&dragon, &out, &[], dir.path());
     let rebuilt = dualsplit_scene::load(out.to_str().unwrap()).unwrap();
     let want = shipped_triangles("dragon_box.ply.gz").unwrap();
     let sha = dualsplit_scene::make::triangles_sha256(&want);
@@ -67,19 +77,8 @@ fn the_closed_dragon_box_adds_ten_triangles_to_the_open_one() {
         dir.path().join("dragon_box.ply.gz"),
         dir.path().join("dragon_box_closed.ply.gz"),
     );
-    for (out, extra) in [(&open, &[][..]), (&closed, &["--closed"][..])] {
-        let mut args = vec![
-            "-q",
-            "scene",
-            "dragon-box",
-            &dragon,
-            "-o",
-            out.to_str().unwrap(),
-        ];
-        args.extend_from_slice(extra);
-        let o = dualsplit(&args, dir.path());
-        assert!(o.status.success(), "{}", stderr(&o));
-    }
+    make_dragon_box(&dragon, &open, &[], dir.path());
+    make_dragon_box(&dragon, &closed, &["--closed"], dir.path());
     let open = dualsplit_scene::load(open.to_str().unwrap()).unwrap();
     let closed = dualsplit_scene::load(closed.to_str().unwrap()).unwrap();
     assert_eq!(closed.triangles.len(), open.triangles.len() + 10);

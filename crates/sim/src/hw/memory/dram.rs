@@ -310,14 +310,16 @@ fn faw_allows(acts: &[u64], s: u64, faw: u64) -> bool {
     let near = &acts[lo..hi];
     let at = near.partition_point(|&t| t <= s);
     // Windows holding `s`: any five consecutive of near[..at] + s + near[at..] spanning
-    // less than `faw`.
-    let v: Vec<u64> = near[..at]
-        .iter()
-        .copied()
-        .chain([s])
-        .chain(near[at..].iter().copied())
-        .collect();
-    v.windows(5).all(|w| w[4] - w[0] >= faw)
+    // less than `faw` (read in place: this runs on every activation).
+    let get = |i: usize| match i.cmp(&at) {
+        std::cmp::Ordering::Less => near[i],
+        std::cmp::Ordering::Equal => s,
+        std::cmp::Ordering::Greater => near[i - 1],
+    };
+    let len = near.len() + 1;
+    (at.saturating_sub(4)..=at)
+        .filter(|&i| i + 4 < len)
+        .all(|i| get(i + 4) - get(i) >= faw)
 }
 
 /// The DRAM system.
