@@ -83,6 +83,23 @@ pub enum SceneError {
         /// [`Scene::MAX_EXTENT`](crate::Scene::MAX_EXTENT).
         limit: f32,
     },
+    /// The scene lies, at least in part, farther than
+    /// [`Scene::MAX_COORDINATE`](crate::Scene::MAX_COORDINATE) from the origin on some axis
+    /// (the centre of a scene at 3e38 overflows to +∞, and so do its camera and light).
+    #[error(
+        "{spec}: the scene's bounds ({:e}, {:e}, {:e}) to ({:e}, {:e}, {:e}) reach beyond ±{:e} on some axis; f32 cameras, lights and ray origins overflow beyond it: move the scene toward the origin",
+        min[0], min[1], min[2], max[0], max[1], max[2], limit
+    )]
+    Far {
+        /// The spec.
+        spec: String,
+        /// Lower corner of the bounds.
+        min: [f32; 3],
+        /// Upper corner of the bounds.
+        max: [f32; 3],
+        /// [`Scene::MAX_COORDINATE`](crate::Scene::MAX_COORDINATE).
+        limit: f32,
+    },
     /// A builtin name or parameter is wrong.
     #[error("builtin scene `{spec}`: {message}")]
     Builtin {

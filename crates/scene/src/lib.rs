@@ -26,11 +26,14 @@
 //! ## Extent
 //!
 //! A scene wider than [`Scene::MAX_EXTENT`] (2^60 ≈ 1.15e18) on some axis is refused with
-//! [`SceneError::Extent`], which names the extent and the bounds. Coordinates up to ±3.4e38
-//! are valid f32, but their differences overflow: a box from −3e38 to 3e38 has an infinite
-//! extent, its surface area overflows from about 1.8e19 across, the fitted camera sits
-//! about 2.3 extents from the scene's centre, and a ray test multiplies two vertex offsets
-//! from the ray's origin. Up to 2^60 every one of these stays finite.
+//! [`SceneError::Extent`], which names the extent and the bounds; one that reaches farther
+//! than [`Scene::MAX_COORDINATE`] (also 2^60) from the origin on some axis, however small,
+//! with [`SceneError::Far`]. Coordinates up to ±3.4e38 are valid f32, but their sums and
+//! differences overflow: a box from −3e38 to 3e38 has an infinite extent, a single point
+//! at 3e38 an infinite centre, a surface area overflows from about 1.8e19 across, the
+//! fitted camera sits about 2.3 extents from the scene's centre, and a ray test multiplies
+//! two vertex offsets from the ray's origin. Within both limits every one of these stays
+//! finite.
 //!
 //! Triangle ids follow the file: the loaders emit triangles in face order of the file, each
 //! polygon fan-triangulated in place (see [`load`](mod@load)), and dropping keeps that order.
@@ -91,9 +94,14 @@ impl Scene {
     /// 1.15e18 (see the crate docs, "Extent").
     pub const MAX_EXTENT: f32 = (1u64 << 60) as f32;
 
+    /// Farthest a scene's bounds may reach from the origin on any axis: 2^60 ≈ 1.15e18 (see
+    /// the crate docs, "Extent").
+    pub const MAX_COORDINATE: f32 = (1u64 << 60) as f32;
+
     /// Builds a scene from triangles, dropping non-finite ones (counted), counting degenerate
     /// ones, and fitting a default camera and light to the bounds. A scene wider than
-    /// [`Scene::MAX_EXTENT`] is [`SceneError::Extent`].
+    /// [`Scene::MAX_EXTENT`] is [`SceneError::Extent`]; one reaching beyond
+    /// ±[`Scene::MAX_COORDINATE`] is [`SceneError::Far`].
     pub fn from_triangles(
         name: impl Into<String>,
         spec: impl Into<String>,
@@ -145,6 +153,15 @@ impl Scene {
                 max: bounds.max.to_array(),
                 extent: extent.to_array(),
                 limit: Self::MAX_EXTENT,
+            });
+        }
+        let reach = bounds.min.abs().max(bounds.max.abs());
+        if !reach.cmple(glam::Vec3::splat(Self::MAX_COORDINATE)).all() {
+            return Err(SceneError::Far {
+                spec,
+                min: bounds.min.to_array(),
+                max: bounds.max.to_array(),
+                limit: Self::MAX_COORDINATE,
             });
         }
         let camera = Camera::fit(&bounds);

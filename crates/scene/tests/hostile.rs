@@ -2,9 +2,10 @@
 //! explode, files that never end, and budgets. Each case ends in a typed error or a correct
 //! result, quickly and within the budgets.
 
+use dualsplit_geometry::{Triangle, Vec3};
 use dualsplit_scene::limits::Budget;
 use dualsplit_scene::load::{self, Format};
-use dualsplit_scene::{Limits, SceneError};
+use dualsplit_scene::{Limits, LoadStats, Scene, SceneError};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -409,7 +410,7 @@ fn the_fuzz_seeds_are_valid_scenes() {
             n += 1;
         }
     }
-    assert_eq!(n, 11);
+    assert_eq!(n, 12);
 }
 
 #[test]
@@ -430,4 +431,34 @@ fn the_extreme_coordinate_seeds_load_or_name_their_extent() {
     let s = dualsplit_scene::load(seeds.join("at_extent_limit.obj").to_str().unwrap()).unwrap();
     assert!((s.bounds.max - s.bounds.min).max_element() <= dualsplit_scene::Scene::MAX_EXTENT);
     assert!(s.camera.eye.is_finite() && s.light.position.is_finite());
+    // A single point at (3e38, −3e38, −3e38): no extent, but its centre would overflow.
+    let e = dualsplit_scene::load(seeds.join("far_point.obj").to_str().unwrap()).unwrap_err();
+    assert!(matches!(&e, SceneError::Far { .. }), "{e:?}");
+    assert!(e.to_string().contains("reach beyond ±1.1529215e18"), "{e}");
+}
+
+#[test]
+fn a_small_scene_far_from_the_origin_is_refused_by_its_reach() {
+    let at = |x: f32| {
+        Triangle::new(
+            Vec3::new(x, 0.0, 0.0),
+            Vec3::new(x, 1.0, 0.0),
+            Vec3::new(x, 0.0, 1.0),
+        )
+    };
+    let limit = dualsplit_scene::Scene::MAX_COORDINATE;
+    for x in [limit * 2.0, -1e30, 3e38] {
+        let e =
+            Scene::from_triangles("far", "far.obj", vec![at(x)], LoadStats::default()).unwrap_err();
+        assert!(
+            matches!(&e, SceneError::Far { limit: l, .. } if *l == limit),
+            "{x}: {e:?}"
+        );
+    }
+    // At the limit itself it loads, with a finite camera and light.
+    let s =
+        Scene::from_triangles("near", "near.obj", vec![at(-limit)], LoadStats::default()).unwrap();
+    assert!(
+        s.camera.eye.is_finite() && s.camera.target.is_finite() && s.light.position.is_finite()
+    );
 }

@@ -153,9 +153,10 @@ fn extreme_obj() -> impl Strategy<Value = (bool, String)> {
 proptest! {
     #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]
 
-    /// A scene at most [`Scene::MAX_EXTENT`] wide loads, and every camera and light placed
-    /// on it (the fit and each file preset) is finite; a wider one is
-    /// [`SceneError::Extent`], naming an extent beyond the limit.
+    /// A scene at most [`Scene::MAX_EXTENT`] wide and within ±[`Scene::MAX_COORDINATE`]
+    /// loads, and every camera and light placed on it (the fit and each file preset) is
+    /// finite; a wider one is [`SceneError::Extent`], naming an extent beyond the limit, and
+    /// a narrow one reaching farther is [`SceneError::Far`].
     #[test]
     fn extreme_coordinates_load_with_finite_views_or_name_the_extent((may_be_wide, obj) in extreme_obj()) {
         let mesh = load::parse_bytes(Path::new("x.obj"), Format::Obj, obj.as_bytes()).unwrap();
@@ -164,10 +165,12 @@ proptest! {
             .iter()
             .fold(dualsplit_geometry::Aabb::EMPTY, |b, t| b.union(t.bounds()));
         let wide = !(bounds.max - bounds.min).cmple(dualsplit_geometry::Vec3::splat(Scene::MAX_EXTENT)).all();
-        prop_assert!(may_be_wide || !wide, "{bounds:?}");
+        let reach = bounds.min.abs().max(bounds.max.abs());
+        let far = !reach.cmple(dualsplit_geometry::Vec3::splat(Scene::MAX_COORDINATE)).all();
+        prop_assert!(may_be_wide || !(wide || far), "{bounds:?}");
         match Scene::from_triangles("x", "x.obj", mesh.triangles, mesh.stats) {
             Ok(scene) => {
-                prop_assert!(!wide, "{:?} loaded", scene.bounds);
+                prop_assert!(!wide && !far, "{:?} loaded", scene.bounds);
                 for stem in ["x", "dragon", "bunny", "dragon_box", "sponza_dabrovic", "dragon_sponza"] {
                     let c = Camera::preset_for(stem, &scene.bounds);
                     prop_assert!(c.eye.is_finite() && c.target.is_finite(), "{stem}: {c:?}");
@@ -179,6 +182,10 @@ proptest! {
             Err(SceneError::Extent { extent, limit, .. }) => {
                 prop_assert!(wide);
                 prop_assert!(extent.iter().any(|&e| e > limit), "{extent:?}");
+            }
+            Err(SceneError::Far { min, max, limit, .. }) => {
+                prop_assert!(far && !wide);
+                prop_assert!(min.iter().chain(&max).any(|&c| c.abs() > limit), "{min:?} {max:?}");
             }
             Err(e) => prop_assert!(false, "{e}"),
         }
