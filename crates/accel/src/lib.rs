@@ -47,7 +47,9 @@
 
 pub mod build;
 pub mod bvh2;
+pub mod cwbvh;
 pub mod dst;
+pub mod dstq;
 pub mod image;
 pub mod observer;
 pub mod query;
