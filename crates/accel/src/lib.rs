@@ -80,7 +80,9 @@ pub use query::{DstPipeline, RayQuery};
 /// The rayon crate builds and batch queries run on (for [`rayon::ThreadPool`]).
 pub use rayon;
 pub use set::TraversalSet;
-pub use tree::{AnyTree, BuildStats, Bvh2Tree, BvhTree, DstDecoding, DstTree, TreeKind};
+pub use tree::{
+    AnyTree, BuildStats, Bvh2Tree, BvhTree, CwbvhTree, DstDecoding, DstQTree, DstTree, TreeKind,
+};
 
 use dualsplit_geometry::{Aabb, Hit, Ray, Triangle};
 use serde::{Deserialize, Serialize};
@@ -105,6 +107,13 @@ pub enum AccelKind {
     /// [`DstDecoding::Pipeline`]; command line `dst`).
     #[doc(alias = "DstPipeline")]
     Dst,
+    /// Compressed 8-wide BVH (Ylitie et al. 2017): the BVH8's nodes in 80 bytes, child
+    /// boxes quantized to 8 bits per plane, conservatively ([`cwbvh`]; command line `cwbvh`).
+    Cwbvh,
+    /// Quantized dual-split tree: the DST's planes as k-bit offsets in a local frame, several
+    /// levels collapsed into one fetch (the paper's §5 future work; [`dstq`]; command line
+    /// `dst-q`).
+    DstQ,
 }
 
 impl AccelKind {
@@ -116,12 +125,14 @@ impl AccelKind {
     pub const DST_PIPELINE: AccelKind = AccelKind::Dst;
 
     /// All kinds, in report order.
-    pub const ALL: [AccelKind; 5] = [
+    pub const ALL: [AccelKind; 7] = [
         AccelKind::Bvh2,
         AccelKind::Bvh4,
         AccelKind::Bvh8,
         AccelKind::DstSw,
         AccelKind::Dst,
+        AccelKind::Cwbvh,
+        AccelKind::DstQ,
     ];
 
     /// The command-line name.
@@ -132,6 +143,8 @@ impl AccelKind {
             AccelKind::Bvh8 => "bvh8",
             AccelKind::DstSw => "dst-sw",
             AccelKind::Dst => "dst",
+            AccelKind::Cwbvh => "cwbvh",
+            AccelKind::DstQ => "dst-q",
         }
     }
 
@@ -152,9 +165,16 @@ pub enum AccelError {
     Dst(#[from] dst::DstError),
 }
 
+/// Wall time since `t0` in milliseconds (build times: host measurements, never results).
+pub(crate) fn ms_since(t0: Instant) -> f64 {
+    t0.elapsed().as_secs_f64() * 1e3
+}
+
 /// Every structure built from one scene's BVH2: the logical BVH2 and the encoded BVH2, BVH4
-/// (Dammertz collapse) and BVH8 (Ylitie collapse), all with identical leaves, and the
-/// dual-split tree converted from the same BVH2 with identical bounds (hardware preset).
+/// (Dammertz collapse) and BVH8 (Ylitie collapse), all with identical leaves, the
+/// dual-split tree converted from the same BVH2 with identical bounds (hardware preset),
+/// and their quantized forms: the compressed BVH8 ([`cwbvh::Cwbvh`]) and the quantized DST
+/// ([`dstq::DstQ`], default [`dstq::DstQConfig`]).
 ///
 /// ```
 /// use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
@@ -181,6 +201,12 @@ pub struct Structures {
     pub dst: dst::Dst,
     /// Wall time of the BVH2 → DST conversion, in milliseconds (a host measurement).
     pub dst_convert_ms: f64,
+    /// The compressed BVH8, encoded from the same collapse as `bvh8`.
+    pub cwbvh: cwbvh::Cwbvh,
+    /// The quantized DST, encoded from `dst`.
+    pub dstq: dstq::DstQ,
+    /// Wall time of the DST → quantized DST encoding, in milliseconds (a host measurement).
+    pub dstq_convert_ms: f64,
 }
 
 impl Structures {
@@ -223,8 +249,15 @@ impl Structures {
         let t8 = t0.elapsed();
         let bvh8 = BvhImage::encode(&wide8, &bvh2, shared.clone(), cfg, t8)?;
         let t0 = Instant::now();
+        let cwbvh = cwbvh::Cwbvh::from_wide(&wide8, &bvh2, shared.clone(), t8)?;
+        let cwbvh_encode = t0.elapsed();
+        let cwbvh = cwbvh.with_time(t8 + cwbvh_encode);
+        let t0 = Instant::now();
         let dst = dst::Dst::from_bvh2(&bvh2, shared.clone(), dst_cfg)?;
-        let dst_convert_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let dst_convert_ms = ms_since(t0);
+        let t0 = Instant::now();
+        let dstq = dstq::DstQ::from_dst(&dst, &dstq::DstQConfig::default())?;
+        let dstq_convert_ms = ms_since(t0);
         let s = Self {
             triangles: shared,
             bvh2,
@@ -233,6 +266,9 @@ impl Structures {
             bvh8,
             dst,
             dst_convert_ms,
+            cwbvh,
+            dstq,
+            dstq_convert_ms,
         };
         // Debug builds check every image (bounds containment is undefined for NaN input,
         // which scene loading drops anyway).
@@ -244,22 +280,27 @@ impl Structures {
         Ok(s)
     }
 
-    /// The encoded BVH that `kind` traverses, or `None` for the two DST kinds.
+    /// The encoded BVH that `kind` traverses (BVH2, BVH4, BVH8), or `None` for the others.
     pub fn encoded(&self, kind: AccelKind) -> Option<&BvhImage> {
         match kind {
             AccelKind::Bvh2 => Some(&self.bvh2_image),
             AccelKind::Bvh4 => Some(&self.bvh4),
             AccelKind::Bvh8 => Some(&self.bvh8),
-            AccelKind::DstSw | AccelKind::Dst => None,
+            AccelKind::DstSw | AccelKind::Dst | AccelKind::Cwbvh | AccelKind::DstQ => None,
         }
     }
 
     /// The memory image `kind` reads (what the simulator replays fetches against). Both DST
     /// kinds read the same DST image.
     pub fn image(&self, kind: AccelKind) -> &MemoryImage {
-        match self.encoded(kind) {
-            Some(b) => &b.image,
-            None => self.dst.image(),
+        match kind {
+            AccelKind::DstSw | AccelKind::Dst => self.dst.image(),
+            AccelKind::Cwbvh => self.cwbvh.image(),
+            AccelKind::DstQ => self.dstq.image(),
+            AccelKind::Bvh2 | AccelKind::Bvh4 | AccelKind::Bvh8 => match self.encoded(kind) {
+                Some(b) => &b.image,
+                None => unreachable!("every BVH kind is encoded"),
+            },
         }
     }
 
@@ -273,6 +314,8 @@ impl Structures {
             AccelKind::Bvh8 => self.bvh8.closest_hit(ray, obs),
             AccelKind::DstSw => self.dst.closest_hit(ray, obs),
             AccelKind::Dst => self.dst.closest_hit_pipeline(ray, obs),
+            AccelKind::Cwbvh => self.cwbvh.closest_hit(ray, obs),
+            AccelKind::DstQ => self.dstq.closest_hit(ray, obs),
         }
     }
 
@@ -285,22 +328,27 @@ impl Structures {
             AccelKind::Bvh8 => self.bvh8.any_hit(ray, obs),
             AccelKind::DstSw => self.dst.any_hit(ray, obs),
             AccelKind::Dst => self.dst.any_hit_pipeline(ray, obs),
+            AccelKind::Cwbvh => self.cwbvh.any_hit(ray, obs),
+            AccelKind::DstQ => self.dstq.any_hit(ray, obs),
         }
     }
 
-    /// Validates the three BVH images (BVH2, BVH4, BVH8) and the DST (which must rebuild
-    /// every BVH2 box exactly from its planes).
+    /// Validates the three BVH images (BVH2, BVH4, BVH8), the DST (which must rebuild
+    /// every BVH2 box exactly from its planes), the compressed BVH8 (every quantized box
+    /// must contain its exact box) and the quantized DST.
     pub fn validate(&self) -> Vec<ValidationReport> {
         vec![
             self.bvh2_image.validate(),
             self.bvh4.validate(),
             self.bvh8.validate(),
             ValidationReport::of_dst(&self.dst, &self.bvh2),
+            self.cwbvh.validate(),
+            self.dstq.validate(&self.bvh2),
         ]
     }
 
-    /// Size and build statistics of BVH2, BVH4, BVH8 and the DST (the paper's Table 3),
-    /// percentages relative to the BVH2 image.
+    /// Size and build statistics of BVH2, BVH4, BVH8, the DST (the paper's Table 3) and the
+    /// quantized structures, percentages relative to the BVH2 image.
     pub fn stats(&self) -> Vec<StructureStats> {
         let base = self.bvh2_image.bytes_total();
         vec![
@@ -308,6 +356,8 @@ impl Structures {
             StructureStats::of("bvh4", &self.bvh4, base),
             StructureStats::of("bvh8", &self.bvh8, base),
             StructureStats::of_dst(&self.dst.stats(), self.dst_convert_ms, base),
+            StructureStats::of_cwbvh(&self.cwbvh, base),
+            StructureStats::of_dstq(&self.dstq, self.dstq_convert_ms, base),
         ]
     }
 }

@@ -101,6 +101,34 @@ impl RayQuery for Dst {
     }
 }
 
+impl RayQuery for crate::cwbvh::Cwbvh {
+    #[inline]
+    fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        self.closest_hit(ray, obs)
+    }
+    #[inline]
+    fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+        self.any_hit(ray, obs)
+    }
+    fn triangles(&self) -> &[Triangle] {
+        self.image().triangle_slice()
+    }
+}
+
+impl RayQuery for crate::dstq::DstQ {
+    #[inline]
+    fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        self.closest_hit(ray, obs)
+    }
+    #[inline]
+    fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+        self.any_hit(ray, obs)
+    }
+    fn triangles(&self) -> &[Triangle] {
+        self.image().triangle_slice()
+    }
+}
+
 /// A [`Dst`] queried through the model of the paper's hardware dual-split pipeline
 /// ([`crate::AccelKind::Dst`]): every node step is computed by the pipeline's step function.
 /// Same answers as the software decoder, several times slower on a CPU; it exists to check

@@ -120,9 +120,10 @@ impl TraversalSet for AnyTree {
     fn scene_box(&self) -> Aabb {
         match self {
             AnyTree::Dst(d) => d.dst().scene_box(),
+            AnyTree::DstQ(q) => q.dstq().scene_box(),
             // The BVH2's root box is the union of the triangles' boxes (min and max are
             // exact, so the order does not matter).
-            AnyTree::Bvh(b) => b
+            AnyTree::Bvh(_) | AnyTree::Cwbvh(_) => self
                 .image()
                 .triangle_slice()
                 .iter()

@@ -25,7 +25,7 @@ pub const MIB: f64 = 1024.0 * 1024.0;
 /// Size and build statistics of one encoded BVH.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct StructureStats {
-    /// `bvh2`, `bvh4` or `bvh8`.
+    /// `bvh2`, `bvh4`, `bvh8`, `dst`, `cwbvh` or `dst-q`.
     pub name: String,
     /// Internal nodes plus leaves.
     pub nodes: u64,
@@ -41,10 +41,11 @@ pub struct StructureStats {
     pub bytes_total: u64,
     /// `bytes_total` as a percentage of the BVH2's.
     pub percent_of_bvh2: f64,
-    /// SAH cost (root-normalised).
+    /// SAH cost (root-normalised; NaN for the structures the BVH's SAH does not price: DST,
+    /// CWBVH and DST-Q).
     pub sah_cost: f32,
-    /// Build (BVH2), collapse (BVH4, BVH8) or conversion (DST) wall time in milliseconds —
-    /// a measurement.
+    /// Build (BVH2), collapse (BVH4, BVH8, CWBVH: collapse and encoding) or conversion (DST;
+    /// DST-Q: from the DST) wall time in milliseconds — a measurement.
     pub build_ms: f64,
     /// DST only: the BVH2 → DST conversion time in milliseconds (equal to `build_ms`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -93,6 +94,45 @@ impl StructureStats {
             build_ms: convert_ms,
             convert_ms: Some(convert_ms),
             dst: Some(*d),
+        }
+    }
+
+    /// Statistics of the compressed BVH8, with percentages relative to `bvh2_total` bytes.
+    pub fn of_cwbvh(c: &crate::cwbvh::Cwbvh, bvh2_total: u64) -> Self {
+        let bytes_total = c.bytes_total();
+        Self {
+            name: "cwbvh".to_string(),
+            nodes: (c.internal_nodes() + c.leaves()) as u64,
+            internal_nodes: c.internal_nodes() as u64,
+            leaves: c.leaves() as u64,
+            bytes_nodes: c.image().node_bytes(),
+            bytes_indices: c.image().index_bytes(),
+            bytes_total,
+            percent_of_bvh2: 100.0 * bytes_total as f64 / bvh2_total.max(1) as f64,
+            sah_cost: f32::NAN,
+            build_ms: c.time().as_secs_f64() * 1e3,
+            convert_ms: None,
+            dst: None,
+        }
+    }
+
+    /// Statistics of the quantized DST, with percentages relative to `bvh2_total` bytes;
+    /// `convert_ms` is its encoding from the DST.
+    pub fn of_dstq(q: &crate::dstq::DstQ, convert_ms: f64, bvh2_total: u64) -> Self {
+        let bytes_total = q.bytes_total();
+        Self {
+            name: "dst-q".to_string(),
+            nodes: (q.internal_nodes() + q.leaves()) as u64,
+            internal_nodes: q.internal_nodes() as u64,
+            leaves: q.leaves() as u64,
+            bytes_nodes: bytes_total - q.image().index_bytes(),
+            bytes_indices: q.image().index_bytes(),
+            bytes_total,
+            percent_of_bvh2: 100.0 * bytes_total as f64 / bvh2_total.max(1) as f64,
+            sah_cost: f32::NAN,
+            build_ms: convert_ms,
+            convert_ms: Some(convert_ms),
+            dst: None,
         }
     }
 }

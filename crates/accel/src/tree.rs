@@ -18,17 +18,20 @@
 //! Builds and conversions use rayon; they run on the current pool, so a caller picks the
 //! threads with [`rayon::ThreadPool::install`] or the `*_in` constructors.
 
+use crate::cwbvh::Cwbvh;
 use crate::dst::{Dst, DstConfig};
+use crate::dstq::{DstQ, DstQConfig};
 use crate::image::{MemoryImage, SharedTriangles};
 use crate::observer::Observer;
 use crate::query::{DstPipeline, RayQuery};
+use crate::validate::ValidationReport;
 use crate::wide::{BvhImage, CollapseConfig, WideBvh};
-use crate::{AccelError, AccelKind, BuildConfig, Bvh2};
+use crate::{AccelError, AccelKind, BuildConfig, Bvh2, ms_since};
 use dualsplit_geometry::{Aabb, Hit, Ray, Triangle};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-/// The four structures a tree can be.
+/// The six structures a tree can be.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum TreeKind {
@@ -40,24 +43,32 @@ pub enum TreeKind {
     Bvh8,
     /// Dual-split tree.
     Dst,
+    /// Compressed 8-wide BVH (80-byte nodes, quantized child boxes).
+    Cwbvh,
+    /// Quantized dual-split tree (k-bit planes in collapsed clusters).
+    DstQ,
 }
 
 impl TreeKind {
     /// All kinds.
-    pub const ALL: [TreeKind; 4] = [
+    pub const ALL: [TreeKind; 6] = [
         TreeKind::Bvh2,
         TreeKind::Bvh4,
         TreeKind::Bvh8,
         TreeKind::Dst,
+        TreeKind::Cwbvh,
+        TreeKind::DstQ,
     ];
 
-    /// The command-line name: `bvh2`, `bvh4`, `bvh8`, `dst`.
+    /// The command-line name: `bvh2`, `bvh4`, `bvh8`, `dst`, `cwbvh`, `dst-q`.
     pub fn name(self) -> &'static str {
         match self {
             TreeKind::Bvh2 => "bvh2",
             TreeKind::Bvh4 => "bvh4",
             TreeKind::Bvh8 => "bvh8",
             TreeKind::Dst => "dst",
+            TreeKind::Cwbvh => "cwbvh",
+            TreeKind::DstQ => "dst-q",
         }
     }
 
@@ -74,6 +85,8 @@ impl TreeKind {
             TreeKind::Bvh4 => &[AccelKind::Bvh4],
             TreeKind::Bvh8 => &[AccelKind::Bvh8],
             TreeKind::Dst => &[AccelKind::DstSw, AccelKind::Dst],
+            TreeKind::Cwbvh => &[AccelKind::Cwbvh],
+            TreeKind::DstQ => &[AccelKind::DstQ],
         }
     }
 
@@ -84,6 +97,8 @@ impl TreeKind {
             AccelKind::Bvh4 => TreeKind::Bvh4,
             AccelKind::Bvh8 => TreeKind::Bvh8,
             AccelKind::DstSw | AccelKind::Dst => TreeKind::Dst,
+            AccelKind::Cwbvh => TreeKind::Cwbvh,
+            AccelKind::DstQ => TreeKind::DstQ,
         }
     }
 }
@@ -166,14 +181,34 @@ impl BuildStats {
         }
     }
 
+    pub(crate) fn of_cwbvh(c: &Cwbvh, build_ms: f64) -> Self {
+        Self {
+            kind: Some(TreeKind::Cwbvh),
+            build_ms,
+            internal_nodes: c.internal_nodes() as u64,
+            leaves: c.leaves() as u64,
+            node_bytes: c.image().node_bytes(),
+            index_bytes: c.image().index_bytes(),
+            triangles: c.image().triangle_slice().len() as u64,
+        }
+    }
+
+    pub(crate) fn of_dstq(q: &DstQ, build_ms: f64) -> Self {
+        Self {
+            kind: Some(TreeKind::DstQ),
+            build_ms,
+            internal_nodes: q.internal_nodes() as u64,
+            leaves: q.leaves() as u64,
+            node_bytes: q.image().node_bytes(),
+            index_bytes: q.image().index_bytes(),
+            triangles: q.image().triangle_slice().len() as u64,
+        }
+    }
+
     /// Node plus index bytes (the size the paper's Table 3 compares).
     pub fn bytes_total(&self) -> u64 {
         self.node_bytes + self.index_bytes
     }
-}
-
-fn ms_since(t0: Instant) -> f64 {
-    t0.elapsed().as_secs_f64() * 1e3
 }
 
 /// The SAH binary BVH over a set of triangles, both as a logical tree (what BVH4, BVH8 and
@@ -281,13 +316,14 @@ impl BvhTree {
         Self::encode(bvh2, &wide, TreeKind::Bvh8, t0)
     }
 
-    /// The BVH of `kind` derived from `bvh2` (`None` for [`TreeKind::Dst`]).
+    /// The BVH of `kind` derived from `bvh2` (`None` for the kinds that are not an
+    /// uncompressed BVH).
     pub fn from_bvh2(bvh2: &Bvh2Tree, kind: TreeKind) -> Option<Result<Self, AccelError>> {
         match kind {
             TreeKind::Bvh2 => Some(Ok(bvh2.tree.clone())),
             TreeKind::Bvh4 => Some(Self::bvh4_from(bvh2)),
             TreeKind::Bvh8 => Some(Self::bvh8_from(bvh2)),
-            TreeKind::Dst => None,
+            TreeKind::Dst | TreeKind::Cwbvh | TreeKind::DstQ => None,
         }
     }
 
@@ -403,6 +439,111 @@ impl DstTree {
     }
 }
 
+/// The compressed 8-wide BVH ([`Cwbvh`]) collapsed from a BVH2, with its build settings
+/// and statistics.
+#[derive(Clone, Debug)]
+pub struct CwbvhTree {
+    pub(crate) cwbvh: Cwbvh,
+    pub(crate) config: BuildConfig,
+    pub(crate) stats: BuildStats,
+}
+
+impl CwbvhTree {
+    /// The BVH8 collapse of `bvh2` (Ylitie et al. 2017, default collapse costs) encoded with
+    /// 80-byte compressed nodes: the BVH8's partitioning, quantized boxes.
+    pub fn from_bvh2(bvh2: &Bvh2Tree) -> Result<Self, AccelError> {
+        let t0 = Instant::now();
+        let wide = WideBvh::collapse_bvh8(&bvh2.logical, &CollapseConfig::default());
+        let collapse = t0.elapsed();
+        let cwbvh = Cwbvh::from_wide(
+            &wide,
+            &bvh2.logical,
+            bvh2.shared_triangles().clone(),
+            collapse,
+        )?;
+        let cwbvh = cwbvh.with_time(t0.elapsed());
+        let stats = BuildStats::of_cwbvh(&cwbvh, ms_since(t0));
+        Ok(Self {
+            cwbvh,
+            config: *bvh2.config(),
+            stats,
+        })
+    }
+
+    /// The structure (image, node counts, traversal).
+    pub fn cwbvh(&self) -> &Cwbvh {
+        &self.cwbvh
+    }
+
+    /// The byte-exact memory image.
+    pub fn image(&self) -> &MemoryImage {
+        self.cwbvh.image()
+    }
+
+    /// The BVH2 build settings the tree came from.
+    pub fn config(&self) -> &BuildConfig {
+        &self.config
+    }
+
+    /// Size and build time.
+    pub fn stats(&self) -> &BuildStats {
+        &self.stats
+    }
+}
+
+/// The quantized dual-split tree ([`DstQ`]) encoded from a DST, with its build settings and
+/// statistics.
+#[derive(Clone, Debug)]
+pub struct DstQTree {
+    pub(crate) dstq: DstQ,
+    pub(crate) config: BuildConfig,
+    pub(crate) stats: BuildStats,
+}
+
+impl DstQTree {
+    /// Quantizes `dst` with `cfg` (the same nodes and decisions; planes rounded outward).
+    /// The build time counts the quantization only.
+    pub fn from_dst(dst: &DstTree, cfg: &DstQConfig) -> Result<Self, AccelError> {
+        let t0 = Instant::now();
+        let dstq = DstQ::from_dst(&dst.dst, cfg)?;
+        let stats = BuildStats::of_dstq(&dstq, ms_since(t0));
+        Ok(Self {
+            dstq,
+            config: dst.config,
+            stats,
+        })
+    }
+
+    /// Converts `bvh2` into a DST with the hardware preset and quantizes it with `cfg`; the
+    /// build time counts both steps.
+    pub fn from_bvh2(bvh2: &Bvh2Tree, cfg: &DstQConfig) -> Result<Self, AccelError> {
+        let t0 = Instant::now();
+        let mut t = Self::from_dst(&DstTree::from_bvh2(bvh2, &DstConfig::hardware())?, cfg)?;
+        t.stats.build_ms = ms_since(t0);
+        Ok(t)
+    }
+
+    /// The structure (image, scene box, traversal).
+    pub fn dstq(&self) -> &DstQ {
+        &self.dstq
+    }
+
+    /// The byte-exact memory image.
+    pub fn image(&self) -> &MemoryImage {
+        self.dstq.image()
+    }
+
+    /// The BVH2 build settings the tree came from.
+    pub fn config(&self) -> &BuildConfig {
+        &self.config
+    }
+
+    /// Size and build time.
+    pub fn stats(&self) -> &BuildStats {
+        &self.stats
+    }
+}
+
 /// One structure of any kind: what a saved tree file holds.
 #[derive(Clone, Debug)]
 pub enum AnyTree {
@@ -410,6 +551,23 @@ pub enum AnyTree {
     Bvh(BvhTree),
     /// A dual-split tree.
     Dst(DstTree),
+    /// A compressed 8-wide BVH.
+    Cwbvh(CwbvhTree),
+    /// A quantized dual-split tree.
+    DstQ(DstQTree),
+}
+
+/// `$body` with `$t` bound to the tree inside `$tree`, whatever its kind (the four tree
+/// types share the accessors `image`, `config` and `stats`).
+macro_rules! each_tree {
+    ($tree:expr, |$t:ident| $body:expr) => {
+        match $tree {
+            AnyTree::Bvh($t) => $body,
+            AnyTree::Dst($t) => $body,
+            AnyTree::Cwbvh($t) => $body,
+            AnyTree::DstQ($t) => $body,
+        }
+    };
 }
 
 impl AnyTree {
@@ -418,36 +576,42 @@ impl AnyTree {
         match self {
             AnyTree::Bvh(b) => b.kind(),
             AnyTree::Dst(_) => TreeKind::Dst,
+            AnyTree::Cwbvh(_) => TreeKind::Cwbvh,
+            AnyTree::DstQ(_) => TreeKind::DstQ,
         }
     }
 
     /// The byte-exact memory image.
     pub fn image(&self) -> &MemoryImage {
-        match self {
-            AnyTree::Bvh(b) => b.image(),
-            AnyTree::Dst(d) => d.image(),
-        }
+        each_tree!(self, |t| t.image())
     }
 
     /// The BVH2 build settings.
     pub fn config(&self) -> &BuildConfig {
-        match self {
-            AnyTree::Bvh(b) => b.config(),
-            AnyTree::Dst(d) => d.config(),
-        }
+        each_tree!(self, |t| t.config())
     }
 
     /// Size and build time.
     pub fn stats(&self) -> &BuildStats {
-        match self {
-            AnyTree::Bvh(b) => b.stats(),
-            AnyTree::Dst(d) => d.stats(),
-        }
+        each_tree!(self, |t| t.stats())
     }
 
     /// The triangles as one shared allocation.
     pub fn shared_triangles(&self) -> &SharedTriangles {
         &self.image().triangle_data
+    }
+
+    /// Checks the tree against `bvh2`, the BVH2 it was derived from (or one built afresh
+    /// with the same settings): a BVH image on its own (boxes hold their children), a DST
+    /// and a quantized DST against `bvh2`'s boxes, a compressed BVH8 for quantized boxes that
+    /// contain their children's exact boxes.
+    pub fn validate(&self, bvh2: &Bvh2) -> ValidationReport {
+        match self {
+            AnyTree::Bvh(b) => b.encoded().validate(),
+            AnyTree::Dst(d) => ValidationReport::of_dst(&d.dst, bvh2),
+            AnyTree::Cwbvh(c) => c.cwbvh.validate(),
+            AnyTree::DstQ(q) => q.dstq.validate(bvh2),
+        }
     }
 
     /// Closest hit through traversal `kind`, or `None` when this tree is not the structure
@@ -461,6 +625,8 @@ impl AnyTree {
         match (self, kind) {
             (AnyTree::Dst(d), AccelKind::DstSw) => Some(d.dst.closest_hit(ray, obs)),
             (AnyTree::Dst(d), AccelKind::Dst) => Some(d.dst.closest_hit_pipeline(ray, obs)),
+            (AnyTree::Cwbvh(c), AccelKind::Cwbvh) => Some(c.cwbvh.closest_hit(ray, obs)),
+            (AnyTree::DstQ(q), AccelKind::DstQ) => Some(q.dstq.closest_hit(ray, obs)),
             (AnyTree::Bvh(b), k) if TreeKind::of_accel(k) == b.kind() => {
                 Some(b.encoded.closest_hit(ray, obs))
             }
@@ -474,6 +640,8 @@ impl AnyTree {
         match (self, kind) {
             (AnyTree::Dst(d), AccelKind::DstSw) => Some(d.dst.any_hit(ray, obs)),
             (AnyTree::Dst(d), AccelKind::Dst) => Some(d.dst.any_hit_pipeline(ray, obs)),
+            (AnyTree::Cwbvh(c), AccelKind::Cwbvh) => Some(c.cwbvh.any_hit(ray, obs)),
+            (AnyTree::DstQ(q), AccelKind::DstQ) => Some(q.dstq.any_hit(ray, obs)),
             (AnyTree::Bvh(b), k) if TreeKind::of_accel(k) == b.kind() => {
                 Some(b.encoded.any_hit(ray, obs))
             }
@@ -491,6 +659,18 @@ impl From<BvhTree> for AnyTree {
 impl From<DstTree> for AnyTree {
     fn from(d: DstTree) -> Self {
         AnyTree::Dst(d)
+    }
+}
+
+impl From<CwbvhTree> for AnyTree {
+    fn from(c: CwbvhTree) -> Self {
+        AnyTree::Cwbvh(c)
+    }
+}
+
+impl From<DstQTree> for AnyTree {
+    fn from(q: DstQTree) -> Self {
+        AnyTree::DstQ(q)
     }
 }
 
@@ -518,22 +698,18 @@ macro_rules! query_via {
 query_via!(Bvh2Tree, |s| &s.tree.encoded);
 query_via!(BvhTree, |s| &s.encoded);
 query_via!(DstTree, |s| &s.dst);
+query_via!(CwbvhTree, |s| &s.cwbvh);
+query_via!(DstQTree, |s| &s.dstq);
 
 /// Queries an [`AnyTree`] through its default traversal (the software decoder for a DST).
 impl RayQuery for AnyTree {
     #[inline]
     fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        match self {
-            AnyTree::Bvh(b) => b.intersect_observed(ray, obs),
-            AnyTree::Dst(d) => d.intersect_observed(ray, obs),
-        }
+        each_tree!(self, |t| t.intersect_observed(ray, obs))
     }
     #[inline]
     fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
-        match self {
-            AnyTree::Bvh(b) => b.occluded_observed(ray, obs),
-            AnyTree::Dst(d) => d.occluded_observed(ray, obs),
-        }
+        each_tree!(self, |t| t.occluded_observed(ray, obs))
     }
     fn triangles(&self) -> &[Triangle] {
         self.image().triangle_slice()

@@ -1,6 +1,6 @@
 //! One correctness suite for every CPU structure: BVH2, BVH4, BVH8, the DST software
-//! decoder (DST*) and the DST pipeline loop ([`AccelKind::ALL`]) answer each ray exactly as
-//! the brute-force oracle does (closest hit `t` bits and triangle id, and the any-hit
+//! decoder (DST*), the DST pipeline loop, the compressed BVH8 and the quantized DST
+//! ([`AccelKind::ALL`]) answer each ray exactly as the brute-force oracle does (closest hit `t` bits and triangle id, and the any-hit
 //! answer), ray by ray.
 //!
 //! Two parts:
@@ -313,7 +313,9 @@ fn suite_covers_every_structure() {
             AccelKind::Bvh4,
             AccelKind::Bvh8,
             AccelKind::DstSw,
-            AccelKind::Dst
+            AccelKind::Dst,
+            AccelKind::Cwbvh,
+            AccelKind::DstQ
         ]
     );
 }

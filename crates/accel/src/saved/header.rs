@@ -4,6 +4,7 @@
 use super::SavedError;
 use crate::BuildConfig;
 use crate::dst::{DstConfig, DstCosts, DstStats, Partitioning};
+use crate::dstq::DstQConfig;
 use crate::tree::TreeKind;
 use dualsplit_geometry::{Aabb, Vec3};
 
@@ -34,6 +35,15 @@ pub(super) enum Extra {
         scene_box: Aabb,
         stats: DstStats,
     },
+    /// A compressed 8-wide BVH.
+    Cwbvh { internal_nodes: u64, leaves: u64 },
+    /// A quantized dual-split tree.
+    DstQ {
+        config: DstQConfig,
+        scene_box: Aabb,
+        internal_nodes: u64,
+        leaves: u64,
+    },
 }
 
 /// The decoded header.
@@ -55,6 +65,8 @@ fn kind_code(k: TreeKind) -> u32 {
         TreeKind::Bvh4 => 2,
         TreeKind::Bvh8 => 3,
         TreeKind::Dst => 4,
+        TreeKind::Cwbvh => 5,
+        TreeKind::DstQ => 6,
     }
 }
 
@@ -78,6 +90,13 @@ impl Out {
     fn f32(&mut self, v: f32) {
         self.u32(v.to_bits());
     }
+    fn scene_box(&mut self, b: Aabb) {
+        for v in [b.min, b.max] {
+            self.f32(v.x);
+            self.f32(v.y);
+            self.f32(v.z);
+        }
+    }
 }
 
 struct In<'a>(&'a [u8]);
@@ -93,6 +112,13 @@ impl In<'_> {
     }
     fn u64(&mut self) -> u64 {
         u64::from_le_bytes(self.take())
+    }
+    fn scene_box(&mut self) -> Aabb {
+        let mut v = [0f32; 6];
+        for x in &mut v {
+            *x = self.f32();
+        }
+        Aabb::new(Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]))
     }
     fn f32(&mut self) -> f32 {
         f32::from_bits(self.u32())
@@ -141,11 +167,7 @@ impl Header {
                     Partitioning::Identical => 0,
                     Partitioning::Similar => 1,
                 });
-                for v in [scene_box.min, scene_box.max] {
-                    o.f32(v.x);
-                    o.f32(v.y);
-                    o.f32(v.z);
-                }
+                o.scene_box(scene_box);
                 for v in [
                     stats.splitting,
                     stats.single_carving,
@@ -160,6 +182,25 @@ impl Header {
                 ] {
                     o.u64(v);
                 }
+            }
+            Extra::Cwbvh {
+                internal_nodes,
+                leaves,
+            } => {
+                o.u64(internal_nodes);
+                o.u64(leaves);
+            }
+            Extra::DstQ {
+                config,
+                scene_box,
+                internal_nodes,
+                leaves,
+            } => {
+                o.u32(config.bits);
+                o.u32(config.cluster_bytes);
+                o.scene_box(scene_box);
+                o.u64(internal_nodes);
+                o.u64(leaves);
             }
         }
         o.0.resize(HEADER_BYTES, 0);
@@ -186,6 +227,8 @@ impl Header {
             2 => TreeKind::Bvh4,
             3 => TreeKind::Bvh8,
             4 => TreeKind::Dst,
+            5 => TreeKind::Cwbvh,
+            6 => TreeKind::DstQ,
             k => return Err(SavedError::malformed(format!("unknown structure kind {k}"))),
         };
         let file_bytes = i.u64();
@@ -218,51 +261,68 @@ impl Header {
             bins: i.u32(),
             parallel_threshold: i.u32(),
         };
-        let extra = if kind == TreeKind::Dst {
-            let costs = DstCosts {
-                split: i.f32(),
-                single_carve: i.f32(),
-                dual_carve: i.f32(),
-                triangle: i.f32(),
-            };
-            let partitioning = match i.u32() {
-                0 => Partitioning::Identical,
-                1 => Partitioning::Similar,
-                p => return Err(SavedError::malformed(format!("unknown partitioning {p}"))),
-            };
-            let mut v = [0f32; 6];
-            for x in &mut v {
-                *x = i.f32();
+        let extra = match kind {
+            TreeKind::Dst => {
+                let costs = DstCosts {
+                    split: i.f32(),
+                    single_carve: i.f32(),
+                    dual_carve: i.f32(),
+                    triangle: i.f32(),
+                };
+                let partitioning = match i.u32() {
+                    0 => Partitioning::Identical,
+                    1 => Partitioning::Similar,
+                    p => return Err(SavedError::malformed(format!("unknown partitioning {p}"))),
+                };
+                let scene_box = i.scene_box();
+                let mut c = [0u64; 10];
+                for x in &mut c {
+                    *x = i.u64();
+                }
+                Extra::Dst {
+                    config: DstConfig {
+                        costs,
+                        partitioning,
+                    },
+                    scene_box,
+                    stats: DstStats {
+                        splitting: c[0],
+                        single_carving: c[1],
+                        dual_carving: c[2],
+                        leaves: c[3],
+                        carving_leaves: c[4],
+                        index_entries: c[5],
+                        node_bytes: c[6],
+                        index_bytes: c[7],
+                        total_bytes: c[8],
+                        bvh2_bytes: c[9],
+                    },
+                }
             }
-            let mut c = [0u64; 10];
-            for x in &mut c {
-                *x = i.u64();
+            TreeKind::Cwbvh => Extra::Cwbvh {
+                internal_nodes: i.u64(),
+                leaves: i.u64(),
+            },
+            TreeKind::DstQ => {
+                let config = DstQConfig {
+                    bits: i.u32(),
+                    cluster_bytes: i.u32(),
+                };
+                config
+                    .check()
+                    .map_err(|e| SavedError::malformed(e.to_string()))?;
+                Extra::DstQ {
+                    config,
+                    scene_box: i.scene_box(),
+                    internal_nodes: i.u64(),
+                    leaves: i.u64(),
+                }
             }
-            Extra::Dst {
-                config: DstConfig {
-                    costs,
-                    partitioning,
-                },
-                scene_box: Aabb::new(Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5])),
-                stats: DstStats {
-                    splitting: c[0],
-                    single_carving: c[1],
-                    dual_carving: c[2],
-                    leaves: c[3],
-                    carving_leaves: c[4],
-                    index_entries: c[5],
-                    node_bytes: c[6],
-                    index_bytes: c[7],
-                    total_bytes: c[8],
-                    bvh2_bytes: c[9],
-                },
-            }
-        } else {
-            Extra::Bvh {
+            TreeKind::Bvh2 | TreeKind::Bvh4 | TreeKind::Bvh8 => Extra::Bvh {
                 internal_nodes: i.u64(),
                 leaves: i.u64(),
                 sah_cost: i.f32(),
-            }
+            },
         };
         Ok(Header {
             kind,

@@ -44,9 +44,11 @@ mod structure;
 
 pub use header::{CHECKSUM_BYTES, FORMAT_VERSION, HEADER_BYTES, MAGIC, WORDS_OFFSET};
 
+use crate::cwbvh::Cwbvh;
 use crate::dst::Dst;
+use crate::dstq::DstQ;
 use crate::image::{MemoryImage, SharedTriangles, Words};
-use crate::tree::{AnyTree, BuildStats, BvhTree, DstTree, TreeKind};
+use crate::tree::{AnyTree, BuildStats, BvhTree, CwbvhTree, DstQTree, DstTree, TreeKind};
 use crate::wide::BvhImage;
 use dualsplit_geometry::Triangle;
 use header::{Extra, Header};
@@ -214,6 +216,16 @@ impl AnyTree {
                 config: *d.dst.config(),
                 scene_box: d.dst.scene_box(),
                 stats: d.dst.stats(),
+            },
+            AnyTree::Cwbvh(c) => Extra::Cwbvh {
+                internal_nodes: c.cwbvh.internal_nodes() as u64,
+                leaves: c.cwbvh.leaves() as u64,
+            },
+            AnyTree::DstQ(q) => Extra::DstQ {
+                config: *q.dstq.config(),
+                scene_box: q.dstq.scene_box(),
+                internal_nodes: q.dstq.internal_nodes() as u64,
+                leaves: q.dstq.leaves() as u64,
             },
         }
     }
@@ -477,6 +489,36 @@ fn assemble(h: &Header, words: Words, tris: SharedTriangles) -> AnyTree {
             AnyTree::Dst(DstTree {
                 stats: BuildStats::of_dst(&dst, 0.0),
                 dst,
+                config: h.build,
+            })
+        }
+        Extra::Cwbvh {
+            internal_nodes,
+            leaves,
+        } => {
+            let cwbvh = Cwbvh::from_parts(image, internal_nodes as usize, leaves as usize);
+            AnyTree::Cwbvh(CwbvhTree {
+                stats: BuildStats::of_cwbvh(&cwbvh, 0.0),
+                cwbvh,
+                config: h.build,
+            })
+        }
+        Extra::DstQ {
+            config,
+            scene_box,
+            internal_nodes,
+            leaves,
+        } => {
+            let dstq = DstQ::from_parts(
+                image,
+                scene_box,
+                config,
+                internal_nodes as usize,
+                leaves as usize,
+            );
+            AnyTree::DstQ(DstQTree {
+                stats: BuildStats::of_dstq(&dstq, 0.0),
+                dstq,
                 config: h.build,
             })
         }

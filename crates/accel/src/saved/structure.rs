@@ -402,7 +402,50 @@ pub(crate) fn check(img: &Regions, kind: TreeKind, extra: &Extra) -> Result<(), 
             _ => check_bvh::<crate::wide::Node8>(img, internal_nodes, leaves),
         },
         Extra::Dst { ref stats, .. } => check_dst(img, stats),
+        Extra::Cwbvh {
+            internal_nodes,
+            leaves,
+        } => counts(
+            crate::cwbvh::check_structure(img.words, &img.nodes, &img.indices, img.triangles),
+            internal_nodes,
+            leaves,
+        ),
+        Extra::DstQ {
+            ref config,
+            internal_nodes,
+            leaves,
+            ..
+        } => counts(
+            crate::dstq::check_structure(
+                img.words,
+                &img.nodes,
+                &img.indices,
+                img.triangles,
+                config,
+            ),
+            internal_nodes,
+            leaves,
+        ),
     }
+}
+
+/// A structure check's result (internal nodes and leaves reached, or the faulty word and
+/// what is wrong there) against the counts the header records.
+fn counts(
+    walked: Result<(u64, u64), (usize, String)>,
+    internal_nodes: u64,
+    leaves: u64,
+) -> Result<(), Violation> {
+    let (n, l) = walked.map_err(|(word, what)| violation(word, what))?;
+    if (n, l) != (internal_nodes, leaves) {
+        return Err(violation(
+            0,
+            format!(
+                "the walk reaches {n} internal nodes and {l} leaves; the header records {internal_nodes} and {leaves}"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

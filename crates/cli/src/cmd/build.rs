@@ -12,9 +12,10 @@
 //! host measurements.
 use crate::progress::Ctx;
 use anyhow::Context;
+use dualsplit_accel::dstq::DstQConfig;
 use dualsplit_accel::{
-    AnyTree, BuildConfig, BuildStats, Bvh2Tree, BvhTree, DstConfig, DstTree, TreeKind,
-    ValidationReport,
+    AnyTree, BuildConfig, BuildStats, Bvh2Tree, BvhTree, CwbvhTree, DstConfig, DstQTree, DstTree,
+    TreeKind,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -37,9 +38,12 @@ pub struct Args {
     json: Option<PathBuf>,
 }
 
-/// Parses `dst`, `bvh2`, `bvh4` or `bvh8`.
+/// Parses a [`TreeKind`] name: `dst`, `bvh2`, `bvh4`, `bvh8`, `cwbvh` or `dst-q`.
 pub fn parse_tree_kind(s: &str) -> Result<TreeKind, String> {
-    TreeKind::parse(s).ok_or_else(|| format!("unknown structure `{s}` (dst, bvh2, bvh4, bvh8)"))
+    TreeKind::parse(s).ok_or_else(|| {
+        let names: Vec<&str> = TreeKind::ALL.iter().map(|k| k.name()).collect();
+        format!("unknown structure `{s}` ({})", names.join(", "))
+    })
 }
 
 /// What `build` reports, also its JSON form.
@@ -74,13 +78,14 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         TreeKind::Bvh2 => None,
         TreeKind::Bvh4 => Some(BvhTree::bvh4_from(&bvh2)?.into()),
         TreeKind::Bvh8 => Some(BvhTree::bvh8_from(&bvh2)?.into()),
+        TreeKind::Cwbvh => Some(CwbvhTree::from_bvh2(&bvh2)?.into()),
+        TreeKind::DstQ => Some(DstQTree::from_bvh2(&bvh2, &DstQConfig::default())?.into()),
     };
     let build_ms = t0.elapsed().as_secs_f64() * 1e3;
     sp.set_message(format!("validating {}", args.accel));
     let report = match &tree {
         None => bvh2.tree().encoded().validate(),
-        Some(AnyTree::Bvh(b)) => b.encoded().validate(),
-        Some(AnyTree::Dst(d)) => ValidationReport::of_dst(d.dst(), bvh2.logical()),
+        Some(t) => t.validate(bvh2.logical()),
     };
     let tree = tree.unwrap_or_else(|| bvh2.into_tree().into());
     if !report.is_ok() {

@@ -61,10 +61,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                 "reference: bvh2 built from the scene in {:.1} ms",
                 fresh.stats().build_ms
             );
-            let report = match tree {
-                AnyTree::Bvh(b) => b.encoded().validate(),
-                AnyTree::Dst(d) => ValidationReport::of_dst(d.dst(), fresh.logical()),
-            };
+            let report = tree.validate(fresh.logical());
             let failed = print_validation(&[report]);
             let reference = AnyTree::from(fresh.into_tree());
             equivalence(&scene, &reference, tree, args.rays, ctx) || failed
