@@ -4,7 +4,7 @@
 //! document. Every Rust error becomes a `dualsplit.DualsplitError` carrying its message
 //! (with its causes, as the command line prints them); no panic crosses into Python.
 use dualsplit_accel::{
-    AccelKind, AnyTree, BuildConfig, Bvh2Tree, BvhTree, DstConfig, DstTree, NoObserver, Structures,
+    AccelKind, AnyTree, BuildConfig, Bvh2Tree, NoObserver, Structures,
     TraversalSet, TreeKind,
 };
 use dualsplit_geometry::{Ray, Triangle, Vec3};
@@ -205,7 +205,8 @@ fn scene_arg(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<Py<Scene>> {
     Py::new(py, s)
 }
 
-/// One structure: a BVH2, BVH4, BVH8 or DST, built or loaded from a saved tree file.
+/// One structure: a BVH2, BVH4, BVH8, DST, CWBVH or DST-Q, built or loaded from a saved
+/// tree file.
 #[pyclass(module = "dualsplit", frozen)]
 struct Tree {
     tree: AnyTree,
@@ -214,13 +215,14 @@ struct Tree {
 
 fn parse_tree_kind(s: &str) -> PyResult<TreeKind> {
     TreeKind::parse(s).ok_or_else(|| {
-        PyValueError::new_err(format!("unknown structure `{s}` (dst, bvh2, bvh4, bvh8)"))
+        let names: Vec<&str> = TreeKind::ALL.iter().map(|k| k.name()).collect();
+        PyValueError::new_err(format!("unknown structure `{s}` ({})", names.join(", ")))
     })
 }
 
 /// Builds one structure of `scene` (a scene or a spec) exactly as `dualsplit build` does:
-/// kind `dst` (hardware preset), `bvh2`, `bvh4` or `bvh8`, the last three derived from the
-/// scene's BVH2 (default build settings).
+/// kind `dst` (hardware preset), `bvh2`, `bvh4`, `bvh8`, `cwbvh` or `dst-q`, each derived
+/// from the scene's BVH2 (default build settings).
 #[pyfunction]
 #[pyo3(signature = (scene, kind="dst"))]
 fn build(py: Python<'_>, scene: &Bound<'_, PyAny>, kind: &str) -> PyResult<Tree> {
@@ -231,12 +233,7 @@ fn build(py: Python<'_>, scene: &Bound<'_, PyAny>, kind: &str) -> PyResult<Tree>
     let tree = py
         .detach(|| -> Result<AnyTree, dualsplit_accel::AccelError> {
             let bvh2 = Bvh2Tree::build(tris, &BuildConfig::default())?;
-            Ok(match kind {
-                TreeKind::Dst => DstTree::from_bvh2(&bvh2, &DstConfig::hardware())?.into(),
-                TreeKind::Bvh2 => bvh2.into_tree().into(),
-                TreeKind::Bvh4 => BvhTree::bvh4_from(&bvh2)?.into(),
-                TreeKind::Bvh8 => BvhTree::bvh8_from(&bvh2)?.into(),
-            })
+            AnyTree::derive(&bvh2, kind).unwrap_or_else(|| Ok(bvh2.into_tree().into()))
         })
         .map_err(|e| py_err(&format!("building the {kind} of {spec}"), &e))?;
     Ok(Tree { tree, scene })

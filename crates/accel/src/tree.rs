@@ -571,6 +571,22 @@ macro_rules! each_tree {
 }
 
 impl AnyTree {
+    /// The structure of `kind` derived from `bvh2` with the default settings `dualsplit
+    /// build` uses (the DST's hardware preset, the default BVH8 collapse and quantized DST),
+    /// or `None` for [`TreeKind::Bvh2`]: the BVH2 is `bvh2` itself
+    /// ([`Bvh2Tree::into_tree`]).
+    pub fn derive(bvh2: &Bvh2Tree, kind: TreeKind) -> Option<Result<AnyTree, AccelError>> {
+        let tree = match kind {
+            TreeKind::Bvh2 => return None,
+            TreeKind::Bvh4 => BvhTree::bvh4_from(bvh2).map(AnyTree::from),
+            TreeKind::Bvh8 => BvhTree::bvh8_from(bvh2).map(AnyTree::from),
+            TreeKind::Dst => DstTree::from_bvh2(bvh2, &DstConfig::hardware()).map(AnyTree::from),
+            TreeKind::Cwbvh => CwbvhTree::from_bvh2(bvh2).map(AnyTree::from),
+            TreeKind::DstQ => DstQTree::from_bvh2(bvh2, &DstQConfig::default()).map(AnyTree::from),
+        };
+        Some(tree)
+    }
+
     /// Which structure.
     pub fn kind(&self) -> TreeKind {
         match self {

@@ -1,7 +1,7 @@
 //! One correctness suite for every CPU structure: BVH2, BVH4, BVH8, the DST software
 //! decoder (DST*), the DST pipeline loop, the compressed BVH8 and the quantized DST
-//! ([`AccelKind::ALL`]) answer each ray exactly as the brute-force oracle does (closest hit `t` bits and triangle id, and the any-hit
-//! answer), ray by ray.
+//! ([`AccelKind::ALL`]) answer each ray exactly as the brute-force oracle does (closest
+//! hit `t` bits and triangle id, and the any-hit answer), ray by ray.
 //!
 //! Two parts:
 //! - a table of edge cases (zero and one triangle, flat and zero-area triangles, NaN and

@@ -44,8 +44,8 @@ pub struct Args {
     /// (hairball, forest, atrium, cornell).
     #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
-    /// Structures to measure, comma-separated (bvh2, bvh4, bvh8, dst-sw, dst); default all
-    /// (with --tree, all of the saved structure's traversals).
+    /// Structures to measure, comma-separated (bvh2, bvh4, bvh8, dst-sw, dst, cwbvh, dst-q);
+    /// default all (with --tree, all of the saved structure's traversals).
     #[arg(long, value_delimiter = ',', value_parser = parse_accel)]
     accel: Vec<AccelKind>,
     /// Measure the tree saved in FILE by `dualsplit build` instead of building; it must come

@@ -12,11 +12,7 @@
 //! host measurements.
 use crate::progress::Ctx;
 use anyhow::Context;
-use dualsplit_accel::dstq::DstQConfig;
-use dualsplit_accel::{
-    AnyTree, BuildConfig, BuildStats, Bvh2Tree, BvhTree, CwbvhTree, DstConfig, DstQTree, DstTree,
-    TreeKind,
-};
+use dualsplit_accel::{AnyTree, BuildConfig, BuildStats, Bvh2Tree, TreeKind};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -73,14 +69,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let bvh2 = Bvh2Tree::build(&scene.triangles[..], &BuildConfig::default())
         .with_context(|| format!("building the BVH2 of {}", args.scene))?;
     let bvh2_ms = bvh2.stats().build_ms;
-    let tree: Option<AnyTree> = match args.accel {
-        TreeKind::Dst => Some(DstTree::from_bvh2(&bvh2, &DstConfig::hardware())?.into()),
-        TreeKind::Bvh2 => None,
-        TreeKind::Bvh4 => Some(BvhTree::bvh4_from(&bvh2)?.into()),
-        TreeKind::Bvh8 => Some(BvhTree::bvh8_from(&bvh2)?.into()),
-        TreeKind::Cwbvh => Some(CwbvhTree::from_bvh2(&bvh2)?.into()),
-        TreeKind::DstQ => Some(DstQTree::from_bvh2(&bvh2, &DstQConfig::default())?.into()),
-    };
+    let tree: Option<AnyTree> = AnyTree::derive(&bvh2, args.accel).transpose()?;
     let build_ms = t0.elapsed().as_secs_f64() * 1e3;
     sp.set_message(format!("validating {}", args.accel));
     let report = match &tree {

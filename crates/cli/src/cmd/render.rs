@@ -23,8 +23,8 @@ pub struct Args {
     /// (hairball, forest, atrium, cornell).
     #[arg(value_parser = parse_scene)]
     scene: String,
-    /// Structure: bvh2, bvh4, bvh8, dst-sw or dst (default bvh2; with --tree, the saved
-    /// structure's traversal: dst-sw for a DST).
+    /// Structure: bvh2, bvh4, bvh8, dst-sw, dst, cwbvh or dst-q (default bvh2; with --tree,
+    /// the saved structure's traversal: dst-sw for a DST).
     #[arg(long, value_parser = parse_accel)]
     accel: Option<AccelKind>,
     /// Render with the tree saved in FILE by `dualsplit build` instead of building; it must

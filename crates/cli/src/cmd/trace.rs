@@ -29,8 +29,8 @@ pub struct Args {
     /// The rays: 32-byte little-endian records (origin, direction, t_min, t_max as f32).
     #[arg(long, value_name = "FILE")]
     rays: PathBuf,
-    /// Traversal: bvh2, bvh4, bvh8, dst-sw or dst (default bvh2; with --tree, the saved
-    /// structure's first traversal).
+    /// Traversal: bvh2, bvh4, bvh8, dst-sw, dst, cwbvh or dst-q (default bvh2; with --tree,
+    /// the saved structure's first traversal).
     #[arg(long, value_parser = parse_accel)]
     accel: Option<AccelKind>,
     /// Trace with the tree saved in FILE by `dualsplit build` instead of building.
