@@ -84,7 +84,15 @@ def test_triangles_are_a_read_only_array_of_the_scene(scene):
 
 @pytest.mark.parametrize(
     "kind,traversal",
-    [("bvh2", "bvh2"), ("bvh4", "bvh4"), ("bvh8", "bvh8"), ("dst", "dst-sw"), ("dst", "dst")],
+    [
+        ("bvh2", "bvh2"),
+        ("bvh4", "bvh4"),
+        ("bvh8", "bvh8"),
+        ("dst", "dst-sw"),
+        ("dst", "dst"),
+        ("cwbvh", "cwbvh"),
+        ("dst-q", "dst-q"),
+    ],
 )
 def test_intersect_matches_the_cli_bit_for_bit(cli, tmp_path, scene, kind, traversal):
     rays = random_rays(scene)
