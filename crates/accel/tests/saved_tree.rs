@@ -3,12 +3,13 @@
 //! an appended byte, another format version and another scene are rejected with a typed
 //! error, never a panic.
 
+use dualsplit_accel::dstq::DstQConfig;
 use dualsplit_accel::image::RUN_END;
 use dualsplit_accel::math::{Hit, Ray, Triangle};
 use dualsplit_accel::saved::{FORMAT_VERSION, SavedError, WORDS_OFFSET};
 use dualsplit_accel::{
-    AccelKind, AnyTree, BuildConfig, Bvh2Tree, BvhTree, DstConfig, DstTree, NoObserver, RayQuery,
-    TreeKind,
+    AccelKind, AnyTree, BuildConfig, Bvh2Tree, BvhTree, CwbvhTree, DstConfig, DstQTree, DstTree,
+    NoObserver, RayQuery, TreeKind,
 };
 use dualsplit_geometry::{Aabb, Pcg32};
 use dualsplit_testkit::rays::random_rays;
@@ -21,7 +22,8 @@ fn trees(tris: &[Triangle]) -> Vec<AnyTree> {
     trees_of(&Bvh2Tree::build(tris, &BuildConfig::default()).expect("bvh2"))
 }
 
-/// Every kind of tree from `bvh2`: BVH2, BVH4, BVH8 and both DST presets.
+/// Every kind of tree from `bvh2`: BVH2, BVH4, BVH8, both DST presets, the compressed BVH8
+/// and the quantized DST.
 fn trees_of(bvh2: &Bvh2Tree) -> Vec<AnyTree> {
     let mut out: Vec<AnyTree> = [TreeKind::Bvh2, TreeKind::Bvh4, TreeKind::Bvh8]
         .into_iter()
@@ -40,6 +42,12 @@ fn trees_of(bvh2: &Bvh2Tree) -> Vec<AnyTree> {
     out.push(
         DstTree::from_bvh2(bvh2, &DstConfig::software())
             .expect("dst")
+            .into(),
+    );
+    out.push(CwbvhTree::from_bvh2(bvh2).expect("cwbvh").into());
+    out.push(
+        DstQTree::from_bvh2(bvh2, &DstQConfig::default())
+            .expect("dst-q")
             .into(),
     );
     out
@@ -76,6 +84,10 @@ fn a_reloaded_tree_answers_every_ray_as_the_built_one() {
             assert_eq!(a.dst().config(), b.dst().config());
             assert_eq!(a.dst().stats(), b.dst().stats());
         }
+        if let (AnyTree::DstQ(a), AnyTree::DstQ(b)) = (&back, &tree) {
+            assert_eq!(a.dstq().scene_box(), b.dstq().scene_box());
+            assert_eq!(a.dstq().config(), b.dstq().config());
+        }
         let mut hits = 0;
         for (j, r) in rays.iter().enumerate() {
             for &k in tree.kind().accel_kinds() {
@@ -109,6 +121,8 @@ fn the_same_tree_gives_the_same_bytes() {
         TreeKind::Bvh8,
         TreeKind::Dst,
         TreeKind::Dst,
+        TreeKind::Cwbvh,
+        TreeKind::DstQ,
     ]) {
         assert_eq!(
             AnyTree::from_bytes(bytes, Some(&tris))
@@ -231,7 +245,15 @@ fn fuzz_seeds_are_the_files_this_code_writes() {
     let tris = &scene("builtin:cornell")[..12];
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds/tree");
     let write = std::env::var_os("DUALSPLIT_WRITE_SEEDS").is_some();
-    let names = ["bvh2", "bvh4", "bvh8", "dst", "dst_software"];
+    let names = [
+        "bvh2",
+        "bvh4",
+        "bvh8",
+        "dst",
+        "dst_software",
+        "cwbvh",
+        "dst_q",
+    ];
     for (tree, name) in trees(tris).iter().zip(names) {
         let bytes = tree.to_bytes();
         let path = dir.join(name);
@@ -545,7 +567,7 @@ fn random_forgeries_load_or_fail_typed_and_traverse_in_bounded_time() {
     }
     drop(tx);
     let mut seen = 0;
-    while seen < 5 {
+    while seen < 7 {
         let (kind, ok, structure, other) = rx
             .recv_timeout(std::time::Duration::from_secs(120))
             .expect("a forgery thread panicked or did not finish in 120 s");
