@@ -8,6 +8,7 @@
 //! calibration and the charts read it from here (`docs/extending.md`).
 
 use crate::config::{KernelsConfig, SimConfig};
+use crate::hw::pipe::TmPipes;
 use dualsplit_accel::AccelKind;
 use serde::{Deserialize, Serialize};
 
@@ -134,6 +135,16 @@ impl SimAccel {
     /// configuration's `units.box_pipes`.
     pub fn box_pipes(self, cfg: &SimConfig) -> u32 {
         self.info().parallel.unwrap_or(cfg.units.box_pipes)
+    }
+    /// The pipelines of each TM in this configuration: [`SimAccel::box_pipes`] ray-box pipes,
+    /// quantized for the CWBVH configurations, and a quantized dual-split pipeline for
+    /// DST-Q.
+    pub fn pipes(self, cfg: &SimConfig) -> TmPipes {
+        TmPipes {
+            box_pipes: self.box_pipes(cfg),
+            quantized_boxes: self.kind() == AccelKind::Cwbvh,
+            quantized_dst: self.kind() == AccelKind::DstQ,
+        }
     }
     /// The colour of its series in the report's charts (RGB).
     pub fn color(self) -> [u8; 3] {

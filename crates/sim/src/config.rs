@@ -168,6 +168,12 @@ pub struct UnitConfig {
     pub dst_pipes: u32,
     /// Dual-split pipeline latency.
     pub dst_latency: u64,
+    /// Latency of a quantized ray-box pipeline (the CWBVH configurations' ray-box pipelines:
+    /// a dequantization stage in front of a ray-box pipeline).
+    pub qbox_latency: u64,
+    /// Latency of the quantized dual-split pipeline (DST-Q: a dequantization stage in front
+    /// of the dual-split pipeline).
+    pub qdst_latency: u64,
     /// Shared reciprocal / inverse-square-root units.
     pub fpinv_units: u32,
     /// Their latency.
@@ -243,6 +249,10 @@ pub struct EnergyConfig {
     pub tri_pipe_nj: f64,
     /// One dual-split pipeline op.
     pub dst_pipe_nj: f64,
+    /// One quantized ray-box pipeline op (one child box dequantized and tested).
+    pub qbox_pipe_nj: f64,
+    /// One quantized dual-split pipeline op (two planes dequantized, one node tested).
+    pub qdst_pipe_nj: f64,
 }
 
 /// The variant of the compiled kernels (`kernels/`): the `[kernels]` table. The default
@@ -406,6 +416,8 @@ impl SimConfig {
                 tri_latency: 24,
                 dst_pipes: 1,
                 dst_latency: 8,
+                qbox_latency: 11,
+                qdst_latency: 11,
                 fpinv_units: 1,
                 fpinv_latency: 16,
                 atomic_latency: 4,
@@ -442,6 +454,8 @@ impl SimConfig {
                 box_pipe_nj: 0.1377,
                 tri_pipe_nj: 0.71,
                 dst_pipe_nj: 0.0610,
+                qbox_pipe_nj: 0.1890,
+                qdst_pipe_nj: 0.0781,
             },
             kernels: KernelsConfig {
                 parity: true,
@@ -557,6 +571,8 @@ impl SimConfig {
             ("units.tri_latency", Int(u.tri_latency)),
             ("units.dst_pipes", int(u.dst_pipes)),
             ("units.dst_latency", Int(u.dst_latency)),
+            ("units.qbox_latency", Int(u.qbox_latency)),
+            ("units.qdst_latency", Int(u.qdst_latency)),
             ("units.fpinv_units", int(u.fpinv_units)),
             ("units.fpinv_latency", Int(u.fpinv_latency)),
             ("units.atomic_latency", Int(u.atomic_latency)),
@@ -591,6 +607,8 @@ impl SimConfig {
             ("energy.box_pipe_nj", Real(e.box_pipe_nj)),
             ("energy.tri_pipe_nj", Real(e.tri_pipe_nj)),
             ("energy.dst_pipe_nj", Real(e.dst_pipe_nj)),
+            ("energy.qbox_pipe_nj", Real(e.qbox_pipe_nj)),
+            ("energy.qdst_pipe_nj", Real(e.qdst_pipe_nj)),
             ("kernels.parity", Flag(self.kernels.parity)),
             (
                 "kernels.node_fetch",

@@ -156,6 +156,8 @@ pub const RANGES: &[KeyRange] = &[
     int("units.tri_latency", 1, MAX_LATENCY, "cycles"),
     int("units.dst_pipes", 1, MAX_UNITS, "pipelines"),
     int("units.dst_latency", 1, MAX_LATENCY, "cycles"),
+    int("units.qbox_latency", 1, MAX_LATENCY, "cycles"),
+    int("units.qdst_latency", 1, MAX_LATENCY, "cycles"),
     int("units.fpinv_units", 1, MAX_UNITS, "units"),
     int("units.fpinv_latency", 1, MAX_LATENCY, "cycles"),
     int("units.atomic_latency", 1, MAX_LATENCY, "cycles"),
@@ -193,6 +195,8 @@ pub const RANGES: &[KeyRange] = &[
     real("energy.box_pipe_nj", 0.0, MAX_NJ, "nJ"),
     real("energy.tri_pipe_nj", 0.0, MAX_NJ, "nJ"),
     real("energy.dst_pipe_nj", 0.0, MAX_NJ, "nJ"),
+    real("energy.qbox_pipe_nj", 0.0, MAX_NJ, "nJ"),
+    real("energy.qdst_pipe_nj", 0.0, MAX_NJ, "nJ"),
     flag("kernels.parity"),
     choice("kernels.node_fetch", &["operand", "loads"]),
 ];

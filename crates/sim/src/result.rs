@@ -121,9 +121,11 @@ impl SimResult {
         let frame_ms = cycles as f64 / (cfg.clock_ghz * 1e6);
         let cyc_units = cycles.max(1) as f64 * cfg.tms as f64;
         let utilisation = Utilisation {
-            box_pipe: stats.units.box_ops as f64 / (cyc_units * accel.box_pipes(cfg) as f64),
+            box_pipe: (stats.units.box_ops + stats.units.qbox_ops) as f64
+                / (cyc_units * accel.box_pipes(cfg) as f64),
             tri_pipe: stats.units.tri_ops as f64 / (cyc_units * cfg.units.tri_pipes as f64),
-            dst_pipe: stats.units.dst_ops as f64 / (cyc_units * cfg.units.dst_pipes as f64),
+            dst_pipe: (stats.units.dst_ops + stats.units.qdst_ops) as f64
+                / (cyc_units * cfg.units.dst_pipes as f64),
             issue: instructions.total() as f64 / (cyc_units * cfg.tps_per_tm as f64),
         };
         SimResult {

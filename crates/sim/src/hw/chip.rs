@@ -10,6 +10,7 @@ use crate::config::SimConfig;
 use crate::hw::atomic::AtomicUnit;
 use crate::hw::counts::UnitStats;
 use crate::hw::memory::{CacheStats, DramStats, L2};
+use crate::hw::pipe::TmPipes;
 use crate::hw::stalls::Stalls;
 use crate::hw::tm::Tm;
 
@@ -48,11 +49,12 @@ pub struct ChipStats {
 }
 
 impl Chip {
-    /// A cold chip; `box_pipes` ray-box pipelines per TM (the "+" configurations use the
-    /// node arity).
-    pub fn new(cfg: &SimConfig, box_pipes: u32) -> Self {
+    /// A cold chip; `pipes` the ray-box pipelines of each TM (the "+" configurations use
+    /// the node arity; [`TmPipes`]).
+    pub fn new(cfg: &SimConfig, pipes: impl Into<TmPipes>) -> Self {
+        let pipes = pipes.into();
         Self {
-            tms: (0..cfg.tms).map(|_| Tm::new(cfg, box_pipes)).collect(),
+            tms: (0..cfg.tms).map(|_| Tm::new(cfg, pipes)).collect(),
             l2: L2::new(cfg),
             atomic: AtomicUnit::new(cfg.units.atomic_latency),
             stalls: Stalls::default(),

@@ -55,6 +55,14 @@ pub struct InstrCounts {
     pub tri_ops: u64,
     /// Dual-split pipeline ops.
     pub dst_ops: u64,
+    /// Quantized ray-box pipeline ops (CWBVH configurations; their issues count in
+    /// `box_issues`).
+    #[serde(default)]
+    pub qbox_ops: u64,
+    /// Quantized dual-split pipeline ops (DST-Q; their issues count in `dst_ops`' place:
+    /// one op per issue).
+    #[serde(default)]
+    pub qdst_ops: u64,
     /// Internal node steps (BVH nodes; DST splitting and carving nodes).
     pub node_steps: u64,
     /// Global atomic increments (pixel hand-out).
@@ -90,7 +98,9 @@ impl InstrCounts {
             box_ops: units.box_ops,
             box_issues: n(F::BoxPipe(1)),
             tri_ops: n(F::TriPipe),
-            dst_ops: n(F::DstPipe),
+            dst_ops: units.dst_ops,
+            qbox_ops: units.qbox_ops,
+            qdst_ops: units.qdst_ops,
             node_steps: 0,
             atomics: n(F::Atomic),
         }
@@ -98,7 +108,13 @@ impl InstrCounts {
 
     /// All issued instructions.
     pub fn total(&self) -> u64 {
-        self.mix_total() + self.loads + self.box_issues + self.tri_ops + self.dst_ops + self.atomics
+        self.mix_total()
+            + self.loads
+            + self.box_issues
+            + self.tri_ops
+            + self.dst_ops
+            + self.qdst_ops
+            + self.atomics
     }
     fn mix_total(&self) -> u64 {
         self.mix.total()
@@ -111,6 +127,8 @@ impl InstrCounts {
         self.box_issues += o.box_issues;
         self.tri_ops += o.tri_ops;
         self.dst_ops += o.dst_ops;
+        self.qbox_ops += o.qbox_ops;
+        self.qdst_ops += o.qdst_ops;
         self.node_steps += o.node_steps;
         self.atomics += o.atomics;
     }
@@ -125,6 +143,12 @@ pub struct UnitStats {
     pub tri_ops: u64,
     /// Dual-split pipeline ops.
     pub dst_ops: u64,
+    /// Quantized ray-box pipeline ops (CWBVH configurations).
+    #[serde(default)]
+    pub qbox_ops: u64,
+    /// Quantized dual-split pipeline ops (DST-Q).
+    #[serde(default)]
+    pub qdst_ops: u64,
     /// Reciprocal-unit ops.
     pub fpinv_ops: u64,
 }

@@ -56,7 +56,9 @@ pub fn split(
         + m.fpinv as f64 * e.fpinv_nj
         + counts.box_ops as f64 * e.box_pipe_nj
         + counts.tri_ops as f64 * e.tri_pipe_nj
-        + counts.dst_ops as f64 * e.dst_pipe_nj)
+        + counts.dst_ops as f64 * e.dst_pipe_nj
+        + counts.qbox_ops as f64 * e.qbox_pipe_nj
+        + counts.qdst_ops as f64 * e.qdst_pipe_nj)
         * nj;
     let d = &cfg.dram;
     let dram_j = (dram.reads as f64 * d.e_read_nj + dram.activations as f64 * d.e_activate_nj) * nj

@@ -18,26 +18,66 @@ pub enum Pipe {
     DualSplit,
 }
 
+/// The pipelines a configuration gives each TM beyond `units`: how many ray-box pipes, and
+/// whether the ray-box and dual-split pipelines are the quantized ones (a dequantization
+/// stage in front: `qbox_latency`, `qdst_latency`, and their energies). A plain count
+/// converts into plain pipelines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TmPipes {
+    /// Ray-box pipelines.
+    pub box_pipes: u32,
+    /// The ray-box pipelines dequantize CWBVH child boxes.
+    pub quantized_boxes: bool,
+    /// The dual-split pipeline dequantizes DST-Q planes.
+    pub quantized_dst: bool,
+}
+
+impl From<u32> for TmPipes {
+    fn from(box_pipes: u32) -> Self {
+        TmPipes {
+            box_pipes,
+            quantized_boxes: false,
+            quantized_dst: false,
+        }
+    }
+}
+
 /// A TM's ray-box, ray-triangle and dual-split pipelines (§2.3, §3): fully pipelined, one
 /// op per pipe per cycle, results after `box_latency`, `tri_latency`, `dst_latency`; the
 /// "+" configurations have one ray-box pipe per child (§4) and test all children of a node
-/// in one issue slot.
+/// in one issue slot. Quantized pipelines ([`TmPipes`]) take `qbox_latency` and
+/// `qdst_latency` and count their ops apart.
 pub struct Pipelines {
     /// Indexed by [`Pipe`] (`pipe as usize`).
     pipes: [Vec<Slots>; 3],
     latency: [u64; 3],
+    /// Whether the ray-box and dual-split pipelines are quantized ones.
+    quantized: [bool; 3],
 }
 
 impl Pipelines {
-    /// Idle pipelines of `units`, with `box_pipes` ray-box pipes.
-    pub fn new(units: &UnitConfig, box_pipes: u32) -> Self {
+    /// Idle pipelines of `units`, with the ray-box pipes of `tm`.
+    pub fn new(units: &UnitConfig, tm: TmPipes) -> Self {
         Self {
             pipes: [
-                vec![Slots::default(); box_pipes.max(1) as usize],
+                vec![Slots::default(); tm.box_pipes.max(1) as usize],
                 vec![Slots::default(); units.tri_pipes as usize],
                 vec![Slots::default(); units.dst_pipes as usize],
             ],
-            latency: [units.box_latency, units.tri_latency, units.dst_latency],
+            latency: [
+                if tm.quantized_boxes {
+                    units.qbox_latency
+                } else {
+                    units.box_latency
+                },
+                units.tri_latency,
+                if tm.quantized_dst {
+                    units.qdst_latency
+                } else {
+                    units.dst_latency
+                },
+            ],
+            quantized: [tm.quantized_boxes, false, tm.quantized_dst],
         }
     }
 
@@ -54,10 +94,12 @@ impl Pipelines {
         at: Cycle,
         units: &mut UnitStats,
     ) -> Issued {
-        match pipe {
-            Pipe::Box => units.box_ops += n as u64,
-            Pipe::Triangle => units.tri_ops += n as u64,
-            Pipe::DualSplit => units.dst_ops += n as u64,
+        match (pipe, self.quantized[pipe as usize]) {
+            (Pipe::Box, false) => units.box_ops += n as u64,
+            (Pipe::Box, true) => units.qbox_ops += n as u64,
+            (Pipe::Triangle, _) => units.tri_ops += n as u64,
+            (Pipe::DualSplit, false) => units.dst_ops += n as u64,
+            (Pipe::DualSplit, true) => units.qdst_ops += n as u64,
         }
         let lat = self.latency[pipe as usize];
         let pipes = &mut self.pipes[pipe as usize];

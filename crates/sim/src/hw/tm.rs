@@ -24,7 +24,7 @@ use crate::hw::icache::ICaches;
 use crate::hw::issued::Issued;
 use crate::hw::l1::L1;
 use crate::hw::memory::{CacheStats, L2};
-use crate::hw::pipe::{Pipe, Pipelines};
+use crate::hw::pipe::{Pipe, Pipelines, TmPipes};
 use crate::hw::slots::{Slots, earliest};
 
 /// One TM's L1, pipelines, reciprocal units and functional-unit pools.
@@ -41,12 +41,12 @@ pub struct Tm {
 }
 
 impl Tm {
-    /// An idle TM with a cold L1; `box_pipes` ray-box pipelines (the "+" configurations use
-    /// the node arity).
-    pub fn new(cfg: &SimConfig, box_pipes: u32) -> Self {
+    /// An idle TM with a cold L1; `pipes` its ray-box pipelines (the "+" configurations use
+    /// the node arity; [`TmPipes`]).
+    pub fn new(cfg: &SimConfig, pipes: impl Into<TmPipes>) -> Self {
         Self {
             l1: L1::new(&cfg.l1),
-            pipes: Pipelines::new(&cfg.units, box_pipes),
+            pipes: Pipelines::new(&cfg.units, pipes.into()),
             fpinv: vec![Slots::default(); cfg.units.fpinv_units as usize],
             fpinv_latency: cfg.units.fpinv_latency,
             pools: Pools::new(&cfg.units),
