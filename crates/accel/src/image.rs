@@ -165,6 +165,20 @@ pub enum ImageError {
         /// Largest storable offset.
         limit: u64,
     },
+    /// A compressed-BVH8 node's leaf runs span more index words than its 5-bit run
+    /// offsets reach (the last leaf's run must start within `limit` words of the node's
+    /// triangle base): too many triangles per leaf ([`crate::cwbvh`]).
+    #[error(
+        "{structure}: a leaf run starts {words} words after the node's triangle base (limit {limit}); use smaller leaves"
+    )]
+    LeafSpan {
+        /// Which node layout.
+        structure: &'static str,
+        /// Offset of the run that does not fit, in words from the triangle base.
+        words: u64,
+        /// Largest storable offset.
+        limit: u64,
+    },
     /// A triangle id is too large for a 31-bit index-list entry.
     #[error("triangle id {given} does not fit a 31-bit index entry (limit {limit})")]
     PrimOverflow {

@@ -248,10 +248,7 @@ impl Structures {
         let wide8 = WideBvh::collapse_bvh8(&bvh2, &CollapseConfig::default());
         let t8 = t0.elapsed();
         let bvh8 = BvhImage::encode(&wide8, &bvh2, shared.clone(), cfg, t8)?;
-        let t0 = Instant::now();
         let cwbvh = cwbvh::Cwbvh::from_wide(&wide8, &bvh2, shared.clone(), t8)?;
-        let cwbvh_encode = t0.elapsed();
-        let cwbvh = cwbvh.with_time(t8 + cwbvh_encode);
         let t0 = Instant::now();
         let dst = dst::Dst::from_bvh2(&bvh2, shared.clone(), dst_cfg)?;
         let dst_convert_ms = ms_since(t0);

@@ -357,6 +357,8 @@ fn check_dst(img: &Regions, stats: &DstStats) -> Result<(), Violation> {
 /// The parts of an image the checks read: the node and index words, their regions, and the
 /// number of triangles.
 pub(crate) struct Regions<'a> {
+    /// The whole image (the structures with their own walk take it whole).
+    pub image: &'a MemoryImage,
     /// The node and index regions' words.
     pub words: &'a [u32],
     /// Word range of the node region.
@@ -370,6 +372,7 @@ pub(crate) struct Regions<'a> {
 impl<'a> Regions<'a> {
     pub fn of(img: &'a MemoryImage) -> Self {
         Regions {
+            image: img,
             words: &img.words,
             nodes: img.nodes.clone(),
             indices: img.indices.clone(),
@@ -406,7 +409,7 @@ pub(crate) fn check(img: &Regions, kind: TreeKind, extra: &Extra) -> Result<(), 
             internal_nodes,
             leaves,
         } => counts(
-            crate::cwbvh::check_structure(img.words, &img.nodes, &img.indices, img.triangles),
+            crate::cwbvh::check_structure(img.image),
             internal_nodes,
             leaves,
         ),

@@ -232,14 +232,14 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
 /// as `f32::max`/`f32::min` ignore a NaN operand. Only the sign of a zero bound may
 /// differ, which no comparison sees. Callers with a NaN interval end use `RayPre::slab`.
 #[derive(Clone, Copy, Debug)]
-struct BoxSlab {
+pub(crate) struct BoxSlab {
     origin: [f32; 3],
     inv: [f32; 3],
     neg: [bool; 3],
 }
 
 impl BoxSlab {
-    fn new(r: &RayPre) -> Self {
+    pub(crate) fn new(r: &RayPre) -> Self {
         Self {
             origin: r.ray.origin.to_array(),
             inv: r.inv_dir.to_array(),
@@ -249,7 +249,7 @@ impl BoxSlab {
 
     /// `(entry, exit)` of box words `w` (min.xyz, max.xyz) clipped to `[t_lo, t_hi]`.
     #[inline(always)]
-    fn test(&self, w: &[f32; 6], t_lo: f32, t_hi: f32) -> (f32, f32) {
+    pub(crate) fn test(&self, w: &[f32; 6], t_lo: f32, t_hi: f32) -> (f32, f32) {
         let mut entry = t_lo;
         let mut exit = t_hi;
         for a in 0..3 {
