@@ -461,7 +461,6 @@ impl CwbvhTree {
             bvh2.shared_triangles().clone(),
             collapse,
         )?;
-        let cwbvh = cwbvh.with_time(t0.elapsed());
         let stats = BuildStats::of_cwbvh(&cwbvh, ms_since(t0));
         Ok(Self {
             cwbvh,

@@ -19,13 +19,6 @@ impl Cwbvh {
             cpu: OnceLock::new(),
         }
     }
-
-    /// This tree with its build time replaced by `time` (collapse and encoding, measured
-    /// by the caller).
-    pub(crate) fn with_time(mut self, time: Duration) -> Self {
-        self.time = time;
-        self
-    }
 }
 
 /// The check on load of a saved compressed BVH8 (`docs/tree-format.md`, "Checks on load"):
