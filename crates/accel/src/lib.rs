@@ -163,6 +163,9 @@ pub enum AccelError {
     /// The dual-split tree could not be converted or encoded.
     #[error(transparent)]
     Dst(#[from] dst::DstError),
+    /// The quantized dual-split tree could not be encoded.
+    #[error(transparent)]
+    DstQ(#[from] dstq::DstQError),
 }
 
 /// Wall time since `t0` in milliseconds (build times: host measurements, never results).
@@ -340,7 +343,7 @@ impl Structures {
             self.bvh8.validate(),
             ValidationReport::of_dst(&self.dst, &self.bvh2),
             self.cwbvh.validate(),
-            self.dstq.validate(&self.bvh2),
+            self.dstq.validate(&self.dst),
         ]
     }
 

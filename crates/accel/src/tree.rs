@@ -618,14 +618,27 @@ impl AnyTree {
 
     /// Checks the tree against `bvh2`, the BVH2 it was derived from (or one built afresh
     /// with the same settings): a BVH image on its own (boxes hold their children), a DST
-    /// and a quantized DST against `bvh2`'s boxes, a compressed BVH8 for quantized boxes that
-    /// contain their children's exact boxes.
+    /// against `bvh2`'s boxes, a compressed BVH8 for quantized boxes that contain their
+    /// children's exact boxes, a quantized DST against the DST converted from `bvh2`
+    /// (hardware preset: the same decisions, planes only looser).
     pub fn validate(&self, bvh2: &Bvh2) -> ValidationReport {
         match self {
             AnyTree::Bvh(b) => b.encoded().validate(),
             AnyTree::Dst(d) => ValidationReport::of_dst(&d.dst, bvh2),
             AnyTree::Cwbvh(c) => c.cwbvh.validate(),
-            AnyTree::DstQ(q) => q.dstq.validate(bvh2),
+            AnyTree::DstQ(q) => {
+                let tris = self.shared_triangles().clone();
+                match Dst::from_bvh2(bvh2, tris, &DstConfig::hardware()) {
+                    Ok(dst) => q.dstq.validate(&dst),
+                    Err(e) => {
+                        let mut rep = q.dstq.validate_structure();
+                        rep.error_count += 1;
+                        rep.errors
+                            .push(format!("the exact DST of the reference BVH2 fails: {e}"));
+                        rep
+                    }
+                }
+            }
         }
     }
 

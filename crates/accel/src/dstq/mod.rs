@@ -1,30 +1,102 @@
-//! The quantized dual-split tree: the DST's planes as k-bit offsets inside a local frame,
-//! several DST levels collapsed into one fetch (Lin et al. 2020, §5, future work).
-//! INTEGRATION STUB: replaced by the real module on merge.
+//! The quantized dual-split tree (`dst-q`): the exact DST's nodes and decisions, grouped
+//! into clusters of one fetch each (several DST levels collapsed), every plane stored as a
+//! k-bit offset inside its cluster's frame and rounded so that no region shrinks
+//! (Lin et al. 2020, §5, future work; layout and measurements in `docs/dstq-encoding.md`).
+//!
+//! ```text
+//!  Dst ──build.rs──▶ exact nodes + exact regions ──▶ clusters (greedy by surface area)
+//!                      │                                 │
+//!                      └── frame.rs: frame (p, e) per cluster, planes rounded outward
+//!                                                        ▼
+//!           MemoryImage: cluster blocks | index runs (the DST's) | triangles (shared)
+//!                 │
+//!   traverse.rs (the DST* rules, planes dequantized)   validate.rs (lockstep with the DST)
+//! ```
+//!
+//! A cluster block is `cluster_bytes` long: a 16-byte frame (origin p as 3 × f32, three
+//! exponent bytes, a record count), then records, each the DST's header-offset word (its
+//! offset field extended with an in-cluster/other-cluster flag, [`QHeader`]) and, for an
+//! internal node, two k-bit plane offsets. Every quantized region contains its exact
+//! region, so closest hits and shadow answers equal the exact DST's (and the BVH2's) on
+//! every ray; the price is extra node steps and triangle tests, measured in the doc.
+//!
+//! ```
+//! use dualsplit_accel::{BuildConfig, Bvh2, NoObserver};
+//! use dualsplit_accel::dst::{Dst, DstConfig};
+//! use dualsplit_accel::dstq::{DstQ, DstQConfig};
+//! use dualsplit_geometry::{Aabb, PrimId, Ray, Triangle, Vec3};
+//! let tris = vec![
+//!     Triangle::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0)),
+//!     Triangle::new(Vec3::new(-1.0, -1.0, 3.0), Vec3::new(1.0, -1.0, 3.0), Vec3::new(0.0, 1.0, 3.0)),
+//! ];
+//! let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
+//! let bvh = Bvh2::build(&boxes, &BuildConfig::default());
+//! let dst = Dst::from_bvh2(&bvh, &tris[..], &DstConfig::hardware()).unwrap();
+//! let q = DstQ::from_dst(&dst, &DstQConfig::default()).unwrap();
+//! assert!(q.validate(&dst).is_ok());
+//! let hit = q.closest_hit(&Ray::new(Vec3::ZERO, Vec3::Z), &mut NoObserver).unwrap();
+//! assert_eq!((hit.t, hit.prim), (2.0, PrimId(0)));
+//! ```
 
-use crate::dst::{Dst, DstError};
+mod build;
+pub mod frame;
+pub mod record;
+mod saved;
+mod stats;
+mod traverse;
+mod validate;
+
+pub use record::{CHILD_LIMIT, ChildRef, QHeader};
+pub use stats::DstQStats;
+
+use crate::dst::DstError;
 use crate::image::MemoryImage;
-use crate::observer::Observer;
 use crate::validate::ValidationReport;
-use dualsplit_geometry::{Aabb, Hit, Ray};
+use dualsplit_geometry::{Aabb, Triangle};
+use serde::{Deserialize, Serialize};
 
-/// Stub.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// Fixed positions inside a cluster block.
+pub mod layout {
+    /// Words of the frame at the start of every block (origin × 3, exponents + count).
+    pub const FRAME_WORDS: usize = 4;
+    /// Bit position of a cluster's first root record (right after the frame).
+    pub const ROOT_BIT: u32 = 128;
+}
+
+/// Errors of [`DstQ::from_dst`].
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum DstQError {
+    /// Reading the exact DST or encoding a header failed (an offset that does not fit).
+    #[error(transparent)]
+    Dst(#[from] DstError),
+    /// The configuration is outside what the encoding supports.
+    #[error(
+        "dst-q config bits = {bits}, cluster_bytes = {cluster_bytes}: need 1 ≤ bits ≤ 16 and a \
+         multiple of 4 bytes in {min_bytes}..=4096 (a frame and a split's two children)"
+    )]
+    BadConfig {
+        /// Bits per plane offset.
+        bits: u32,
+        /// Bytes per cluster block.
+        cluster_bytes: u32,
+        /// The smallest block that holds a frame and two internal records at these bits.
+        min_bytes: u32,
+    },
+}
+
+/// Settings of the quantized DST. The default is the measured choice
+/// (`docs/dstq-encoding.md`, §7): 8-bit planes in 64-byte clusters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct DstQConfig {
-    /// Plane bits.
+    /// Bits per plane offset k (1–16). The measured table covers 4, 6, 8, 10, 12 and 16.
     pub bits: u32,
-    /// Cluster bytes.
+    /// Bytes per cluster block: one fetch (64 = one cache line of the simulated L1).
     pub cluster_bytes: u32,
 }
 
-impl DstQConfig {
-    /// Stub.
-    pub fn check(&self) -> Result<(), DstError> {
-        todo!()
-    }
-}
-
 impl Default for DstQConfig {
+    /// k = 8 in 64-byte clusters: the smallest tree of the measured settings whose extra
+    /// traversal work stays small (`docs/dstq-encoding.md`, §7, states the numbers).
     fn default() -> Self {
         Self {
             bits: 8,
@@ -33,81 +105,117 @@ impl Default for DstQConfig {
     }
 }
 
-/// Stub.
+impl DstQConfig {
+    /// The k values and cluster sizes of the measurement table.
+    pub const MEASURED_BITS: [u32; 6] = [4, 6, 8, 10, 12, 16];
+    /// The cluster sizes of the measurement table.
+    pub const MEASURED_CLUSTER_BYTES: [u32; 2] = [64, 128];
+
+    /// Words per cluster block.
+    pub fn cluster_words(&self) -> u32 {
+        self.cluster_bytes / 4
+    }
+
+    /// Bits of an internal-node record: 32 + 2k.
+    pub fn internal_record_bits(&self) -> u32 {
+        32 + 2 * self.bits
+    }
+
+    fn min_bytes(bits: u32) -> u32 {
+        // Frame + two internal records (a split's children), rounded up to a word.
+        (layout::ROOT_BIT + 2 * (32 + 2 * bits)).div_ceil(32) * 4
+    }
+
+    /// Checks the config against the encoding's limits.
+    pub fn check(&self) -> Result<(), DstQError> {
+        let ok_bits = (1..=16).contains(&self.bits);
+        let min_bytes = Self::min_bytes(self.bits.min(16));
+        let ok_bytes = self.cluster_bytes % 4 == 0
+            && self.cluster_bytes >= min_bytes
+            && self.cluster_bytes <= 4096;
+        if ok_bits && ok_bytes {
+            Ok(())
+        } else {
+            Err(DstQError::BadConfig {
+                bits: self.bits,
+                cluster_bytes: self.cluster_bytes,
+                min_bytes,
+            })
+        }
+    }
+}
+
+/// A quantized dual-split tree: its memory image (cluster blocks, the DST's index runs, the
+/// shared triangles), the scene box rays are clipped to, and its config.
 #[derive(Clone, Debug)]
 pub struct DstQ {
     image: MemoryImage,
-    cfg: DstQConfig,
+    scene_box: Aabb,
+    config: DstQConfig,
 }
 
 impl DstQ {
-    /// Stub.
-    pub fn from_dst(_dst: &Dst, _cfg: &DstQConfig) -> Result<Self, DstError> {
-        todo!()
+    fn assemble(image: MemoryImage, scene_box: Aabb, config: DstQConfig) -> Self {
+        Self {
+            image,
+            scene_box,
+            config,
+        }
     }
-    /// Stub.
+
+    /// A tree from a saved image: checks its structure (valid headers, records inside their
+    /// blocks, offsets and runs in range, nothing reached twice, every triangle referenced
+    /// once) before traversal may read it; the report when it fails.
     pub fn from_image(
-        _image: MemoryImage,
-        _scene_box: Aabb,
-        _cfg: DstQConfig,
+        image: MemoryImage,
+        scene_box: Aabb,
+        config: DstQConfig,
     ) -> Result<Self, ValidationReport> {
-        todo!()
+        if let Err(e) = config.check() {
+            let mut rep = validate::empty_report(&image);
+            rep.error_count = 1;
+            rep.errors.push(e.to_string());
+            return Err(rep);
+        }
+        let q = Self::assemble(image, scene_box, config);
+        let rep = q.validate_structure();
+        if rep.is_ok() { Ok(q) } else { Err(rep) }
     }
-    /// Stub.
-    pub fn from_parts(
-        _image: MemoryImage,
-        _scene_box: Aabb,
-        _cfg: DstQConfig,
-        _internal_nodes: usize,
-        _leaves: usize,
-    ) -> Self {
-        todo!()
-    }
-    /// Stub.
+
+    /// The byte-exact memory image.
     pub fn image(&self) -> &MemoryImage {
         &self.image
     }
-    /// Stub.
-    pub fn scene_box(&self) -> Aabb {
-        todo!()
-    }
-    /// Stub.
-    pub fn config(&self) -> &DstQConfig {
-        &self.cfg
-    }
-    /// Stub.
-    pub fn internal_nodes(&self) -> usize {
-        todo!()
-    }
-    /// Stub.
-    pub fn leaves(&self) -> usize {
-        todo!()
-    }
-    /// Stub.
-    pub fn bytes_total(&self) -> u64 {
-        todo!()
-    }
-    /// Stub.
-    pub fn closest_hit<O: Observer>(&self, _ray: &Ray, _obs: &mut O) -> Option<Hit> {
-        todo!()
-    }
-    /// Stub.
-    pub fn any_hit<O: Observer>(&self, _ray: &Ray, _obs: &mut O) -> bool {
-        todo!()
-    }
-    /// Stub.
-    pub fn validate(&self, _bvh: &crate::Bvh2) -> ValidationReport {
-        todo!()
-    }
-}
 
-/// Stub.
-pub fn check_structure(
-    _words: &[u32],
-    _nodes: &std::ops::Range<usize>,
-    _indices: &std::ops::Range<usize>,
-    _triangles: usize,
-    _cfg: &DstQConfig,
-) -> Result<(u64, u64), (usize, String)> {
-    todo!()
+    /// The scene box, stored beside the tree (24 B); rays are clipped to it.
+    pub fn scene_box(&self) -> Aabb {
+        self.scene_box
+    }
+
+    /// The config the tree was built with.
+    pub fn config(&self) -> &DstQConfig {
+        &self.config
+    }
+
+    /// True for a tree over zero triangles.
+    pub fn is_empty(&self) -> bool {
+        self.image.nodes.is_empty()
+    }
+
+    /// The triangles, read from the image's triangle region.
+    pub fn triangles(&self) -> &[Triangle] {
+        self.image.triangle_slice()
+    }
+
+    /// Cluster blocks in the node region.
+    pub fn clusters(&self) -> u64 {
+        (self.image.nodes.len() / self.config.cluster_words() as usize) as u64
+    }
+
+    /// Node bytes (whole cluster blocks, padding included) + index bytes + the 24-byte
+    /// scene box: the quantity of Lin et al. 2020, Table 3, defined as
+    /// [`crate::dst::DstStats::total_bytes`].
+    pub fn bytes_total(&self) -> u64 {
+        self.image.node_bytes() + self.image.index_bytes() + 24
+    }
 }

@@ -236,12 +236,7 @@ impl AnyTree {
     /// by [`crate::image::RUN_END`] and not overlapping, triangle ids below the triangle
     /// count, valid DST node headers, and the counts the header records. Linear time.
     pub fn check_structure(&self) -> Result<(), SavedError> {
-        structure::check(
-            &structure::Regions::of(self.image()),
-            self.kind(),
-            &self.extra(),
-        )
-        .map_err(|v| SavedError::Structure {
+        structure::check(self, &self.extra()).map_err(|v| SavedError::Structure {
             structure: self.kind().name(),
             word: v.word as u64,
             what: v.what,
@@ -509,13 +504,9 @@ fn assemble(h: &Header, words: Words, tris: SharedTriangles) -> AnyTree {
             internal_nodes,
             leaves,
         } => {
-            let dstq = DstQ::from_parts(
-                image,
-                scene_box,
-                config,
-                internal_nodes as usize,
-                leaves as usize,
-            );
+            // The counts are checked against the walk's (`structure::check`).
+            let _ = (internal_nodes, leaves);
+            let dstq = DstQ::from_parts(image, scene_box, config);
             AnyTree::DstQ(DstQTree {
                 stats: BuildStats::of_dstq(&dstq, 0.0),
                 dstq,

@@ -22,7 +22,7 @@ use super::header::Extra;
 use crate::dst::{DstStats, HeaderOffset};
 use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
 use crate::observer::DstNodeKind;
-use crate::tree::TreeKind;
+use crate::tree::{AnyTree, TreeKind};
 use std::ops::Range;
 
 /// What is wrong with an image and where.
@@ -357,8 +357,6 @@ fn check_dst(img: &Regions, stats: &DstStats) -> Result<(), Violation> {
 /// The parts of an image the checks read: the node and index words, their regions, and the
 /// number of triangles.
 pub(crate) struct Regions<'a> {
-    /// The whole image (the structures with their own walk take it whole).
-    pub image: &'a MemoryImage,
     /// The node and index regions' words.
     pub words: &'a [u32],
     /// Word range of the node region.
@@ -372,7 +370,6 @@ pub(crate) struct Regions<'a> {
 impl<'a> Regions<'a> {
     pub fn of(img: &'a MemoryImage) -> Self {
         Regions {
-            image: img,
             words: &img.words,
             nodes: img.nodes.clone(),
             indices: img.indices.clone(),
@@ -381,8 +378,11 @@ impl<'a> Regions<'a> {
     }
 }
 
-/// Checks the regions of a tree of `kind` whose header has `extra`.
-pub(crate) fn check(img: &Regions, kind: TreeKind, extra: &Extra) -> Result<(), Violation> {
+/// Checks the regions of `tree`, whose header has `extra`: the BVH and DST walks here, the
+/// compressed BVH8's and the quantized DST's own walks (their modules' `check_structure`).
+pub(crate) fn check(tree: &AnyTree, extra: &Extra) -> Result<(), Violation> {
+    let img = &Regions::of(tree.image());
+    let kind = tree.kind();
     if img.nodes.end > img.words.len() || img.indices.end > img.words.len() {
         return Err(violation(
             0,
@@ -408,28 +408,29 @@ pub(crate) fn check(img: &Regions, kind: TreeKind, extra: &Extra) -> Result<(), 
         Extra::Cwbvh {
             internal_nodes,
             leaves,
-        } => counts(
-            crate::cwbvh::check_structure(img.image),
-            internal_nodes,
-            leaves,
-        ),
+        } => match tree {
+            AnyTree::Cwbvh(c) => counts(
+                crate::cwbvh::check_structure(c.cwbvh().image()),
+                internal_nodes,
+                leaves,
+            ),
+            _ => Err(kind_mismatch(kind)),
+        },
         Extra::DstQ {
-            ref config,
             internal_nodes,
             leaves,
             ..
-        } => counts(
-            crate::dstq::check_structure(
-                img.words,
-                &img.nodes,
-                &img.indices,
-                img.triangles,
-                config,
-            ),
-            internal_nodes,
-            leaves,
-        ),
+        } => match tree {
+            AnyTree::DstQ(q) => counts(q.dstq().check_structure(), internal_nodes, leaves),
+            _ => Err(kind_mismatch(kind)),
+        },
     }
+}
+
+/// A header whose fields are another kind's than the tree it describes (never made by
+/// the loader, which builds the tree from the header).
+fn kind_mismatch(kind: TreeKind) -> Violation {
+    violation(0, format!("the header's fields are not a {kind}'s"))
 }
 
 /// A structure check's result (internal nodes and leaves reached, or the faulty word and

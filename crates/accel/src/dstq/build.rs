@@ -1,0 +1,292 @@
+//! `DstQ::from_dst`: reads the exact DST's nodes with their exact regions, groups them into
+//! clusters (greedy by region surface area), and writes every cluster block: its frame, then
+//! its records with conservatively rounded planes (`docs/dstq-encoding.md`, §2–§4).
+
+use super::frame::{Frame, quantize_down, quantize_up};
+use super::layout::ROOT_BIT;
+use super::record::{ChildRef, QHeader, write_bits};
+use super::{DstQ, DstQConfig, DstQError};
+use crate::dst::{Dst, DstError, HeaderOffset};
+use crate::image::MemoryImage;
+use crate::observer::DstNodeKind;
+use dualsplit_geometry::Aabb;
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, VecDeque};
+
+const NONE: u32 = u32::MAX;
+
+/// One exact DST node with the exact region it is entered with (intersection of the scene
+/// box and every half-space on its path).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ExactNode {
+    /// Its header word in the exact DST.
+    pub hdr: HeaderOffset,
+    /// Its planes P0, P1 (0 for a plain leaf).
+    pub planes: [f32; 2],
+    /// The region entering it.
+    pub region: Aabb,
+    /// Children (node ids; [`NONE`] when absent): split left/right, or the carving child.
+    pub kids: [u32; 2],
+}
+
+impl ExactNode {
+    fn child_count(&self) -> usize {
+        self.kids.iter().filter(|&&k| k != NONE).count()
+    }
+}
+
+/// The region left of `region` by the half-space planes of `hdr` for child `side`
+/// (0 = left / carving child, 1 = right), with intersection semantics.
+pub(super) fn child_region(hdr: HeaderOffset, planes: [f32; 2], region: Aabb, side: usize) -> Aabb {
+    let mut r = region;
+    match hdr.node_kind() {
+        DstNodeKind::Leaf => {}
+        DstNodeKind::Split => {
+            let a = hdr.axis();
+            if side == 0 {
+                r.max[a] = r.max[a].min(planes[0]);
+            } else {
+                r.min[a] = r.min[a].max(planes[1]);
+            }
+        }
+        DstNodeKind::SingleCarve => {
+            let a = hdr.axis();
+            r.max[a] = r.max[a].min(planes[0]);
+            r.min[a] = r.min[a].max(planes[1]);
+        }
+        DstNodeKind::DualCarve => {
+            for (a, p, lower) in plane_roles(hdr) {
+                if lower {
+                    r.min[a] = r.min[a].max(planes[p]);
+                } else {
+                    r.max[a] = r.max[a].min(planes[p]);
+                }
+            }
+        }
+    }
+    r
+}
+
+/// For each plane slot of an internal node: (axis, slot, is a lower bound "≥" plane).
+/// Splitting and single-axis carving nodes: P0 upper, P1 lower; dual-axis carving: by corner.
+#[inline(always)]
+pub(super) fn plane_roles(hdr: HeaderOffset) -> [(usize, usize, bool); 2] {
+    match hdr.node_kind() {
+        DstNodeKind::DualCarve => {
+            let (a0, a1) = hdr.axis_pair().axes();
+            let c = hdr.corner();
+            [(a0, 0, c.first_lower), (a1, 1, c.second_lower)]
+        }
+        _ => {
+            let a = hdr.axis();
+            [(a, 0, false), (a, 1, true)]
+        }
+    }
+}
+
+/// Reads the exact DST into nodes in depth-first preorder (node 0 = root).
+pub(super) fn read_exact(dst: &Dst) -> Result<Vec<ExactNode>, DstError> {
+    let img = dst.image();
+    let words = &img.words;
+    let n_nodes = img.nodes.len();
+    let mut out: Vec<ExactNode> = Vec::new();
+    if n_nodes == 0 {
+        return Ok(out);
+    }
+    // (word, region, parent id, child slot)
+    let mut stack: Vec<(u32, Aabb, u32, usize)> = vec![(0, dst.scene_box(), NONE, 0)];
+    while let Some((at, region, parent, slot)) = stack.pop() {
+        if at as usize >= n_nodes || out.len() > n_nodes {
+            return Err(DstError::OffsetOutOfRange {
+                at,
+                offset: at,
+                limit: n_nodes as u32,
+            });
+        }
+        let hdr = HeaderOffset::decode(words[at as usize], at)?;
+        let size = hdr.size_words() as usize;
+        if at as usize + size > n_nodes {
+            return Err(DstError::OffsetOutOfRange {
+                at,
+                offset: at + size as u32,
+                limit: n_nodes as u32,
+            });
+        }
+        let planes = if size == 3 {
+            [
+                f32::from_bits(words[at as usize + 1]),
+                f32::from_bits(words[at as usize + 2]),
+            ]
+        } else {
+            [0.0; 2]
+        };
+        let id = out.len() as u32;
+        out.push(ExactNode {
+            hdr,
+            planes,
+            region,
+            kids: [NONE; 2],
+        });
+        if parent != NONE {
+            out[parent as usize].kids[slot] = id;
+        }
+        match hdr.node_kind() {
+            DstNodeKind::Leaf => {}
+            DstNodeKind::Split => {
+                let l = hdr.offset();
+                let r = l + hdr.left_size();
+                // Right pushed first so the left subtree comes next in preorder.
+                stack.push((r, child_region(hdr, planes, region, 1), id, 1));
+                stack.push((l, child_region(hdr, planes, region, 0), id, 0));
+            }
+            _ => {
+                if !hdr.is_leaf_flag() {
+                    stack.push((hdr.offset(), child_region(hdr, planes, region, 0), id, 0));
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// A cluster waiting to be filled: its roots (1, or a split's 2 children), its frame box and
+/// its block index.
+struct Pending {
+    roots: Vec<u32>,
+    frame: Aabb,
+    block: u32,
+}
+
+fn record_bits(n: &ExactNode, k: u32) -> u32 {
+    if n.hdr.is_plain_leaf() {
+        32
+    } else {
+        32 + 2 * k
+    }
+}
+
+fn union_region(nodes: &[ExactNode], ids: &[u32]) -> Aabb {
+    ids.iter()
+        .fold(Aabb::EMPTY, |b, &i| b.union(nodes[i as usize].region))
+}
+
+/// Surface-area priority of expanding node `n` into its cluster (larger first, then
+/// preorder): the chance a ray entering the cluster reaches `n`'s children.
+fn priority(n: &ExactNode, id: u32) -> (u32, Reverse<u32>) {
+    let a = n.region.half_area();
+    let key = if a.is_nan() { 0 } else { a.max(0.0).to_bits() };
+    (key, Reverse(id))
+}
+
+impl DstQ {
+    /// Converts the exact DST `dst` (itself converted from the BVH2 with identical or
+    /// similar partitioning): the same nodes and decisions, its planes quantized to
+    /// `cfg.bits`-bit offsets inside clusters of `cfg.cluster_bytes` bytes, rounded so every
+    /// region only grows (`docs/dstq-encoding.md`, §4). Lin et al. 2020, §5 (future work).
+    pub fn from_dst(dst: &Dst, cfg: &DstQConfig) -> Result<Self, DstQError> {
+        cfg.check()?;
+        let k = cfg.bits;
+        let cbits = cfg.cluster_bytes * 8;
+        let cw = cfg.cluster_words() as usize;
+        let nodes = read_exact(dst)?;
+        let src = dst.image();
+        let n_idx = src.indices.len();
+        if nodes.is_empty() {
+            let mut image = MemoryImage::with_triangles(0, n_idx, src.triangle_data.clone());
+            image.words[..n_idx].copy_from_slice(&src.words[src.indices.clone()]);
+            return Ok(Self::assemble(image, dst.scene_box(), *cfg));
+        }
+        let mut words: Vec<u32> = Vec::new();
+        let mut queue = VecDeque::from([Pending {
+            roots: vec![0],
+            frame: dst.scene_box(),
+            block: 0,
+        }]);
+        let mut next_block = 1u32;
+        // Per node: where its children went (set while filling its cluster).
+        let mut child_at: Vec<Option<ChildRef>> = vec![None; nodes.len()];
+        while let Some(p) = queue.pop_front() {
+            debug_assert_eq!(p.block as usize * cw, words.len());
+            let mut placed: Vec<(u32, u32)> = Vec::new();
+            let mut heap = BinaryHeap::new();
+            let mut pos = ROOT_BIT;
+            for &r in &p.roots {
+                placed.push((r, pos));
+                pos += record_bits(&nodes[r as usize], k);
+                if nodes[r as usize].child_count() > 0 {
+                    heap.push(priority(&nodes[r as usize], r));
+                }
+            }
+            while let Some((_, Reverse(n))) = heap.pop() {
+                let node = &nodes[n as usize];
+                let kids: Vec<u32> = node.kids.iter().copied().filter(|&c| c != NONE).collect();
+                let need: u32 = kids
+                    .iter()
+                    .map(|&c| record_bits(&nodes[c as usize], k))
+                    .sum();
+                if pos + need <= cbits {
+                    child_at[n as usize] = Some(ChildRef::Local(pos));
+                    for &c in &kids {
+                        placed.push((c, pos));
+                        pos += record_bits(&nodes[c as usize], k);
+                        if nodes[c as usize].child_count() > 0 {
+                            heap.push(priority(&nodes[c as usize], c));
+                        }
+                    }
+                } else {
+                    child_at[n as usize] = Some(ChildRef::Cluster(next_block));
+                    queue.push_back(Pending {
+                        frame: union_region(&nodes, &kids),
+                        roots: kids,
+                        block: next_block,
+                    });
+                    next_block += 1;
+                }
+            }
+            // Write the block.
+            let base = words.len();
+            words.resize(base + cw, 0);
+            let block = &mut words[base..];
+            let frame = Frame::of_box(p.frame.min.to_array(), p.frame.max.to_array(), k);
+            block[..4].copy_from_slice(&frame.words(placed.len().min(255) as u8));
+            for &(n, bit) in &placed {
+                let node = &nodes[n as usize];
+                let hdr = node.hdr;
+                let child = || child_at[n as usize].expect("every expanded node has a child ref");
+                let q = match hdr.node_kind() {
+                    DstNodeKind::Leaf => QHeader::leaf(hdr.offset() as u64)?,
+                    DstNodeKind::Split => {
+                        let left = &nodes[node.kids[0] as usize];
+                        QHeader::split(hdr.axis(), !left.hdr.is_plain_leaf(), child())?
+                    }
+                    _ if hdr.is_leaf_flag() => QHeader::carve_leaf(hdr, hdr.offset() as u64)?,
+                    _ => QHeader::carve(hdr, child())?,
+                };
+                write_bits(block, bit as usize, 32, q.bits());
+                if !hdr.is_plain_leaf() {
+                    for (a, slot, lower) in plane_roles(hdr) {
+                        let x = node.planes[slot];
+                        let (o, e) = (frame.origin[a], frame.exp[a]);
+                        let qv = if lower {
+                            quantize_down(x, o, e, k)
+                        } else {
+                            quantize_up(x, o, e, k)
+                        };
+                        write_bits(block, (bit + 32 + slot as u32 * k) as usize, k, qv);
+                    }
+                }
+            }
+        }
+        if next_block as u64 > super::record::CHILD_LIMIT {
+            return Err(DstQError::Dst(DstError::OffsetOverflow {
+                given: next_block as u64,
+                limit: super::record::CHILD_LIMIT,
+            }));
+        }
+        let n_nodes = words.len();
+        let mut image = MemoryImage::with_triangles(n_nodes, n_idx, src.triangle_data.clone());
+        image.words[..n_nodes].copy_from_slice(&words);
+        image.words[n_nodes..n_nodes + n_idx].copy_from_slice(&src.words[src.indices.clone()]);
+        Ok(Self::assemble(image, dst.scene_box(), *cfg))
+    }
+}

@@ -1,0 +1,38 @@
+//! What the saved-tree format and the structure statistics need of a quantized DST
+//! (`crate::saved`, `crate::stats`): counts, a tree from the parts a file holds, and the
+//! check on load.
+
+use super::{DstQ, DstQConfig};
+use crate::image::MemoryImage;
+use dualsplit_geometry::Aabb;
+
+impl DstQ {
+    /// The tree of `image` with the scene box and config a saved file's header records,
+    /// unchecked: the loader runs [`DstQ::check_structure`] on it before handing it out.
+    pub(crate) fn from_parts(image: MemoryImage, scene_box: Aabb, config: DstQConfig) -> Self {
+        Self::assemble(image, scene_box, config)
+    }
+
+    /// Internal-node records (splitting and carving nodes), counted by a walk.
+    pub fn internal_nodes(&self) -> usize {
+        self.stats().internal_nodes() as usize
+    }
+
+    /// Leaves: plain-leaf records and carving records acting as leaves (as the exact DST
+    /// counts them), counted by a walk.
+    pub fn leaves(&self) -> usize {
+        let s = self.stats();
+        (s.leaves + s.carving_leaves) as usize
+    }
+
+    /// The check on load of a saved quantized DST (`docs/tree-format.md`, "Checks on
+    /// load"): [`DstQ::validate_structure`]'s walk. Returns the internal nodes and leaves
+    /// reached, or the first violation (the walk names the block and bit in its message).
+    pub(crate) fn check_structure(&self) -> Result<(u64, u64), (usize, String)> {
+        let rep = self.validate_structure();
+        match rep.errors.first() {
+            Some(e) => Err((0, format!("{e} ({} violations)", rep.error_count))),
+            None => Ok((self.internal_nodes() as u64, self.leaves() as u64)),
+        }
+    }
+}

@@ -1,0 +1,232 @@
+//! Traversal of the quantized DST: the exact DST's node rules (`dst/traverse.rs`; Lin et al.
+//! 2020, §3, Figs. 2–3), with each plane dequantized from its cluster's frame
+//! (`plane = p_a + q · 2^(e_a − 127)`) before the same distance, widening and `le_or_nan`
+//! tests. A stack entry carries the cluster block and the record's bit position beside its
+//! interval.
+//!
+//! Fetch accounting (`docs/dstq-encoding.md`, §6): the frame (16 B at the block's start)
+//! when the traversal starts working in a block other than the one whose frame it holds
+//! (descending into a child cluster, or popping an entry of another cluster); then, per
+//! node step, the whole 32-bit words that hold the record's bits (a record may straddle a
+//! word boundary); 4 B per index entry and 36 B per triangle, as the exact DST.
+
+use super::DstQ;
+use super::frame::Frame;
+use super::layout::{FRAME_WORDS, ROOT_BIT};
+use super::record::{ChildRef, QHeader, read_bits};
+use crate::dst::pipeline::{ReturnCode, le_or_nan};
+use crate::image::{MemoryImage, RUN_END};
+use crate::observer::{DstNodeKind, NodeStep, Observer};
+use dualsplit_geometry::{Hit, PrimId, Ray, cull_limit, widen_exit};
+
+/// A traversal-stack entry: a record (cluster block, bit position) and its ray interval.
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    block: u32,
+    bit: u32,
+    t_min: f32,
+    t_max: f32,
+}
+
+#[inline(always)]
+fn dst_step(kind: DstNodeKind, code: ReturnCode, carving_leaf: bool) -> NodeStep {
+    NodeStep::Dst {
+        kind,
+        code,
+        carving_leaf,
+    }
+}
+
+impl DstQ {
+    /// Closest hit of `ray`, ordered by `(t, prim)`: equal to the exact DST's and the BVH2's
+    /// on every ray (conservative planes only add work). Lin et al. 2020, §3, §5.
+    pub fn closest_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        self.traverse::<O, false>(ray, obs)
+    }
+
+    /// True when `ray` hits any triangle within `[t_min, t_max]`.
+    pub fn any_hit<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+        self.traverse::<O, true>(ray, obs).is_some()
+    }
+
+    /// Where the child `c` of a record in `block` lies: (block, bit).
+    #[inline(always)]
+    fn locate(block: u32, c: ChildRef) -> (u32, u32) {
+        match c {
+            ChildRef::Local(bit) => (block, bit),
+            ChildRef::Cluster(b) => (b, ROOT_BIT),
+        }
+    }
+
+    fn traverse<O: Observer, const ANY: bool>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        if self.is_empty() {
+            return None;
+        }
+        let r = ray.precompute();
+        let sb = self.scene_box;
+        let (mut t_min, mut t_max) = r.slab(sb.min, sb.max, ray.t_min, cull_limit(ray.t_max));
+        if t_min > t_max {
+            return None;
+        }
+        let img = &self.image;
+        let words: &[u32] = &img.words;
+        let k = self.config.bits;
+        let cw = self.config.cluster_words() as usize;
+        let tris = self.triangles();
+        let mut best: Option<Hit> = None;
+        let mut best_t = ray.t_max;
+        let mut stack: Vec<Entry> = Vec::with_capacity(64);
+        let mut frame_block = u32::MAX;
+        let mut frame = Frame {
+            origin: [0.0; 3],
+            exp: [0; 3],
+        };
+        let (mut block, mut bit) = (0u32, ROOT_BIT);
+        loop {
+            let base = block as usize * cw;
+            if block != frame_block {
+                obs.fetch(MemoryImage::addr(base), 4 * FRAME_WORDS as u32);
+                let mut fw = [0u32; 4];
+                fw.copy_from_slice(&words[base..base + FRAME_WORDS]);
+                frame = Frame::from_words(fw);
+                frame_block = block;
+            }
+            let cwords = &words[base..base + cw];
+            let h = QHeader::from_bits(read_bits(cwords, bit as usize, 32));
+            let rb = h.record_bits(k);
+            let (w0, w1) = (bit / 32, (bit + rb - 1) / 32);
+            obs.fetch(MemoryImage::addr(base + w0 as usize), 4 * (w1 - w0 + 1));
+            let plane = |slot: u32, a: usize| {
+                frame.plane(a, read_bits(cwords, (bit + 32 + slot * k) as usize, k))
+            };
+            let run = match h.node_kind() {
+                DstNodeKind::Leaf => {
+                    obs.step(dst_step(DstNodeKind::Leaf, ReturnCode::Leaf, false));
+                    Some(h.run())
+                }
+                DstNodeKind::Split => {
+                    let a = h.exact().axis();
+                    let (p0, p1) = (plane(0, a), plane(1, a));
+                    let (cb, lbit) = Self::locate(block, h.child());
+                    let lsize = if h.left_is_internal() { 32 + 2 * k } else { 32 };
+                    let (left, right) = ((cb, lbit), (cb, lbit + lsize));
+                    let (near, far, t1, t2) = if r.neg[a] {
+                        (right, left, r.exit_t(a, p1), r.plane_t(a, p0))
+                    } else {
+                        (left, right, r.exit_t(a, p0), r.plane_t(a, p1))
+                    };
+                    let near_hit = le_or_nan(t_min, t1);
+                    let far_hit = le_or_nan(t2, t_max);
+                    obs.step(dst_step(
+                        DstNodeKind::Split,
+                        ReturnCode::from_bits(near_hit as u8 + far_hit as u8),
+                        false,
+                    ));
+                    match (near_hit, far_hit) {
+                        (true, true) => {
+                            stack.push(Entry {
+                                block: far.0,
+                                bit: far.1,
+                                t_min: t_min.max(t2),
+                                t_max,
+                            });
+                            obs.push();
+                            (block, bit) = near;
+                            t_max = t_max.min(t1);
+                            continue;
+                        }
+                        (true, false) => {
+                            (block, bit) = near;
+                            t_max = t_max.min(t1);
+                            continue;
+                        }
+                        (false, true) => {
+                            (block, bit) = far;
+                            t_min = t_min.max(t2);
+                            continue;
+                        }
+                        (false, false) => None,
+                    }
+                }
+                kind => {
+                    let (lo, hi) = if kind == DstNodeKind::SingleCarve {
+                        let a = h.exact().axis();
+                        let (p0, p1) = (plane(0, a), plane(1, a));
+                        let (t1, t2) = if r.neg[a] {
+                            (r.exit_t(a, p1), r.plane_t(a, p0))
+                        } else {
+                            (r.exit_t(a, p0), r.plane_t(a, p1))
+                        };
+                        (t_min.max(t2), t_max.min(t1))
+                    } else {
+                        let (a0, a1) = h.exact().axis_pair().axes();
+                        let c = h.exact().corner();
+                        let (mut lo, mut hi) = (t_min, t_max);
+                        for (a, slot, lower) in [(a0, 0, c.first_lower), (a1, 1, c.second_lower)] {
+                            let t = r.plane_t(a, plane(slot, a));
+                            if r.neg[a] == lower {
+                                hi = hi.min(widen_exit(t));
+                            } else {
+                                lo = lo.max(t);
+                            }
+                        }
+                        (lo, hi)
+                    };
+                    let hit = le_or_nan(lo, hi);
+                    let leaf = h.is_leaf_flag();
+                    let code = ReturnCode::from_bits(hit as u8 * (1 + 2 * leaf as u8));
+                    obs.step(dst_step(kind, code, leaf));
+                    if hit {
+                        t_min = lo;
+                        t_max = hi;
+                        if !leaf {
+                            (block, bit) = Self::locate(block, h.child());
+                            continue;
+                        }
+                        Some(h.run())
+                    } else {
+                        None
+                    }
+                }
+            };
+            if let Some(first) = run {
+                // The run on the ray's own interval [ray.t_min, best_t], as the exact DST.
+                let start = img.indices.start + first as usize;
+                let count = words[start..img.indices.end]
+                    .iter()
+                    .position(|&e| e & RUN_END != 0)
+                    .map_or(0, |p| p + 1);
+                obs.step(NodeStep::Leaf {
+                    count: count as u32,
+                });
+                for i in start..start + count {
+                    let p = PrimId(words[i] & !RUN_END);
+                    obs.fetch(MemoryImage::addr(i), 4);
+                    obs.fetch(MemoryImage::addr(img.triangles.start + 9 * p.index()), 36);
+                    let hit = tris[p.index()].intersect(&r, ray.t_min, best_t);
+                    obs.triangle_test(p, hit.is_some());
+                    if let Some(hh) = hit {
+                        if ANY {
+                            return Some(Hit::on(p, hh));
+                        }
+                        if Hit::keep_closest(&mut best, p, hh) {
+                            best_t = hh.t;
+                        }
+                    }
+                }
+            }
+            // Pop the next entry that can still hold a closer hit, clamping its t_max.
+            let limit = cull_limit(best_t);
+            loop {
+                let Some(e) = stack.pop() else {
+                    return best;
+                };
+                obs.pop();
+                if le_or_nan(e.t_min, limit) {
+                    (block, bit, t_min, t_max) = (e.block, e.bit, e.t_min, e.t_max.min(limit));
+                    break;
+                }
+            }
+        }
+    }
+}

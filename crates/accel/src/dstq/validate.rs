@@ -1,0 +1,358 @@
+//! `validate()`: walks the quantized DST's records from the root, alone (the structural
+//! check of a loaded image) or in lockstep with its exact DST (conservative planes).
+//!
+//! Structure: every block's size and frame, every record inside its block (at or after bit
+//! 128) and reached once, headers among the exact DST's 37 valid codes, child clusters
+//! inside the node region, runs inside the index region and terminated, every index entry
+//! in exactly one run, every triangle referenced exactly once, each block's record count
+//! equal to the records reached in it. Lockstep with the exact DST: the same node kind,
+//! axis, corner and run at every node, and every plane conservative: a "≤" plane decodes to
+//! at least `min(exact plane, exact region max)`, a "≥" plane to at most
+//! `max(exact plane, exact region min)` (the exact region being the one the exact node is
+//! entered with), so every quantized region contains its exact region (also checked).
+//! Any words give a report, never a panic or an endless walk.
+
+use super::build::{ExactNode, child_region, plane_roles, read_exact};
+use super::frame::Frame;
+use super::layout::{FRAME_WORDS, ROOT_BIT};
+use super::record::{ChildRef, QHeader, read_bits};
+use super::{DstQ, DstQStats};
+use crate::dst::Dst;
+use crate::image::{MemoryImage, RUN_END};
+use crate::observer::DstNodeKind;
+use crate::validate::{MAX_MESSAGES, ValidationReport};
+use dualsplit_geometry::Aabb;
+
+/// A report with nothing reached yet.
+pub(super) fn empty_report(img: &MemoryImage) -> ValidationReport {
+    ValidationReport {
+        structure: "dst-q",
+        triangles: img.triangle_slice().len(),
+        ..ValidationReport::default()
+    }
+}
+
+fn error(rep: &mut ValidationReport, msg: String) {
+    rep.error_count += 1;
+    if rep.errors.len() < MAX_MESSAGES {
+        rep.errors.push(msg);
+    }
+}
+
+const NONE: u32 = u32::MAX;
+
+/// One record to check: where it is, its depth, its exact node (or [`NONE`]) and the
+/// quantized region entering it.
+struct Visit {
+    block: u32,
+    bit: u32,
+    depth: usize,
+    exact: u32,
+    region: Aabb,
+}
+
+impl DstQ {
+    /// Checks the tree against `dst`, the exact DST it was converted from: the structure and,
+    /// node by node, the same decisions with conservative planes (module docs). Structure
+    /// name "dst-q".
+    pub fn validate(&self, dst: &Dst) -> ValidationReport {
+        match read_exact(dst) {
+            Ok(nodes) => self.walk(Some(&nodes)).0,
+            Err(e) => {
+                let mut rep = empty_report(&self.image);
+                error(&mut rep, format!("the exact DST does not read: {e}"));
+                rep
+            }
+        }
+    }
+
+    /// The structural check alone (what loading a saved tree runs).
+    pub fn validate_structure(&self) -> ValidationReport {
+        self.walk(None).0
+    }
+
+    /// Node counts and sizes, counted by walking the records.
+    pub fn stats(&self) -> DstQStats {
+        let mut s = self.walk(None).1;
+        s.clusters = self.clusters();
+        s.node_bytes = self.image.node_bytes();
+        s.index_bytes = self.image.index_bytes();
+        s.total_bytes = self.bytes_total();
+        s
+    }
+
+    fn walk(&self, exact: Option<&[ExactNode]>) -> (ValidationReport, DstQStats) {
+        let img = &self.image;
+        let mut rep = empty_report(img);
+        let mut st = DstQStats::default();
+        let k = self.config.bits;
+        let cw = self.config.cluster_words() as usize;
+        let cbits = self.config.cluster_bytes * 8;
+        let words: &[u32] = &img.words;
+        let n_tris = rep.triangles;
+        if img.nodes.start != 0
+            || img.nodes.end != img.indices.start
+            || words.len() < img.indices.end
+            || img.nodes.len() % cw != 0
+        {
+            error(
+                &mut rep,
+                format!(
+                    "regions nodes {:?}, indices {:?} over {} words do not fit {}-word blocks",
+                    img.nodes,
+                    img.indices,
+                    words.len(),
+                    cw
+                ),
+            );
+            return (rep, st);
+        }
+        let n_blocks = img.nodes.len() / cw;
+        let mut index_cover = vec![0u8; img.indices.len()];
+        let mut tri_refs = vec![0u32; n_tris];
+        if let Some(ex) = exact
+            && ex.is_empty() != (n_blocks == 0)
+        {
+            error(
+                &mut rep,
+                "the exact DST and dst-q disagree on emptiness".into(),
+            );
+            return (rep, st);
+        }
+        // One bit per record position reached; records counted per block.
+        let mut seen = vec![0u64; (n_blocks * cbits as usize).div_ceil(64)];
+        let mut per_block = vec![0u32; n_blocks];
+        let mut stack: Vec<Visit> = Vec::new();
+        if n_blocks > 0 {
+            stack.push(Visit {
+                block: 0,
+                bit: ROOT_BIT,
+                depth: 0,
+                exact: if exact.is_some() { 0 } else { NONE },
+                region: self.scene_box,
+            });
+        }
+        while let Some(v) = stack.pop() {
+            let at = format!("record {}:{}", v.block, v.bit);
+            if v.block as usize >= n_blocks {
+                error(&mut rep, format!("{at}: block outside 0..{n_blocks}"));
+                continue;
+            }
+            if v.bit < ROOT_BIT || v.bit + 32 > cbits {
+                error(&mut rep, format!("{at}: bit outside {ROOT_BIT}..{cbits}"));
+                continue;
+            }
+            let base = v.block as usize * cw;
+            let cwords = &words[base..base + cw];
+            let word = read_bits(cwords, v.bit as usize, 32);
+            let h = match QHeader::decode(word, v.bit) {
+                Ok(h) => h,
+                Err(e) => {
+                    error(&mut rep, format!("{at}: {e}"));
+                    continue;
+                }
+            };
+            let rb = h.record_bits(k);
+            if v.bit + rb > cbits {
+                error(
+                    &mut rep,
+                    format!("{at}: record of {rb} bits leaves the block"),
+                );
+                continue;
+            }
+            let key = v.block as usize * cbits as usize + v.bit as usize;
+            if seen[key / 64] & (1 << (key % 64)) != 0 {
+                error(&mut rep, format!("{at}: reached twice"));
+                continue;
+            }
+            seen[key / 64] |= 1 << (key % 64);
+            per_block[v.block as usize] += 1;
+            rep.max_depth = rep.max_depth.max(v.depth);
+            let mut fw = [0u32; 4];
+            fw.copy_from_slice(&cwords[..FRAME_WORDS]);
+            let frame = Frame::from_words(fw);
+            let kind = h.node_kind();
+            let planes = if kind == DstNodeKind::Leaf {
+                [0.0; 2]
+            } else {
+                let hx = h.exact();
+                let mut p = [0.0f32; 2];
+                for (a, slot, _) in plane_roles(hx) {
+                    let q = read_bits(cwords, (v.bit + 32 + slot as u32 * k) as usize, k);
+                    p[slot] = frame.plane(a, q);
+                }
+                p
+            };
+            // Lockstep with the exact node.
+            let ex = exact.and_then(|e| e.get(v.exact as usize));
+            if let Some(en) = ex {
+                if en.hdr.header() != h.exact().header()
+                    || (h.is_leaf_flag() && en.hdr.offset() != h.run())
+                {
+                    error(
+                        &mut rep,
+                        format!("{at}: {h:?} differs from the exact node {:?}", en.hdr),
+                    );
+                    continue;
+                }
+                if !v.region.contains_box(&en.region) {
+                    error(
+                        &mut rep,
+                        format!(
+                            "{at}: region {:?} does not contain the exact region {:?}",
+                            v.region, en.region
+                        ),
+                    );
+                }
+                if kind != DstNodeKind::Leaf {
+                    for (a, slot, lower) in plane_roles(en.hdr) {
+                        let (x, got) = (en.planes[slot], planes[slot]);
+                        let ok = if lower {
+                            got <= x.max(en.region.min[a])
+                        } else {
+                            got >= x.min(en.region.max[a])
+                        };
+                        if !ok {
+                            error(
+                                &mut rep,
+                                format!(
+                                    "{at}: plane P{slot} = {got} is not conservative \
+                                     (exact {x}, {} bound)",
+                                    if lower { "lower" } else { "upper" }
+                                ),
+                            );
+                        }
+                    }
+                }
+            }
+            let exact_kid = |i: usize| ex.map_or(NONE, |en| en.kids[i]);
+            match kind {
+                DstNodeKind::Leaf => {
+                    st.leaves += 1;
+                    rep.leaves += 1;
+                }
+                DstNodeKind::Split => st.splitting += 1,
+                DstNodeKind::SingleCarve => st.single_carving += 1,
+                DstNodeKind::DualCarve => st.dual_carving += 1,
+            }
+            if kind != DstNodeKind::Leaf {
+                rep.internal_nodes += 1;
+            }
+            if h.is_leaf_flag() {
+                if kind != DstNodeKind::Leaf {
+                    st.carving_leaves += 1;
+                    rep.leaves += 1;
+                }
+                self.check_run(&mut rep, &at, h.run(), &mut index_cover, &mut tri_refs);
+                continue;
+            }
+            let (cb, cbit) = match h.child() {
+                ChildRef::Local(b) => (v.block, b),
+                ChildRef::Cluster(c) => (c, ROOT_BIT),
+            };
+            let hx = h.exact();
+            if kind == DstNodeKind::Split {
+                let lsize = if h.left_is_internal() { 32 + 2 * k } else { 32 };
+                for (side, bit) in [(1, cbit.saturating_add(lsize)), (0, cbit)] {
+                    stack.push(Visit {
+                        block: cb,
+                        bit,
+                        depth: v.depth + 1,
+                        exact: exact_kid(side),
+                        region: child_region(hx, planes, v.region, side),
+                    });
+                }
+                // The left size field must name the left record's real size.
+                if (cb as usize) < n_blocks && cbit + 32 <= cbits {
+                    let lw = read_bits(&words[cb as usize * cw..][..cw], cbit as usize, 32);
+                    let real = QHeader::from_bits(lw).record_bits(k);
+                    if real != lsize {
+                        error(&mut rep, format!("{at}: left size {lsize} but {real} bits"));
+                    }
+                }
+            } else {
+                stack.push(Visit {
+                    block: cb,
+                    bit: cbit,
+                    depth: v.depth + 1,
+                    exact: exact_kid(0),
+                    region: child_region(hx, planes, v.region, 0),
+                });
+            }
+        }
+        // Record counts in the frames, every block reached, every entry and triangle once.
+        for (b, &n) in per_block.iter().enumerate() {
+            let stored = cluster_count(words, b * cw);
+            if n.min(255) != stored as u32 {
+                error(
+                    &mut rep,
+                    format!("block {b}: frame says {stored} records, {n} reached"),
+                );
+            }
+        }
+        let unused = index_cover.iter().filter(|&&c| c == 0).count();
+        if unused > 0 {
+            error(
+                &mut rep,
+                format!("{unused} index entries in no reached run"),
+            );
+        }
+        rep.triangles_referenced = tri_refs.iter().filter(|&&c| c > 0).count();
+        for (p, &c) in tri_refs.iter().enumerate() {
+            if c != 1 {
+                error(&mut rep, format!("triangle {p} referenced {c} times"));
+            }
+        }
+        st.index_entries = img.indices.len() as u64;
+        st.used_bits = self.used_bits_estimate(&st);
+        (rep, st)
+    }
+
+    fn used_bits_estimate(&self, st: &DstQStats) -> u64 {
+        let internal = st.splitting + st.single_carving + st.dual_carving;
+        internal * self.config.internal_record_bits() as u64
+            + 32 * st.leaves
+            + ROOT_BIT as u64 * self.clusters()
+    }
+
+    fn check_run(
+        &self,
+        rep: &mut ValidationReport,
+        at: &str,
+        first: u32,
+        cover: &mut [u8],
+        tri_refs: &mut [u32],
+    ) {
+        let img = &self.image;
+        let run = &img.words[img.indices.clone()];
+        let mut j = first as usize;
+        loop {
+            if j >= run.len() {
+                error(
+                    rep,
+                    format!("{at}: run from {first} leaves the index region"),
+                );
+                return;
+            }
+            cover[j] = cover[j].saturating_add(1);
+            if cover[j] > 1 {
+                error(rep, format!("{at}: index entry {j} in two runs"));
+                return;
+            }
+            let p = (run[j] & !RUN_END) as usize;
+            match tri_refs.get_mut(p) {
+                Some(c) => *c += 1,
+                None => error(rep, format!("{at}: triangle {p} out of range")),
+            }
+            if run[j] & RUN_END != 0 {
+                return;
+            }
+            j += 1;
+        }
+    }
+}
+
+/// The record count stored in byte 3 of a block's frame word 3.
+fn cluster_count(words: &[u32], base: usize) -> u8 {
+    (words[base + 3] >> 24) as u8
+}

@@ -1,0 +1,637 @@
+//! The quantized DST (`dst-q`): record round trips, conservative plane rounding (proptest),
+//! per-ray equivalence with the BVH2 (closest t bits, triangle id, shadow answer) on the
+//! shipped meshes and random small scenes for every supported k and cluster size,
+//! `validate()` on every tree and on corrupted images, and the measurement table of
+//! `docs/dstq-encoding.md` (`measure_table`, ignored: run it with
+//! `cargo test --release -p dualsplit-accel --test dstq measure_table -- --ignored --nocapture`).
+
+use dualsplit_accel::dst::{Dst, DstConfig, HeaderOffset, Partitioning};
+use dualsplit_accel::dstq::frame::{choose_exponent, decode, q_max, quantize_down, quantize_up};
+use dualsplit_accel::dstq::layout::ROOT_BIT;
+use dualsplit_accel::dstq::record::{read_bits, write_bits};
+use dualsplit_accel::dstq::{ChildRef, DstQ, DstQConfig, QHeader};
+use dualsplit_accel::{
+    AccelKind, BuildConfig, ByteAddr, CountingObserver, DstNodeKind, NoObserver, Observer,
+    Structures,
+};
+use dualsplit_geometry::{Aabb, Pcg32, Ray, Triangle, Vec3};
+use dualsplit_testkit::oracle::{key, oracle_closest};
+use dualsplit_testkit::rays::{random_rays, record_rays};
+use dualsplit_testkit::scenes::shipped;
+use proptest::prelude::*;
+use std::collections::HashSet;
+
+/// Every supported config: k ∈ {4, 6, 8, 10, 12, 16} × 64 and 128-byte clusters.
+fn configs() -> Vec<DstQConfig> {
+    let mut v = Vec::new();
+    for &cluster_bytes in &DstQConfig::MEASURED_CLUSTER_BYTES {
+        for &bits in &DstQConfig::MEASURED_BITS {
+            v.push(DstQConfig {
+                bits,
+                cluster_bytes,
+            });
+        }
+    }
+    v
+}
+
+/// Checks `q` against the BVH2 of `s` on one ray: closest t bits and triangle id (plain and
+/// observed), and the shadow answer.
+fn check_ray(s: &Structures, q: &DstQ, ray: &Ray, what: &str) {
+    let want = s.closest_hit(AccelKind::Bvh2, ray, &mut NoObserver);
+    let got = q.closest_hit(ray, &mut NoObserver);
+    assert_eq!(key(got), key(want), "{what}: closest hit, ray {ray:?}");
+    let obs = q.closest_hit(ray, &mut CountingObserver::default());
+    assert_eq!(
+        key(obs),
+        key(want),
+        "{what}: observed closest hit, ray {ray:?}"
+    );
+    let any = s.any_hit(AccelKind::Bvh2, ray, &mut NoObserver);
+    assert_eq!(
+        q.any_hit(ray, &mut NoObserver),
+        any,
+        "{what}: any hit, ray {ray:?}"
+    );
+}
+
+fn build_all(s: &Structures, what: &str) -> Vec<DstQ> {
+    configs()
+        .into_iter()
+        .map(|cfg| {
+            let q = DstQ::from_dst(&s.dst, &cfg).expect("dst-q converts");
+            let rep = q.validate(&s.dst);
+            assert!(rep.is_ok(), "{what} {cfg:?}: {rep:?}");
+            assert!(q.validate_structure().is_ok(), "{what} {cfg:?}");
+            q
+        })
+        .collect()
+}
+
+// ---------------------------------------------------------------- records and frames
+
+proptest! {
+    #[test]
+    fn header_round_trip(
+        code in prop::sample::select(HeaderOffset::ALL_VALID_HEADERS.to_vec()),
+        local in any::<bool>(),
+        child in 0u32..(1 << 25),
+        run in 0u64..(1 << 26),
+        bit in 0usize..200,
+        k in prop::sample::select(DstQConfig::MEASURED_BITS.to_vec()),
+        q0 in any::<u32>(),
+        q1 in any::<u32>(),
+    ) {
+        let exact = HeaderOffset::from_bits((code as u32) << 26);
+        let c = if local { ChildRef::Local(child) } else { ChildRef::Cluster(child) };
+        let h = match exact.node_kind() {
+            DstNodeKind::Leaf => QHeader::leaf(run).unwrap(),
+            DstNodeKind::Split => QHeader::split(exact.axis(), exact.left_size() == 3, c).unwrap(),
+            _ if exact.is_leaf_flag() => QHeader::carve_leaf(exact, run).unwrap(),
+            _ => QHeader::carve(exact, c).unwrap(),
+        };
+        prop_assert_eq!(h.exact().header(), code);
+        prop_assert_eq!(QHeader::decode(h.bits(), 0).unwrap(), h);
+        if h.is_leaf_flag() {
+            prop_assert_eq!(h.run() as u64, run);
+        } else {
+            prop_assert_eq!(h.child(), c);
+        }
+        // The record through the bit stream, at any alignment.
+        let mut w = [0u32; 12];
+        let (q0, q1) = (q0 & q_max(k), q1 & q_max(k));
+        write_bits(&mut w, bit, 32, h.bits());
+        write_bits(&mut w, bit + 32, k, q0);
+        write_bits(&mut w, bit + 32 + k as usize, k, q1);
+        prop_assert_eq!(read_bits(&w, bit, 32), h.bits());
+        prop_assert_eq!(read_bits(&w, bit + 32, k), q0);
+        prop_assert_eq!(read_bits(&w, bit + 32 + k as usize, k), q1);
+    }
+}
+
+/// A coordinate: ordinary, huge (up to ±2^60), tiny or subnormal, or zero.
+fn coordinate() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        -8.0f32..8.0,
+        (any::<bool>(), 0u32..(127 + 61), 0u32..1 << 23)
+            .prop_map(|(neg, e, m)| f32::from_bits(u32::from(neg) << 31 | e << 23 | m)),
+        (any::<bool>(), 0u32..1 << 23)
+            .prop_map(|(neg, m)| f32::from_bits(u32::from(neg) << 31 | m)),
+        Just(0.0f32),
+        Just(-0.0f32),
+        prop::sample::select(vec![(1u64 << 60) as f32, -((1u64 << 60) as f32)]),
+    ]
+}
+
+/// A plane to quantize in the frame `[lo, hi]`: inside it (interpolated or at its ends),
+/// just outside, or anywhere.
+fn plane_in(lo: f32, hi: f32) -> impl Strategy<Value = f32> {
+    prop_oneof![
+        (0.0f64..=1.0).prop_map(move |t| (lo as f64 + t * (hi as f64 - lo as f64)) as f32),
+        prop::sample::select(vec![
+            lo,
+            hi,
+            lo.next_up(),
+            hi.next_down(),
+            lo.next_down(),
+            hi.next_up()
+        ]),
+        coordinate(),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 4096, ..ProptestConfig::default() })]
+
+    /// Fails when a quantized plane is not conservative: inside its frame a "≤" plane must
+    /// decode at or above the exact plane and a "≥" plane at or below it, with the tightest
+    /// such offset; outside it, at or beyond the frame's bound on the plane's side.
+    #[test]
+    fn quantized_planes_are_conservative(
+        (lo, hi, x) in (coordinate(), coordinate(), any::<bool>())
+            .prop_flat_map(|(a, b, flat)| {
+                let (lo, hi) = if flat { (a, a) } else { (a.min(b), a.max(b)) };
+                (Just(lo), Just(hi), plane_in(lo, hi))
+            }),
+        k in prop::sample::select(DstQConfig::MEASURED_BITS.to_vec()),
+    ) {
+        let e = choose_exponent(lo, hi, k);
+        prop_assert!(decode(lo, e, q_max(k)) >= hi, "the frame's top reaches hi");
+        prop_assert!(e == 0 || decode(lo, e - 1, q_max(k)) < hi, "smallest exponent");
+        let up = quantize_up(x, lo, e, k);
+        let down = quantize_down(x, lo, e, k);
+        let (pu, pd) = (decode(lo, e, up), decode(lo, e, down));
+        prop_assert!(up <= q_max(k) && down <= q_max(k));
+        if (lo..=hi).contains(&x) {
+            prop_assert!(pu >= x, "≤ plane {x} rounded down to {pu} (frame {lo}..{hi}, k {k})");
+            prop_assert!(pd <= x, "≥ plane {x} rounded up to {pd} (frame {lo}..{hi}, k {k})");
+            prop_assert!(up == 0 || decode(lo, e, up - 1) < x, "tightest ≤ plane");
+            prop_assert!(down == q_max(k) || decode(lo, e, down + 1) > x, "tightest ≥ plane");
+        }
+        prop_assert!(pu >= x.min(hi), "≤ plane {x} below min(x, frame top {hi}): {pu}");
+        prop_assert!(pd <= x.max(lo), "≥ plane {x} above max(x, frame bottom {lo}): {pd}");
+    }
+}
+
+#[test]
+fn infinite_planes_map_to_the_frame() {
+    for k in DstQConfig::MEASURED_BITS {
+        let e = choose_exponent(-3.0, 5.0, k);
+        assert_eq!(quantize_up(f32::INFINITY, -3.0, e, k), q_max(k));
+        assert_eq!(quantize_down(f32::NEG_INFINITY, -3.0, e, k), 0);
+        assert!(decode(-3.0, e, q_max(k)) >= 5.0);
+    }
+}
+
+#[test]
+fn bad_configs_are_refused() {
+    let dst = dualsplit_testkit::dst::build(&one_triangle(), &DstConfig::hardware()).dst;
+    for (bits, cluster_bytes) in [(0, 64), (17, 64), (8, 30), (8, 62), (16, 28), (8, 8192)] {
+        let cfg = DstQConfig {
+            bits,
+            cluster_bytes,
+        };
+        assert!(DstQ::from_dst(&dst, &cfg).is_err(), "{cfg:?}");
+    }
+}
+
+// ---------------------------------------------------------------- equivalence with BVH2
+
+fn one_triangle() -> Vec<Triangle> {
+    vec![Triangle::new(
+        Vec3::new(-1.0, -1.0, 2.0),
+        Vec3::new(1.0, -1.0, 2.0),
+        Vec3::new(0.0, 1.0, 2.0),
+    )]
+}
+
+/// Scene shapes of `tests/dst_random.rs`: 0 free small triangles, 1 grid-snapped, 2
+/// axis-aligned triangles in coordinate planes, 3 flat (one z).
+fn scene(seed: u64, n: usize, shape: u32) -> Vec<Triangle> {
+    let mut rng = Pcg32::new(seed, 7);
+    let pt = |rng: &mut Pcg32| {
+        let p = Vec3::new(
+            rng.range_f32(-4.0, 4.0),
+            rng.range_f32(-4.0, 4.0),
+            rng.range_f32(-4.0, 4.0),
+        );
+        match shape {
+            1 | 2 => p.round(),
+            3 => Vec3::new(p.x, p.y, 1.0),
+            _ => p,
+        }
+    };
+    (0..n)
+        .map(|_| {
+            let a = pt(&mut rng);
+            let mut b = pt(&mut rng);
+            let mut c = pt(&mut rng);
+            if shape == 2 {
+                let axis = rng.below(3) as usize;
+                b[axis] = a[axis];
+                c[axis] = a[axis];
+            } else if shape == 0 {
+                b = a + (b - a) * 0.3;
+                c = a + (c - a) * 0.3;
+            }
+            Triangle::new(a, b, c)
+        })
+        .collect()
+}
+
+fn random_case(tris: &[Triangle], seed: u64, leaf: u32, similar: bool, scale: f32) {
+    let tris: Vec<Triangle> = tris
+        .iter()
+        .map(|t| Triangle::new(t.v[0] * scale, t.v[1] * scale, t.v[2] * scale))
+        .collect();
+    let bcfg = BuildConfig {
+        max_leaf_size: leaf,
+        ..BuildConfig::default()
+    };
+    let dcfg = if similar {
+        DstConfig::hardware().with_partitioning(Partitioning::Similar)
+    } else {
+        DstConfig::hardware()
+    };
+    let s = Structures::try_build_with(&tris, &bcfg, &dcfg).expect("structures");
+    let qs = build_all(&s, "random scene");
+    if tris.is_empty() {
+        return;
+    }
+    let b = tris.iter().fold(Aabb::EMPTY, |a, t| a.union(t.bounds()));
+    let mut rng = Pcg32::new(seed ^ 0x5eed, 11);
+    let rays = random_rays(&mut rng, &tris, &b, 60);
+    for ray in &rays {
+        // The BVH2 equals the oracle on these scenes (tests/dst_random.rs); hold it here too.
+        assert_eq!(
+            key(s.closest_hit(AccelKind::Bvh2, ray, &mut NoObserver)),
+            key(oracle_closest(&tris, ray))
+        );
+        for q in &qs {
+            check_ray(&s, q, ray, &format!("{:?}", q.config()));
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_scenes_match_bvh2(
+        seed in any::<u64>(),
+        n in 1usize..48,
+        shape in 0u32..4,
+        leaf in prop::sample::select(vec![1u32, 2, 4]),
+        similar in any::<bool>(),
+        scale in prop::sample::select(vec![1.0f32, 1e-30, 1e15, 3.0e17]),
+    ) {
+        random_case(&scene(seed, n, shape), seed, leaf, similar, scale);
+    }
+}
+
+#[test]
+fn edge_scenes_match_bvh2() {
+    // Empty scene: every ray misses.
+    let s = Structures::build(&[], &BuildConfig::default());
+    for q in build_all(&s, "empty") {
+        assert!(q.is_empty());
+        assert!(
+            q.closest_hit(&Ray::new(Vec3::ZERO, Vec3::Z), &mut NoObserver)
+                .is_none()
+        );
+        assert!(!q.any_hit(&Ray::new(Vec3::ZERO, Vec3::Z), &mut NoObserver));
+    }
+    random_case(&one_triangle(), 1, 4, false, 1.0);
+    // Triangles in axis planes, a flat scene, a scene far from the origin.
+    for shape in 0..4 {
+        for seed in 0..6 {
+            random_case(&scene(seed, 40, shape), seed, 1, false, 1.0);
+        }
+    }
+    let far: Vec<Triangle> = scene(9, 40, 0)
+        .iter()
+        .map(|t| {
+            let o = Vec3::splat((1u64 << 40) as f32);
+            Triangle::new(t.v[0] * 1e8 + o, t.v[1] * 1e8 + o, t.v[2] * 1e8 + o)
+        })
+        .collect();
+    random_case(&far, 9, 2, false, 1.0);
+    // Rays with zero direction components along the planes of a grid scene.
+    let tris = scene(3, 30, 1);
+    let s = Structures::build(&tris, &BuildConfig::default());
+    let qs = build_all(&s, "grid");
+    for t in &tris {
+        for d in [Vec3::X, -Vec3::Y, Vec3::Z, Vec3::new(1.0, 0.0, -1.0)] {
+            let ray = Ray::new(t.v[0] - d * 10.0, d);
+            for q in &qs {
+                check_ray(&s, q, &ray, "axis ray");
+            }
+        }
+    }
+}
+
+fn shipped_case(name: &str, n: usize) {
+    let Some(scene) = shipped(name) else {
+        return;
+    };
+    let s = Structures::build(&scene.triangles, &BuildConfig::default());
+    let qs = build_all(&s, name);
+    let sets = record_rays(&scene, &s, 48, n);
+    let b = s.dst.scene_box();
+    let random = random_rays(&mut Pcg32::new(5, 5), &scene.triangles, &b, n);
+    for q in &qs {
+        let what = format!("{name} {:?}", q.config());
+        for rays in [&sets.primary, &sets.shadow, &sets.diffuse, &random] {
+            for ray in rays.iter().take(n) {
+                check_ray(&s, q, ray, &what);
+            }
+        }
+    }
+}
+
+#[test]
+fn dragon_res4_matches_bvh2() {
+    shipped_case("dragon_res4.ply.gz", 3000);
+}
+
+#[test]
+fn bunny_matches_bvh2() {
+    shipped_case("bunny.ply.gz", 3000);
+}
+
+/// The observed traversal reports the exact DST's steps for every node it shares with it,
+/// and the frame and record words it reads lie inside the node region.
+#[test]
+fn observer_reports_word_accurate_fetches() {
+    #[derive(Default)]
+    struct Fetches(Vec<(ByteAddr, u32)>);
+    impl Observer for Fetches {
+        fn fetch(&mut self, addr: ByteAddr, bytes: u32) {
+            self.0.push((addr, bytes));
+        }
+    }
+    let tris = scene(4, 40, 0);
+    let s = Structures::build(&tris, &BuildConfig::default());
+    let b = s.dst.scene_box();
+    let rays = random_rays(&mut Pcg32::new(1, 2), &tris, &b, 200);
+    for q in build_all(&s, "observer") {
+        let node_end = q.image().node_bytes();
+        let cb = q.config().cluster_bytes as u64;
+        for ray in &rays {
+            let mut f = Fetches::default();
+            q.closest_hit(ray, &mut f);
+            for &(a, n) in &f.0 {
+                assert!(a.0 % 4 == 0 && n % 4 == 0 && n > 0);
+                if a.0 < node_end {
+                    // A record never crosses its block.
+                    assert_eq!(a.0 / cb, (a.0 + n as u64 - 1) / cb, "{a:?} {n}");
+                }
+            }
+            // Exact DST work is a lower bound of the quantized work.
+            let (mut e, mut o) = (CountingObserver::default(), CountingObserver::default());
+            s.dst.closest_hit(ray, &mut e);
+            q.closest_hit(ray, &mut o);
+            assert!(o.nodes >= e.nodes && o.triangle_tests >= e.triangle_tests);
+        }
+    }
+}
+
+// ---------------------------------------------------------------- validate
+
+fn dragon_or_random() -> Structures {
+    match shipped("dragon_res4.ply.gz") {
+        Some(sc) => Structures::build(&sc.triangles, &BuildConfig::default()),
+        None => Structures::build(&scene(2, 400, 0), &BuildConfig::default()),
+    }
+}
+
+/// Bit position of the first record in block 0 whose kind is `kind` (walking the
+/// in-cluster records from the root in order of their bits).
+fn first_record(q: &DstQ, kind: DstNodeKind) -> Option<u32> {
+    let cw = q.config().cluster_words() as usize;
+    let words = &q.image().words[..cw];
+    let k = q.config().bits;
+    let mut bit = ROOT_BIT;
+    while bit + 32 <= q.config().cluster_bytes * 8 {
+        let h = QHeader::from_bits(read_bits(words, bit as usize, 32));
+        if h.node_kind() == kind && HeaderOffset::decode(h.bits(), 0).is_ok() {
+            return Some(bit);
+        }
+        bit += h.record_bits(k);
+    }
+    None
+}
+
+#[test]
+fn validate_catches_a_shrunk_plane() {
+    let s = dragon_or_random();
+    for cfg in configs() {
+        let q = DstQ::from_dst(&s.dst, &cfg).unwrap();
+        let bit = first_record(&q, DstNodeKind::Split).expect("a split in the root block");
+        let k = cfg.bits as usize;
+        let mut img = q.image().clone();
+        // P0 of a split is a "≤" plane: offset 0 moves it to the frame's bottom.
+        let p0 = bit as usize + 32;
+        assert_ne!(read_bits(&img.words, p0, k as u32), 0);
+        write_bits(&mut img.words, p0, k as u32, 0);
+        let bad = DstQ::from_image(img, q.scene_box(), cfg).expect("still well formed");
+        let rep = bad.validate(&s.dst);
+        assert!(!rep.is_ok(), "{cfg:?}");
+        assert!(
+            rep.errors.iter().any(|e| e.contains("not conservative")),
+            "{cfg:?}: {rep:?}"
+        );
+        // P1 is a "≥" plane: the top offset moves it to the frame's top.
+        let mut img = q.image().clone();
+        write_bits(&mut img.words, p0 + k, k as u32, q_max(k as u32));
+        let bad = DstQ::from_image(img, q.scene_box(), cfg).unwrap();
+        assert!(!bad.validate(&s.dst).is_ok(), "{cfg:?}");
+    }
+}
+
+#[test]
+fn validate_catches_bad_offsets() {
+    let s = dragon_or_random();
+    let cfg = DstQConfig::default();
+    let q = DstQ::from_dst(&s.dst, &cfg).unwrap();
+    let bit = first_record(&q, DstNodeKind::Split).unwrap() as usize;
+    let w = read_bits(&q.image().words, bit, 32);
+    let ext = QHeader::split(0, true, ChildRef::Cluster((1 << 25) - 1)).unwrap();
+    for bad_word in [
+        (w & !((1 << 25) - 1)) | 3,    // a local child inside the frame
+        (w & !((1 << 25) - 1)) | 4000, // a local child beyond the block
+        (w & 0xfc00_0000) | (ext.bits() & 0x03ff_ffff), // a cluster beyond the region
+        0x3c00_0000,                   // an invalid header code
+    ] {
+        let mut img = q.image().clone();
+        write_bits(&mut img.words, bit, 32, bad_word);
+        let rep = DstQ::from_image(img, q.scene_box(), cfg).expect_err("refused");
+        assert!(!rep.is_ok() && rep.structure == "dst-q", "{bad_word:#x}");
+    }
+    // A truncated node region.
+    let mut img = q.image().clone();
+    img.nodes.end -= 1;
+    assert!(DstQ::from_image(img, q.scene_box(), cfg).is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    /// Arbitrary words in a tree's node region give a report (or a tree that traverses
+    /// without panicking), never a panic or an endless walk.
+    #[test]
+    fn arbitrary_words_never_panic(
+        seed in any::<u64>(),
+        edits in prop::collection::vec((any::<u32>(), any::<u32>()), 1..24),
+    ) {
+        let tris = scene(seed, 30, 0);
+        let s = Structures::build(&tris, &BuildConfig::default());
+        let cfg = DstQConfig::default();
+        let q = DstQ::from_dst(&s.dst, &cfg).unwrap();
+        let mut img = q.image().clone();
+        let n = img.nodes.len().max(1) as u32;
+        for (at, v) in edits {
+            let i = (at % n) as usize;
+            if i < img.nodes.len() {
+                img.words[i] = v;
+            }
+        }
+        if let Ok(t) = DstQ::from_image(img, q.scene_box(), cfg) {
+            let _ = t.validate(&s.dst);
+            let b = s.dst.scene_box();
+            for ray in random_rays(&mut Pcg32::new(seed, 3), &tris, &b, 8) {
+                t.closest_hit(&ray, &mut CountingObserver::default());
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------- measurement
+
+/// Per-ray work of one structure on one ray set.
+#[derive(Default, Clone, Copy)]
+struct Work {
+    nodes: f64,
+    tris: f64,
+    bytes: f64,
+    lines: f64,
+}
+
+/// Counts bytes and the distinct 64-byte lines a ray touches.
+#[derive(Default)]
+struct Lines {
+    c: CountingObserver,
+    lines: HashSet<u64>,
+}
+impl Observer for Lines {
+    fn fetch(&mut self, addr: ByteAddr, bytes: u32) {
+        self.c.fetch(addr, bytes);
+        for l in addr.0 / 64..=(addr.0 + bytes as u64 - 1) / 64 {
+            self.lines.insert(l);
+        }
+    }
+    fn step(&mut self, s: dualsplit_accel::NodeStep) {
+        self.c.step(s);
+    }
+    fn triangle_test(&mut self, p: dualsplit_geometry::PrimId, h: bool) {
+        self.c.triangle_test(p, h);
+    }
+}
+
+fn work(rays: &[Ray], mut f: impl FnMut(&Ray, &mut Lines)) -> Work {
+    let mut w = Work::default();
+    for r in rays {
+        let mut o = Lines::default();
+        f(r, &mut o);
+        w.nodes += o.c.nodes as f64;
+        w.tris += o.c.triangle_tests as f64;
+        w.bytes += o.c.bytes as f64;
+        w.lines += o.lines.len() as f64;
+    }
+    let n = rays.len().max(1) as f64;
+    Work {
+        nodes: w.nodes / n,
+        tris: w.tris / n,
+        bytes: w.bytes / n,
+        lines: w.lines / n,
+    }
+}
+
+fn measure(name: &str, configs: &[DstQConfig]) {
+    let Some(scene) = shipped(name) else {
+        return;
+    };
+    let s = Structures::build(&scene.triangles, &BuildConfig::default());
+    let sets = record_rays(&scene, &s, 128, 16384);
+    let b = s.dst.scene_box();
+    let random = random_rays(&mut Pcg32::new(5, 5), &scene.triangles, &b, 16384);
+    let sets = [("primary", &sets.primary), ("random", &random)];
+    let dst: &Dst = &s.dst;
+    let dst_bytes = dst.stats().total_bytes as f64;
+    let bvh2_bytes = s.bvh2_image.bytes_total() as f64;
+    let exact: Vec<Work> = sets
+        .iter()
+        .map(|(_, r)| {
+            work(r, |ray, o| {
+                dst.closest_hit(ray, o);
+            })
+        })
+        .collect();
+    println!(
+        "\n{name}: exact DST {:.3} MiB ({:.1} % of BVH2 {:.3} MiB)",
+        dst_bytes / 1048576.0,
+        100.0 * dst_bytes / bvh2_bytes,
+        bvh2_bytes / 1048576.0
+    );
+    for ((set, rays), e) in sets.iter().zip(&exact) {
+        println!(
+            "  exact DST, {set} ({} rays): {:.2} nodes, {:.2} triangles, {:.0} B, {:.2} lines per ray",
+            rays.len(),
+            e.nodes,
+            e.tris,
+            e.bytes,
+            e.lines
+        );
+    }
+    println!(
+        "| k | block | MiB | % DST | % BVH2 | B/node | fill | prim B/ray | prim lines | prim +nodes | prim +tris | rand B/ray | rand lines | rand +nodes | rand +tris |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for cfg in configs {
+        let q = DstQ::from_dst(dst, cfg).unwrap();
+        let st = q.stats();
+        let tot = q.bytes_total() as f64;
+        let mut row = format!(
+            "| {} | {} | {:.3} | {:.1} | {:.1} | {:.2} | {:.0} % |",
+            cfg.bits,
+            cfg.cluster_bytes,
+            tot / 1048576.0,
+            100.0 * tot / dst_bytes,
+            100.0 * tot / bvh2_bytes,
+            st.bytes_per_node(),
+            100.0 * st.fill()
+        );
+        for ((_, rays), e) in sets.iter().zip(&exact) {
+            let w = work(rays, |ray, o| {
+                q.closest_hit(ray, o);
+            });
+            row += &format!(
+                " {:.0} | {:.2} | {:+.1} % | {:+.1} % |",
+                w.bytes,
+                w.lines,
+                100.0 * (w.nodes / e.nodes - 1.0),
+                100.0 * (w.tris / e.tris - 1.0)
+            );
+        }
+        println!("{row}");
+    }
+}
+
+#[test]
+#[ignore = "prints the measurement table of docs/dstq-encoding.md (release build, ~1 min)"]
+fn measure_table() {
+    let cfgs = configs();
+    for name in ["dragon_res4.ply.gz", "bunny.ply.gz"] {
+        measure(name, &cfgs);
+    }
+}
