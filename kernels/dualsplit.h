@@ -116,6 +116,33 @@ struct DstNode {
 #define DST_FIELD_B(w) (((w) >> 27) & 3u)
 #define DST_A_SINGLE 2u
 
+/* ---- Compressed BVH8 (crates/accel/src/cwbvh/node.rs, docs/cwbvh-encoding.md) ------------ */
+
+/* 80-byte node (Ylitie et al. 2017): frame, child addressing, 8-bit quantized child boxes. */
+struct CwNode {
+    float p[3];           /* quantization origin */
+    uint8_t e[3];         /* exponents: scale = 2^(e - 127) */
+    uint8_t imask;        /* bit k: slot k is an internal node */
+    uint32_t child_base;  /* word of the first internal child (20 words each, slot order) */
+    uint32_t tri_base;    /* word of the node's first leaf run */
+    uint8_t meta[8];      /* 0 empty; internal 0b001_00000 | (24 + k); leaf: count | offset */
+    uint8_t q_lo[3][8];   /* quantized minima, axis by axis */
+    uint8_t q_hi[3][8];   /* quantized maxima */
+};
+
+_Static_assert(sizeof(struct CwNode) == 80, "CwNode is 80 bytes");
+
+#define CW_NODE_WORDS 20u
+#define CW_META_OFFSET(m) ((uint32_t)(m) & 31u)
+
+/* ---- Quantized DST (crates/accel/src/dstq, docs/dstq-encoding.md) ------------------------ */
+
+/* The unit's geometry (crates/accel/src/dstq/unit.rs): 64-byte clusters, the first root of a
+ * cluster at bit 128 (after its 16-byte frame). Records are named by bit address: the byte
+ * address of their cluster block times 8 plus their bit position in it. */
+#define DSTQ_BLOCK_BITS 512u
+#define DSTQ_ROOT_BIT 128u
+
 /* ---- Geometry constants (crates/geometry) ------------------------------------------------ */
 
 /* EXIT_WIDEN = 1 + 2 * gamma(3) (crates/geometry/src/ray.rs), as f32 bits 0x3F800003. */

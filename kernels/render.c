@@ -8,6 +8,8 @@
  *   -DACCEL_BVH -DBVH_ARITY=N   BVH2/4/8 ... -DBVH_WIDE_BOX=1 for the "+" configurations
  *   -DACCEL_DST_SW              DST* (software decoder)
  *   -DACCEL_DST                 DST (the dual-split instruction)
+ *   -DACCEL_CWBVH               CWBVH, CWBVH+ (the quantized wide box instruction)
+ *   -DACCEL_DSTQ                DST-Q (the quantized dual-split instruction)
  *   -DKERNEL_PARITY=0|1         1: the traversals as the paper describes them (bvh.h: every
  *                               box slot tested; dst_common.h: the scene-box clip on rt.box)
  *   -DPIPE_LOADS=0|1            1: node words reach the pipelines through rt.ldp and the
@@ -181,8 +183,12 @@ static void set_ray(const struct Ray *ray, struct RayPre *pre)
 #include "dst_sw.h"
 #elif defined(ACCEL_DST)
 #include "dst.h"
+#elif defined(ACCEL_CWBVH)
+#include "cwbvh.h"
+#elif defined(ACCEL_DSTQ)
+#include "dstq.h"
 #else
-#error "choose a traversal: -DACCEL_BVH, -DACCEL_DST_SW or -DACCEL_DST"
+#error "choose a traversal: -DACCEL_BVH, -DACCEL_DST_SW, -DACCEL_DST, -DACCEL_CWBVH or -DACCEL_DSTQ"
 #endif
 
 /* Closest hit of `ray`: 1 and the hit, or 0. */

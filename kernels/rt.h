@@ -137,6 +137,18 @@ static inline uint32_t rt_dst_offset_stack(void)
 }
 
 
+/* The 8 child boxes of the 80-byte compressed-BVH8 node at `node`, dequantized and tested on
+ * [t_lo, t_hi] by the quantized ray-box pipelines: bit k of the result is set when child k
+ * is hit; the entries go to the box latch (rt_boxget). */
+static inline uint32_t rt_qboxn(const void *node, float t_lo, float t_hi)
+{
+    uint32_t r;
+    __asm__ volatile(".insn r4 0x2B, 6, 0, %0, %1, %2, %3"
+                     : "=r"(r)
+                     : "r"(node), "f"(t_lo), "f"(t_hi));
+    return r;
+}
+
 /* ---- custom-2: loads into the pipeline input registers P ------------------------------ */
 
 /* P[k] = the word at `p`, an ordinary load (k a constant 0-31); the register forms below read
@@ -184,6 +196,28 @@ static inline uint32_t rt_dstp(float t_min, float t_max)
     return r;
 }
 
+/* rt_qboxn on the node in P[0..20]. */
+static inline uint32_t rt_qboxnp(float t_lo, float t_hi)
+{
+    uint32_t r;
+    __asm__ volatile(".insn r4 0x7B, 6, 0, %0, x0, %1, %2" : "=r"(r) : "f"(t_lo), "f"(t_hi));
+    return r;
+}
+
+/* One quantized dual-split pipeline step on the DST-Q record at bit address `at` (its
+ * cluster's frame in P[0..4], the three words from the one holding its first bit in
+ * P[4..7]): code | next << 2 (next: the record to continue at, by bit address, or the
+ * triangle run's index entry); the rest goes to the DST latch (rt_dst_tmin, rt_dst_tmax,
+ * rt_dst_offset_stack: the far child's bit address). */
+static inline uint32_t rt_dstqp(uint32_t at, float t_min, float t_max)
+{
+    uint32_t r;
+    __asm__ volatile(".insn r4 0x7B, 7, 0, %0, %1, %2, %3"
+                     : "=r"(r)
+                     : "r"(at), "f"(t_min), "f"(t_max));
+    return r;
+}
+
 /* ---- how the kernels reach the pipelines ----------------------------------------------- */
 
 /* RT_BOX, RT_BOXN, RT_TRI, RT_DST: with PIPE_LOADS, one rt.ldp per node word into P, then the
@@ -202,6 +236,8 @@ static inline uint32_t rt_dstp(float t_min, float t_max)
 #define PIPE_LD6(k, p) PIPE_LD3(k, p); PIPE_LD3((k) + 3, p)
 #define PIPE_LD12(k, p) PIPE_LD6(k, p); PIPE_LD6((k) + 6, p)
 #define PIPE_LD24(k, p) PIPE_LD12(k, p); PIPE_LD12((k) + 12, p)
+#define PIPE_LD4(k, p) PIPE_LD3(k, p); PIPE_LD((k) + 3, p)
+#define PIPE_LD20(k, p) PIPE_LD12(k, p); PIPE_LD6((k) + 12, p); PIPE_LD((k) + 18, p); PIPE_LD((k) + 19, p)
 
 #if PIPE_LOADS
 #define RT_BOX(box, t_lo, t_hi)                                                      \
@@ -235,7 +271,14 @@ static inline uint32_t rt_dstp(float t_min, float t_max)
         PIPE_LD3(0, w_);                                                             \
         rt_dstp(t_min, t_max);                                                       \
     })
+#define RT_QBOXN(node, t_lo, t_hi)                                                   \
+    ({                                                                               \
+        const uint32_t *w_ = (const uint32_t *)(node);                               \
+        PIPE_LD20(0, w_);                                                            \
+        rt_qboxnp(t_lo, t_hi);                                                       \
+    })
 #else
+#define RT_QBOXN(node, t_lo, t_hi) rt_qboxn(node, t_lo, t_hi)
 #define RT_BOX(box, t_lo, t_hi) rt_box(box, t_lo, t_hi)
 #define RT_BOXN(n, boxes, t_lo, t_hi) rt_boxn(n, boxes, t_lo, t_hi)
 #define RT_TRI(tri, t_lo, t_hi) rt_tri(tri, t_lo, t_hi)

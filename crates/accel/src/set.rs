@@ -24,6 +24,7 @@
 //! # Ok::<(), dualsplit_accel::AccelError>(())
 //! ```
 
+use crate::dstq::DstQConfig;
 use crate::image::MemoryImage;
 use crate::observer::Observer;
 use crate::tree::AnyTree;
@@ -72,6 +73,9 @@ pub trait TraversalSet: Sync {
     /// The box around every triangle (the BVH2's root box; the DST stores it beside its
     /// image).
     fn scene_box(&self) -> Aabb;
+
+    /// The settings of the set's quantized DST, if it has one.
+    fn dstq_config(&self) -> Option<DstQConfig>;
 }
 
 impl TraversalSet for Structures {
@@ -95,6 +99,10 @@ impl TraversalSet for Structures {
 
     fn scene_box(&self) -> Aabb {
         self.dst.scene_box()
+    }
+
+    fn dstq_config(&self) -> Option<DstQConfig> {
+        Some(*self.dstq.config())
     }
 }
 
@@ -128,6 +136,13 @@ impl TraversalSet for AnyTree {
                 .triangle_slice()
                 .iter()
                 .fold(Aabb::EMPTY, |acc, t| acc.union(t.bounds())),
+        }
+    }
+
+    fn dstq_config(&self) -> Option<DstQConfig> {
+        match self {
+            AnyTree::DstQ(q) => Some(*q.dstq().config()),
+            _ => None,
         }
     }
 }

@@ -7,7 +7,7 @@
 //! `CONFIGS` builds; a test checks the two lists agree). The CLI, the simulator, the kernel table, the
 //! calibration and the charts read it from here (`docs/extending.md`).
 
-use crate::config::{KernelsConfig, SimConfig};
+use crate::config::{KernelsConfig, SimConfig, UnitConfig};
 use crate::hw::pipe::TmPipes;
 use dualsplit_accel::AccelKind;
 use serde::{Deserialize, Serialize};
@@ -29,7 +29,8 @@ macro_rules! sim_accels {
         $(#[doc = $doc:literal])*
         $v:ident = $name:literal, $label:literal, $kind:ident, parallel: $par:expr, color: $rgb:expr;
     )*) => {
-        /// The simulated configurations: the paper's eight (§4).
+        /// The simulated configurations: the paper's eight (§4) and the quantized structures'
+        /// three (beyond the paper).
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
         #[serde(rename_all = "kebab-case")]
         pub enum SimAccel {
@@ -102,14 +103,45 @@ sim_accels! {
     DstSw = "dst-sw", "DST*", DstSw, parallel: None, color: [130, 70, 170];
     /// DST on the dual-split pipeline.
     Dst = "dst", "DST", Dst, parallel: None, color: [210, 30, 40];
+    /// Compressed BVH8 (beyond the paper): one quantized ray-box pipeline, the 8 child
+    /// tests of a node one after another.
+    Cwbvh = "cwbvh", "CWBVH", Cwbvh, parallel: None, color: [90, 90, 90];
+    /// Compressed BVH8 with 8 quantized ray-box pipelines (all children in one issue).
+    CwbvhPlus = "cwbvh+", "CWBVH+", Cwbvh, parallel: Some(8), color: [170, 170, 170];
+    /// Quantized DST on the quantized dual-split pipeline (beyond the paper).
+    DstQ = "dst-q", "DST-Q", DstQ, parallel: None, color: [240, 110, 160];
 }
 
 impl SimAccel {
-    /// Command-line name: `bvh2`, `bvh2+`, ..., `dst-sw`, `dst`.
+    /// The paper's eight configurations (§4, Tables 4–7), in its table order.
+    pub const PAPER: [SimAccel; 8] = [
+        SimAccel::Bvh2,
+        SimAccel::Bvh2Plus,
+        SimAccel::Bvh4,
+        SimAccel::Bvh4Plus,
+        SimAccel::Bvh8,
+        SimAccel::Bvh8Plus,
+        SimAccel::DstSw,
+        SimAccel::Dst,
+    ];
+
+    /// The configurations of the report's "Beyond the paper" study: the baseline, the
+    /// paper's wide BVH and DST, and the quantized structures.
+    pub const BEYOND: [SimAccel; 7] = [
+        SimAccel::Bvh2,
+        SimAccel::Bvh8,
+        SimAccel::Bvh8Plus,
+        SimAccel::Dst,
+        SimAccel::Cwbvh,
+        SimAccel::CwbvhPlus,
+        SimAccel::DstQ,
+    ];
+
+    /// Command-line name: `bvh2`, `bvh2+`, ..., `dst-sw`, `dst`, `cwbvh`, `cwbvh+`, `dst-q`.
     pub fn name(self) -> &'static str {
         self.info().name
     }
-    /// The paper's label: `BVH2`, `BVH2+`, ..., `DST*`, `DST`.
+    /// The paper's label: `BVH2`, `BVH2+`, ..., `DST*`, `DST`; `CWBVH`, `CWBVH+`, `DST-Q`.
     pub fn label(self) -> &'static str {
         self.info().label
     }
@@ -126,10 +158,17 @@ impl SimAccel {
     pub fn parallel_boxes(self) -> bool {
         self.info().parallel.is_some()
     }
-    /// DST and DST\*: the traversal of the dual-split tree (stack entries carry
+    /// DST, DST\* and DST-Q: the traversal of a dual-split tree (stack entries carry
     /// `[t_min, t_max]`).
     pub fn is_dst(self) -> bool {
-        matches!(self.kind(), AccelKind::Dst | AccelKind::DstSw)
+        matches!(
+            self.kind(),
+            AccelKind::Dst | AccelKind::DstSw | AccelKind::DstQ
+        )
+    }
+    /// One of the paper's eight configurations ([`SimAccel::PAPER`]).
+    pub fn in_paper(self) -> bool {
+        Self::PAPER.contains(&self)
     }
     /// Ray-box pipelines per TM: the node arity for the "+" configurations (§4), else the
     /// configuration's `units.box_pipes`.
@@ -139,9 +178,9 @@ impl SimAccel {
     /// The pipelines of each TM in this configuration: [`SimAccel::box_pipes`] ray-box pipes,
     /// quantized for the CWBVH configurations, and a quantized dual-split pipeline for
     /// DST-Q.
-    pub fn pipes(self, cfg: &SimConfig) -> TmPipes {
+    pub fn pipes(self, units: &UnitConfig) -> TmPipes {
         TmPipes {
-            box_pipes: self.box_pipes(cfg),
+            box_pipes: self.info().parallel.unwrap_or(units.box_pipes),
             quantized_boxes: self.kind() == AccelKind::Cwbvh,
             quantized_dst: self.kind() == AccelKind::DstQ,
         }

@@ -6,7 +6,8 @@ use crate::error::SimError;
 use crate::footprint;
 use crate::model::{ThreadModel, fast, rv32};
 use crate::result::SimResult;
-use dualsplit_accel::TraversalSet;
+use dualsplit_accel::dstq::unit::unit_supports;
+use dualsplit_accel::{AccelKind, TraversalSet};
 use dualsplit_render::RenderSettings;
 use dualsplit_scene::Scene;
 
@@ -73,6 +74,33 @@ pub fn check_model(cfg: &SimConfig, model: ThreadModel) -> Result<(), SimError> 
     Ok(())
 }
 
+/// DST-Q runs on a unit of fixed geometry (`dstq::unit`): its tree must have the unit's
+/// plane bits and cluster size, and its records' bit addresses must fit the 30 bits
+/// `rt.dstqp` returns them in (a node region up to 128 MiB).
+fn check_quantized_dst<S: TraversalSet>(structures: &S, accel: SimAccel) -> Result<(), SimError> {
+    if accel.kind() != AccelKind::DstQ {
+        return Ok(());
+    }
+    if let Some(cfg) = structures.dstq_config()
+        && !unit_supports(&cfg)
+    {
+        return Err(SimError::DstQGeometry {
+            bits: cfg.bits,
+            cluster_bytes: cfg.cluster_bytes,
+        });
+    }
+    let bytes = structures.image(accel.kind()).node_bytes();
+    let limit = 1u64 << 27;
+    if bytes > limit {
+        return Err(SimError::MemoryMap {
+            region: "DST-Q node region (records named by 30-bit bit addresses)",
+            bytes,
+            limit,
+        });
+    }
+    Ok(())
+}
+
 /// Simulates one frame; `progress` is called with (pixels done, pixels total).
 pub fn simulate<S: TraversalSet>(
     frame: &FrameRequest<'_, S>,
@@ -101,6 +129,7 @@ pub fn simulate<S: TraversalSet>(
     }
     footprint::check(cfg, accel, model, frame.pixels())?;
     check_model(cfg, model)?;
+    check_quantized_dst(structures, accel)?;
     match model {
         ThreadModel::Rv32 => rv32::frame::run(frame, progress),
         ThreadModel::Fast => fast::frame::run(frame, progress),

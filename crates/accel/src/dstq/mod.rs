@@ -44,6 +44,7 @@ pub mod record;
 mod saved;
 mod stats;
 mod traverse;
+pub mod unit;
 mod validate;
 
 pub use record::{CHILD_LIMIT, ChildRef, QHeader};

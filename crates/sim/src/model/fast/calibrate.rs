@@ -40,6 +40,7 @@ use crate::accel::SimAccel;
 use crate::config::{KernelsConfig, UnitConfig};
 use crate::hw::counts::InstrCounts;
 use crate::hw::fu::{FU_CLASSES, FuClass, fu_index};
+use crate::hw::pipe::TmPipes;
 use crate::model::fast::costs::Costs;
 use crate::model::fast::costs::{
     Calibration, CalibrationError, DEPENDENCY, FRAC_BITS, L1_WORDS, PIPELINE, TARGET_NAMES,
@@ -74,6 +75,7 @@ fn kernel_segments(
     prog: &Program,
     mem: &mut FrameMemory<'_>,
     units: &UnitConfig,
+    pipes: TmPipes,
 ) -> Result<Vec<Segment>, RunError> {
     let mut hart = Hart::new(prog, units.local_store_bytes);
     // The instructions before the first pixel (start-up) form a segment of their own.
@@ -143,8 +145,10 @@ fn kernel_segments(
             segs.last_mut().expect("a segment is open").y[L1_WORDS] += r.mem.words as i64;
         }
         let done = match r.info.fu {
+            FuClass::BoxPipe(_) if pipes.quantized_boxes => (at + units.qbox_latency, true),
             FuClass::BoxPipe(_) => (at + units.box_latency, true),
             FuClass::TriPipe => (at + units.tri_latency, true),
+            FuClass::DstPipe if pipes.quantized_dst => (at + units.qdst_latency, true),
             FuClass::DstPipe => (at + units.dst_latency, true),
             fu => (
                 crate::hw::fu::unit_latency(fu, units).map_or(0, |l| at + l),
@@ -374,7 +378,7 @@ fn measure(
             scene: name.to_string(),
             source,
         };
-        let kernel = kernel_segments(&prog, &mut mem, units).map_err(error)?;
+        let kernel = kernel_segments(&prog, &mut mem, units, accel.pipes(units)).map_err(error)?;
         let events = event_segments(scene, structures, accel, &settings);
         // The kernel's segments: start-up, then per pixel its own and its rays', then the
         // last `rt.atominc` that finds no pixel left.

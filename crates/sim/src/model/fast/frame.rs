@@ -155,7 +155,7 @@ pub(crate) fn run<S: TraversalSet>(
         structures.image(accel.kind()),
         cfg.l1.line_bytes,
     );
-    let mut chip = Chip::new(cfg, accel.pipes(cfg));
+    let mut chip = Chip::new(cfg, accel.pipes(&cfg.units));
     let mut threads: Vec<Thread> = (0..cfg.tms * cfg.tps_per_tm)
         .map(|i| Thread::new((i / cfg.tps_per_tm) as usize))
         .collect();

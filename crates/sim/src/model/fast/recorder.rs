@@ -36,8 +36,10 @@ pub struct Recorder<'a> {
     open: bool,
     /// The run's issue cycles and reciprocal ops, fixed point (with the carried fraction).
     run: Run,
-    /// DST on the dual-split pipeline (not decoded in software).
+    /// DST or DST-Q on a dual-split pipeline (not decoded in software).
     dst_hw: bool,
+    /// CWBVH: one wide quantized box op of all 8 slots per node (`rt.qboxn`).
+    quantized_boxes: bool,
     /// The "+" configurations: all child boxes in one issue slot.
     parallel_boxes: bool,
     /// The last fetch (physical word address, words): the measured extra L1 words are
@@ -93,7 +95,8 @@ impl<'a> Recorder<'a> {
             tally,
             open: run.is_some(),
             run: run.unwrap_or_default(),
-            dst_hw: accel == SimAccel::Dst,
+            dst_hw: matches!(accel, SimAccel::Dst | SimAccel::DstQ),
+            quantized_boxes: matches!(accel, SimAccel::Cwbvh | SimAccel::CwbvhPlus),
             parallel_boxes: accel.parallel_boxes(),
             last,
             boxes: 0,
@@ -279,8 +282,16 @@ impl Observer for Recorder<'_> {
     fn step(&mut self, step: NodeStep) {
         match step {
             NodeStep::Bvh { valid, hits, .. } => {
-                // Serial box tests were recorded with their boxes' fetches.
-                if valid != 0 && self.parallel_boxes {
+                // Serial box tests were recorded with their boxes' fetches; a compressed
+                // node's 8 slots are tested by one instruction, on one pipe or eight.
+                if self.quantized_boxes {
+                    self.push_op(Op::Pipe {
+                        pipe: Pipe::Box,
+                        n: 8,
+                        parallel: self.parallel_boxes,
+                    });
+                    self.tally.boxed_nodes += 1;
+                } else if valid != 0 && self.parallel_boxes {
                     self.push_op(Op::Pipe {
                         pipe: Pipe::Box,
                         n: valid,

@@ -97,11 +97,19 @@ impl Tally {
         } else {
             c.box_ops
         };
+        if matches!(self.accel, SimAccel::Cwbvh | SimAccel::CwbvhPlus) {
+            // rt.qboxn: one issue and 8 quantized box ops per node, every slot tested.
+            c.box_ops = 0;
+            c.qbox_ops = 8 * self.boxed_nodes;
+            c.box_issues = self.boxed_nodes;
+        }
         c.tri_ops = e[Event::TriTest.index()];
         let dst = &e[Event::Dst(DST_KINDS[0], ReturnCode::ALL[0]).index()..];
         let dst_leaf = &dst[4 * DstNodeKind::Leaf as usize..];
-        if self.accel == SimAccel::Dst {
-            c.dst_ops = dst.iter().sum();
+        match self.accel {
+            SimAccel::Dst => c.dst_ops = dst.iter().sum(),
+            SimAccel::DstQ => c.qdst_ops = dst.iter().sum(),
+            _ => {}
         }
         c.node_steps =
             e[Event::BvhNode.index()] + dst.iter().sum::<u64>() - dst_leaf.iter().sum::<u64>();

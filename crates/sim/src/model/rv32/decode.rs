@@ -256,6 +256,14 @@ pub enum Op {
     RtTriP,
     /// `rt.dstp`: `rt.dst` on the node in `P[0..3]`.
     RtDstP,
+    /// `rt.qboxn`: the 8 dequantized child boxes of the 80-byte CWBVH node at `x[rs1]`,
+    /// `x[rd]` = hit mask, entries to `B`.
+    RtQBoxN,
+    /// `rt.qboxnp`: `rt.qboxn` on the node in `P[0..20]`.
+    RtQBoxNP,
+    /// `rt.dstqp`: the DST-Q record at bit address `x[rs1]` (frame in `P[0..4]`, the
+    /// record's words in `P[4..7]`): `x[rd] = code | next << 2`, the rest to `D`.
+    RtDstQP,
     /// A word that does not decode (`imm` = the word); executing it is an error.
     Illegal,
 }
@@ -363,6 +371,9 @@ fn shape(op: Op, imm: i32) -> (K, K, K, K, FuClass, u8) {
         RtBoxNP => (X, N, F, F, U::BoxPipe(imm as u8), p | Latches::WRITES_BOX),
         RtTriP => (F, N, F, F, U::TriPipe, p),
         RtDstP => (X, N, F, F, U::DstPipe, p | Latches::WRITES_DST),
+        RtQBoxN => (X, X, F, F, U::BoxPipe(8), r | Latches::WRITES_BOX),
+        RtQBoxNP => (X, N, F, F, U::BoxPipe(8), p | Latches::WRITES_BOX),
+        RtDstQP => (X, X, F, F, U::DstPipe, p | Latches::WRITES_DST),
     }
 }
 

@@ -104,7 +104,7 @@ pub(crate) fn run<S: TraversalSet>(
     let params = Params::new(scene, structures, accel, settings);
     let mut mem = FrameMemory::new(image, params.as_bytes(), params.frame_bytes());
     let placement = placement(&params, &prog, image, cfg.l1.line_bytes);
-    let mut chip = Chip::new(cfg, accel.pipes(cfg));
+    let mut chip = Chip::new(cfg, accel.pipes(&cfg.units));
     let total = frame.pixels();
     let mut threads = Compiled {
         tps: (0..cfg.tms * cfg.tps_per_tm)

@@ -5,8 +5,10 @@ use super::elf::Program;
 use super::isa::PIPE_INPUT_WORDS;
 use super::memory::{LOCAL_STORE_ADDR, MemFault, Memory};
 use crate::hw::fu::FuClass;
+use dualsplit_accel::cwbvh::{CwNode, NODE_WORDS as CW_NODE_WORDS};
 use dualsplit_accel::dst::HeaderOffset;
 use dualsplit_accel::dst::pipeline::{PipelineInput, step as dst_step};
+use dualsplit_accel::dstq::unit::unit_step as dstq_unit_step;
 use dualsplit_geometry::{Ray, RayPre, Triangle, Vec3};
 
 /// RISC-V's canonical NaN, the result of every arithmetic instruction whose result is NaN,
@@ -791,6 +793,37 @@ impl Hart {
                     offset_stack: out.offset_stack,
                 };
                 wx!(out.code as u32 | (out.offset << 2));
+            }
+            RtQBoxN | RtQBoxNP => {
+                let mut w = [0u32; CW_NODE_WORDS];
+                self.node_words(op == RtQBoxNP, prog, mem, a!(), &mut w, &mut acc)?;
+                let node = CwNode::read(&w, 0);
+                let mut mask = 0;
+                for k in 0..8 {
+                    let b = node.box_words(k).map(f32::to_bits);
+                    let (hit, entry, _) = self.box_test(&b, fb!(), fc!());
+                    mask |= (hit as u32) << k;
+                    self.box_latch[k] = f32::from_bits(entry);
+                }
+                wx!(mask);
+            }
+            RtDstQP => {
+                let p = &self.pipe_in;
+                let out = dstq_unit_step(
+                    [p[0], p[1], p[2], p[3]],
+                    [p[4], p[5], p[6]],
+                    a!(),
+                    self.ray.ray.origin.to_array(),
+                    self.ray.inv_dir.to_array(),
+                    fb!(),
+                    fc!(),
+                );
+                self.dst_latch = DstLatch {
+                    t_min_out: out.t_min_out,
+                    t_max_out: out.t_max_out,
+                    offset_stack: out.stack,
+                };
+                wx!(out.code as u32 | (out.next << 2));
             }
             RtLdp => {
                 let v = u32::from_le_bytes(self.load::<4, M>(prog, mem, ea!(), &mut acc)?);

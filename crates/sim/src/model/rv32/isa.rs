@@ -10,13 +10,14 @@ use super::decode::Op;
 /// Opcode of the custom-0 space (`rt.set*`, `rt.rcp`, `rt.atominc`).
 pub const OPCODE_CUSTOM0: u32 = 0x0B;
 /// Opcode of the custom-1 space (`rt.box`, `rt.boxn`, `rt.boxget`, `rt.tri`, `rt.dst`,
-/// `rt.dstget`).
+/// `rt.dstget`, `rt.qboxn`).
 pub const OPCODE_CUSTOM1: u32 = 0x2B;
 /// Opcode of the custom-2 space (`rt.ldp`, `rt.ldph`: loads into the pipeline input
 /// registers `P`).
 pub const OPCODE_CUSTOM2: u32 = 0x5B;
-/// Opcode of the custom-3 space (`rt.boxp`, `rt.boxnp`, `rt.trip`, `rt.dstp`: the register
-/// forms, reading their node words from `P`; `funct3` and `funct2` as the memory forms').
+/// Opcode of the custom-3 space (`rt.boxp`, `rt.boxnp`, `rt.trip`, `rt.dstp`, `rt.qboxnp`:
+/// the register forms, reading their node words from `P`; `funct3` and `funct2` as the
+/// memory forms'; and `rt.dstqp`, which has no memory form).
 pub const OPCODE_CUSTOM3: u32 = 0x7B;
 /// Words of the pipeline input registers `P` (the largest reader: `rt.boxnp` with 8 boxes).
 pub const PIPE_INPUT_WORDS: usize = 48;
@@ -112,8 +113,9 @@ const PIPE: [bool; 4] = [true, false, true, true];
 /// A load into `P`: the address register `rs1` (the `rd` field is the `P` index).
 const LDP: [bool; 4] = [false, true, false, false];
 
-/// Every ray-tracing instruction (Lin et al. 2020, §2.3, §3; `docs/isa.md`).
-pub const RT_INSTRUCTIONS: [RtEncoding; 18] = [
+/// Every ray-tracing instruction (Lin et al. 2020, §2.3, §3; `docs/isa.md`), and the
+/// quantized structures' (`rt.qboxn`, `rt.qboxnp`, `rt.dstqp`; beyond the paper).
+pub const RT_INSTRUCTIONS: [RtEncoding; 21] = [
     row(
         "rt.setorg",
         Op::RtSetOrg,
@@ -248,6 +250,33 @@ pub const RT_INSTRUCTIONS: [RtEncoding; 18] = [
         4,
         R4,
         PIPE,
+        Imm::None,
+    ),
+    row(
+        "rt.qboxn",
+        Op::RtQBoxN,
+        OPCODE_CUSTOM1,
+        6,
+        R4,
+        MEM,
+        Imm::None,
+    ),
+    row(
+        "rt.qboxnp",
+        Op::RtQBoxNP,
+        OPCODE_CUSTOM3,
+        6,
+        R4,
+        PIPE,
+        Imm::None,
+    ),
+    row(
+        "rt.dstqp",
+        Op::RtDstQP,
+        OPCODE_CUSTOM3,
+        7,
+        R4,
+        MEM,
         Imm::None,
     ),
 ];

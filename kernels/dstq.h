@@ -1,0 +1,55 @@
+/* DST-Q: the quantized dual-split tree traversed with rt.dstqp (the quantized dual-split
+ * pipeline; crates/accel/src/dstq/unit.rs), included by render.c. The loop is dst.h's with
+ * records named by bit address: when the traversal enters a cluster other than the one whose
+ * frame it holds, it loads that cluster's 4 frame words into P[0..4]; per record it loads the
+ * 3 words from the one holding the record's first bit into P[4..7]; the instruction decodes
+ * the record, dequantizes its planes and returns the code and the next record's bit address
+ * (or the triangle run's index entry). DST-Q has only this load form (docs/isa.md), so the
+ * PIPE_LOADS=0 variants build the same node loop (their triangle tests still
+ * follow PIPE_LOADS). */
+#include "dst_common.h"
+
+#define CODE_MISS 0u
+#define CODE_ONE_CHILD 1u
+#define CODE_BOTH_CHILDREN 2u
+#define CODE_LEAF 3u
+
+static int traverse(const struct Ray *ray, const struct RayPre *r, int any, struct Hit *best)
+{
+    DST_TRAVERSE_BEGIN(ray, r);
+    node = DSTQ_ROOT_BIT;
+    uint32_t frame_block = ~0u;
+    for (;;) {
+        uint32_t block = node / DSTQ_BLOCK_BITS;
+        if (block != frame_block) {
+            const uint32_t *f = WORD_ADDR(block * (DSTQ_BLOCK_BITS / 32u));
+            PIPE_LD4(0, f);
+            frame_block = block;
+        }
+        const uint32_t *w = WORD_ADDR(node >> 5);
+        PIPE_LD3(4, w);
+        uint32_t out = rt_dstqp(node, t_min, t_max);
+        uint32_t code = out & 3u;
+        uint32_t next = out >> 2;
+        if (code == CODE_ONE_CHILD) {
+            node = next;
+            t_min = rt_dst_tmin();
+            t_max = rt_dst_tmax();
+            continue;
+        }
+        if (code == CODE_BOTH_CHILDREN) {
+            if (sp == STACK_SIZE)
+                kernel_fault(); /* deeper than any tree the converter makes */
+            stack[sp].node = rt_dst_offset_stack();
+            stack[sp].t_min = rt_dst_tmin();
+            stack[sp].t_max = t_max;
+            sp++;
+            node = next;
+            t_max = rt_dst_tmax();
+            continue;
+        }
+        if (code == CODE_LEAF && test_run(next, ray->t_min, any, &have, best, &best_t))
+            return 1;
+        DST_POP_OR_RETURN();
+    }
+}
