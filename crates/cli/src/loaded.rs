@@ -176,4 +176,11 @@ impl TraversalSet for Loaded {
             Loaded::Saved { tree, .. } => TraversalSet::scene_box(tree),
         }
     }
+
+    fn dstq_config(&self) -> Option<dualsplit_accel::dstq::DstQConfig> {
+        match self {
+            Loaded::Built { structures, .. } => TraversalSet::dstq_config(structures),
+            Loaded::Saved { tree, .. } => TraversalSet::dstq_config(tree),
+        }
+    }
 }

@@ -74,7 +74,7 @@ pub fn fig78(
                 .sim(SimAccel::Bvh2, workload, tms)
                 .map(|r| metric(r, metric_kind));
             let mut bars = Vec::new();
-            for (i, a) in SimAccel::ALL.iter().enumerate() {
+            for (i, a) in SimAccel::PAPER.iter().enumerate() {
                 let x = i as f64;
                 if let (Some(r), Some(b)) = (s.sim(*a, workload, tms), base)
                     && b > 0.0
@@ -115,7 +115,7 @@ pub fn fig78(
                 .x_label_formatter(&|x| {
                     let i = x.round();
                     if (x - i).abs() < 1e-6 && (0.0..8.0).contains(&i) {
-                        SimAccel::ALL[i as usize].label().to_string()
+                        SimAccel::PAPER[i as usize].label().to_string()
                     } else {
                         String::new()
                     }
@@ -204,7 +204,7 @@ fn legend(
     area: &DrawingArea<SVGBackend, plotters::coord::Shift>,
     err: &dyn Fn(String) -> ReportError,
 ) -> Result<(), ReportError> {
-    for (i, a) in SimAccel::ALL.iter().enumerate() {
+    for (i, a) in SimAccel::PAPER.iter().enumerate() {
         let y = 40 + 20 * i as i32;
         area.draw(&PathElement::new(
             [(6, y), (30, y)],
@@ -223,7 +223,7 @@ fn legend(
 pub fn fig9(data: &ReportData, s: &SceneReport) -> Result<Option<String>, ReportError> {
     register_font();
     let tms = &data.settings.tms;
-    let ours: Vec<(SimAccel, Vec<(f64, f64)>)> = SimAccel::ALL
+    let ours: Vec<(SimAccel, Vec<(f64, f64)>)> = SimAccel::PAPER
         .iter()
         .map(|&a| {
             let pts = tms
@@ -258,7 +258,7 @@ pub fn fig9(data: &ReportData, s: &SceneReport) -> Result<Option<String>, Report
             &err,
         )?;
         if let Some(m) = pm {
-            let paper_series: Vec<(SimAccel, Vec<(f64, f64)>)> = SimAccel::ALL
+            let paper_series: Vec<(SimAccel, Vec<(f64, f64)>)> = SimAccel::PAPER
                 .iter()
                 .map(|&a| {
                     let pts = paper::TABLE7_TMS

@@ -105,6 +105,32 @@ pub struct CpuData {
     pub all_structures_ms: f64,
     /// Traversal throughput per structure and ray kind.
     pub throughput: Vec<Throughput>,
+    /// Per-ray traversal work of the wide and dual-split structures and their quantized
+    /// forms on the same ray sets: what quantization adds ("Beyond the paper").
+    #[serde(default)]
+    pub counts: Vec<TraversalCounts>,
+}
+
+/// Per-ray traversal work of one structure on one ray set (a counting observer over the
+/// rays the CPU timings use, traced as the workload traces them).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TraversalCounts {
+    /// The structure.
+    pub kind: AccelKind,
+    /// The ray kind.
+    pub ray_kind: RayKind,
+    /// Rays in the set.
+    pub rays: u64,
+    /// Internal nodes stepped per ray (BVH nodes; DST splitting and carving nodes).
+    pub nodes: f64,
+    /// Child boxes tested per ray (BVH: the occupied slots of each node stepped).
+    pub box_tests: f64,
+    /// Planes tested per ray (DST: two per internal node).
+    pub plane_tests: f64,
+    /// Ray-triangle tests per ray.
+    pub triangle_tests: f64,
+    /// Node and index bytes fetched per ray.
+    pub bytes: f64,
 }
 
 /// Host time of one construction step.

@@ -22,6 +22,7 @@
 //! Host timings (build times, Mrays/s) are measurements of this machine and are shown only
 //! in the CPU section; simulated tables hold simulated quantities only.
 
+pub mod beyond;
 pub mod cache;
 pub mod charts;
 pub mod data;

@@ -32,7 +32,7 @@ pub fn section(data: &ReportData) -> Section {
             ]
             .map(String::from)
             .to_vec();
-            let rows = SimAccel::ALL
+            let rows = SimAccel::PAPER
                 .iter()
                 .filter_map(|&a| {
                     let r = s.sim(a, workload, tms)?;

@@ -2,7 +2,7 @@
 //! so the report can show them beside ours.
 //!
 //! Every array is indexed `[configuration][scene]` in the paper's order: configurations as
-//! [`SimAccel::ALL`] (BVH2, BVH2+, BVH4, BVH4+, BVH8, BVH8+, DST*, DST) and scenes as
+//! [`SimAccel::PAPER`] (BVH2, BVH2+, BVH4, BVH4+, BVH8, BVH8+, DST*, DST) and scenes as
 //! [`PaperScene::ALL`] (Crytek Sponza, Dragon Box, Vegetation, Hairball, Dragon Sponza,
 //! San Miguel).
 
@@ -276,7 +276,10 @@ impl Metric {
 /// The published Table 4 (`Cast`) or Table 5 (`Path`) value, in the paper's units (ms, J,
 /// millions of lines).
 pub fn table45(workload: Workload, metric: Metric, accel: SimAccel, scene: PaperScene) -> f64 {
-    let a = SimAccel::ALL.iter().position(|&k| k == accel).unwrap_or(0);
+    let a = SimAccel::PAPER
+        .iter()
+        .position(|&k| k == accel)
+        .unwrap_or(0);
     let s = scene.index();
     let t = match (workload, metric) {
         (Workload::Cast, Metric::FrameMs) => &TABLE4_MS,
@@ -291,7 +294,7 @@ pub fn table45(workload: Workload, metric: Metric, accel: SimAccel, scene: Paper
 
 /// The published Table 7 frame time (ms) for `scene` (Crytek Sponza or Hairball) at `tms`.
 pub fn table7(accel: SimAccel, scene: PaperScene, tms: u32) -> Option<f64> {
-    let a = SimAccel::ALL.iter().position(|&k| k == accel)?;
+    let a = SimAccel::PAPER.iter().position(|&k| k == accel)?;
     let s = scene.table67_index()?;
     let t = TABLE7_TMS.iter().position(|&n| n == tms)?;
     Some(TABLE7_MS[a][s][t])
@@ -299,7 +302,7 @@ pub fn table7(accel: SimAccel, scene: PaperScene, tms: u32) -> Option<f64> {
 
 /// The published Table 6 split (DRAM, caches, compute in J) for `scene`.
 pub fn table6(accel: SimAccel, scene: PaperScene) -> Option<[f64; 3]> {
-    let a = SimAccel::ALL.iter().position(|&k| k == accel)?;
+    let a = SimAccel::PAPER.iter().position(|&k| k == accel)?;
     Some(TABLE6_J[a][scene.table67_index()?])
 }
 
@@ -338,7 +341,7 @@ impl PaperValues {
                 .iter()
                 .map(|s| s.label().to_string())
                 .collect(),
-            configurations: SimAccel::ALL
+            configurations: SimAccel::PAPER
                 .iter()
                 .map(|a| a.label().to_string())
                 .collect(),
@@ -374,7 +377,7 @@ mod tests {
 
     #[test]
     fn table7_at_64_tms_equals_table5() {
-        for a in SimAccel::ALL {
+        for a in SimAccel::PAPER {
             for s in [PaperScene::CrytekSponza, PaperScene::Hairball] {
                 let t7 = table7(a, s, 64).unwrap();
                 let t5 = table45(Workload::Path, Metric::FrameMs, a, s);
@@ -385,7 +388,7 @@ mod tests {
 
     #[test]
     fn table6_sums_to_table5_energy() {
-        for a in SimAccel::ALL {
+        for a in SimAccel::PAPER {
             for s in [PaperScene::CrytekSponza, PaperScene::Hairball] {
                 let split: f64 = table6(a, s).unwrap().iter().sum();
                 let total = table45(Workload::Path, Metric::EnergyJ, a, s);

@@ -15,11 +15,11 @@ use crate::ReportError;
 use crate::cache::{CODE_VERSION, Cache, CacheKey, SCHEMA};
 use crate::data::{
     BuildTime, CpuData, ReportData, ReportSettings, SceneReport, SimRun, Skipped, StructureSize,
-    Throughput,
+    Throughput, TraversalCounts,
 };
 use crate::paper::{PaperMatch, PaperScene, PaperValues};
 use base64::Engine;
-use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
+use dualsplit_accel::{AccelKind, BuildConfig, CountingObserver, NoObserver, Structures};
 use dualsplit_geometry::Hit;
 use dualsplit_render::{PixelJob, RayKind, RayQuery, RenderSettings, TraceResult, Workload};
 use dualsplit_scene::Scene;
@@ -42,6 +42,9 @@ pub const CPU_RAYS: usize = 100_000;
 pub const CPU_MAX_FRAMES: u32 = 8;
 /// Simulations run side by side.
 pub const SIM_WORKERS: usize = 2;
+/// The second TM count of "Beyond the paper" (beside the base count, the paper's 64): twice
+/// the paper's chip, where the paper's memory-bound regime is stronger (its Table 7).
+pub const BEYOND_TMS: u32 = 128;
 
 /// Where producers report progress (the CLI draws indicatif bars; tests pass
 /// [`NoProgress`]).
@@ -130,7 +133,9 @@ impl<'a> Producer<'a> {
     }
 
     /// The simulated jobs of a scene: every configuration × workload at the base TM count
-    /// (Tables 4–6), plus path tracing at every TM count when `scaling` (Table 7).
+    /// (Tables 4–6, and the quantized structures for "Beyond the paper"), path tracing with
+    /// the paper's configurations at every TM count when `scaling` (Table 7), and the
+    /// "Beyond the paper" configurations in both workloads at [`BEYOND_TMS`].
     fn sim_plan(&self, scaling: bool) -> Vec<(SimAccel, Workload, u32)> {
         let s = &self.settings;
         let mut plan = Vec::new();
@@ -142,9 +147,17 @@ impl<'a> Producer<'a> {
         if scaling {
             for &tms in &s.tms {
                 if tms != s.base_tms {
-                    for accel in SimAccel::ALL {
+                    for accel in SimAccel::PAPER {
                         plan.push((accel, Workload::Path, tms));
                     }
+                }
+            }
+        }
+        for workload in [Workload::Cast, Workload::Path] {
+            for accel in SimAccel::BEYOND {
+                let job = (accel, workload, BEYOND_TMS);
+                if !plan.contains(&job) {
+                    plan.push(job);
                 }
             }
         }
@@ -556,12 +569,55 @@ pub fn cpu_data(scene: &Scene, cpu_res: u32) -> Result<CpuData, ReportError> {
             });
         }
     }
+    let counts = traversal_counts(&structures, &sets);
     Ok(CpuData {
         sizes,
         build_ms,
         all_structures_ms,
         throughput,
+        counts,
     })
+}
+
+/// The structures whose per-ray work "Beyond the paper" compares: the BVH8 and its
+/// compressed form, the DST and its quantized form.
+pub const COUNTED: [AccelKind; 4] = [
+    AccelKind::Bvh8,
+    AccelKind::Cwbvh,
+    AccelKind::Dst,
+    AccelKind::DstQ,
+];
+
+/// [`TraversalCounts`] of the [`COUNTED`] structures on each ray set (primary, shadow,
+/// diffuse), with a counting observer.
+fn traversal_counts(structures: &Structures, sets: &[Vec<Traced>; 3]) -> Vec<TraversalCounts> {
+    let mut out = Vec::new();
+    for (ray_kind, set) in [RayKind::Primary, RayKind::Shadow, RayKind::Diffuse]
+        .into_iter()
+        .zip(sets)
+    {
+        if set.is_empty() {
+            continue;
+        }
+        for kind in COUNTED {
+            let mut obs = CountingObserver::default();
+            for r in set {
+                dualsplit_render::trace_query(structures, kind, &r.query, &mut obs);
+            }
+            let n = set.len() as f64;
+            out.push(TraversalCounts {
+                kind,
+                ray_kind,
+                rays: set.len() as u64,
+                nodes: obs.nodes as f64 / n,
+                box_tests: obs.box_tests as f64 / n,
+                plane_tests: obs.plane_tests as f64 / n,
+                triangle_tests: obs.triangle_tests as f64 / n,
+                bytes: obs.bytes as f64 / n,
+            });
+        }
+    }
+    out
 }
 
 fn time_set(

@@ -288,14 +288,14 @@ pub fn table45(data: &ReportData, workload: Workload) -> Section {
         }
         notes.push(paper_note(s));
         let ours = |m: Metric| -> Vec<f64> {
-            SimAccel::ALL
+            SimAccel::PAPER
                 .iter()
                 .filter_map(|&a| Some(metric(s.sim(a, workload, tms)?, m)))
                 .collect()
         };
         let theirs = |m: Metric| -> Vec<f64> {
             s.paper.map_or_else(Vec::new, |pm| {
-                SimAccel::ALL
+                SimAccel::PAPER
                     .iter()
                     .map(|&a| paper::table45(workload, m, a, pm.scene))
                     .collect()
@@ -323,7 +323,7 @@ pub fn table45(data: &ReportData, workload: Workload) -> Section {
             }
         }
         let mut rows = Vec::new();
-        for a in SimAccel::ALL {
+        for a in SimAccel::PAPER {
             let mut row = vec![Cell::text(a.label())];
             for (m, (_, scale)) in Metric::ALL.iter().copied().zip(&our_units) {
                 let base = s.sim(SimAccel::Bvh2, workload, tms).map(|r| metric(r, m));
@@ -413,7 +413,7 @@ pub fn table6(data: &ReportData) -> Section {
         };
         let column_units: Vec<(&str, f64)> = (0..6)
             .map(|c| {
-                let v: Vec<f64> = SimAccel::ALL
+                let v: Vec<f64> = SimAccel::PAPER
                     .iter()
                     .filter_map(|&a| s.sim(a, Workload::Path, tms))
                     .map(|r| parts(r)[c])
@@ -439,7 +439,7 @@ pub fn table6(data: &ReportData) -> Section {
         let first_paper = header.len();
         let paper_vals: Vec<f64> = pm
             .map(|m| {
-                SimAccel::ALL
+                SimAccel::PAPER
                     .iter()
                     .filter_map(|&a| paper::table6(a, m.scene))
                     .flatten()
@@ -454,7 +454,7 @@ pub fn table6(data: &ReportData) -> Section {
             header.push(format!("paper {}: DRAM share", m.scene.label()));
         }
         let mut rows = Vec::new();
-        for a in SimAccel::ALL {
+        for a in SimAccel::PAPER {
             let mut row = vec![Cell::text(a.label())];
             match s.sim(a, Workload::Path, tms) {
                 Some(r) => {
@@ -518,7 +518,7 @@ pub fn table7(data: &ReportData) -> Section {
             continue;
         }
         let pm = s.paper.filter(|m| m.scene.table67_index().is_some());
-        let ours: Vec<f64> = SimAccel::ALL
+        let ours: Vec<f64> = SimAccel::PAPER
             .iter()
             .flat_map(|&a| tms.iter().filter_map(move |&t| s.sim(a, Workload::Path, t)))
             .map(|r| r.frame_ms)
@@ -526,7 +526,7 @@ pub fn table7(data: &ReportData) -> Section {
         let (unit, scale) = units::time_unit(&ours);
         let theirs: Vec<f64> = pm
             .map(|m| {
-                SimAccel::ALL
+                SimAccel::PAPER
                     .iter()
                     .flat_map(|&a| {
                         paper::TABLE7_TMS
@@ -551,7 +551,7 @@ pub fn table7(data: &ReportData) -> Section {
             }
         }
         let mut rows = Vec::new();
-        for a in SimAccel::ALL {
+        for a in SimAccel::PAPER {
             let mut row = vec![Cell::text(a.label())];
             let first = s.sim(a, Workload::Path, tms[0]).map(|r| r.frame_ms);
             for (j, &t) in tms.iter().enumerate() {
@@ -728,6 +728,7 @@ pub fn sections(data: &ReportData) -> Vec<Section> {
         crate::memory::section(data),
         table6(data),
         table7(data),
+        crate::beyond::section(data),
         cpu(data),
     ]
 }

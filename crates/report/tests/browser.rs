@@ -35,7 +35,7 @@ fn gradient_png(seed: u32) -> String {
 fn synthetic_scene(name: &str, spec: &str, seed: u32, tms: &[u32]) -> SceneReport {
     let mut sim = Vec::new();
     for w in [Workload::Cast, Workload::Path] {
-        for a in SimAccel::ALL {
+        for a in SimAccel::PAPER {
             sim.push(SimRun {
                 accel: a,
                 workload: w,
@@ -45,7 +45,7 @@ fn synthetic_scene(name: &str, spec: &str, seed: u32, tms: &[u32]) -> SceneRepor
         }
     }
     for &t in tms.iter().filter(|&&t| t != 64) {
-        for a in SimAccel::ALL {
+        for a in SimAccel::PAPER {
             sim.push(SimRun {
                 accel: a,
                 workload: Workload::Path,
@@ -90,6 +90,7 @@ fn synthetic_scene(name: &str, spec: &str, seed: u32, tms: &[u32]) -> SceneRepor
                 .collect(),
             all_structures_ms: 20.0,
             throughput,
+            counts: Vec::new(),
         },
         sim,
         render_png_base64: gradient_png(seed),
