@@ -115,7 +115,7 @@ fn check(name: &str, tris: &[Triangle], rays: &[Ray]) {
 #[test]
 fn the_unit_loop_answers_every_ray_as_the_quantized_dst() {
     let n = if cfg!(debug_assertions) { 500 } else { 20_000 };
-    for name in ["dragon_res4", "bunny"] {
+    for name in ["dragon_res4.ply.gz", "bunny.ply.gz"] {
         let Some(scene) = shipped(name) else {
             panic!("{name} is shipped with the repository");
         };
