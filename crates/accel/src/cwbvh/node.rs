@@ -394,6 +394,25 @@ mod tests {
         assert_eq!(n.slot(4), Meta::Empty);
     }
 
+    /// Far from the origin the scale (4) is below the ulp (8): the decode check, not the
+    /// f64 quotient, picks the bytes (docs/cwbvh-encoding.md, §4).
+    #[test]
+    fn rounding_example() {
+        let iv = [
+            (1e8, 100_000_504.0),
+            (100_000_496.0, 100_000_512.0),
+            (1e8, 100_001_000.0),
+        ];
+        let q = quantize_axis(&iv);
+        assert_eq!(q.frame, AxisFrame { p: 1e8, e: 129 });
+        // `1e8 + 4` rounds (tie to even) to `1e8`: `q_lo = 1` is the largest still below.
+        assert_eq!(q.q, vec![(1, 126), (125, 127), (1, 250)]);
+        assert_eq!(q.frame.decode(1), 1e8);
+        assert_eq!(q.frame.decode(125), 100_000_496.0);
+        assert_eq!(q.frame.decode(127), 100_000_512.0);
+        assert_eq!(q.frame.decode(249), 100_000_992.0);
+    }
+
     #[test]
     fn leaf_meta_bytes() {
         assert_eq!(Meta::leaf(0, 1).byte(0), 0b001_00000);

@@ -18,6 +18,16 @@ enum ChildRef {
     Leaf(Aabb),
 }
 
+/// A node still to be walked.
+struct Pending {
+    /// Its word.
+    at: usize,
+    /// Its depth (root 0).
+    depth: usize,
+    /// Its parent's walk index and the slot's position among the parent's children.
+    parent: Option<(usize, usize)>,
+}
+
 /// A reached non-empty slot: its decoded box, the exact bounds of the triangles below it,
 /// and the exact bounds of its node (the union over the node's slots).
 #[derive(Clone, Copy, Debug)]
@@ -97,9 +107,12 @@ pub(crate) fn walk(img: &MemoryImage) -> Walk {
     };
     // Walked nodes, preorder: per non-empty slot, its decoded box and what it refers to.
     let mut recs: Vec<Vec<(Aabb, ChildRef)>> = Vec::new();
-    // (node word, depth, (parent walk index, position in its children))
-    let mut stack: Vec<(usize, usize, Option<(usize, usize)>)> = vec![(0, 0, None)];
-    while let Some((at, depth, parent)) = stack.pop() {
+    let mut stack = vec![Pending {
+        at: 0,
+        depth: 0,
+        parent: None,
+    }];
+    while let Some(Pending { at, depth, parent }) = stack.pop() {
         if at < img.nodes.start || at.saturating_add(NODE_WORDS) > img.nodes.end {
             error(
                 &mut rep,
@@ -166,11 +179,11 @@ pub(crate) fn walk(img: &MemoryImage) -> Walk {
                     }
                     children.push((decoded, ChildRef::Node(None)));
                     if block_ok {
-                        stack.push((
-                            node.child_node(k) as usize,
-                            depth + 1,
-                            Some((idx, children.len() - 1)),
-                        ));
+                        stack.push(Pending {
+                            at: node.child_node(k) as usize,
+                            depth: depth + 1,
+                            parent: Some((idx, children.len() - 1)),
+                        });
                     }
                 }
                 Meta::Leaf { offset, count_hint } => {

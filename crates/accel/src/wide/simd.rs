@@ -19,10 +19,13 @@ pub fn prefetch<T>(r: &T) {
             // SAFETY: `_mm_prefetch` only needs SSE, which every x86-64 CPU has (it is in the
             // target's baseline features), and it never dereferences its pointer for the
             // program: it is a hint that cannot fault, whatever the address. The address is
-            // within a line `*r` touches; `wrapping_byte_add` needs no bounds.
+            // within a line `*r` touches; `wrapping_byte_add` needs no bounds (the first
+            // line may start before `start`: the wrapped difference lands on it).
             unsafe {
                 use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-                _mm_prefetch::<_MM_HINT_T0>(start.wrapping_byte_add(line - start as usize));
+                _mm_prefetch::<_MM_HINT_T0>(
+                    start.wrapping_byte_add(line.wrapping_sub(start as usize)),
+                );
             }
             line += 64;
         }
