@@ -1,12 +1,13 @@
 /* DST-Q: the quantized dual-split tree traversed with rt.dstqp (the quantized dual-split
  * pipeline; crates/accel/src/dstq/unit.rs), included by render.c. The loop is dst.h's with
- * records named by bit address: when the traversal enters a cluster other than the one whose
- * frame it holds, it loads that cluster's 4 frame words into P[0..4]; per record it loads the
- * 3 words from the one holding the record's first bit into P[4..7]; the instruction decodes
- * the record, dequantizes its planes and returns the code and the next record's bit address
- * (or the triangle run's index entry). DST-Q has only this load form (docs/isa.md), so the
- * PIPE_LOADS=0 variants build the same node loop (their triangle tests still
- * follow PIPE_LOADS). */
+ * records named by one word, their cluster's word address << 9 | their bit position in the
+ * cluster: when the traversal enters a cluster other than the one whose frame it holds, it
+ * loads that cluster's 4 frame words into P[0..4]; per record it loads the 3 words from the
+ * one holding the record's first bit into P[4..7]; the instruction decodes the record,
+ * dequantizes its planes and returns the next record's name (or the triangle run's index
+ * entry), its code in the DST latch. DST-Q has only this load form (docs/isa.md), so the
+ * PIPE_LOADS=0 variants build the same node loop (their triangle tests still follow
+ * PIPE_LOADS). */
 #include "dst_common.h"
 
 #define CODE_MISS 0u
@@ -17,20 +18,19 @@
 static int traverse(const struct Ray *ray, const struct RayPre *r, int any, struct Hit *best)
 {
     DST_TRAVERSE_BEGIN(ray, r);
-    node = DSTQ_ROOT_BIT;
-    uint32_t frame_block = ~0u;
+    node = DSTQ_ROOT_BIT; /* the root cluster is at word 0 */
+    uint32_t frame_cluster = ~0u;
     for (;;) {
-        uint32_t block = node / DSTQ_BLOCK_BITS;
-        if (block != frame_block) {
-            const uint32_t *f = WORD_ADDR(block * (DSTQ_BLOCK_BITS / 32u));
+        uint32_t cluster = node >> DSTQ_POS_BITS;
+        if (cluster != frame_cluster) {
+            const uint32_t *f = WORD_ADDR(cluster);
             PIPE_LD4(0, f);
-            frame_block = block;
+            frame_cluster = cluster;
         }
-        const uint32_t *w = WORD_ADDR(node >> 5);
+        const uint32_t *w = WORD_ADDR(cluster + ((node & DSTQ_POS_MASK) >> 5));
         PIPE_LD3(4, w);
-        uint32_t out = rt_dstqp(node, t_min, t_max);
-        uint32_t code = out & 3u;
-        uint32_t next = out >> 2;
+        uint32_t next = rt_dstqp(node, t_min, t_max);
+        uint32_t code = rt_dst_code();
         if (code == CODE_ONE_CHILD) {
             node = next;
             t_min = rt_dst_tmin();

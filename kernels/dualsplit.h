@@ -137,10 +137,11 @@ _Static_assert(sizeof(struct CwNode) == 80, "CwNode is 80 bytes");
 
 /* ---- Quantized DST (crates/accel/src/dstq, docs/dstq-encoding.md) ------------------------ */
 
-/* The unit's geometry (crates/accel/src/dstq/unit.rs): 64-byte clusters, the first root of a
- * cluster at bit 128 (after its 16-byte frame). Records are named by bit address: the byte
- * address of their cluster block times 8 plus their bit position in it. */
-#define DSTQ_BLOCK_BITS 512u
+/* The unit's geometry (crates/accel/src/dstq/unit.rs): clusters of at most 64 bytes, the
+ * first root of a cluster at bit 128 (after its 16-byte frame). A record is named by one
+ * word: its cluster's word address << DSTQ_POS_BITS | its bit position in the cluster. */
+#define DSTQ_POS_BITS 9u
+#define DSTQ_POS_MASK ((1u << DSTQ_POS_BITS) - 1u)
 #define DSTQ_ROOT_BIT 128u
 
 /* ---- Geometry constants (crates/geometry) ------------------------------------------------ */

@@ -135,6 +135,13 @@ static inline uint32_t rt_dst_offset_stack(void)
     __asm__ volatile(".insn r 0x2B, 5, 2, %0, x0, x0" : "=r"(r));
     return r;
 }
+/* The return code of the last rt_dstqp. */
+static inline uint32_t rt_dst_code(void)
+{
+    uint32_t r;
+    __asm__ volatile(".insn r 0x2B, 5, 3, %0, x0, x0" : "=r"(r));
+    return r;
+}
 
 
 /* The 8 child boxes of the 80-byte compressed-BVH8 node at `node`, dequantized and tested on
@@ -204,11 +211,11 @@ static inline uint32_t rt_qboxnp(float t_lo, float t_hi)
     return r;
 }
 
-/* One quantized dual-split pipeline step on the DST-Q record at bit address `at` (its
- * cluster's frame in P[0..4], the three words from the one holding its first bit in
- * P[4..7]): code | next << 2 (next: the record to continue at, by bit address, or the
- * triangle run's index entry); the rest goes to the DST latch (rt_dst_tmin, rt_dst_tmax,
- * rt_dst_offset_stack: the far child's bit address). */
+/* One quantized dual-split pipeline step on the DST-Q record named `at` (its cluster's word
+ * address << 9 | its bit position in the cluster; the cluster's frame in P[0..4], the three
+ * words from the one holding the record's first bit in P[4..7]): the name of the record to
+ * continue at, or the triangle run's index entry; the rest goes to the DST latch
+ * (rt_dst_code, rt_dst_tmin, rt_dst_tmax, rt_dst_offset_stack: the far child's name). */
 static inline uint32_t rt_dstqp(uint32_t at, float t_min, float t_max)
 {
     uint32_t r;

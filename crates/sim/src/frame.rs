@@ -75,8 +75,8 @@ pub fn check_model(cfg: &SimConfig, model: ThreadModel) -> Result<(), SimError> 
 }
 
 /// DST-Q runs on a unit of fixed geometry (`dstq::unit`): its tree must have the unit's
-/// plane bits and cluster size, and its records' bit addresses must fit the 30 bits
-/// `rt.dstqp` returns them in (a node region up to 128 MiB).
+/// plane bits and cluster size, and its records' names (cluster word address << 9 | bit
+/// position) must fit 32 bits (a node region up to 32 MiB).
 fn check_quantized_dst<S: TraversalSet>(structures: &S, accel: SimAccel) -> Result<(), SimError> {
     if accel.kind() != AccelKind::DstQ {
         return Ok(());
@@ -90,10 +90,10 @@ fn check_quantized_dst<S: TraversalSet>(structures: &S, accel: SimAccel) -> Resu
         });
     }
     let bytes = structures.image(accel.kind()).node_bytes();
-    let limit = 1u64 << 27;
+    let limit = dualsplit_accel::dstq::unit::UNIT_MAX_NODE_BYTES;
     if bytes > limit {
         return Err(SimError::MemoryMap {
-            region: "DST-Q node region (records named by 30-bit bit addresses)",
+            region: "DST-Q node region (records named by a 23-bit cluster word address and a 9-bit position)",
             bytes,
             limit,
         });

@@ -156,7 +156,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         );
     }
     println!(
-        "time: BVH2 build, BVH4/BVH8 collapse, DST conversion from the BVH2 (wall clock, this machine)"
+        "time: BVH2 build, BVH4/BVH8 collapse, DST conversion from the BVH2, CWBVH collapse and encoding, DST-Q quantization of the DST (wall clock, this machine)"
     );
     if let Some(d) = stats.iter().find_map(|st| st.dst) {
         println!(

@@ -243,7 +243,7 @@ pub enum Op {
     RtTri,
     /// `rt.dst`: `x[rd] = code | offset << 2`, the rest to `D`.
     RtDst,
-    /// `rt.dstget` (`imm` = field 0, 1, 2).
+    /// `rt.dstget` (`imm` = field 0, 1, 2, 3).
     RtDstGet,
     /// `rt.ldp` / `rt.ldph`: `P[k] = mem[x[rs1] + imm]`, `k = rd + 32 · rs2` (0–47; the
     /// two fields name no register).
@@ -261,8 +261,9 @@ pub enum Op {
     RtQBoxN,
     /// `rt.qboxnp`: `rt.qboxn` on the node in `P[0..20]`.
     RtQBoxNP,
-    /// `rt.dstqp`: the DST-Q record at bit address `x[rs1]` (frame in `P[0..4]`, the
-    /// record's words in `P[4..7]`): `x[rd] = code | next << 2`, the rest to `D`.
+    /// `rt.dstqp`: the DST-Q record named by `x[rs1]` (cluster word address << 9 | bit
+    /// position; frame in `P[0..4]`, the record's words in `P[4..7]`): `x[rd]` = the next
+    /// record's name or the run's index entry, the rest (code included) to `D`.
     RtDstQP,
     /// A word that does not decode (`imm` = the word); executing it is an error.
     Illegal,
@@ -363,7 +364,7 @@ fn shape(op: Op, imm: i32) -> (K, K, K, K, FuClass, u8) {
         RtTri => (F, X, F, F, U::TriPipe, r),
         RtDst => (X, X, F, F, U::DstPipe, r | Latches::WRITES_DST),
         RtDstGet => {
-            let rd = if imm == 2 { X } else { F };
+            let rd = if imm >= 2 { X } else { F };
             (rd, N, N, N, U::IntAlu, Latches::READS_DST)
         }
         RtLdp => (N, X, N, N, U::Load, Latches::WRITES_PIPE),

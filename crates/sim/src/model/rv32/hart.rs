@@ -150,6 +150,9 @@ pub struct DstLatch {
     pub t_max_out: f32,
     /// `offset_stack`.
     pub offset_stack: u32,
+    /// The return code of the last `rt.dstqp` (`rt.dst` and `rt.dstp` return theirs in
+    /// `rd` and leave this 0).
+    pub code: u32,
 }
 
 /// One hardware thread's architectural state.
@@ -791,6 +794,7 @@ impl Hart {
                     t_min_out: out.t_min_out,
                     t_max_out: out.t_max_out,
                     offset_stack: out.offset_stack,
+                    code: 0,
                 };
                 wx!(out.code as u32 | (out.offset << 2));
             }
@@ -822,8 +826,9 @@ impl Hart {
                     t_min_out: out.t_min_out,
                     t_max_out: out.t_max_out,
                     offset_stack: out.stack,
+                    code: out.code as u32,
                 };
-                wx!(out.code as u32 | (out.next << 2));
+                wx!(out.next);
             }
             RtLdp => {
                 let v = u32::from_le_bytes(self.load::<4, M>(prog, mem, ea!(), &mut acc)?);
@@ -832,7 +837,8 @@ impl Hart {
             RtDstGet => match imm {
                 0 => wf!(self.dst_latch.t_min_out.to_bits()),
                 1 => wf!(self.dst_latch.t_max_out.to_bits()),
-                _ => wx!(self.dst_latch.offset_stack),
+                2 => wx!(self.dst_latch.offset_stack),
+                _ => wx!(self.dst_latch.code),
             },
             Illegal => {
                 let word = imm as u32;

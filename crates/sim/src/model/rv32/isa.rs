@@ -188,7 +188,7 @@ pub const RT_INSTRUCTIONS: [RtEncoding; 21] = [
         Op::RtDstGet,
         OPCODE_CUSTOM1,
         5,
-        Format::R { funct7_max: 2 },
+        Format::R { funct7_max: 3 },
         GET,
         Imm::Field,
     ),
