@@ -594,22 +594,24 @@ fn measure(name: &str, configs: &[DstQConfig]) {
         );
     }
     println!(
-        "| k | block | MiB | % DST | % BVH2 | B/node | fill | prim B/ray | prim lines | prim +nodes | prim +tris | rand B/ray | rand lines | rand +nodes | rand +tris |"
+        "| k | line | MiB | % DST | % BVH2 | B/node | fill | clusters | prim B/ray | prim lines | prim +nodes | prim +tris | rand B/ray | rand lines | rand +nodes | rand +tris |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for cfg in configs {
         let q = DstQ::from_dst(dst, cfg).unwrap();
+        assert!(q.validate(dst).is_ok());
         let st = q.stats();
         let tot = q.bytes_total() as f64;
         let mut row = format!(
-            "| {} | {} | {:.3} | {:.1} | {:.1} | {:.2} | {:.0} % |",
+            "| {} | {} | {:.3} | {:.1} | {:.1} | {:.2} | {:.0} % | {} |",
             cfg.bits,
             cfg.cluster_bytes,
             tot / 1048576.0,
             100.0 * tot / dst_bytes,
             100.0 * tot / bvh2_bytes,
             st.bytes_per_node(),
-            100.0 * st.fill()
+            100.0 * st.fill(),
+            st.clusters
         );
         for ((_, rays), e) in sets.iter().zip(&exact) {
             let w = work(rays, |ray, o| {

@@ -150,11 +150,52 @@ pub(super) fn read_exact(dst: &Dst) -> Result<Vec<ExactNode>, DstError> {
 }
 
 /// A cluster waiting to be filled: its roots (1, or a split's 2 children), its frame box and
-/// its block index.
+/// its cluster id.
 struct Pending {
     roots: Vec<u32>,
     frame: Aabb,
-    block: u32,
+    id: u32,
+}
+
+/// A filled cluster: its frame box, its records (node, bit position) and its size in bits.
+struct Cluster {
+    frame: Aabb,
+    placed: Vec<(u32, u32)>,
+    bits: u32,
+}
+
+/// Where an expanded node's children went: this cluster at a bit position, or a cluster id.
+#[derive(Clone, Copy)]
+enum Child {
+    Local(u32),
+    Cluster(u32),
+}
+
+/// First-fit packing of clusters into `line_words`-word lines, so that no cluster crosses
+/// a line boundary: the first of the last [`OPEN_LINES`] lines with room, else a new line.
+/// Returns each cluster's word address and the number of lines.
+fn pack(sizes: &[u32], line_words: u32) -> (Vec<u32>, u32) {
+    const OPEN_LINES: usize = 16;
+    let mut open: Vec<(u32, u32)> = Vec::new(); // (line, free words)
+    let mut lines = 0u32;
+    let addr = sizes
+        .iter()
+        .map(|&s| {
+            let slot = open.iter().position(|&(_, free)| free >= s);
+            let i = slot.unwrap_or_else(|| {
+                if open.len() == OPEN_LINES {
+                    open.remove(0);
+                }
+                open.push((lines, line_words));
+                lines += 1;
+                open.len() - 1
+            });
+            let (line, free) = open[i];
+            open[i].1 -= s;
+            line * line_words + (line_words - free)
+        })
+        .collect();
+    (addr, lines)
 }
 
 fn record_bits(n: &ExactNode, k: u32) -> u32 {
@@ -196,17 +237,16 @@ impl DstQ {
             image.words[..n_idx].copy_from_slice(&src.words[src.indices.clone()]);
             return Ok(Self::assemble(image, dst.scene_box(), *cfg));
         }
-        let mut words: Vec<u32> = Vec::new();
+        // Pass 1: fill the clusters, parents before children.
         let mut queue = VecDeque::from([Pending {
             roots: vec![0],
             frame: dst.scene_box(),
-            block: 0,
+            id: 0,
         }]);
-        let mut next_block = 1u32;
-        // Per node: where its children went (set while filling its cluster).
-        let mut child_at: Vec<Option<ChildRef>> = vec![None; nodes.len()];
+        let mut clusters: Vec<Cluster> = Vec::new();
+        let mut child_at: Vec<Option<Child>> = vec![None; nodes.len()];
         while let Some(p) = queue.pop_front() {
-            debug_assert_eq!(p.block as usize * cw, words.len());
+            debug_assert_eq!(p.id as usize, clusters.len());
             let mut placed: Vec<(u32, u32)> = Vec::new();
             let mut heap = BinaryHeap::new();
             let mut pos = ROOT_BIT;
@@ -225,7 +265,7 @@ impl DstQ {
                     .map(|&c| record_bits(&nodes[c as usize], k))
                     .sum();
                 if pos + need <= cbits {
-                    child_at[n as usize] = Some(ChildRef::Local(pos));
+                    child_at[n as usize] = Some(Child::Local(pos));
                     for &c in &kids {
                         placed.push((c, pos));
                         pos += record_bits(&nodes[c as usize], k);
@@ -234,25 +274,38 @@ impl DstQ {
                         }
                     }
                 } else {
-                    child_at[n as usize] = Some(ChildRef::Cluster(next_block));
+                    let id = (clusters.len() + 1 + queue.len()) as u32;
+                    child_at[n as usize] = Some(Child::Cluster(id));
                     queue.push_back(Pending {
                         frame: union_region(&nodes, &kids),
                         roots: kids,
-                        block: next_block,
+                        id,
                     });
-                    next_block += 1;
                 }
             }
-            // Write the block.
-            let base = words.len();
-            words.resize(base + cw, 0);
-            let block = &mut words[base..];
-            let frame = Frame::of_box(p.frame.min.to_array(), p.frame.max.to_array(), k);
-            block[..4].copy_from_slice(&frame.words(placed.len().min(255) as u8));
-            for &(n, bit) in &placed {
+            clusters.push(Cluster {
+                frame: p.frame,
+                placed,
+                bits: pos,
+            });
+        }
+        // Pass 2: place the clusters (whole words) in lines of `cluster_bytes`.
+        let sizes: Vec<u32> = clusters.iter().map(|c| c.bits.div_ceil(32)).collect();
+        let (addr, lines) = pack(&sizes, cw as u32);
+        let mut words: Vec<u32> = vec![0; lines as usize * cw];
+        // Pass 3: write every cluster at its address.
+        for (c, &base) in clusters.iter().zip(&addr) {
+            let block = &mut words[base as usize..];
+            let frame = Frame::of_box(c.frame.min.to_array(), c.frame.max.to_array(), k);
+            block[..4].copy_from_slice(&frame.words(c.placed.len().min(255) as u8));
+            for &(n, bit) in &c.placed {
                 let node = &nodes[n as usize];
                 let hdr = node.hdr;
-                let child = || child_at[n as usize].expect("every expanded node has a child ref");
+                let child = || match child_at[n as usize] {
+                    Some(Child::Local(b)) => ChildRef::Local(b),
+                    Some(Child::Cluster(id)) => ChildRef::Cluster(addr[id as usize]),
+                    None => unreachable!("every expanded node has a child"),
+                };
                 let q = match hdr.node_kind() {
                     DstNodeKind::Leaf => QHeader::leaf(hdr.offset() as u64)?,
                     DstNodeKind::Split => {
@@ -276,12 +329,6 @@ impl DstQ {
                     }
                 }
             }
-        }
-        if next_block as u64 > super::record::CHILD_LIMIT {
-            return Err(DstQError::Dst(DstError::OffsetOverflow {
-                given: next_block as u64,
-                limit: super::record::CHILD_LIMIT,
-            }));
         }
         let n_nodes = words.len();
         let mut image = MemoryImage::with_triangles(n_nodes, n_idx, src.triangle_data.clone());

@@ -129,7 +129,7 @@ impl DstQConfig {
     pub fn check(&self) -> Result<(), DstQError> {
         let ok_bits = (1..=16).contains(&self.bits);
         let min_bytes = Self::min_bytes(self.bits.min(16));
-        let ok_bytes = self.cluster_bytes % 4 == 0
+        let ok_bytes = self.cluster_bytes.is_multiple_of(4)
             && self.cluster_bytes >= min_bytes
             && self.cluster_bytes <= 4096;
         if ok_bits && ok_bytes {
@@ -206,12 +206,7 @@ impl DstQ {
         self.image.triangle_slice()
     }
 
-    /// Cluster blocks in the node region.
-    pub fn clusters(&self) -> u64 {
-        (self.image.nodes.len() / self.config.cluster_words() as usize) as u64
-    }
-
-    /// Node bytes (whole cluster blocks, padding included) + index bytes + the 24-byte
+    /// Node bytes (whole lines, padding included) + index bytes + the 24-byte
     /// scene box: the quantity of Lin et al. 2020, Table 3, defined as
     /// [`crate::dst::DstStats::total_bytes`].
     pub fn bytes_total(&self) -> u64 {

@@ -9,8 +9,8 @@
 //!                             L = 1:  index entry of the triangle run (26 bits, as the DST)
 //!                             L = 0:  X  | child (25 bits)
 //!                                     X = 0: bit position of the child record in this cluster
-//!                                     X = 1: block index of the child's cluster (its roots
-//!                                            start at bit 128 of that block)
+//!                                     X = 1: word address of the child's cluster (its
+//!                                            frame; its roots start 128 bits later)
 //! record:  header (32 bits) | q0 (k bits) | q1 (k bits)      internal node: 32 + 2k bits
 //!          header (32 bits)                                  plain leaf:    32 bits
 //! ```
@@ -28,7 +28,7 @@ use crate::observer::DstNodeKind;
 const BIT_X: u32 = 1 << 25;
 /// Mask of the 25-bit child field.
 const CHILD_MASK: u32 = BIT_X - 1;
-/// Largest child bit position or block index + 1: 2^25.
+/// Largest child bit position or cluster word address + 1: 2^25 (128 MiB of node words).
 pub const CHILD_LIMIT: u64 = 1 << 25;
 
 /// Where a record's child (or a split's left child) lies.
@@ -36,7 +36,8 @@ pub const CHILD_LIMIT: u64 = 1 << 25;
 pub enum ChildRef {
     /// The record at this bit position of the same cluster.
     Local(u32),
-    /// The first root of this cluster block (bit [`super::layout::ROOT_BIT`]).
+    /// The first root of the cluster whose frame is at this word of the node region (at bit
+    /// [`super::layout::ROOT_BIT`] of the cluster).
     Cluster(u32),
 }
 

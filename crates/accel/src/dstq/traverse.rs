@@ -1,11 +1,11 @@
 //! Traversal of the quantized DST: the exact DST's node rules (`dst/traverse.rs`; Lin et al.
 //! 2020, §3, Figs. 2–3), with each plane dequantized from its cluster's frame
 //! (`plane = p_a + q · 2^(e_a − 127)`) before the same distance, widening and `le_or_nan`
-//! tests. A stack entry carries the cluster block and the record's bit position beside its
-//! interval.
+//! tests. A stack entry carries the cluster's word address and the record's bit position
+//! beside its interval.
 //!
-//! Fetch accounting (`docs/dstq-encoding.md`, §6): the frame (16 B at the block's start)
-//! when the traversal starts working in a block other than the one whose frame it holds
+//! Fetch accounting (`docs/dstq-encoding.md`, §6): the frame (16 B at the cluster's start)
+//! when the traversal starts working in a cluster other than the one whose frame it holds
 //! (descending into a child cluster, or popping an entry of another cluster); then, per
 //! node step, the whole 32-bit words that hold the record's bits (a record may straddle a
 //! word boundary); 4 B per index entry and 36 B per triangle, as the exact DST.
@@ -19,7 +19,8 @@ use crate::image::{MemoryImage, RUN_END};
 use crate::observer::{DstNodeKind, NodeStep, Observer};
 use dualsplit_geometry::{Hit, PrimId, Ray, cull_limit, widen_exit};
 
-/// A traversal-stack entry: a record (cluster block, bit position) and its ray interval.
+/// A traversal-stack entry: a record (its cluster's word address and its bit position in
+/// the cluster) and its ray interval.
 #[derive(Clone, Copy, Debug)]
 struct Entry {
     block: u32,
@@ -49,7 +50,7 @@ impl DstQ {
         self.traverse::<O, true>(ray, obs).is_some()
     }
 
-    /// Where the child `c` of a record in `block` lies: (block, bit).
+    /// Where the child `c` of a record in the cluster at word `block` lies: (cluster word, bit).
     #[inline(always)]
     fn locate(block: u32, c: ChildRef) -> (u32, u32) {
         match c {
@@ -83,7 +84,7 @@ impl DstQ {
         };
         let (mut block, mut bit) = (0u32, ROOT_BIT);
         loop {
-            let base = block as usize * cw;
+            let base = block as usize;
             if block != frame_block {
                 obs.fetch(MemoryImage::addr(base), 4 * FRAME_WORDS as u32);
                 let mut fw = [0u32; 4];
@@ -91,7 +92,8 @@ impl DstQ {
                 frame = Frame::from_words(fw);
                 frame_block = block;
             }
-            let cwords = &words[base..base + cw];
+            // A cluster never crosses its line: its records lie before the line's end.
+            let cwords = &words[base..(base / cw + 1) * cw];
             let h = QHeader::from_bits(read_bits(cwords, bit as usize, 32));
             let rb = h.record_bits(k);
             let (w0, w1) = (bit / 32, (bit + rb - 1) / 32);
@@ -199,8 +201,8 @@ impl DstQ {
                 obs.step(NodeStep::Leaf {
                     count: count as u32,
                 });
-                for i in start..start + count {
-                    let p = PrimId(words[i] & !RUN_END);
+                for (i, &entry) in words.iter().enumerate().skip(start).take(count) {
+                    let p = PrimId(entry & !RUN_END);
                     obs.fetch(MemoryImage::addr(i), 4);
                     obs.fetch(MemoryImage::addr(img.triangles.start + 9 * p.index()), 36);
                     let hit = tris[p.index()].intersect(&r, ray.t_min, best_t);

@@ -74,7 +74,6 @@ impl DstQ {
     /// Node counts and sizes, counted by walking the records.
     pub fn stats(&self) -> DstQStats {
         let mut s = self.walk(None).1;
-        s.clusters = self.clusters();
         s.node_bytes = self.image.node_bytes();
         s.index_bytes = self.image.index_bytes();
         s.total_bytes = self.bytes_total();
@@ -93,7 +92,7 @@ impl DstQ {
         if img.nodes.start != 0
             || img.nodes.end != img.indices.start
             || words.len() < img.indices.end
-            || img.nodes.len() % cw != 0
+            || !img.nodes.len().is_multiple_of(cw)
         {
             error(
                 &mut rep,
@@ -107,11 +106,11 @@ impl DstQ {
             );
             return (rep, st);
         }
-        let n_blocks = img.nodes.len() / cw;
+        let n_words = img.nodes.len();
         let mut index_cover = vec![0u8; img.indices.len()];
         let mut tri_refs = vec![0u32; n_tris];
         if let Some(ex) = exact
-            && ex.is_empty() != (n_blocks == 0)
+            && ex.is_empty() != (n_words == 0)
         {
             error(
                 &mut rep,
@@ -119,11 +118,11 @@ impl DstQ {
             );
             return (rep, st);
         }
-        // One bit per record position reached; records counted per block.
-        let mut seen = vec![0u64; (n_blocks * cbits as usize).div_ceil(64)];
-        let mut per_block = vec![0u32; n_blocks];
+        // One bit per node-region bit covered by a frame or a record; records per cluster.
+        let mut seen = vec![0u64; (n_words * 32).div_ceil(64)];
+        let mut per_cluster: std::collections::BTreeMap<u32, u32> = Default::default();
         let mut stack: Vec<Visit> = Vec::new();
-        if n_blocks > 0 {
+        if n_words > 0 {
             stack.push(Visit {
                 block: 0,
                 bit: ROOT_BIT,
@@ -134,16 +133,22 @@ impl DstQ {
         }
         while let Some(v) = stack.pop() {
             let at = format!("record {}:{}", v.block, v.bit);
-            if v.block as usize >= n_blocks {
-                error(&mut rep, format!("{at}: block outside 0..{n_blocks}"));
+            let base = v.block as usize;
+            // A cluster lies inside one line of `cw` words (the node region is whole lines).
+            let line_end = (base / cw + 1) * cw;
+            if base + FRAME_WORDS > n_words || line_end > n_words {
+                error(
+                    &mut rep,
+                    format!("{at}: cluster outside the node region 0..{n_words}"),
+                );
                 continue;
             }
-            if v.bit < ROOT_BIT || v.bit + 32 > cbits {
-                error(&mut rep, format!("{at}: bit outside {ROOT_BIT}..{cbits}"));
+            let avail = ((line_end - base) * 32).min(cbits as usize) as u32;
+            if v.bit < ROOT_BIT || v.bit + 32 > avail {
+                error(&mut rep, format!("{at}: bit outside {ROOT_BIT}..{avail}"));
                 continue;
             }
-            let base = v.block as usize * cw;
-            let cwords = &words[base..base + cw];
+            let cwords = &words[base..line_end];
             let word = read_bits(cwords, v.bit as usize, 32);
             let h = match QHeader::decode(word, v.bit) {
                 Ok(h) => h,
@@ -153,20 +158,30 @@ impl DstQ {
                 }
             };
             let rb = h.record_bits(k);
-            if v.bit + rb > cbits {
+            if v.bit + rb > avail {
                 error(
                     &mut rep,
-                    format!("{at}: record of {rb} bits leaves the block"),
+                    format!("{at}: record of {rb} bits leaves its line"),
                 );
                 continue;
             }
-            let key = v.block as usize * cbits as usize + v.bit as usize;
-            if seen[key / 64] & (1 << (key % 64)) != 0 {
-                error(&mut rep, format!("{at}: reached twice"));
+            let first_visit = !per_cluster.contains_key(&v.block);
+            if first_visit && !cover(&mut seen, base * 32, ROOT_BIT as usize) {
+                error(
+                    &mut rep,
+                    format!("{at}: the cluster's frame overlaps another record"),
+                );
                 continue;
             }
-            seen[key / 64] |= 1 << (key % 64);
-            per_block[v.block as usize] += 1;
+            *per_cluster.entry(v.block).or_insert(0) += 1;
+            if !cover(&mut seen, base * 32 + v.bit as usize, rb as usize) {
+                error(
+                    &mut rep,
+                    format!("{at}: reached twice or overlapping another record"),
+                );
+                continue;
+            }
+            st.used_bits += rb as u64 + if first_visit { ROOT_BIT as u64 } else { 0 };
             rep.max_depth = rep.max_depth.max(v.depth);
             let mut fw = [0u32; 4];
             fw.copy_from_slice(&cwords[..FRAME_WORDS]);
@@ -263,8 +278,8 @@ impl DstQ {
                     });
                 }
                 // The left size field must name the left record's real size.
-                if (cb as usize) < n_blocks && cbit + 32 <= cbits {
-                    let lw = read_bits(&words[cb as usize * cw..][..cw], cbit as usize, 32);
+                if (cb as usize) < n_words && cbit as usize + 32 <= (n_words - cb as usize) * 32 {
+                    let lw = read_bits(&words[cb as usize..n_words], cbit as usize, 32);
                     let real = QHeader::from_bits(lw).record_bits(k);
                     if real != lsize {
                         error(&mut rep, format!("{at}: left size {lsize} but {real} bits"));
@@ -281,15 +296,16 @@ impl DstQ {
             }
         }
         // Record counts in the frames, every block reached, every entry and triangle once.
-        for (b, &n) in per_block.iter().enumerate() {
-            let stored = cluster_count(words, b * cw);
+        for (&b, &n) in &per_cluster {
+            let stored = cluster_count(words, b as usize);
             if n.min(255) != stored as u32 {
                 error(
                     &mut rep,
-                    format!("block {b}: frame says {stored} records, {n} reached"),
+                    format!("cluster at word {b}: frame says {stored} records, {n} reached"),
                 );
             }
         }
+        st.clusters = per_cluster.len() as u64;
         let unused = index_cover.iter().filter(|&&c| c == 0).count();
         if unused > 0 {
             error(
@@ -304,15 +320,7 @@ impl DstQ {
             }
         }
         st.index_entries = img.indices.len() as u64;
-        st.used_bits = self.used_bits_estimate(&st);
         (rep, st)
-    }
-
-    fn used_bits_estimate(&self, st: &DstQStats) -> u64 {
-        let internal = st.splitting + st.single_carving + st.dual_carving;
-        internal * self.config.internal_record_bits() as u64
-            + 32 * st.leaves
-            + ROOT_BIT as u64 * self.clusters()
     }
 
     fn check_run(
@@ -352,7 +360,17 @@ impl DstQ {
     }
 }
 
-/// The record count stored in byte 3 of a block's frame word 3.
+/// Marks bits `at..at + n` of `seen`; false when one of them already was.
+fn cover(seen: &mut [u64], at: usize, n: usize) -> bool {
+    let mut fresh = true;
+    for b in at..at + n {
+        fresh &= seen[b / 64] & (1 << (b % 64)) == 0;
+        seen[b / 64] |= 1 << (b % 64);
+    }
+    fresh
+}
+
+/// The record count stored in byte 3 of a cluster's frame word 3.
 fn cluster_count(words: &[u32], base: usize) -> u8 {
     (words[base + 3] >> 24) as u8
 }
