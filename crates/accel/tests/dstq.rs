@@ -637,3 +637,46 @@ fn measure_table() {
         measure(name, &cfgs);
     }
 }
+
+/// The worked example of `docs/dstq-encoding.md`, §5, word for word.
+#[test]
+fn worked_example_words() {
+    let tris = vec![
+        Triangle::new(
+            Vec3::new(-1.0, -1.0, 2.0),
+            Vec3::new(1.0, -1.0, 2.0),
+            Vec3::new(0.0, 1.0, 2.0),
+        ),
+        Triangle::new(
+            Vec3::new(-0.5, -2.0, 3.0),
+            Vec3::new(1.0, -1.0, 3.5),
+            Vec3::new(0.0, 0.3, 3.0),
+        ),
+    ];
+    let bcfg = BuildConfig {
+        max_leaf_size: 1,
+        ..BuildConfig::default()
+    };
+    let s = Structures::try_build_with(&tris, &bcfg, &DstConfig::hardware()).unwrap();
+    let q = DstQ::from_dst(&s.dst, &DstQConfig::default()).unwrap();
+    assert!(q.validate(&s.dst).is_ok());
+    let img = q.image();
+    assert_eq!(img.nodes.len(), 16, "one 64-byte line");
+    assert_eq!(
+        &img.words[..9],
+        &[
+            0xbf80_0000, // origin x = -1.0
+            0xc000_0000, // origin y = -2.0
+            0x4000_0000, // origin z = 2.0
+            0x0378_7979, // e = (121, 121, 120), 3 records
+            0x5800_00b0, // root: split on z, left internal, local child at bit 176
+            0x0000_8000, // q0 = 0 (z ≤ 2.0), q1 = 128 (z ≥ 3.0); left header low half
+            0x40ff_cc00, // left header high half; q0 = 255 (y ≤ +∞ → 1.984375), q1 = 64
+            0x9400_0001, // right: dual xy carving leaf, x lower / y upper, run 1
+            0x0000_9420, // q0 = 32 (x ≥ -0.5), q1 = 148 (y ≤ 0.3 → 0.3125)
+        ]
+    );
+    assert!(img.words[9..16].iter().all(|&w| w == 0));
+    let st = q.stats();
+    assert_eq!((st.clusters, st.used_bits, st.node_bytes), (1, 272, 64));
+}

@@ -1,5 +1,5 @@
 //! `DstQ::from_dst`: reads the exact DST's nodes with their exact regions, groups them into
-//! clusters (greedy by region surface area), and writes every cluster block: its frame, then
+//! clusters (greedy by region surface area), and packs the clusters into lines and writes each: its frame, then
 //! its records with conservatively rounded planes (`docs/dstq-encoding.md`, §2–§4).
 
 use super::frame::{Frame, quantize_down, quantize_up};
@@ -295,9 +295,9 @@ impl DstQ {
         let mut words: Vec<u32> = vec![0; lines as usize * cw];
         // Pass 3: write every cluster at its address.
         for (c, &base) in clusters.iter().zip(&addr) {
-            let block = &mut words[base as usize..];
+            let out = &mut words[base as usize..];
             let frame = Frame::of_box(c.frame.min.to_array(), c.frame.max.to_array(), k);
-            block[..4].copy_from_slice(&frame.words(c.placed.len().min(255) as u8));
+            out[..4].copy_from_slice(&frame.words(c.placed.len().min(255) as u8));
             for &(n, bit) in &c.placed {
                 let node = &nodes[n as usize];
                 let hdr = node.hdr;
@@ -315,7 +315,7 @@ impl DstQ {
                     _ if hdr.is_leaf_flag() => QHeader::carve_leaf(hdr, hdr.offset() as u64)?,
                     _ => QHeader::carve(hdr, child())?,
                 };
-                write_bits(block, bit as usize, 32, q.bits());
+                write_bits(out, bit as usize, 32, q.bits());
                 if !hdr.is_plain_leaf() {
                     for (a, slot, lower) in plane_roles(hdr) {
                         let x = node.planes[slot];
@@ -325,7 +325,7 @@ impl DstQ {
                         } else {
                             quantize_up(x, o, e, k)
                         };
-                        write_bits(block, (bit + 32 + slot as u32 * k) as usize, k, qv);
+                        write_bits(out, (bit + 32 + slot as u32 * k) as usize, k, qv);
                     }
                 }
             }

@@ -23,7 +23,7 @@ use dualsplit_geometry::{Hit, PrimId, Ray, cull_limit, widen_exit};
 /// the cluster) and its ray interval.
 #[derive(Clone, Copy, Debug)]
 struct Entry {
-    block: u32,
+    cluster: u32,
     bit: u32,
     t_min: f32,
     t_max: f32,
@@ -50,11 +50,11 @@ impl DstQ {
         self.traverse::<O, true>(ray, obs).is_some()
     }
 
-    /// Where the child `c` of a record in the cluster at word `block` lies: (cluster word, bit).
+    /// Where the child `c` of a record in the cluster at word `cluster` lies: (cluster word, bit).
     #[inline(always)]
-    fn locate(block: u32, c: ChildRef) -> (u32, u32) {
+    fn locate(cluster: u32, c: ChildRef) -> (u32, u32) {
         match c {
-            ChildRef::Local(bit) => (block, bit),
+            ChildRef::Local(bit) => (cluster, bit),
             ChildRef::Cluster(b) => (b, ROOT_BIT),
         }
     }
@@ -77,20 +77,20 @@ impl DstQ {
         let mut best: Option<Hit> = None;
         let mut best_t = ray.t_max;
         let mut stack: Vec<Entry> = Vec::with_capacity(64);
-        let mut frame_block = u32::MAX;
+        let mut frame_at = u32::MAX;
         let mut frame = Frame {
             origin: [0.0; 3],
             exp: [0; 3],
         };
-        let (mut block, mut bit) = (0u32, ROOT_BIT);
+        let (mut cluster, mut bit) = (0u32, ROOT_BIT);
         loop {
-            let base = block as usize;
-            if block != frame_block {
+            let base = cluster as usize;
+            if cluster != frame_at {
                 obs.fetch(MemoryImage::addr(base), 4 * FRAME_WORDS as u32);
                 let mut fw = [0u32; 4];
                 fw.copy_from_slice(&words[base..base + FRAME_WORDS]);
                 frame = Frame::from_words(fw);
-                frame_block = block;
+                frame_at = cluster;
             }
             // A cluster never crosses its line: its records lie before the line's end.
             let cwords = &words[base..(base / cw + 1) * cw];
@@ -109,7 +109,7 @@ impl DstQ {
                 DstNodeKind::Split => {
                     let a = h.exact().axis();
                     let (p0, p1) = (plane(0, a), plane(1, a));
-                    let (cb, lbit) = Self::locate(block, h.child());
+                    let (cb, lbit) = Self::locate(cluster, h.child());
                     let lsize = if h.left_is_internal() { 32 + 2 * k } else { 32 };
                     let (left, right) = ((cb, lbit), (cb, lbit + lsize));
                     let (near, far, t1, t2) = if r.neg[a] {
@@ -127,23 +127,23 @@ impl DstQ {
                     match (near_hit, far_hit) {
                         (true, true) => {
                             stack.push(Entry {
-                                block: far.0,
+                                cluster: far.0,
                                 bit: far.1,
                                 t_min: t_min.max(t2),
                                 t_max,
                             });
                             obs.push();
-                            (block, bit) = near;
+                            (cluster, bit) = near;
                             t_max = t_max.min(t1);
                             continue;
                         }
                         (true, false) => {
-                            (block, bit) = near;
+                            (cluster, bit) = near;
                             t_max = t_max.min(t1);
                             continue;
                         }
                         (false, true) => {
-                            (block, bit) = far;
+                            (cluster, bit) = far;
                             t_min = t_min.max(t2);
                             continue;
                         }
@@ -182,7 +182,7 @@ impl DstQ {
                         t_min = lo;
                         t_max = hi;
                         if !leaf {
-                            (block, bit) = Self::locate(block, h.child());
+                            (cluster, bit) = Self::locate(cluster, h.child());
                             continue;
                         }
                         Some(h.run())
@@ -225,7 +225,7 @@ impl DstQ {
                 };
                 obs.pop();
                 if le_or_nan(e.t_min, limit) {
-                    (block, bit, t_min, t_max) = (e.block, e.bit, e.t_min, e.t_max.min(limit));
+                    (cluster, bit, t_min, t_max) = (e.cluster, e.bit, e.t_min, e.t_max.min(limit));
                     break;
                 }
             }

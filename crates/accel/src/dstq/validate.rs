@@ -1,10 +1,11 @@
 //! `validate()`: walks the quantized DST's records from the root, alone (the structural
 //! check of a loaded image) or in lockstep with its exact DST (conservative planes).
 //!
-//! Structure: every block's size and frame, every record inside its block (at or after bit
-//! 128) and reached once, headers among the exact DST's 37 valid codes, child clusters
+//! Structure: every cluster's frame inside the node region (whole lines), every record
+//! inside its cluster's line (at or after bit 128), reached once and overlapping nothing,
+//! headers among the exact DST's 37 valid codes, child clusters
 //! inside the node region, runs inside the index region and terminated, every index entry
-//! in exactly one run, every triangle referenced exactly once, each block's record count
+//! in exactly one run, every triangle referenced exactly once, each cluster's record count
 //! equal to the records reached in it. Lockstep with the exact DST: the same node kind,
 //! axis, corner and run at every node, and every plane conservative: a "≤" plane decodes to
 //! at least `min(exact plane, exact region max)`, a "≥" plane to at most
@@ -44,7 +45,7 @@ const NONE: u32 = u32::MAX;
 /// One record to check: where it is, its depth, its exact node (or [`NONE`]) and the
 /// quantized region entering it.
 struct Visit {
-    block: u32,
+    cluster: u32,
     bit: u32,
     depth: usize,
     exact: u32,
@@ -97,7 +98,7 @@ impl DstQ {
             error(
                 &mut rep,
                 format!(
-                    "regions nodes {:?}, indices {:?} over {} words do not fit {}-word blocks",
+                    "regions nodes {:?}, indices {:?} over {} words do not fit {}-word lines",
                     img.nodes,
                     img.indices,
                     words.len(),
@@ -124,7 +125,7 @@ impl DstQ {
         let mut stack: Vec<Visit> = Vec::new();
         if n_words > 0 {
             stack.push(Visit {
-                block: 0,
+                cluster: 0,
                 bit: ROOT_BIT,
                 depth: 0,
                 exact: if exact.is_some() { 0 } else { NONE },
@@ -132,8 +133,8 @@ impl DstQ {
             });
         }
         while let Some(v) = stack.pop() {
-            let at = format!("record {}:{}", v.block, v.bit);
-            let base = v.block as usize;
+            let at = format!("record {}:{}", v.cluster, v.bit);
+            let base = v.cluster as usize;
             // A cluster lies inside one line of `cw` words (the node region is whole lines).
             let line_end = (base / cw + 1) * cw;
             if base + FRAME_WORDS > n_words || line_end > n_words {
@@ -165,7 +166,7 @@ impl DstQ {
                 );
                 continue;
             }
-            let first_visit = !per_cluster.contains_key(&v.block);
+            let first_visit = !per_cluster.contains_key(&v.cluster);
             if first_visit && !cover(&mut seen, base * 32, ROOT_BIT as usize) {
                 error(
                     &mut rep,
@@ -173,7 +174,7 @@ impl DstQ {
                 );
                 continue;
             }
-            *per_cluster.entry(v.block).or_insert(0) += 1;
+            *per_cluster.entry(v.cluster).or_insert(0) += 1;
             if !cover(&mut seen, base * 32 + v.bit as usize, rb as usize) {
                 error(
                     &mut rep,
@@ -262,7 +263,7 @@ impl DstQ {
                 continue;
             }
             let (cb, cbit) = match h.child() {
-                ChildRef::Local(b) => (v.block, b),
+                ChildRef::Local(b) => (v.cluster, b),
                 ChildRef::Cluster(c) => (c, ROOT_BIT),
             };
             let hx = h.exact();
@@ -270,7 +271,7 @@ impl DstQ {
                 let lsize = if h.left_is_internal() { 32 + 2 * k } else { 32 };
                 for (side, bit) in [(1, cbit.saturating_add(lsize)), (0, cbit)] {
                     stack.push(Visit {
-                        block: cb,
+                        cluster: cb,
                         bit,
                         depth: v.depth + 1,
                         exact: exact_kid(side),
@@ -287,7 +288,7 @@ impl DstQ {
                 }
             } else {
                 stack.push(Visit {
-                    block: cb,
+                    cluster: cb,
                     bit: cbit,
                     depth: v.depth + 1,
                     exact: exact_kid(0),
@@ -295,7 +296,7 @@ impl DstQ {
                 });
             }
         }
-        // Record counts in the frames, every block reached, every entry and triangle once.
+        // Record counts in the frames, every cluster reached, every entry and triangle once.
         for (&b, &n) in &per_cluster {
             let stored = cluster_count(words, b as usize);
             if n.min(255) != stored as u32 {
