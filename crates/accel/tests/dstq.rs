@@ -680,3 +680,35 @@ fn worked_example_words() {
     let st = q.stats();
     assert_eq!((st.clusters, st.used_bits, st.node_bytes), (1, 272, 64));
 }
+
+/// A coordinate from anywhere in the finite f32 range (as `tests/extreme_coordinates.rs`).
+fn any_coordinate() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        (any::<bool>(), 0u32..255, 0u32..1 << 23)
+            .prop_map(|(neg, e, m)| f32::from_bits(u32::from(neg) << 31 | e << 23 | m)),
+        prop::sample::select(vec![f32::MAX, -f32::MAX, 3e38, -3e38, 1.9e19, -1.9e19]),
+        -4.0f32..4.0,
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    /// Scenes spanning the whole finite f32 range (frames wider than `f32::MAX`, subnormal
+    /// extents next to huge ones) convert under every config and validate against the DST.
+    #[test]
+    fn extreme_scenes_convert_and_validate(
+        tris in prop::collection::vec(
+            [any_coordinate(), any_coordinate(), any_coordinate()]
+                .prop_map(Vec3::from_array)
+                .prop_flat_map(|a| (Just(a), [any_coordinate(), any_coordinate(), any_coordinate()].prop_map(Vec3::from_array), [any_coordinate(), any_coordinate(), any_coordinate()].prop_map(Vec3::from_array)))
+                .prop_map(|(a, b, c)| Triangle::new(a, b, c)),
+            1..40,
+        ),
+        leaf in prop::sample::select(vec![1u32, 4]),
+    ) {
+        let bcfg = BuildConfig { max_leaf_size: leaf, ..BuildConfig::default() };
+        let s = Structures::try_build_with(&tris, &bcfg, &DstConfig::hardware()).expect("structures");
+        build_all(&s, "extreme scene");
+    }
+}
