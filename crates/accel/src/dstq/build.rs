@@ -4,7 +4,7 @@
 
 use super::frame::{Frame, quantize_down, quantize_up};
 use super::layout::ROOT_BIT;
-use super::record::{ChildRef, QHeader, write_bits};
+use super::record::{ChildRef, LeftRecord, QHeader, RecordFormat, write_bits};
 use super::{DstQ, DstQConfig, DstQError};
 use crate::dst::{Dst, DstError, HeaderOffset};
 use crate::image::MemoryImage;
@@ -164,7 +164,8 @@ struct Cluster {
     bits: u32,
 }
 
-/// Where an expanded node's children went: this cluster at a bit position, or a cluster id.
+/// Where an expanded node's children went: this cluster (the index of the first child in
+/// the cluster's record list), or a cluster id.
 #[derive(Clone, Copy)]
 enum Child {
     Local(u32),
@@ -198,11 +199,38 @@ fn pack(sizes: &[u32], line_words: u32) -> (Vec<u32>, u32) {
     (addr, lines)
 }
 
-fn record_bits(n: &ExactNode, k: u32) -> u32 {
+/// Bits reserved for a node's record while filling: its final size, except that an
+/// internal node whose child may still go to another cluster gets the 32-bit header; it
+/// shrinks to the short header once its children are placed in the same cluster.
+fn reserved_bits(n: &ExactNode, k: u32) -> u32 {
     if n.hdr.is_plain_leaf() {
         32
     } else {
         32 + 2 * k
+    }
+}
+
+/// A node's final record size: a plain leaf 32 bits, an internal node 32 + 2k, or
+/// 7 + W + 2k when its children are in its own cluster.
+fn final_bits(nodes: &[ExactNode], child_at: &[Option<Child>], n: u32, fmt: &RecordFormat) -> u32 {
+    let node = &nodes[n as usize];
+    if node.hdr.is_plain_leaf() {
+        32
+    } else if let Some(Child::Local(_)) = child_at[n as usize] {
+        fmt.short_header_bits() + 2 * fmt.k
+    } else {
+        32 + 2 * fmt.k
+    }
+}
+
+/// The B field a split writes for its left child `n`.
+fn left_record(nodes: &[ExactNode], child_at: &[Option<Child>], n: u32) -> LeftRecord {
+    if nodes[n as usize].hdr.is_plain_leaf() {
+        LeftRecord::Leaf
+    } else if let Some(Child::Local(_)) = child_at[n as usize] {
+        LeftRecord::Short
+    } else {
+        LeftRecord::Long
     }
 }
 
@@ -244,15 +272,17 @@ impl DstQ {
             id: 0,
         }]);
         let mut clusters: Vec<Cluster> = Vec::new();
+        let fmt = RecordFormat::new(k, cfg.cluster_bytes);
         let mut child_at: Vec<Option<Child>> = vec![None; nodes.len()];
         while let Some(p) = queue.pop_front() {
             debug_assert_eq!(p.id as usize, clusters.len());
-            let mut placed: Vec<(u32, u32)> = Vec::new();
+            let mut placed: Vec<u32> = Vec::new();
             let mut heap = BinaryHeap::new();
-            let mut pos = ROOT_BIT;
+            // Bits used: frame + reserved record sizes (short headers once known).
+            let mut used = ROOT_BIT;
             for &r in &p.roots {
-                placed.push((r, pos));
-                pos += record_bits(&nodes[r as usize], k);
+                placed.push(r);
+                used += reserved_bits(&nodes[r as usize], k);
                 if nodes[r as usize].child_count() > 0 {
                     heap.push(priority(&nodes[r as usize], r));
                 }
@@ -262,13 +292,13 @@ impl DstQ {
                 let kids: Vec<u32> = node.kids.iter().copied().filter(|&c| c != NONE).collect();
                 let need: u32 = kids
                     .iter()
-                    .map(|&c| record_bits(&nodes[c as usize], k))
+                    .map(|&c| reserved_bits(&nodes[c as usize], k))
                     .sum();
-                if pos + need <= cbits {
-                    child_at[n as usize] = Some(Child::Local(pos));
+                if used + need <= cbits {
+                    child_at[n as usize] = Some(Child::Local(placed.len() as u32));
+                    used = used + need - (32 - fmt.short_header_bits());
                     for &c in &kids {
-                        placed.push((c, pos));
-                        pos += record_bits(&nodes[c as usize], k);
+                        placed.push(c);
                         if nodes[c as usize].child_count() > 0 {
                             heap.push(priority(&nodes[c as usize], c));
                         }
@@ -283,6 +313,17 @@ impl DstQ {
                     });
                 }
             }
+            // Final positions, in placement order (a split's children stay adjacent).
+            let mut pos = ROOT_BIT;
+            let placed: Vec<(u32, u32)> = placed
+                .into_iter()
+                .map(|n| {
+                    let at = pos;
+                    pos += final_bits(&nodes, &child_at, n, &fmt);
+                    (n, at)
+                })
+                .collect();
+            debug_assert_eq!(pos, used);
             clusters.push(Cluster {
                 frame: p.frame,
                 placed,
@@ -302,20 +343,21 @@ impl DstQ {
                 let node = &nodes[n as usize];
                 let hdr = node.hdr;
                 let child = || match child_at[n as usize] {
-                    Some(Child::Local(b)) => ChildRef::Local(b),
+                    Some(Child::Local(i)) => ChildRef::Local(c.placed[i as usize].1),
                     Some(Child::Cluster(id)) => ChildRef::Cluster(addr[id as usize]),
                     None => unreachable!("every expanded node has a child"),
                 };
                 let q = match hdr.node_kind() {
                     DstNodeKind::Leaf => QHeader::leaf(hdr.offset() as u64)?,
                     DstNodeKind::Split => {
-                        let left = &nodes[node.kids[0] as usize];
-                        QHeader::split(hdr.axis(), !left.hdr.is_plain_leaf(), child())?
+                        let left = left_record(&nodes, &child_at, node.kids[0]);
+                        QHeader::split(hdr.axis(), left, child(), &fmt)?
                     }
                     _ if hdr.is_leaf_flag() => QHeader::carve_leaf(hdr, hdr.offset() as u64)?,
-                    _ => QHeader::carve(hdr, child())?,
+                    _ => QHeader::carve(hdr, child(), &fmt)?,
                 };
-                write_bits(out, bit as usize, 32, q.bits());
+                let hb = q.header_bits(&fmt);
+                write_bits(out, bit as usize, hb, q.bits());
                 if !hdr.is_plain_leaf() {
                     for (a, slot, lower) in plane_roles(hdr) {
                         let x = node.planes[slot];
@@ -325,7 +367,7 @@ impl DstQ {
                         } else {
                             quantize_up(x, o, e, k)
                         };
-                        write_bits(out, (bit + 32 + slot as u32 * k) as usize, k, qv);
+                        write_bits(out, (bit + hb + slot as u32 * k) as usize, k, qv);
                     }
                 }
             }

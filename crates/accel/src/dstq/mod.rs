@@ -45,7 +45,7 @@ mod stats;
 mod traverse;
 mod validate;
 
-pub use record::{CHILD_LIMIT, ChildRef, QHeader};
+pub use record::{CHILD_LIMIT, ChildRef, LeftRecord, QHeader, RecordFormat};
 pub use stats::DstQStats;
 
 use crate::dst::DstError;
@@ -122,7 +122,12 @@ impl DstQConfig {
         self.cluster_bytes / 4
     }
 
-    /// Bits of an internal-node record: 32 + 2k.
+    /// The record geometry: k and the local child-field width W.
+    pub fn record_format(&self) -> RecordFormat {
+        RecordFormat::new(self.bits, self.cluster_bytes)
+    }
+
+    /// Bits of an internal-node record with a 32-bit header: 32 + 2k.
     pub fn internal_record_bits(&self) -> u32 {
         32 + 2 * self.bits
     }

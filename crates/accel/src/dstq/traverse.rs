@@ -72,6 +72,7 @@ impl DstQ {
         let img = &self.image;
         let words: &[u32] = &img.words;
         let k = self.config.bits;
+        let fmt = self.config.record_format();
         let cw = self.config.cluster_words() as usize;
         let tris = self.triangles();
         let mut best: Option<Hit> = None;
@@ -94,12 +95,12 @@ impl DstQ {
             }
             // A cluster never crosses its line: its records lie before the line's end.
             let cwords = &words[base..(base / cw + 1) * cw];
-            let h = QHeader::from_bits(read_bits(cwords, bit as usize, 32));
-            let rb = h.record_bits(k);
+            let h = QHeader::read(read_bits(cwords, bit as usize, 32), &fmt);
+            let (hb, rb) = (h.header_bits(&fmt), h.record_bits(&fmt));
             let (w0, w1) = (bit / 32, (bit + rb - 1) / 32);
             obs.fetch(MemoryImage::addr(base + w0 as usize), 4 * (w1 - w0 + 1));
             let plane = |slot: u32, a: usize| {
-                frame.plane(a, read_bits(cwords, (bit + 32 + slot * k) as usize, k))
+                frame.plane(a, read_bits(cwords, (bit + hb + slot * k) as usize, k))
             };
             let run = match h.node_kind() {
                 DstNodeKind::Leaf => {
@@ -109,8 +110,8 @@ impl DstQ {
                 DstNodeKind::Split => {
                     let a = h.exact().axis();
                     let (p0, p1) = (plane(0, a), plane(1, a));
-                    let (cb, lbit) = Self::locate(cluster, h.child());
-                    let lsize = if h.left_is_internal() { 32 + 2 * k } else { 32 };
+                    let (cb, lbit) = Self::locate(cluster, h.child(&fmt));
+                    let lsize = h.left_bits(&fmt);
                     let (left, right) = ((cb, lbit), (cb, lbit + lsize));
                     let (near, far, t1, t2) = if r.neg[a] {
                         (right, left, r.exit_t(a, p1), r.plane_t(a, p0))
@@ -182,7 +183,7 @@ impl DstQ {
                         t_min = lo;
                         t_max = hi;
                         if !leaf {
-                            (cluster, bit) = Self::locate(cluster, h.child());
+                            (cluster, bit) = Self::locate(cluster, h.child(&fmt));
                             continue;
                         }
                         Some(h.run())

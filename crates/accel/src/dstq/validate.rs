@@ -86,6 +86,7 @@ impl DstQ {
         let mut rep = empty_report(img);
         let mut st = DstQStats::default();
         let k = self.config.bits;
+        let fmt = self.config.record_format();
         let cw = self.config.cluster_words() as usize;
         let cbits = self.config.cluster_bytes * 8;
         let words: &[u32] = &img.words;
@@ -151,14 +152,14 @@ impl DstQ {
             }
             let cwords = &words[base..line_end];
             let word = read_bits(cwords, v.bit as usize, 32);
-            let h = match QHeader::decode(word, v.bit) {
+            let h = match QHeader::decode(word, &fmt, v.bit) {
                 Ok(h) => h,
                 Err(e) => {
                     error(&mut rep, format!("{at}: {e}"));
                     continue;
                 }
             };
-            let rb = h.record_bits(k);
+            let (hb, rb) = (h.header_bits(&fmt), h.record_bits(&fmt));
             if v.bit + rb > avail {
                 error(
                     &mut rep,
@@ -194,7 +195,7 @@ impl DstQ {
                 let hx = h.exact();
                 let mut p = [0.0f32; 2];
                 for (a, slot, _) in plane_roles(hx) {
-                    let q = read_bits(cwords, (v.bit + 32 + slot as u32 * k) as usize, k);
+                    let q = read_bits(cwords, (v.bit + hb + slot as u32 * k) as usize, k);
                     p[slot] = frame.plane(a, q);
                 }
                 p
@@ -202,9 +203,14 @@ impl DstQ {
             // Lockstep with the exact node.
             let ex = exact.and_then(|e| e.get(v.exact as usize));
             if let Some(en) = ex {
-                if en.hdr.header() != h.exact().header()
-                    || (h.is_leaf_flag() && en.hdr.offset() != h.run())
-                {
+                // A split's B field names its left record's size, which differs from the
+                // exact DST's left size in words: compare kind and axis for splits.
+                let same = if en.hdr.is_split() {
+                    h.node_kind() == DstNodeKind::Split && h.exact().axis() == en.hdr.axis()
+                } else {
+                    en.hdr.header() as u32 == h.code()
+                };
+                if !same || (h.is_leaf_flag() && en.hdr.offset() != h.run()) {
                     error(
                         &mut rep,
                         format!("{at}: {h:?} differs from the exact node {:?}", en.hdr),
@@ -262,13 +268,13 @@ impl DstQ {
                 self.check_run(&mut rep, &at, h.run(), &mut index_cover, &mut tri_refs);
                 continue;
             }
-            let (cb, cbit) = match h.child() {
+            let (cb, cbit) = match h.child(&fmt) {
                 ChildRef::Local(b) => (v.cluster, b),
                 ChildRef::Cluster(c) => (c, ROOT_BIT),
             };
             let hx = h.exact();
             if kind == DstNodeKind::Split {
-                let lsize = if h.left_is_internal() { 32 + 2 * k } else { 32 };
+                let lsize = h.left_bits(&fmt);
                 for (side, bit) in [(1, cbit.saturating_add(lsize)), (0, cbit)] {
                     stack.push(Visit {
                         cluster: cb,
@@ -281,7 +287,7 @@ impl DstQ {
                 // The left size field must name the left record's real size.
                 if (cb as usize) < n_words && cbit as usize + 32 <= (n_words - cb as usize) * 32 {
                     let lw = read_bits(&words[cb as usize..n_words], cbit as usize, 32);
-                    let real = QHeader::from_bits(lw).record_bits(k);
+                    let real = QHeader::read(lw, &fmt).record_bits(&fmt);
                     if real != lsize {
                         error(&mut rep, format!("{at}: left size {lsize} but {real} bits"));
                     }
