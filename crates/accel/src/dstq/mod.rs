@@ -13,12 +13,13 @@
 //!   traverse.rs (the DST* rules, planes dequantized)   validate.rs (lockstep with the DST)
 //! ```
 //!
-//! A cluster takes at most `cluster_bytes` inside one aligned line of that size: a 16-byte frame (origin p as 3 × f32, three
-//! exponent bytes, a record count), then records, each the DST's header-offset word (its
-//! offset field extended with an in-cluster/other-cluster flag, [`QHeader`]) and, for an
-//! internal node, two k-bit plane offsets. Every quantized region contains its exact
-//! region, so closest hits and shadow answers equal the exact DST's (and the BVH2's) on
-//! every ray; the price is extra node steps and triangle tests, measured in the doc.
+//! A cluster takes at most `cluster_bytes` inside one aligned line of that size: a 16-byte
+//! frame (origin p as 3 × f32, three exponent bytes, a record count), then records, each the
+//! DST's 6-bit header code with a child field that is short (7 + W bits) when the child is
+//! in the same cluster ([`QHeader`]) and, for an internal node, two k-bit plane offsets.
+//! Every quantized region contains its exact region, so closest hits and shadow answers
+//! equal the exact DST's (and the BVH2's) on every ray; the price is extra node steps and
+//! triangle tests, measured in the doc.
 //!
 //! ```
 //! use dualsplit_accel::{BuildConfig, Bvh2, NoObserver};
@@ -100,9 +101,9 @@ pub struct DstQConfig {
 impl Default for DstQConfig {
     /// k = 8 in 64-byte clusters, measured (`docs/dstq-encoding.md`, §7): of the settings
     /// smaller than the exact DST and within 5 % of its traversal work, the one whose rays
-    /// touch the fewest 64-byte lines (−29 to −33 % vs the exact DST on primary rays), at
-    /// 86 % of its size for +2.5 % node steps and +3.7 % triangle tests; one cluster is one
-    /// L1 line.
+    /// touch the fewest 64-byte lines (31–38 % fewer than the exact DST) and read the fewest
+    /// bytes, at 78 % of its size for about +2.5 % node steps and +3.5 % triangle tests;
+    /// one cluster is one L1 line and a node whose child shares its cluster one word.
     fn default() -> Self {
         Self {
             bits: 8,

@@ -350,7 +350,7 @@ mod tests {
             ChildRef::Cluster((1 << 25) - 1),
         ] {
             let h = QHeader::split(2, LeftRecord::Short, c, &fmt).unwrap();
-            let h = QHeader::read(h.bits() | 0xffff_0000 * h.is_short() as u32, &fmt);
+            let h = QHeader::read(h.bits() | (0xffff_0000 * h.is_short() as u32), &fmt);
             assert_eq!(h.child(&fmt), c);
             assert_eq!(h.left_record(), LeftRecord::Short);
             assert_eq!(h.node_kind(), DstNodeKind::Split);
