@@ -9,7 +9,7 @@ use dualsplit_accel::dst::{Dst, DstConfig, HeaderOffset, Partitioning};
 use dualsplit_accel::dstq::frame::{choose_exponent, decode, q_max, quantize_down, quantize_up};
 use dualsplit_accel::dstq::layout::ROOT_BIT;
 use dualsplit_accel::dstq::record::{read_bits, write_bits};
-use dualsplit_accel::dstq::{ChildRef, DstQ, DstQConfig, QHeader};
+use dualsplit_accel::dstq::{ChildRef, DstQ, DstQConfig, LeftRecord, QHeader, RecordFormat};
 use dualsplit_accel::{
     AccelKind, BuildConfig, ByteAddr, CountingObserver, DstNodeKind, NoObserver, Observer,
     Structures,
@@ -75,38 +75,65 @@ proptest! {
     fn header_round_trip(
         code in prop::sample::select(HeaderOffset::ALL_VALID_HEADERS.to_vec()),
         local in any::<bool>(),
-        child in 0u32..(1 << 25),
+        child in any::<u32>(),
         run in 0u64..(1 << 26),
         bit in 0usize..200,
-        k in prop::sample::select(DstQConfig::MEASURED_BITS.to_vec()),
+        cfg in prop::sample::select(configs()),
+        left in prop::sample::select(vec![LeftRecord::Leaf, LeftRecord::Long, LeftRecord::Short]),
         q0 in any::<u32>(),
         q1 in any::<u32>(),
     ) {
+        let fmt = cfg.record_format();
+        let k = fmt.k;
         let exact = HeaderOffset::from_bits((code as u32) << 26);
-        let c = if local { ChildRef::Local(child) } else { ChildRef::Cluster(child) };
+        let c = if local {
+            ChildRef::Local(child % (cfg.cluster_bytes * 8))
+        } else {
+            ChildRef::Cluster(child % (1 << 25))
+        };
         let h = match exact.node_kind() {
             DstNodeKind::Leaf => QHeader::leaf(run).unwrap(),
-            DstNodeKind::Split => QHeader::split(exact.axis(), exact.left_size() == 3, c).unwrap(),
+            DstNodeKind::Split => QHeader::split(exact.axis(), left, c, &fmt).unwrap(),
             _ if exact.is_leaf_flag() => QHeader::carve_leaf(exact, run).unwrap(),
-            _ => QHeader::carve(exact, c).unwrap(),
+            _ => QHeader::carve(exact, c, &fmt).unwrap(),
         };
-        prop_assert_eq!(h.exact().header(), code);
-        prop_assert_eq!(QHeader::decode(h.bits(), 0).unwrap(), h);
+        prop_assert!(QHeader::code_is_valid(h.code()));
+        prop_assert_eq!(h.node_kind(), exact.node_kind());
+        if exact.is_split() {
+            prop_assert_eq!(h.exact().axis(), exact.axis());
+            prop_assert_eq!(h.left_record(), left);
+        } else {
+            prop_assert_eq!(h.code(), code as u32);
+        }
         if h.is_leaf_flag() {
             prop_assert_eq!(h.run() as u64, run);
         } else {
-            prop_assert_eq!(h.child(), c);
+            prop_assert_eq!(h.child(&fmt), c);
         }
-        // The record through the bit stream, at any alignment.
-        let mut w = [0u32; 12];
+        prop_assert_eq!(h.is_short(), !h.is_leaf_flag() && local);
+        // The record through the bit stream, at any alignment, after junk bits.
+        let mut w = [u32::MAX; 12];
+        let hb = h.header_bits(&fmt);
         let (q0, q1) = (q0 & q_max(k), q1 & q_max(k));
-        write_bits(&mut w, bit, 32, h.bits());
-        write_bits(&mut w, bit + 32, k, q0);
-        write_bits(&mut w, bit + 32 + k as usize, k, q1);
-        prop_assert_eq!(read_bits(&w, bit, 32), h.bits());
-        prop_assert_eq!(read_bits(&w, bit + 32, k), q0);
-        prop_assert_eq!(read_bits(&w, bit + 32 + k as usize, k), q1);
+        write_bits(&mut w, bit, hb, h.bits());
+        write_bits(&mut w, bit + hb as usize, k, q0);
+        write_bits(&mut w, bit + (hb + k) as usize, k, q1);
+        let back = QHeader::decode(read_bits(&w, bit, 32), &fmt, 0).unwrap();
+        prop_assert_eq!(back, h);
+        prop_assert_eq!(back.record_bits(&fmt), hb + if exact.is_plain_leaf() { 0 } else { 2 * k });
+        prop_assert_eq!(read_bits(&w, bit + hb as usize, k), q0);
+        prop_assert_eq!(read_bits(&w, bit + (hb + k) as usize, k), q1);
     }
+}
+
+#[test]
+fn short_headers_are_7_plus_w_bits() {
+    let f64b = RecordFormat::new(8, 64);
+    let f128b = RecordFormat::new(8, 128);
+    assert_eq!(
+        (f64b.short_header_bits(), f128b.short_header_bits()),
+        (16, 17)
+    );
 }
 
 /// A coordinate: ordinary, huge (up to ±2^60), tiny or subnormal, or zero.
@@ -410,14 +437,14 @@ fn dragon_or_random() -> Structures {
 fn first_record(q: &DstQ, kind: DstNodeKind) -> Option<u32> {
     let cw = q.config().cluster_words() as usize;
     let words = &q.image().words[..cw];
-    let k = q.config().bits;
+    let fmt = q.config().record_format();
     let mut bit = ROOT_BIT;
     while bit + 32 <= q.config().cluster_bytes * 8 {
-        let h = QHeader::from_bits(read_bits(words, bit as usize, 32));
-        if h.node_kind() == kind && HeaderOffset::decode(h.bits(), 0).is_ok() {
+        let h = QHeader::read(read_bits(words, bit as usize, 32), &fmt);
+        if h.node_kind() == kind && QHeader::code_is_valid(h.code()) {
             return Some(bit);
         }
-        bit += h.record_bits(k);
+        bit += h.record_bits(&fmt);
     }
     None
 }
@@ -431,7 +458,9 @@ fn validate_catches_a_shrunk_plane() {
         let k = cfg.bits as usize;
         let mut img = q.image().clone();
         // P0 of a split is a "≤" plane: offset 0 moves it to the frame's bottom.
-        let p0 = bit as usize + 32;
+        let fmt = cfg.record_format();
+        let h = QHeader::read(read_bits(&img.words, bit as usize, 32), &fmt);
+        let p0 = (bit + h.header_bits(&fmt)) as usize;
         assert_ne!(read_bits(&img.words, p0, k as u32), 0);
         write_bits(&mut img.words, p0, k as u32, 0);
         let bad = DstQ::from_image(img, q.scene_box(), cfg).expect("still well formed");
@@ -455,18 +484,27 @@ fn validate_catches_bad_offsets() {
     let cfg = DstQConfig::default();
     let q = DstQ::from_dst(&s.dst, &cfg).unwrap();
     let bit = first_record(&q, DstNodeKind::Split).unwrap() as usize;
-    let w = read_bits(&q.image().words, bit, 32);
-    let ext = QHeader::split(0, true, ChildRef::Cluster((1 << 25) - 1)).unwrap();
-    for bad_word in [
-        (w & !((1 << 25) - 1)) | 3,    // a local child inside the frame
-        (w & !((1 << 25) - 1)) | 4000, // a local child beyond the block
-        (w & 0xfc00_0000) | (ext.bits() & 0x03ff_ffff), // a cluster beyond the region
-        0x3c00_0000,                   // an invalid header code
+    let fmt = cfg.record_format();
+    let h = QHeader::read(read_bits(&q.image().words, bit, 32), &fmt);
+    assert!(h.is_short(), "the root's children share its cluster");
+    let axis = h.exact().axis();
+    let short = |c| QHeader::split(axis, h.left_record(), c, &fmt).unwrap();
+    let long = QHeader::split(
+        axis,
+        h.left_record(),
+        ChildRef::Cluster((1 << 25) - 1),
+        &fmt,
+    );
+    for (bad, n) in [
+        (short(ChildRef::Local(3)).bits(), 16), // a local child inside the frame
+        (short(ChildRef::Local(511)).bits(), 16), // a local child at the line's end
+        (long.unwrap().bits(), 32),             // a cluster past the region
+        (0, 16),                                // an invalid code (split with B = 00)
     ] {
         let mut img = q.image().clone();
-        write_bits(&mut img.words, bit, 32, bad_word);
+        write_bits(&mut img.words, bit, n, bad);
         let rep = DstQ::from_image(img, q.scene_box(), cfg).expect_err("refused");
-        assert!(!rep.is_ok() && rep.structure == "dst-q", "{bad_word:#x}");
+        assert!(!rep.is_ok() && rep.structure == "dst-q", "{bad:#x}");
     }
     // A truncated node region.
     let mut img = q.image().clone();
@@ -594,22 +632,24 @@ fn measure(name: &str, configs: &[DstQConfig]) {
         );
     }
     println!(
-        "| k | block | MiB | % DST | % BVH2 | B/node | fill | prim B/ray | prim lines | prim +nodes | prim +tris | rand B/ray | rand lines | rand +nodes | rand +tris |"
+        "| k | line | MiB | % DST | % BVH2 | B/node | fill | clusters | prim B/ray | prim lines | prim +nodes | prim +tris | rand B/ray | rand lines | rand +nodes | rand +tris |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for cfg in configs {
         let q = DstQ::from_dst(dst, cfg).unwrap();
+        assert!(q.validate(dst).is_ok());
         let st = q.stats();
         let tot = q.bytes_total() as f64;
         let mut row = format!(
-            "| {} | {} | {:.3} | {:.1} | {:.1} | {:.2} | {:.0} % |",
+            "| {} | {} | {:.3} | {:.1} | {:.1} | {:.2} | {:.0} % | {} |",
             cfg.bits,
             cfg.cluster_bytes,
             tot / 1048576.0,
             100.0 * tot / dst_bytes,
             100.0 * tot / bvh2_bytes,
             st.bytes_per_node(),
-            100.0 * st.fill()
+            100.0 * st.fill(),
+            st.clusters
         );
         for ((_, rays), e) in sets.iter().zip(&exact) {
             let w = work(rays, |ray, o| {
@@ -633,5 +673,80 @@ fn measure_table() {
     let cfgs = configs();
     for name in ["dragon_res4.ply.gz", "bunny.ply.gz"] {
         measure(name, &cfgs);
+    }
+}
+
+/// The worked example of `docs/dstq-encoding.md`, §5, word for word.
+#[test]
+fn worked_example_words() {
+    let tris = vec![
+        Triangle::new(
+            Vec3::new(-1.0, -1.0, 2.0),
+            Vec3::new(1.0, -1.0, 2.0),
+            Vec3::new(0.0, 1.0, 2.0),
+        ),
+        Triangle::new(
+            Vec3::new(-0.5, -2.0, 3.0),
+            Vec3::new(1.0, -1.0, 3.5),
+            Vec3::new(0.0, 0.3, 3.0),
+        ),
+    ];
+    let bcfg = BuildConfig {
+        max_leaf_size: 1,
+        ..BuildConfig::default()
+    };
+    let s = Structures::try_build_with(&tris, &bcfg, &DstConfig::hardware()).unwrap();
+    let q = DstQ::from_dst(&s.dst, &DstQConfig::default()).unwrap();
+    assert!(q.validate(&s.dst).is_ok());
+    let img = q.image();
+    assert_eq!(img.nodes.len(), 16, "one 64-byte line");
+    assert_eq!(
+        &img.words[..8],
+        &[
+            0xbf80_0000, // origin x = -1.0
+            0xc000_0000, // origin y = -2.0
+            0x4000_0000, // origin z = 2.0
+            0x0378_7979, // e = (121, 121, 120), 3 records
+            0x8000_5016, // root, short header: split on z, left long, local child at bit 160;
+            //              q0 = 0x00 (z ≤ 2.0), q1 = 0x80 (z ≥ 3.0)
+            0x0000_0033, // left: single-axis y carving leaf, run 0
+            0x0065_40ff, // left q0 = 255 (y ≤ +∞ → 1.984375), q1 = 64 (y ≥ -1); right header, low half
+            0x9420_0000, // right header, high half (dual xy carving leaf, run 1); q0 = 32, q1 = 148
+        ]
+    );
+    assert!(img.words[8..16].iter().all(|&w| w == 0));
+    let st = q.stats();
+    assert_eq!((st.clusters, st.used_bits, st.node_bytes), (1, 256, 64));
+}
+
+/// A coordinate from anywhere in the finite f32 range (as `tests/extreme_coordinates.rs`).
+fn any_coordinate() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        (any::<bool>(), 0u32..255, 0u32..1 << 23)
+            .prop_map(|(neg, e, m)| f32::from_bits(u32::from(neg) << 31 | e << 23 | m)),
+        prop::sample::select(vec![f32::MAX, -f32::MAX, 3e38, -3e38, 1.9e19, -1.9e19]),
+        -4.0f32..4.0,
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    /// Scenes spanning the whole finite f32 range (frames wider than `f32::MAX`, subnormal
+    /// extents next to huge ones) convert under every config and validate against the DST.
+    #[test]
+    fn extreme_scenes_convert_and_validate(
+        tris in prop::collection::vec(
+            [any_coordinate(), any_coordinate(), any_coordinate()]
+                .prop_map(Vec3::from_array)
+                .prop_flat_map(|a| (Just(a), [any_coordinate(), any_coordinate(), any_coordinate()].prop_map(Vec3::from_array), [any_coordinate(), any_coordinate(), any_coordinate()].prop_map(Vec3::from_array)))
+                .prop_map(|(a, b, c)| Triangle::new(a, b, c)),
+            1..40,
+        ),
+        leaf in prop::sample::select(vec![1u32, 4]),
+    ) {
+        let bcfg = BuildConfig { max_leaf_size: leaf, ..BuildConfig::default() };
+        let s = Structures::try_build_with(&tris, &bcfg, &DstConfig::hardware()).expect("structures");
+        build_all(&s, "extreme scene");
     }
 }

@@ -1,10 +1,10 @@
 //! `DstQ::from_dst`: reads the exact DST's nodes with their exact regions, groups them into
-//! clusters (greedy by region surface area), and writes every cluster block: its frame, then
+//! clusters (greedy by region surface area), and packs the clusters into lines and writes each: its frame, then
 //! its records with conservatively rounded planes (`docs/dstq-encoding.md`, §2–§4).
 
 use super::frame::{Frame, quantize_down, quantize_up};
 use super::layout::ROOT_BIT;
-use super::record::{ChildRef, QHeader, write_bits};
+use super::record::{ChildRef, LeftRecord, QHeader, RecordFormat, write_bits};
 use super::{DstQ, DstQConfig, DstQError};
 use crate::dst::{Dst, DstError, HeaderOffset};
 use crate::image::MemoryImage;
@@ -150,18 +150,87 @@ pub(super) fn read_exact(dst: &Dst) -> Result<Vec<ExactNode>, DstError> {
 }
 
 /// A cluster waiting to be filled: its roots (1, or a split's 2 children), its frame box and
-/// its block index.
+/// its cluster id.
 struct Pending {
     roots: Vec<u32>,
     frame: Aabb,
-    block: u32,
+    id: u32,
 }
 
-fn record_bits(n: &ExactNode, k: u32) -> u32 {
+/// A filled cluster: its frame box, its records (node, bit position) and its size in bits.
+struct Cluster {
+    frame: Aabb,
+    placed: Vec<(u32, u32)>,
+    bits: u32,
+}
+
+/// Where an expanded node's children went: this cluster (the index of the first child in
+/// the cluster's record list), or a cluster id.
+#[derive(Clone, Copy)]
+enum Child {
+    Local(u32),
+    Cluster(u32),
+}
+
+/// First-fit packing of clusters into `line_words`-word lines, so that no cluster crosses
+/// a line boundary: the first of the last [`OPEN_LINES`] lines with room, else a new line.
+/// Returns each cluster's word address and the number of lines.
+fn pack(sizes: &[u32], line_words: u32) -> (Vec<u32>, u32) {
+    const OPEN_LINES: usize = 16;
+    let mut open: Vec<(u32, u32)> = Vec::new(); // (line, free words)
+    let mut lines = 0u32;
+    let addr = sizes
+        .iter()
+        .map(|&s| {
+            let slot = open.iter().position(|&(_, free)| free >= s);
+            let i = slot.unwrap_or_else(|| {
+                if open.len() == OPEN_LINES {
+                    open.remove(0);
+                }
+                open.push((lines, line_words));
+                lines += 1;
+                open.len() - 1
+            });
+            let (line, free) = open[i];
+            open[i].1 -= s;
+            line * line_words + (line_words - free)
+        })
+        .collect();
+    (addr, lines)
+}
+
+/// Bits reserved for a node's record while filling: its final size, except that an
+/// internal node whose child may still go to another cluster gets the 32-bit header; it
+/// shrinks to the short header once its children are placed in the same cluster.
+fn reserved_bits(n: &ExactNode, k: u32) -> u32 {
     if n.hdr.is_plain_leaf() {
         32
     } else {
         32 + 2 * k
+    }
+}
+
+/// A node's final record size: a plain leaf 32 bits, an internal node 32 + 2k, or
+/// 7 + W + 2k when its children are in its own cluster.
+fn final_bits(nodes: &[ExactNode], child_at: &[Option<Child>], n: u32, fmt: &RecordFormat) -> u32 {
+    let node = &nodes[n as usize];
+    if node.hdr.is_plain_leaf() {
+        32
+    } else if let Some(Child::Local(_)) = child_at[n as usize] {
+        fmt.short_header_bits() + 2 * fmt.k
+    } else {
+        32 + 2 * fmt.k
+    }
+}
+
+/// The B field a split writes for its left child `n`.
+fn left_record(nodes: &[ExactNode], child_at: &[Option<Child>], n: u32) -> LeftRecord {
+    if nodes[n as usize].hdr.is_plain_leaf() {
+        LeftRecord::Leaf
+    } else if let Some(Child::Local(_)) = child_at[n as usize] {
+        LeftRecord::Short
+    } else {
+        LeftRecord::Long
     }
 }
 
@@ -196,23 +265,24 @@ impl DstQ {
             image.words[..n_idx].copy_from_slice(&src.words[src.indices.clone()]);
             return Ok(Self::assemble(image, dst.scene_box(), *cfg));
         }
-        let mut words: Vec<u32> = Vec::new();
+        // Pass 1: fill the clusters, parents before children.
         let mut queue = VecDeque::from([Pending {
             roots: vec![0],
             frame: dst.scene_box(),
-            block: 0,
+            id: 0,
         }]);
-        let mut next_block = 1u32;
-        // Per node: where its children went (set while filling its cluster).
-        let mut child_at: Vec<Option<ChildRef>> = vec![None; nodes.len()];
+        let mut clusters: Vec<Cluster> = Vec::new();
+        let fmt = RecordFormat::new(k, cfg.cluster_bytes);
+        let mut child_at: Vec<Option<Child>> = vec![None; nodes.len()];
         while let Some(p) = queue.pop_front() {
-            debug_assert_eq!(p.block as usize * cw, words.len());
-            let mut placed: Vec<(u32, u32)> = Vec::new();
+            debug_assert_eq!(p.id as usize, clusters.len());
+            let mut placed: Vec<u32> = Vec::new();
             let mut heap = BinaryHeap::new();
-            let mut pos = ROOT_BIT;
+            // Bits used: frame + reserved record sizes (short headers once known).
+            let mut used = ROOT_BIT;
             for &r in &p.roots {
-                placed.push((r, pos));
-                pos += record_bits(&nodes[r as usize], k);
+                placed.push(r);
+                used += reserved_bits(&nodes[r as usize], k);
                 if nodes[r as usize].child_count() > 0 {
                     heap.push(priority(&nodes[r as usize], r));
                 }
@@ -222,47 +292,72 @@ impl DstQ {
                 let kids: Vec<u32> = node.kids.iter().copied().filter(|&c| c != NONE).collect();
                 let need: u32 = kids
                     .iter()
-                    .map(|&c| record_bits(&nodes[c as usize], k))
+                    .map(|&c| reserved_bits(&nodes[c as usize], k))
                     .sum();
-                if pos + need <= cbits {
-                    child_at[n as usize] = Some(ChildRef::Local(pos));
+                if used + need <= cbits {
+                    child_at[n as usize] = Some(Child::Local(placed.len() as u32));
+                    used = used + need - (32 - fmt.short_header_bits());
                     for &c in &kids {
-                        placed.push((c, pos));
-                        pos += record_bits(&nodes[c as usize], k);
+                        placed.push(c);
                         if nodes[c as usize].child_count() > 0 {
                             heap.push(priority(&nodes[c as usize], c));
                         }
                     }
                 } else {
-                    child_at[n as usize] = Some(ChildRef::Cluster(next_block));
+                    let id = (clusters.len() + 1 + queue.len()) as u32;
+                    child_at[n as usize] = Some(Child::Cluster(id));
                     queue.push_back(Pending {
                         frame: union_region(&nodes, &kids),
                         roots: kids,
-                        block: next_block,
+                        id,
                     });
-                    next_block += 1;
                 }
             }
-            // Write the block.
-            let base = words.len();
-            words.resize(base + cw, 0);
-            let block = &mut words[base..];
-            let frame = Frame::of_box(p.frame.min.to_array(), p.frame.max.to_array(), k);
-            block[..4].copy_from_slice(&frame.words(placed.len().min(255) as u8));
-            for &(n, bit) in &placed {
+            // Final positions, in placement order (a split's children stay adjacent).
+            let mut pos = ROOT_BIT;
+            let placed: Vec<(u32, u32)> = placed
+                .into_iter()
+                .map(|n| {
+                    let at = pos;
+                    pos += final_bits(&nodes, &child_at, n, &fmt);
+                    (n, at)
+                })
+                .collect();
+            debug_assert_eq!(pos, used);
+            clusters.push(Cluster {
+                frame: p.frame,
+                placed,
+                bits: pos,
+            });
+        }
+        // Pass 2: place the clusters (whole words) in lines of `cluster_bytes`.
+        let sizes: Vec<u32> = clusters.iter().map(|c| c.bits.div_ceil(32)).collect();
+        let (addr, lines) = pack(&sizes, cw as u32);
+        let mut words: Vec<u32> = vec![0; lines as usize * cw];
+        // Pass 3: write every cluster at its address.
+        for (c, &base) in clusters.iter().zip(&addr) {
+            let out = &mut words[base as usize..];
+            let frame = Frame::of_box(c.frame.min.to_array(), c.frame.max.to_array(), k);
+            out[..4].copy_from_slice(&frame.words(c.placed.len().min(255) as u8));
+            for &(n, bit) in &c.placed {
                 let node = &nodes[n as usize];
                 let hdr = node.hdr;
-                let child = || child_at[n as usize].expect("every expanded node has a child ref");
+                let child = || match child_at[n as usize] {
+                    Some(Child::Local(i)) => ChildRef::Local(c.placed[i as usize].1),
+                    Some(Child::Cluster(id)) => ChildRef::Cluster(addr[id as usize]),
+                    None => unreachable!("every expanded node has a child"),
+                };
                 let q = match hdr.node_kind() {
                     DstNodeKind::Leaf => QHeader::leaf(hdr.offset() as u64)?,
                     DstNodeKind::Split => {
-                        let left = &nodes[node.kids[0] as usize];
-                        QHeader::split(hdr.axis(), !left.hdr.is_plain_leaf(), child())?
+                        let left = left_record(&nodes, &child_at, node.kids[0]);
+                        QHeader::split(hdr.axis(), left, child(), &fmt)?
                     }
                     _ if hdr.is_leaf_flag() => QHeader::carve_leaf(hdr, hdr.offset() as u64)?,
-                    _ => QHeader::carve(hdr, child())?,
+                    _ => QHeader::carve(hdr, child(), &fmt)?,
                 };
-                write_bits(block, bit as usize, 32, q.bits());
+                let hb = q.header_bits(&fmt);
+                write_bits(out, bit as usize, hb, q.bits());
                 if !hdr.is_plain_leaf() {
                     for (a, slot, lower) in plane_roles(hdr) {
                         let x = node.planes[slot];
@@ -272,16 +367,10 @@ impl DstQ {
                         } else {
                             quantize_up(x, o, e, k)
                         };
-                        write_bits(block, (bit + 32 + slot as u32 * k) as usize, k, qv);
+                        write_bits(out, (bit + hb + slot as u32 * k) as usize, k, qv);
                     }
                 }
             }
-        }
-        if next_block as u64 > super::record::CHILD_LIMIT {
-            return Err(DstQError::Dst(DstError::OffsetOverflow {
-                given: next_block as u64,
-                limit: super::record::CHILD_LIMIT,
-            }));
         }
         let n_nodes = words.len();
         let mut image = MemoryImage::with_triangles(n_nodes, n_idx, src.triangle_data.clone());

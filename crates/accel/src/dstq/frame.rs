@@ -57,10 +57,29 @@ pub fn choose_exponent(lo: f32, hi: f32, bits: u32) -> u8 {
     } else {
         0
     };
-    while e < 254 && !(decode(lo, e as u8, qm) >= hi) {
+    // `decode < hi` or NaN: not there yet.
+    while e < 254 && !reaches_up(decode(lo, e as u8, qm), hi) {
         e += 1;
     }
     e as u8
+}
+
+/// `p ≥ x` (false when either is NaN).
+#[inline(always)]
+fn reaches_up(p: f32, x: f32) -> bool {
+    matches!(
+        p.partial_cmp(&x),
+        Some(std::cmp::Ordering::Greater | std::cmp::Ordering::Equal)
+    )
+}
+
+/// `p ≤ x` (false when either is NaN).
+#[inline(always)]
+fn reaches_down(p: f32, x: f32) -> bool {
+    matches!(
+        p.partial_cmp(&x),
+        Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+    )
 }
 
 /// The smallest `q ∈ [0, q_max]` with `decode(origin, e, q) ≥ x`: an upper-bound ("≤")
@@ -68,7 +87,7 @@ pub fn choose_exponent(lo: f32, hi: f32, bits: u32) -> u8 {
 /// `q_max`, whose plane is at or above the frame's top (see [`choose_exponent`]).
 pub fn quantize_up(x: f32, origin: f32, e: u8, bits: u32) -> u32 {
     let (mut lo, mut hi) = (0u32, q_max(bits));
-    if !(decode(origin, e, hi) >= x) {
+    if !reaches_up(decode(origin, e, hi), x) {
         return hi;
     }
     // Invariant: decode(hi) >= x; answer in [lo, hi].
@@ -88,7 +107,7 @@ pub fn quantize_up(x: f32, origin: f32, e: u8, bits: u32) -> u32 {
 /// whose plane is the frame's origin, its bottom.
 pub fn quantize_down(x: f32, origin: f32, e: u8, bits: u32) -> u32 {
     let (mut lo, mut hi) = (0u32, q_max(bits));
-    if !(decode(origin, e, lo) <= x) {
+    if !reaches_down(decode(origin, e, lo), x) {
         return 0;
     }
     // Invariant: decode(lo) <= x; answer in [lo, hi].

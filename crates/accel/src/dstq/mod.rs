@@ -8,17 +8,18 @@
 //!                      │                                 │
 //!                      └── frame.rs: frame (p, e) per cluster, planes rounded outward
 //!                                                        ▼
-//!           MemoryImage: cluster blocks | index runs (the DST's) | triangles (shared)
+//!           MemoryImage: lines of clusters | index runs (the DST's) | triangles (shared)
 //!                 │
 //!   traverse.rs (the DST* rules, planes dequantized)   validate.rs (lockstep with the DST)
 //! ```
 //!
-//! A cluster block is `cluster_bytes` long: a 16-byte frame (origin p as 3 × f32, three
-//! exponent bytes, a record count), then records, each the DST's header-offset word (its
-//! offset field extended with an in-cluster/other-cluster flag, [`QHeader`]) and, for an
-//! internal node, two k-bit plane offsets. Every quantized region contains its exact
-//! region, so closest hits and shadow answers equal the exact DST's (and the BVH2's) on
-//! every ray; the price is extra node steps and triangle tests, measured in the doc.
+//! A cluster takes at most `cluster_bytes` inside one aligned line of that size: a 16-byte
+//! frame (origin p as 3 × f32, three exponent bytes, a record count), then records, each the
+//! DST's 6-bit header code with a child field that is short (7 + W bits) when the child is
+//! in the same cluster ([`QHeader`]) and, for an internal node, two k-bit plane offsets.
+//! Every quantized region contains its exact region, so closest hits and shadow answers
+//! equal the exact DST's (and the BVH2's) on every ray; the price is extra node steps and
+//! triangle tests, measured in the doc.
 //!
 //! ```
 //! use dualsplit_accel::{BuildConfig, Bvh2, NoObserver};
@@ -47,7 +48,7 @@ mod traverse;
 pub mod unit;
 mod validate;
 
-pub use record::{CHILD_LIMIT, ChildRef, QHeader};
+pub use record::{CHILD_LIMIT, ChildRef, LeftRecord, QHeader, RecordFormat};
 pub use stats::DstQStats;
 
 use crate::dst::DstError;
@@ -56,9 +57,9 @@ use crate::validate::ValidationReport;
 use dualsplit_geometry::{Aabb, Triangle};
 use serde::{Deserialize, Serialize};
 
-/// Fixed positions inside a cluster block.
+/// Fixed positions inside a cluster.
 pub mod layout {
-    /// Words of the frame at the start of every block (origin × 3, exponents + count).
+    /// Words of the frame at the start of every cluster (origin × 3, exponents + count).
     pub const FRAME_WORDS: usize = 4;
     /// Bit position of a cluster's first root record (right after the frame).
     pub const ROOT_BIT: u32 = 128;
@@ -78,26 +79,33 @@ pub enum DstQError {
     BadConfig {
         /// Bits per plane offset.
         bits: u32,
-        /// Bytes per cluster block.
+        /// Largest cluster / line size in bytes.
         cluster_bytes: u32,
-        /// The smallest block that holds a frame and two internal records at these bits.
+        /// The smallest cluster that holds a frame and two internal records at these bits.
         min_bytes: u32,
     },
 }
 
 /// Settings of the quantized DST. The default is the measured choice
 /// (`docs/dstq-encoding.md`, §7): 8-bit planes in 64-byte clusters.
+///
+/// A cluster takes at most `cluster_bytes` and never crosses a `cluster_bytes`-aligned line
+/// of the node region (clusters are packed into such lines).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct DstQConfig {
     /// Bits per plane offset k (1–16). The measured table covers 4, 6, 8, 10, 12 and 16.
     pub bits: u32,
-    /// Bytes per cluster block: one fetch (64 = one cache line of the simulated L1).
+    /// Largest cluster and line size in bytes, a multiple of 4: one aligned fetch (64 = one
+    /// cache line of the simulated L1).
     pub cluster_bytes: u32,
 }
 
 impl Default for DstQConfig {
-    /// k = 8 in 64-byte clusters: the smallest tree of the measured settings whose extra
-    /// traversal work stays small (`docs/dstq-encoding.md`, §7, states the numbers).
+    /// k = 8 in 64-byte clusters, measured (`docs/dstq-encoding.md`, §7): of the settings
+    /// smaller than the exact DST and within 5 % of its traversal work, the one whose rays
+    /// touch the fewest 64-byte lines (31–38 % fewer than the exact DST) and read the fewest
+    /// bytes, at 78 % of its size for about +2.5 % node steps and +3.5 % triangle tests;
+    /// one cluster is one L1 line and a node whose child shares its cluster one word.
     fn default() -> Self {
         Self {
             bits: 8,
@@ -112,12 +120,17 @@ impl DstQConfig {
     /// The cluster sizes of the measurement table.
     pub const MEASURED_CLUSTER_BYTES: [u32; 2] = [64, 128];
 
-    /// Words per cluster block.
+    /// Words per line (the largest cluster).
     pub fn cluster_words(&self) -> u32 {
         self.cluster_bytes / 4
     }
 
-    /// Bits of an internal-node record: 32 + 2k.
+    /// The record geometry: k and the local child-field width W.
+    pub fn record_format(&self) -> RecordFormat {
+        RecordFormat::new(self.bits, self.cluster_bytes)
+    }
+
+    /// Bits of an internal-node record with a 32-bit header: 32 + 2k.
     pub fn internal_record_bits(&self) -> u32 {
         32 + 2 * self.bits
     }
@@ -131,7 +144,7 @@ impl DstQConfig {
     pub fn check(&self) -> Result<(), DstQError> {
         let ok_bits = (1..=16).contains(&self.bits);
         let min_bytes = Self::min_bytes(self.bits.min(16));
-        let ok_bytes = self.cluster_bytes % 4 == 0
+        let ok_bytes = self.cluster_bytes.is_multiple_of(4)
             && self.cluster_bytes >= min_bytes
             && self.cluster_bytes <= 4096;
         if ok_bits && ok_bytes {
@@ -146,7 +159,7 @@ impl DstQConfig {
     }
 }
 
-/// A quantized dual-split tree: its memory image (cluster blocks, the DST's index runs, the
+/// A quantized dual-split tree: its memory image (lines of clusters, the DST's index runs, the
 /// shared triangles), the scene box rays are clipped to, and its config.
 #[derive(Clone, Debug)]
 pub struct DstQ {
@@ -165,7 +178,7 @@ impl DstQ {
     }
 
     /// A tree from a saved image: checks its structure (valid headers, records inside their
-    /// blocks, offsets and runs in range, nothing reached twice, every triangle referenced
+    /// lines, offsets and runs in range, nothing reached twice, every triangle referenced
     /// once) before traversal may read it; the report when it fails.
     pub fn from_image(
         image: MemoryImage,
@@ -208,12 +221,7 @@ impl DstQ {
         self.image.triangle_slice()
     }
 
-    /// Cluster blocks in the node region.
-    pub fn clusters(&self) -> u64 {
-        (self.image.nodes.len() / self.config.cluster_words() as usize) as u64
-    }
-
-    /// Node bytes (whole cluster blocks, padding included) + index bytes + the 24-byte
+    /// Node bytes (whole lines, padding included) + index bytes + the 24-byte
     /// scene box: the quantity of Lin et al. 2020, Table 3, defined as
     /// [`crate::dst::DstStats::total_bytes`].
     pub fn bytes_total(&self) -> u64 {

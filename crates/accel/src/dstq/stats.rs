@@ -1,12 +1,12 @@
 //! Sizes of a quantized DST as values (formatted elsewhere): node counts by kind, clusters,
-//! bytes, bytes per node and how full the blocks are (Lin et al. 2020, Table 3 quantity).
+//! bytes, bytes per node and how full the lines are (Lin et al. 2020, Table 3 quantity).
 
 use serde::Serialize;
 
 /// Node counts and sizes of a [`super::DstQ`] ([`super::DstQ::stats`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct DstQStats {
-    /// Cluster blocks.
+    /// Clusters.
     pub clusters: u64,
     /// Splitting-node records.
     pub splitting: u64,
@@ -20,9 +20,9 @@ pub struct DstQStats {
     pub carving_leaves: u64,
     /// Triangle-index entries.
     pub index_entries: u64,
-    /// Bits holding frames and records (the rest of the blocks is padding).
+    /// Bits holding frames and records (the rest of the lines is padding).
     pub used_bits: u64,
-    /// Bytes of the node region: whole blocks, padding included.
+    /// Bytes of the node region: whole lines, padding included.
     pub node_bytes: u64,
     /// Bytes of the triangle-index list (4 per entry).
     pub index_bytes: u64,

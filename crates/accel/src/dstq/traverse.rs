@@ -1,11 +1,11 @@
 //! Traversal of the quantized DST: the exact DST's node rules (`dst/traverse.rs`; Lin et al.
 //! 2020, §3, Figs. 2–3), with each plane dequantized from its cluster's frame
 //! (`plane = p_a + q · 2^(e_a − 127)`) before the same distance, widening and `le_or_nan`
-//! tests. A stack entry carries the cluster block and the record's bit position beside its
-//! interval.
+//! tests. A stack entry carries the cluster's word address and the record's bit position
+//! beside its interval.
 //!
-//! Fetch accounting (`docs/dstq-encoding.md`, §6): the frame (16 B at the block's start)
-//! when the traversal starts working in a block other than the one whose frame it holds
+//! Fetch accounting (`docs/dstq-encoding.md`, §6): the frame (16 B at the cluster's start)
+//! when the traversal starts working in a cluster other than the one whose frame it holds
 //! (descending into a child cluster, or popping an entry of another cluster); then, per
 //! node step, the whole 32-bit words that hold the record's bits (a record may straddle a
 //! word boundary); 4 B per index entry and 36 B per triangle, as the exact DST.
@@ -19,10 +19,11 @@ use crate::image::{MemoryImage, RUN_END};
 use crate::observer::{DstNodeKind, NodeStep, Observer};
 use dualsplit_geometry::{Hit, PrimId, Ray, cull_limit, widen_exit};
 
-/// A traversal-stack entry: a record (cluster block, bit position) and its ray interval.
+/// A traversal-stack entry: a record (its cluster's word address and its bit position in
+/// the cluster) and its ray interval.
 #[derive(Clone, Copy, Debug)]
 struct Entry {
-    block: u32,
+    cluster: u32,
     bit: u32,
     t_min: f32,
     t_max: f32,
@@ -49,11 +50,11 @@ impl DstQ {
         self.traverse::<O, true>(ray, obs).is_some()
     }
 
-    /// Where the child `c` of a record in `block` lies: (block, bit).
+    /// Where the child `c` of a record in the cluster at word `cluster` lies: (cluster word, bit).
     #[inline(always)]
-    fn locate(block: u32, c: ChildRef) -> (u32, u32) {
+    fn locate(cluster: u32, c: ChildRef) -> (u32, u32) {
         match c {
-            ChildRef::Local(bit) => (block, bit),
+            ChildRef::Local(bit) => (cluster, bit),
             ChildRef::Cluster(b) => (b, ROOT_BIT),
         }
     }
@@ -71,33 +72,35 @@ impl DstQ {
         let img = &self.image;
         let words: &[u32] = &img.words;
         let k = self.config.bits;
+        let fmt = self.config.record_format();
         let cw = self.config.cluster_words() as usize;
         let tris = self.triangles();
         let mut best: Option<Hit> = None;
         let mut best_t = ray.t_max;
         let mut stack: Vec<Entry> = Vec::with_capacity(64);
-        let mut frame_block = u32::MAX;
+        let mut frame_at = u32::MAX;
         let mut frame = Frame {
             origin: [0.0; 3],
             exp: [0; 3],
         };
-        let (mut block, mut bit) = (0u32, ROOT_BIT);
+        let (mut cluster, mut bit) = (0u32, ROOT_BIT);
         loop {
-            let base = block as usize * cw;
-            if block != frame_block {
+            let base = cluster as usize;
+            if cluster != frame_at {
                 obs.fetch(MemoryImage::addr(base), 4 * FRAME_WORDS as u32);
                 let mut fw = [0u32; 4];
                 fw.copy_from_slice(&words[base..base + FRAME_WORDS]);
                 frame = Frame::from_words(fw);
-                frame_block = block;
+                frame_at = cluster;
             }
-            let cwords = &words[base..base + cw];
-            let h = QHeader::from_bits(read_bits(cwords, bit as usize, 32));
-            let rb = h.record_bits(k);
+            // A cluster never crosses its line: its records lie before the line's end.
+            let cwords = &words[base..(base / cw + 1) * cw];
+            let h = QHeader::read(read_bits(cwords, bit as usize, 32), &fmt);
+            let (hb, rb) = (h.header_bits(&fmt), h.record_bits(&fmt));
             let (w0, w1) = (bit / 32, (bit + rb - 1) / 32);
             obs.fetch(MemoryImage::addr(base + w0 as usize), 4 * (w1 - w0 + 1));
             let plane = |slot: u32, a: usize| {
-                frame.plane(a, read_bits(cwords, (bit + 32 + slot * k) as usize, k))
+                frame.plane(a, read_bits(cwords, (bit + hb + slot * k) as usize, k))
             };
             let run = match h.node_kind() {
                 DstNodeKind::Leaf => {
@@ -107,8 +110,8 @@ impl DstQ {
                 DstNodeKind::Split => {
                     let a = h.exact().axis();
                     let (p0, p1) = (plane(0, a), plane(1, a));
-                    let (cb, lbit) = Self::locate(block, h.child());
-                    let lsize = if h.left_is_internal() { 32 + 2 * k } else { 32 };
+                    let (cb, lbit) = Self::locate(cluster, h.child(&fmt));
+                    let lsize = h.left_bits(&fmt);
                     let (left, right) = ((cb, lbit), (cb, lbit + lsize));
                     let (near, far, t1, t2) = if r.neg[a] {
                         (right, left, r.exit_t(a, p1), r.plane_t(a, p0))
@@ -125,23 +128,23 @@ impl DstQ {
                     match (near_hit, far_hit) {
                         (true, true) => {
                             stack.push(Entry {
-                                block: far.0,
+                                cluster: far.0,
                                 bit: far.1,
                                 t_min: t_min.max(t2),
                                 t_max,
                             });
                             obs.push();
-                            (block, bit) = near;
+                            (cluster, bit) = near;
                             t_max = t_max.min(t1);
                             continue;
                         }
                         (true, false) => {
-                            (block, bit) = near;
+                            (cluster, bit) = near;
                             t_max = t_max.min(t1);
                             continue;
                         }
                         (false, true) => {
-                            (block, bit) = far;
+                            (cluster, bit) = far;
                             t_min = t_min.max(t2);
                             continue;
                         }
@@ -180,7 +183,7 @@ impl DstQ {
                         t_min = lo;
                         t_max = hi;
                         if !leaf {
-                            (block, bit) = Self::locate(block, h.child());
+                            (cluster, bit) = Self::locate(cluster, h.child(&fmt));
                             continue;
                         }
                         Some(h.run())
@@ -199,8 +202,8 @@ impl DstQ {
                 obs.step(NodeStep::Leaf {
                     count: count as u32,
                 });
-                for i in start..start + count {
-                    let p = PrimId(words[i] & !RUN_END);
+                for (i, &entry) in words.iter().enumerate().skip(start).take(count) {
+                    let p = PrimId(entry & !RUN_END);
                     obs.fetch(MemoryImage::addr(i), 4);
                     obs.fetch(MemoryImage::addr(img.triangles.start + 9 * p.index()), 36);
                     let hit = tris[p.index()].intersect(&r, ray.t_min, best_t);
@@ -223,7 +226,7 @@ impl DstQ {
                 };
                 obs.pop();
                 if le_or_nan(e.t_min, limit) {
-                    (block, bit, t_min, t_max) = (e.block, e.bit, e.t_min, e.t_max.min(limit));
+                    (cluster, bit, t_min, t_max) = (e.cluster, e.bit, e.t_min, e.t_max.min(limit));
                     break;
                 }
             }

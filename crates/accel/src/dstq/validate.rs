@@ -1,10 +1,11 @@
 //! `validate()`: walks the quantized DST's records from the root, alone (the structural
 //! check of a loaded image) or in lockstep with its exact DST (conservative planes).
 //!
-//! Structure: every block's size and frame, every record inside its block (at or after bit
-//! 128) and reached once, headers among the exact DST's 37 valid codes, child clusters
+//! Structure: every cluster's frame inside the node region (whole lines), every record
+//! inside its cluster's line (at or after bit 128), reached once and overlapping nothing,
+//! headers among the exact DST's 37 valid codes, child clusters
 //! inside the node region, runs inside the index region and terminated, every index entry
-//! in exactly one run, every triangle referenced exactly once, each block's record count
+//! in exactly one run, every triangle referenced exactly once, each cluster's record count
 //! equal to the records reached in it. Lockstep with the exact DST: the same node kind,
 //! axis, corner and run at every node, and every plane conservative: a "≤" plane decodes to
 //! at least `min(exact plane, exact region max)`, a "≥" plane to at most
@@ -44,7 +45,7 @@ const NONE: u32 = u32::MAX;
 /// One record to check: where it is, its depth, its exact node (or [`NONE`]) and the
 /// quantized region entering it.
 struct Visit {
-    block: u32,
+    cluster: u32,
     bit: u32,
     depth: usize,
     exact: u32,
@@ -74,7 +75,6 @@ impl DstQ {
     /// Node counts and sizes, counted by walking the records.
     pub fn stats(&self) -> DstQStats {
         let mut s = self.walk(None).1;
-        s.clusters = self.clusters();
         s.node_bytes = self.image.node_bytes();
         s.index_bytes = self.image.index_bytes();
         s.total_bytes = self.bytes_total();
@@ -86,6 +86,7 @@ impl DstQ {
         let mut rep = empty_report(img);
         let mut st = DstQStats::default();
         let k = self.config.bits;
+        let fmt = self.config.record_format();
         let cw = self.config.cluster_words() as usize;
         let cbits = self.config.cluster_bytes * 8;
         let words: &[u32] = &img.words;
@@ -93,12 +94,12 @@ impl DstQ {
         if img.nodes.start != 0
             || img.nodes.end != img.indices.start
             || words.len() < img.indices.end
-            || img.nodes.len() % cw != 0
+            || !img.nodes.len().is_multiple_of(cw)
         {
             error(
                 &mut rep,
                 format!(
-                    "regions nodes {:?}, indices {:?} over {} words do not fit {}-word blocks",
+                    "regions nodes {:?}, indices {:?} over {} words do not fit {}-word lines",
                     img.nodes,
                     img.indices,
                     words.len(),
@@ -107,11 +108,11 @@ impl DstQ {
             );
             return (rep, st);
         }
-        let n_blocks = img.nodes.len() / cw;
+        let n_words = img.nodes.len();
         let mut index_cover = vec![0u8; img.indices.len()];
         let mut tri_refs = vec![0u32; n_tris];
         if let Some(ex) = exact
-            && ex.is_empty() != (n_blocks == 0)
+            && ex.is_empty() != (n_words == 0)
         {
             error(
                 &mut rep,
@@ -119,13 +120,13 @@ impl DstQ {
             );
             return (rep, st);
         }
-        // One bit per record position reached; records counted per block.
-        let mut seen = vec![0u64; (n_blocks * cbits as usize).div_ceil(64)];
-        let mut per_block = vec![0u32; n_blocks];
+        // One bit per node-region bit covered by a frame or a record; records per cluster.
+        let mut seen = vec![0u64; (n_words * 32).div_ceil(64)];
+        let mut per_cluster: std::collections::BTreeMap<u32, u32> = Default::default();
         let mut stack: Vec<Visit> = Vec::new();
-        if n_blocks > 0 {
+        if n_words > 0 {
             stack.push(Visit {
-                block: 0,
+                cluster: 0,
                 bit: ROOT_BIT,
                 depth: 0,
                 exact: if exact.is_some() { 0 } else { NONE },
@@ -133,40 +134,56 @@ impl DstQ {
             });
         }
         while let Some(v) = stack.pop() {
-            let at = format!("record {}:{}", v.block, v.bit);
-            if v.block as usize >= n_blocks {
-                error(&mut rep, format!("{at}: block outside 0..{n_blocks}"));
+            let at = format!("record {}:{}", v.cluster, v.bit);
+            let base = v.cluster as usize;
+            // A cluster lies inside one line of `cw` words (the node region is whole lines).
+            let line_end = (base / cw + 1) * cw;
+            if base + FRAME_WORDS > n_words || line_end > n_words {
+                error(
+                    &mut rep,
+                    format!("{at}: cluster outside the node region 0..{n_words}"),
+                );
                 continue;
             }
-            if v.bit < ROOT_BIT || v.bit + 32 > cbits {
-                error(&mut rep, format!("{at}: bit outside {ROOT_BIT}..{cbits}"));
+            let avail = ((line_end - base) * 32).min(cbits as usize) as u32;
+            if v.bit < ROOT_BIT || v.bit + 32 > avail {
+                error(&mut rep, format!("{at}: bit outside {ROOT_BIT}..{avail}"));
                 continue;
             }
-            let base = v.block as usize * cw;
-            let cwords = &words[base..base + cw];
+            let cwords = &words[base..line_end];
             let word = read_bits(cwords, v.bit as usize, 32);
-            let h = match QHeader::decode(word, v.bit) {
+            let h = match QHeader::decode(word, &fmt, v.bit) {
                 Ok(h) => h,
                 Err(e) => {
                     error(&mut rep, format!("{at}: {e}"));
                     continue;
                 }
             };
-            let rb = h.record_bits(k);
-            if v.bit + rb > cbits {
+            let (hb, rb) = (h.header_bits(&fmt), h.record_bits(&fmt));
+            if v.bit + rb > avail {
                 error(
                     &mut rep,
-                    format!("{at}: record of {rb} bits leaves the block"),
+                    format!("{at}: record of {rb} bits leaves its line"),
                 );
                 continue;
             }
-            let key = v.block as usize * cbits as usize + v.bit as usize;
-            if seen[key / 64] & (1 << (key % 64)) != 0 {
-                error(&mut rep, format!("{at}: reached twice"));
+            let first_visit = !per_cluster.contains_key(&v.cluster);
+            if first_visit && !cover(&mut seen, base * 32, ROOT_BIT as usize) {
+                error(
+                    &mut rep,
+                    format!("{at}: the cluster's frame overlaps another record"),
+                );
                 continue;
             }
-            seen[key / 64] |= 1 << (key % 64);
-            per_block[v.block as usize] += 1;
+            *per_cluster.entry(v.cluster).or_insert(0) += 1;
+            if !cover(&mut seen, base * 32 + v.bit as usize, rb as usize) {
+                error(
+                    &mut rep,
+                    format!("{at}: reached twice or overlapping another record"),
+                );
+                continue;
+            }
+            st.used_bits += rb as u64 + if first_visit { ROOT_BIT as u64 } else { 0 };
             rep.max_depth = rep.max_depth.max(v.depth);
             let mut fw = [0u32; 4];
             fw.copy_from_slice(&cwords[..FRAME_WORDS]);
@@ -178,7 +195,7 @@ impl DstQ {
                 let hx = h.exact();
                 let mut p = [0.0f32; 2];
                 for (a, slot, _) in plane_roles(hx) {
-                    let q = read_bits(cwords, (v.bit + 32 + slot as u32 * k) as usize, k);
+                    let q = read_bits(cwords, (v.bit + hb + slot as u32 * k) as usize, k);
                     p[slot] = frame.plane(a, q);
                 }
                 p
@@ -186,9 +203,14 @@ impl DstQ {
             // Lockstep with the exact node.
             let ex = exact.and_then(|e| e.get(v.exact as usize));
             if let Some(en) = ex {
-                if en.hdr.header() != h.exact().header()
-                    || (h.is_leaf_flag() && en.hdr.offset() != h.run())
-                {
+                // A split's B field names its left record's size, which differs from the
+                // exact DST's left size in words: compare kind and axis for splits.
+                let same = if en.hdr.is_split() {
+                    h.node_kind() == DstNodeKind::Split && h.exact().axis() == en.hdr.axis()
+                } else {
+                    en.hdr.header() as u32 == h.code()
+                };
+                if !same || (h.is_leaf_flag() && en.hdr.offset() != h.run()) {
                     error(
                         &mut rep,
                         format!("{at}: {h:?} differs from the exact node {:?}", en.hdr),
@@ -246,16 +268,16 @@ impl DstQ {
                 self.check_run(&mut rep, &at, h.run(), &mut index_cover, &mut tri_refs);
                 continue;
             }
-            let (cb, cbit) = match h.child() {
-                ChildRef::Local(b) => (v.block, b),
+            let (cb, cbit) = match h.child(&fmt) {
+                ChildRef::Local(b) => (v.cluster, b),
                 ChildRef::Cluster(c) => (c, ROOT_BIT),
             };
             let hx = h.exact();
             if kind == DstNodeKind::Split {
-                let lsize = if h.left_is_internal() { 32 + 2 * k } else { 32 };
+                let lsize = h.left_bits(&fmt);
                 for (side, bit) in [(1, cbit.saturating_add(lsize)), (0, cbit)] {
                     stack.push(Visit {
-                        block: cb,
+                        cluster: cb,
                         bit,
                         depth: v.depth + 1,
                         exact: exact_kid(side),
@@ -263,16 +285,16 @@ impl DstQ {
                     });
                 }
                 // The left size field must name the left record's real size.
-                if (cb as usize) < n_blocks && cbit + 32 <= cbits {
-                    let lw = read_bits(&words[cb as usize * cw..][..cw], cbit as usize, 32);
-                    let real = QHeader::from_bits(lw).record_bits(k);
+                if (cb as usize) < n_words && cbit as usize + 32 <= (n_words - cb as usize) * 32 {
+                    let lw = read_bits(&words[cb as usize..n_words], cbit as usize, 32);
+                    let real = QHeader::read(lw, &fmt).record_bits(&fmt);
                     if real != lsize {
                         error(&mut rep, format!("{at}: left size {lsize} but {real} bits"));
                     }
                 }
             } else {
                 stack.push(Visit {
-                    block: cb,
+                    cluster: cb,
                     bit: cbit,
                     depth: v.depth + 1,
                     exact: exact_kid(0),
@@ -280,16 +302,17 @@ impl DstQ {
                 });
             }
         }
-        // Record counts in the frames, every block reached, every entry and triangle once.
-        for (b, &n) in per_block.iter().enumerate() {
-            let stored = cluster_count(words, b * cw);
+        // Record counts in the frames, every cluster reached, every entry and triangle once.
+        for (&b, &n) in &per_cluster {
+            let stored = cluster_count(words, b as usize);
             if n.min(255) != stored as u32 {
                 error(
                     &mut rep,
-                    format!("block {b}: frame says {stored} records, {n} reached"),
+                    format!("cluster at word {b}: frame says {stored} records, {n} reached"),
                 );
             }
         }
+        st.clusters = per_cluster.len() as u64;
         let unused = index_cover.iter().filter(|&&c| c == 0).count();
         if unused > 0 {
             error(
@@ -304,15 +327,7 @@ impl DstQ {
             }
         }
         st.index_entries = img.indices.len() as u64;
-        st.used_bits = self.used_bits_estimate(&st);
         (rep, st)
-    }
-
-    fn used_bits_estimate(&self, st: &DstQStats) -> u64 {
-        let internal = st.splitting + st.single_carving + st.dual_carving;
-        internal * self.config.internal_record_bits() as u64
-            + 32 * st.leaves
-            + ROOT_BIT as u64 * self.clusters()
     }
 
     fn check_run(
@@ -352,7 +367,17 @@ impl DstQ {
     }
 }
 
-/// The record count stored in byte 3 of a block's frame word 3.
+/// Marks bits `at..at + n` of `seen`; false when one of them already was.
+fn cover(seen: &mut [u64], at: usize, n: usize) -> bool {
+    let mut fresh = true;
+    for b in at..at + n {
+        fresh &= seen[b / 64] & (1 << (b % 64)) == 0;
+        seen[b / 64] |= 1 << (b % 64);
+    }
+    fresh
+}
+
+/// The record count stored in byte 3 of a cluster's frame word 3.
 fn cluster_count(words: &[u32], base: usize) -> u8 {
     (words[base + 3] >> 24) as u8
 }
