@@ -2,10 +2,10 @@
 //! `rt.dstqp` computes) drives a traversal that answers every ray as the quantized DST's own
 //! traversal does: the same closest hit (t bits, triangle id) and shadow answer, visiting
 //! the same records in the same order. The loop is the compiled kernel's (`kernels/dstq.h`):
-//! the frame and three record words per step, a stack of (bit address, interval).
+//! the frame and three record words per step, a stack of (record name, interval).
 
 use dualsplit_accel::dst::pipeline::ReturnCode;
-use dualsplit_accel::dstq::unit::{UNIT_BITS, UNIT_CLUSTER_BYTES, unit_step};
+use dualsplit_accel::dstq::unit::{POS_BITS, UNIT_BITS, unit_step};
 use dualsplit_accel::dstq::{DstQ, layout::ROOT_BIT};
 use dualsplit_accel::image::RUN_END;
 use dualsplit_accel::{BuildConfig, CountingObserver, Structures};
@@ -36,9 +36,9 @@ fn unit_traverse(q: &DstQ, ray: &Ray, any: bool) -> (Option<Hit>, u64) {
     let word = |i: usize| words.get(i).copied().unwrap_or(0);
     loop {
         steps += 1;
-        let block_word = (node / (UNIT_CLUSTER_BYTES * 8) * UNIT_CLUSTER_BYTES / 4) as usize;
-        let frame = [0, 1, 2, 3].map(|i| word(block_word + i));
-        let w0 = (node / 32) as usize;
+        let cluster = (node >> POS_BITS) as usize;
+        let frame = [0, 1, 2, 3].map(|i| word(cluster + i));
+        let w0 = cluster + ((node & ((1 << POS_BITS) - 1)) / 32) as usize;
         let rec = [0, 1, 2].map(|i| word(w0 + i));
         let out = unit_step(
             frame,

@@ -53,7 +53,9 @@ fn from_rt_h() -> BTreeMap<String, (u32, u32, char, Option<u32>)> {
             .take()
             .expect(".insn without a function name before it");
         let mnemonic = match n.as_str() {
-            "rt_dst_tmin" | "rt_dst_tmax" | "rt_dst_offset_stack" | "rt_dst_code" => "rt.dstget".to_string(),
+            "rt_dst_tmin" | "rt_dst_tmax" | "rt_dst_offset_stack" | "rt_dst_code" => {
+                "rt.dstget".to_string()
+            }
             "rt_boxexit" => "rt.boxget".to_string(),
             other => other.replacen("rt_", "rt.", 1),
         };
