@@ -212,8 +212,8 @@ static inline uint32_t rt_qboxnp(float t_lo, float t_hi)
 }
 
 /* One quantized dual-split pipeline step on the DST-Q record named `at` (its cluster's word
- * address << 9 | its bit position in the cluster; the cluster's frame in P[0..4], the three
- * words from the one holding the record's first bit in P[4..7]): the name of the record to
+ * address << 9 | its bit position in the cluster; the cluster's frame in P[32..36], the
+ * three words from the one holding the record's first bit in P[36..39]): the name of the record to
  * continue at, or the triangle run's index entry; the rest goes to the DST latch
  * (rt_dst_code, rt_dst_tmin, rt_dst_tmax, rt_dst_offset_stack: the far child's name). */
 static inline uint32_t rt_dstqp(uint32_t at, float t_min, float t_max)

@@ -262,7 +262,7 @@ pub enum Op {
     /// `rt.qboxnp`: `rt.qboxn` on the node in `P[0..20]`.
     RtQBoxNP,
     /// `rt.dstqp`: the DST-Q record named by `x[rs1]` (cluster word address << 9 | bit
-    /// position; frame in `P[0..4]`, the record's words in `P[4..7]`): `x[rd]` = the next
+    /// position; frame in `P[32..36]`, the record's words in `P[36..39]`): `x[rd]` = the next
     /// record's name or the run's index entry, the rest (code included) to `D`.
     RtDstQP,
     /// A word that does not decode (`imm` = the word); executing it is an error.

@@ -814,8 +814,8 @@ impl Hart {
             RtDstQP => {
                 let p = &self.pipe_in;
                 let out = dstq_unit_step(
-                    [p[0], p[1], p[2], p[3]],
-                    [p[4], p[5], p[6]],
+                    [p[32], p[33], p[34], p[35]],
+                    [p[36], p[37], p[38]],
                     a!(),
                     self.ray.ray.origin.to_array(),
                     self.ray.inv_dir.to_array(),
