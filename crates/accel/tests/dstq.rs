@@ -668,7 +668,7 @@ fn measure(name: &str, configs: &[DstQConfig]) {
 }
 
 #[test]
-#[ignore = "prints the measurement table of docs/dstq-encoding.md (release build, ~1 min)"]
+#[ignore = "prints the measurement table of docs/dstq-encoding.md (release build, about 5 s)"]
 fn measure_table() {
     let cfgs = configs();
     for name in ["dragon_res4.ply.gz", "bunny.ply.gz"] {
