@@ -137,31 +137,7 @@ impl<'a> Producer<'a> {
     /// the paper's configurations at every TM count when `scaling` (Table 7), and the
     /// "Beyond the paper" configurations in both workloads at [`BEYOND_TMS`].
     fn sim_plan(&self, scaling: bool) -> Vec<(SimAccel, Workload, u32)> {
-        let s = &self.settings;
-        let mut plan = Vec::new();
-        for workload in [Workload::Cast, Workload::Path] {
-            for accel in SimAccel::ALL {
-                plan.push((accel, workload, s.base_tms));
-            }
-        }
-        if scaling {
-            for &tms in &s.tms {
-                if tms != s.base_tms {
-                    for accel in SimAccel::PAPER {
-                        plan.push((accel, Workload::Path, tms));
-                    }
-                }
-            }
-        }
-        for workload in [Workload::Cast, Workload::Path] {
-            for accel in SimAccel::BEYOND {
-                let job = (accel, workload, BEYOND_TMS);
-                if !plan.contains(&job) {
-                    plan.push(job);
-                }
-            }
-        }
-        plan
+        sim_jobs(self.settings.base_tms, &self.settings.tms, scaling)
     }
 
     /// The scenes that get the TM-scaling study: those standing for the paper's Crytek
@@ -577,6 +553,39 @@ pub fn cpu_data(scene: &Scene, cpu_res: u32) -> Result<CpuData, ReportError> {
         throughput,
         counts,
     })
+}
+
+/// The simulated jobs of one scene (configuration, workload, TM count) for a report at
+/// `base_tms` with the scaling study at `tms`: every configuration × workload at the base
+/// count (Tables 4–6, and the quantized structures for "Beyond the paper"), path tracing
+/// with the paper's configurations at every other count of `tms` when `scaling` (Table 7),
+/// and the "Beyond the paper" configurations in both workloads at [`BEYOND_TMS`]; each job
+/// once.
+pub fn sim_jobs(base_tms: u32, tms: &[u32], scaling: bool) -> Vec<(SimAccel, Workload, u32)> {
+    let mut plan = Vec::new();
+    for workload in [Workload::Cast, Workload::Path] {
+        for accel in SimAccel::ALL {
+            plan.push((accel, workload, base_tms));
+        }
+    }
+    if scaling {
+        for &t in tms {
+            if t != base_tms {
+                for accel in SimAccel::PAPER {
+                    plan.push((accel, Workload::Path, t));
+                }
+            }
+        }
+    }
+    for workload in [Workload::Cast, Workload::Path] {
+        for accel in SimAccel::BEYOND {
+            let job = (accel, workload, BEYOND_TMS);
+            if !plan.contains(&job) {
+                plan.push(job);
+            }
+        }
+    }
+    plan
 }
 
 /// The structures whose per-ray work "Beyond the paper" compares: the BVH8 and its

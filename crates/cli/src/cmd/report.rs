@@ -7,12 +7,13 @@
 
 use crate::progress::Ctx;
 use anyhow::Context;
+use dualsplit_render::Workload;
 use dualsplit_report::data::{ReportSettings, Skipped};
 use dualsplit_report::paper::PaperScene;
-use dualsplit_report::produce::real_simulator;
+use dualsplit_report::produce::{BEYOND_TMS, real_simulator, sim_jobs};
 use dualsplit_report::scenes::{self, SceneFiles};
 use dualsplit_report::{Cache, Producer, Progress};
-use dualsplit_sim::ThreadModel;
+use dualsplit_sim::{SimAccel, ThreadModel};
 use indicatif::ProgressBar;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -290,16 +291,20 @@ struct Plan<'a> {
 }
 
 impl Plan<'_> {
-    /// Simulated frames: every configuration, cast and path, per scene at the base TM
-    /// count, and path at the other TM counts on the scaling scenes (Table 7).
+    /// Every scene's simulated jobs ([`dualsplit_report::produce::sim_jobs`]).
+    fn jobs(&self) -> Vec<(SimAccel, Workload, u32)> {
+        Producer::scaling_specs(self.specs)
+            .into_iter()
+            .flat_map(|scaling| sim_jobs(self.base_tms, self.tms, scaling))
+            .collect()
+    }
+
+    /// Simulated frames at the base TM count and at the other counts (the TM-scaling study
+    /// of Table 7 and "Beyond the paper" at 128 TMs).
     fn frames(&self) -> (usize, usize) {
-        let scaling = Producer::scaling_specs(self.specs)
-            .iter()
-            .filter(|&&b| b)
-            .count();
-        let extra_tms = self.tms.iter().filter(|&&t| t != self.base_tms).count();
-        let n = dualsplit_sim::SimAccel::ALL.len();
-        (self.specs.len() * 2 * n, scaling * extra_tms * n)
+        let jobs = self.jobs();
+        let base = jobs.iter().filter(|j| j.2 == self.base_tms).count();
+        (base, jobs.len() - base)
     }
 
     /// Wall seconds the simulations take on a 2-core machine, from the rays of the frames
@@ -307,8 +312,11 @@ impl Plan<'_> {
     /// scenes) and the measured simulation speed.
     fn seconds(&self) -> f64 {
         let pixels = f64::from(self.res) * f64::from(self.res);
-        let (base, scaling) = self.frames();
-        let rays = base as f64 / 2.0 * pixels * (1.5 + 6.0) + scaling as f64 * pixels * 6.0;
+        let per_pixel = |w: Workload| match w {
+            Workload::Cast => 1.5,
+            Workload::Path => 6.0,
+        };
+        let rays: f64 = self.jobs().iter().map(|j| pixels * per_pixel(j.1)).sum();
         rays / match self.thread_model {
             ThreadModel::Rv32 => SIM_RAYS_PER_SECOND_RV32,
             ThreadModel::Fast => SIM_RAYS_PER_SECOND,
@@ -327,12 +335,15 @@ impl Plan<'_> {
         };
         format!(
             "plan: {} scenes ({}) at {r}×{r}, {} thread model; {base} frames at {} TMs \
-             (8 configurations, cast and path) and {scaling} TM-scaling frames at {:?} TMs; \
-             simulations roughly {when} on a 2-core machine (cached frames are skipped)",
+             ({} configurations, cast and path) and {scaling} frames at other TM counts (the \
+             paper's configurations at {:?} TMs on the scaling scenes, and BVH2, BVH8, BVH8+, \
+             DST and the quantized structures at {BEYOND_TMS}); simulations roughly {when} \
+             on a 2-core machine (cached frames are skipped)",
             self.specs.len(),
             self.specs.join(", "),
             self.thread_model.name(),
             self.base_tms,
+            SimAccel::ALL.len(),
             self.tms,
             r = self.res,
         )

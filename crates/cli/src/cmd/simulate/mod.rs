@@ -255,9 +255,15 @@ fn print_result(r: &SimResult, host: Duration) {
         i.loads,
         i.box_issues,
         i.tri_ops,
-        i.dst_ops,
+        i.dst_ops + i.qdst_ops,
         i.atomics
     );
+    if i.qbox_ops + i.qdst_ops > 0 {
+        println!(
+            "  quantized      box ops {} (dequantized child boxes), dual-split ops {} (records)",
+            i.qbox_ops, i.qdst_ops
+        );
+    }
     println!(
         "  utilisation    issue {:.1} %, ray-box {:.1} %, ray-triangle {:.1} %, dual-split {:.1} %",
         100.0 * u.issue,

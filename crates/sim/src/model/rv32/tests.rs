@@ -552,7 +552,7 @@ fn decode_errors_and_rounding_modes() {
     // Custom instructions with bad function fields.
     assert!(decode(r4(0x2B, 1, 3, 1, 2, 3, 4)).is_err()); // boxn N = 16
     assert!(decode(r(0x2B, 2, 9, 1, 0, 0)).is_err()); // boxget k = 9
-    assert!(decode(r(0x2B, 5, 3, 1, 0, 0)).is_err()); // dstget field 3
+    assert!(decode(r(0x2B, 5, 4, 1, 0, 0)).is_err()); // dstget field 4
     assert!(decode(r(0x0B, 6, 0, 1, 0, 0)).is_err());
     // CSRs read 0; writing frm = RNE is fine, another mode is an error.
     let prog = Program::from_words(BASE, &[i(0x73, 2, 5, 0, 2), i(0x73, 5, 0, 1, 2), EBREAK]);
