@@ -2,7 +2,9 @@
 //!
 //! ```text
 //!   Bvh2 (build/) ──collapse──▶ BVH4 (Dammertz), BVH8 (Ylitie)     (wide/)
+//!        │                          └──quantize──▶ CWBVH, 80-B nodes (cwbvh/)
 //!        └──────────convert──▶ DST, identical bounds               (dst/)
+//!                                   └──quantize──▶ DST-Q, clusters  (dstq/)
 //!   each encoded into a byte-exact MemoryImage (image.rs) that its traversal reads
 //! ```
 //!
@@ -28,9 +30,10 @@
 //! # Ok::<(), dualsplit_accel::AccelError>(())
 //! ```
 //!
-//! * Structures: [`Bvh2Tree::build`]; [`BvhTree::bvh4_from`], [`BvhTree::bvh8_from`] and
-//!   [`DstTree::from_bvh2`] derive the others from a BVH2, each with its [`BuildStats`]
-//!   (times in milliseconds).
+//! * Structures: [`Bvh2Tree::build`]; [`BvhTree::bvh4_from`], [`BvhTree::bvh8_from`],
+//!   [`DstTree::from_bvh2`] and the quantized [`CwbvhTree::from_bvh2`] (compressed BVH8,
+//!   [`cwbvh`]) and [`DstQTree::from_bvh2`] (quantized DST, [`dstq`]) derive the others from
+//!   a BVH2, each with its [`BuildStats`] (times in milliseconds).
 //! * Queries: [`RayQuery`] (`intersect`, `occluded`, batch forms, and the `_observed` forms
 //!   the simulator uses). The plain and batch forms observe nothing, so they run the
 //!   CPU-side path ([`Observer::OBSERVES_NOTHING`]: [`wide::cpu`] for a BVH, the DST's plain

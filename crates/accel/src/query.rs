@@ -71,63 +71,37 @@ pub trait RayQuery: Sync {
     }
 }
 
-impl RayQuery for BvhImage {
-    #[inline]
-    fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        self.closest_hit(ray, obs)
-    }
-    #[inline]
-    fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
-        self.any_hit(ray, obs)
-    }
-    fn triangles(&self) -> &[Triangle] {
-        self.image.triangle_slice()
-    }
+/// `RayQuery` for a structure whose `closest_hit` and `any_hit` take an [`Observer`]: the
+/// observed queries are those, the triangles `$tris`.
+macro_rules! query_by_traversal {
+    ($(#[$doc:meta])* $ty:ty, |$s:ident| $tris:expr) => {
+        $(#[$doc])*
+        impl RayQuery for $ty {
+            #[inline]
+            fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+                self.closest_hit(ray, obs)
+            }
+            #[inline]
+            fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+                self.any_hit(ray, obs)
+            }
+            fn triangles(&self) -> &[Triangle] {
+                let $s = self;
+                $tris
+            }
+        }
+    };
 }
 
-/// A [`Dst`] queried through its software decoder (the paper's DST\*, [`crate::AccelKind::DstSw`]):
-/// the fast CPU traversal.
-impl RayQuery for Dst {
-    #[inline]
-    fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        self.closest_hit(ray, obs)
-    }
-    #[inline]
-    fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
-        self.any_hit(ray, obs)
-    }
-    fn triangles(&self) -> &[Triangle] {
-        Dst::triangles(self)
-    }
-}
-
-impl RayQuery for crate::cwbvh::Cwbvh {
-    #[inline]
-    fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        self.closest_hit(ray, obs)
-    }
-    #[inline]
-    fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
-        self.any_hit(ray, obs)
-    }
-    fn triangles(&self) -> &[Triangle] {
-        self.image().triangle_slice()
-    }
-}
-
-impl RayQuery for crate::dstq::DstQ {
-    #[inline]
-    fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        self.closest_hit(ray, obs)
-    }
-    #[inline]
-    fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
-        self.any_hit(ray, obs)
-    }
-    fn triangles(&self) -> &[Triangle] {
-        self.image().triangle_slice()
-    }
-}
+query_by_traversal!(BvhImage, |s| s.image.triangle_slice());
+query_by_traversal!(
+    /// A [`Dst`] queried through its software decoder (the paper's DST\*,
+    /// [`crate::AccelKind::DstSw`]): the fast CPU traversal.
+    Dst,
+    |s| Dst::triangles(s)
+);
+query_by_traversal!(crate::cwbvh::Cwbvh, |s| s.image().triangle_slice());
+query_by_traversal!(crate::dstq::DstQ, |s| s.image().triangle_slice());
 
 /// A [`Dst`] queried through the model of the paper's hardware dual-split pipeline
 /// ([`crate::AccelKind::Dst`]): every node step is computed by the pipeline's step function.

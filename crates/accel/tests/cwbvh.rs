@@ -19,7 +19,7 @@ use dualsplit_accel::{
 use dualsplit_geometry::{Aabb, Pcg32, Ray, Triangle, Vec3};
 use dualsplit_testkit::oracle::{hit_bits, oracle_any, oracle_closest};
 use dualsplit_testkit::rays::{random_rays, record_rays};
-use dualsplit_testkit::scenes::{cuboid, room, shipped, sphere};
+use dualsplit_testkit::scenes::{cuboid, random_scene, room, shipped, sphere};
 use proptest::prelude::*;
 use rayon::prelude::*;
 
@@ -203,41 +203,6 @@ fn equivalence_cuboids_and_spheres() {
         check_closest(&b, &copies, ray, &format!("cuboids {i}"));
         check_any(&b, &copies, ray, &format!("cuboids {i}"));
     }
-}
-
-/// Scene shapes of `dst_random.rs`: 0 free triangles, 1 grid-snapped, 2 axis-aligned
-/// triangles, 3 flat scene.
-fn random_scene(seed: u64, n: usize, shape: u32, scale: f32) -> Vec<Triangle> {
-    let mut rng = Pcg32::new(seed, 7);
-    let pt = |rng: &mut Pcg32| {
-        let p = Vec3::new(
-            rng.range_f32(-4.0, 4.0),
-            rng.range_f32(-4.0, 4.0),
-            rng.range_f32(-4.0, 4.0),
-        );
-        let p = match shape {
-            1 | 2 => p.round(),
-            3 => Vec3::new(p.x, p.y, 1.0),
-            _ => p,
-        };
-        p * scale
-    };
-    (0..n)
-        .map(|_| {
-            let a = pt(&mut rng);
-            let mut b = pt(&mut rng);
-            let mut c = pt(&mut rng);
-            if shape == 2 {
-                let axis = rng.below(3) as usize;
-                b[axis] = a[axis];
-                c[axis] = a[axis];
-            } else if shape == 0 {
-                b = a + (b - a) * 0.3;
-                c = a + (c - a) * 0.3;
-            }
-            Triangle::new(a, b, c)
-        })
-        .collect()
 }
 
 fn run_random(tris: &[Triangle], leaf: u32, seed: u64) {

@@ -9,45 +9,11 @@ use dualsplit_testkit::dst::{build, build_with, check_all, check_dst_ray, dst_pr
 use dualsplit_testkit::grazing::{GRAZING_CASES, grazing_case};
 use dualsplit_testkit::oracle::oracle_closest;
 use dualsplit_testkit::rays::random_rays;
+use dualsplit_testkit::scenes::random_scene;
 use proptest::prelude::*;
 
-/// Scene shapes: 0 free triangles, 1 grid-snapped (coincident planes, coordinates 0.0),
-/// 2 axis-aligned triangles (each lying in a coordinate plane), 3 flat scene (one z).
-fn scene(seed: u64, n: usize, shape: u32) -> Vec<Triangle> {
-    let mut rng = Pcg32::new(seed, 7);
-    let pt = |rng: &mut Pcg32| {
-        let p = Vec3::new(
-            rng.range_f32(-4.0, 4.0),
-            rng.range_f32(-4.0, 4.0),
-            rng.range_f32(-4.0, 4.0),
-        );
-        match shape {
-            1 | 2 => p.round(),
-            3 => Vec3::new(p.x, p.y, 1.0),
-            _ => p,
-        }
-    };
-    (0..n)
-        .map(|_| {
-            let a = pt(&mut rng);
-            let mut b = pt(&mut rng);
-            let mut c = pt(&mut rng);
-            if shape == 2 {
-                let axis = rng.below(3) as usize;
-                b[axis] = a[axis];
-                c[axis] = a[axis];
-            } else if shape == 0 {
-                // Mostly small triangles so boxes differ.
-                b = a + (b - a) * 0.3;
-                c = a + (c - a) * 0.3;
-            }
-            Triangle::new(a, b, c)
-        })
-        .collect()
-}
-
 fn run_case(seed: u64, n: usize, shape: u32, leaf: u32) {
-    let tris = scene(seed, n, shape);
+    let tris = random_scene(seed, n, shape, 1.0);
     let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
     let scene_box = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
     let bcfg = BuildConfig {

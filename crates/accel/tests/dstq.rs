@@ -17,7 +17,7 @@ use dualsplit_accel::{
 use dualsplit_geometry::{Aabb, Pcg32, Ray, Triangle, Vec3};
 use dualsplit_testkit::oracle::{key, oracle_closest};
 use dualsplit_testkit::rays::{random_rays, record_rays};
-use dualsplit_testkit::scenes::shipped;
+use dualsplit_testkit::scenes::{random_scene, shipped};
 use proptest::prelude::*;
 use std::collections::HashSet;
 
@@ -232,40 +232,6 @@ fn one_triangle() -> Vec<Triangle> {
     )]
 }
 
-/// Scene shapes of `tests/dst_random.rs`: 0 free small triangles, 1 grid-snapped, 2
-/// axis-aligned triangles in coordinate planes, 3 flat (one z).
-fn scene(seed: u64, n: usize, shape: u32) -> Vec<Triangle> {
-    let mut rng = Pcg32::new(seed, 7);
-    let pt = |rng: &mut Pcg32| {
-        let p = Vec3::new(
-            rng.range_f32(-4.0, 4.0),
-            rng.range_f32(-4.0, 4.0),
-            rng.range_f32(-4.0, 4.0),
-        );
-        match shape {
-            1 | 2 => p.round(),
-            3 => Vec3::new(p.x, p.y, 1.0),
-            _ => p,
-        }
-    };
-    (0..n)
-        .map(|_| {
-            let a = pt(&mut rng);
-            let mut b = pt(&mut rng);
-            let mut c = pt(&mut rng);
-            if shape == 2 {
-                let axis = rng.below(3) as usize;
-                b[axis] = a[axis];
-                c[axis] = a[axis];
-            } else if shape == 0 {
-                b = a + (b - a) * 0.3;
-                c = a + (c - a) * 0.3;
-            }
-            Triangle::new(a, b, c)
-        })
-        .collect()
-}
-
 fn random_case(tris: &[Triangle], seed: u64, leaf: u32, similar: bool, scale: f32) {
     let tris: Vec<Triangle> = tris
         .iter()
@@ -312,7 +278,7 @@ proptest! {
         similar in any::<bool>(),
         scale in prop::sample::select(vec![1.0f32, 1e-30, 1e15, 3.0e17]),
     ) {
-        random_case(&scene(seed, n, shape), seed, leaf, similar, scale);
+        random_case(&random_scene(seed, n, shape, 1.0), seed, leaf, similar, scale);
     }
 }
 
@@ -332,10 +298,10 @@ fn edge_scenes_match_bvh2() {
     // Triangles in axis planes, a flat scene, a scene far from the origin.
     for shape in 0..4 {
         for seed in 0..6 {
-            random_case(&scene(seed, 40, shape), seed, 1, false, 1.0);
+            random_case(&random_scene(seed, 40, shape, 1.0), seed, 1, false, 1.0);
         }
     }
-    let far: Vec<Triangle> = scene(9, 40, 0)
+    let far: Vec<Triangle> = random_scene(9, 40, 0, 1.0)
         .iter()
         .map(|t| {
             let o = Vec3::splat((1u64 << 40) as f32);
@@ -344,7 +310,7 @@ fn edge_scenes_match_bvh2() {
         .collect();
     random_case(&far, 9, 2, false, 1.0);
     // Rays with zero direction components along the planes of a grid scene.
-    let tris = scene(3, 30, 1);
+    let tris = random_scene(3, 30, 1, 1.0);
     let s = Structures::build(&tris, &BuildConfig::default());
     let qs = build_all(&s, "grid");
     for t in &tris {
@@ -397,7 +363,7 @@ fn observer_reports_word_accurate_fetches() {
             self.0.push((addr, bytes));
         }
     }
-    let tris = scene(4, 40, 0);
+    let tris = random_scene(4, 40, 0, 1.0);
     let s = Structures::build(&tris, &BuildConfig::default());
     let b = s.dst.scene_box();
     let rays = random_rays(&mut Pcg32::new(1, 2), &tris, &b, 200);
@@ -428,7 +394,7 @@ fn observer_reports_word_accurate_fetches() {
 fn dragon_or_random() -> Structures {
     match shipped("dragon_res4.ply.gz") {
         Some(sc) => Structures::build(&sc.triangles, &BuildConfig::default()),
-        None => Structures::build(&scene(2, 400, 0), &BuildConfig::default()),
+        None => Structures::build(&random_scene(2, 400, 0, 1.0), &BuildConfig::default()),
     }
 }
 
@@ -522,7 +488,7 @@ proptest! {
         seed in any::<u64>(),
         edits in prop::collection::vec((any::<u32>(), any::<u32>()), 1..24),
     ) {
-        let tris = scene(seed, 30, 0);
+        let tris = random_scene(seed, 30, 0, 1.0);
         let s = Structures::build(&tris, &BuildConfig::default());
         let cfg = DstQConfig::default();
         let q = DstQ::from_dst(&s.dst, &cfg).unwrap();

@@ -8,7 +8,7 @@
 //! neither folder holds the file, so a test needing a large mesh skips on a fresh clone; when
 //! the `CI` environment variable is set they panic with that reason instead.
 
-use dualsplit_geometry::{Triangle, Vec3};
+use dualsplit_geometry::{Pcg32, Triangle, Vec3};
 use dualsplit_scene::{Camera, Light, LoadStats, Scene};
 use std::path::{Path, PathBuf};
 
@@ -192,4 +192,42 @@ pub fn room(closed: bool, seg: u32) -> Scene {
         intensity: 1.0,
     };
     s
+}
+
+/// `n` random triangles from `seed`, scaled by `scale`, in one of four shapes: 0 free small
+/// triangles (the second and third vertex pulled towards the first, so boxes differ), 1
+/// grid-snapped (coordinates rounded: coincident planes, coordinates 0.0), 2 axis-aligned
+/// (each triangle lying in a coordinate plane, on the grid), 3 flat (one z). Coordinates in
+/// [−4, 4] before scaling. The structures' random-scene tests share it.
+pub fn random_scene(seed: u64, n: usize, shape: u32, scale: f32) -> Vec<Triangle> {
+    let mut rng = Pcg32::new(seed, 7);
+    let pt = |rng: &mut Pcg32| {
+        let p = Vec3::new(
+            rng.range_f32(-4.0, 4.0),
+            rng.range_f32(-4.0, 4.0),
+            rng.range_f32(-4.0, 4.0),
+        );
+        let p = match shape {
+            1 | 2 => p.round(),
+            3 => Vec3::new(p.x, p.y, 1.0),
+            _ => p,
+        };
+        p * scale
+    };
+    (0..n)
+        .map(|_| {
+            let a = pt(&mut rng);
+            let mut b = pt(&mut rng);
+            let mut c = pt(&mut rng);
+            if shape == 2 {
+                let axis = rng.below(3) as usize;
+                b[axis] = a[axis];
+                c[axis] = a[axis];
+            } else if shape == 0 {
+                b = a + (b - a) * 0.3;
+                c = a + (c - a) * 0.3;
+            }
+            Triangle::new(a, b, c)
+        })
+        .collect()
 }
