@@ -4,7 +4,7 @@
 //! the same records in the same order. The loop is the compiled kernel's (`kernels/dstq.h`):
 //! the frame and three record words per step, a stack of (record name, interval).
 
-use dualsplit_accel::dst::pipeline::ReturnCode;
+use dualsplit_accel::dst::pipeline::{ReturnCode, le_or_nan};
 use dualsplit_accel::dstq::unit::{POS_BITS, UNIT_BITS, unit_step};
 use dualsplit_accel::dstq::{DstQ, layout::ROOT_BIT};
 use dualsplit_accel::image::RUN_END;
@@ -85,7 +85,7 @@ fn unit_traverse(q: &DstQ, ray: &Ray, any: bool) -> (Option<Hit>, u64) {
             let Some((n, lo, hi)) = stack.pop() else {
                 return (best, steps);
             };
-            if !(lo > limit) {
+            if le_or_nan(lo, limit) {
                 (node, t_min, t_max) = (n, lo, hi.min(limit));
                 break;
             }
