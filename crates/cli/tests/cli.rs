@@ -246,12 +246,13 @@ fn simulate_compares_configurations_and_keeps_every_number_in_json() {
         .skip(2)
         .take_while(|l| !l.starts_with("note"))
         .collect();
-    assert_eq!(rows.len(), 8, "{table}");
+    assert_eq!(rows.len(), 11, "{table}");
     assert!(
         rows[0].starts_with("BVH2 ") && rows[0].contains("100.0 %"),
         "{table}"
     );
     assert!(rows[7].starts_with("DST "), "{table}");
+    assert!(rows[10].starts_with("DST-Q "), "{table}");
     // 32 pixels on 2048 threads: the chip is idle, and the output says so.
     assert!(out.contains("note: threads sat idle"), "{out}");
 

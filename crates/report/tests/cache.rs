@@ -42,12 +42,15 @@ fn second_run_computes_nothing() {
         calls.fetch_add(1, Ordering::Relaxed);
         fake_simulate(a, b, c, d, e, f)
     };
-    // hairball-test stands in for Hairball, so it gets the TM study: 16 + 16 runs; the
-    // other scene 16. Plus a CPU and a render piece per scene.
+    // Each scene: the 11 configurations cast and path at 64 TMs (22) and "Beyond the paper"
+    // at 128 TMs (7 configurations, cast and path: 14). hairball-test stands in for
+    // Hairball, so it also gets the TM study of the paper's 8 (path at 32 and 128: 16), of
+    // which BVH2, BVH8, BVH8+ and DST at 128 are Beyond's already (−4): 48; the other 36.
+    // Plus a CPU and a render piece per scene.
     let p = Producer::new(Cache::new(&dir), settings(4), &NoProgress, &sim);
     let first = p.run(&scenes, vec![]).unwrap();
     let runs: usize = first.scenes.iter().map(|s| s.sim.len()).sum();
-    assert_eq!(runs, 16 + 16 + 16);
+    assert_eq!(runs, (22 + 16 + 14 - 4) + (22 + 14));
     // DST runs are simulated only once the accel crate builds a DST.
     let expect_sims = first
         .scenes
