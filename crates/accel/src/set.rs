@@ -1,5 +1,5 @@
 //! [`TraversalSet`]: the structures a workload runs on, each traversal chosen by its
-//! [`AccelKind`]. Two sets exist: every structure of a scene ([`Structures`], all five
+//! [`AccelKind`]. Two sets exist: every structure of a scene ([`Structures`], all seven
 //! kinds) and one saved or built tree ([`AnyTree`], the kinds of
 //! [`TreeKind::accel_kinds`](crate::TreeKind::accel_kinds): `dst-sw` and `dst` for a DST,
 //! its own kind for a BVH). The renderer, the benchmarks and the simulator take either.

@@ -86,7 +86,7 @@ pub fn check_dst_ray(dst: &Dst, ray: &Ray, expected: Option<Hit>, what: &str) {
     );
 }
 
-/// Checks one ray on all five structures of `b` against the oracle
+/// Checks one ray on all seven traversals of `b` against the oracle
 /// ([`crate::oracle::check_ray`]), naming the DST's partitioning mode. With exits widened by
 /// `dualsplit_geometry::EXIT_WIDEN` no structure may round a grazing hit away, so there is
 /// no allowance.

@@ -4,7 +4,7 @@
 //!
 //! | module | what it gives |
 //! |---|---|
-//! | [`oracle`] | the brute-force closest hit and any hit; per-ray checks of all five CPU structures against them |
+//! | [`oracle`] | the brute-force closest hit and any hit; per-ray checks of all seven CPU traversals against them |
 //! | [`dst`] | a BVH2 and its DST built together, and the per-ray check of both DST traversals |
 //! | [`scenes`] | shipped meshes and a synthetic room built in code |
 //! | [`rays`] | rays from the renderer's path-tracing jobs; random rays aimed at the edge cases |

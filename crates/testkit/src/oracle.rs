@@ -30,8 +30,9 @@ pub fn key(h: Option<Hit>) -> Option<(u32, PrimId)> {
     h.map(|h| (h.t.to_bits(), h.prim))
 }
 
-/// Checks one ray on all five CPU structures of `s` ([`AccelKind::ALL`]: BVH2, BVH4, BVH8,
-/// the DST software decoder and the DST pipeline loop) against the oracle over `tris`: the
+/// Checks one ray on all seven CPU traversals of `s` ([`AccelKind::ALL`]: BVH2, BVH4, BVH8,
+/// the DST software decoder, the DST pipeline loop, the compressed BVH8 and the quantized
+/// DST) against the oracle over `tris`: the
 /// closest hit's `t` bits and triangle id, and the any-hit answer. `what` names the case in
 /// the failure message.
 ///
