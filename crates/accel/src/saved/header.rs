@@ -37,13 +37,8 @@ pub(super) enum Extra {
     },
     /// A compressed 8-wide BVH.
     Cwbvh { internal_nodes: u64, leaves: u64 },
-    /// A quantized dual-split tree.
-    DstQ {
-        config: DstQConfig,
-        scene_box: Aabb,
-        internal_nodes: u64,
-        leaves: u64,
-    },
+    /// A quantized dual-split tree (no counts: the tree has none but its walk's).
+    DstQ { config: DstQConfig, scene_box: Aabb },
 }
 
 /// The decoded header.
@@ -190,17 +185,10 @@ impl Header {
                 o.u64(internal_nodes);
                 o.u64(leaves);
             }
-            Extra::DstQ {
-                config,
-                scene_box,
-                internal_nodes,
-                leaves,
-            } => {
+            Extra::DstQ { config, scene_box } => {
                 o.u32(config.bits);
                 o.u32(config.cluster_bytes);
                 o.scene_box(scene_box);
-                o.u64(internal_nodes);
-                o.u64(leaves);
             }
         }
         o.0.resize(HEADER_BYTES, 0);
@@ -314,8 +302,6 @@ impl Header {
                 Extra::DstQ {
                     config,
                     scene_box: i.scene_box(),
-                    internal_nodes: i.u64(),
-                    leaves: i.u64(),
                 }
             }
             TreeKind::Bvh2 | TreeKind::Bvh4 | TreeKind::Bvh8 => Extra::Bvh {

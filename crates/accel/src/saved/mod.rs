@@ -224,8 +224,6 @@ impl AnyTree {
             AnyTree::DstQ(q) => Extra::DstQ {
                 config: *q.dstq.config(),
                 scene_box: q.dstq.scene_box(),
-                internal_nodes: q.dstq.internal_nodes() as u64,
-                leaves: q.dstq.leaves() as u64,
             },
         }
     }
@@ -498,14 +496,7 @@ fn assemble(h: &Header, words: Words, tris: SharedTriangles) -> AnyTree {
                 config: h.build,
             })
         }
-        Extra::DstQ {
-            config,
-            scene_box,
-            internal_nodes,
-            leaves,
-        } => {
-            // The counts are checked against the walk's (`structure::check`).
-            let _ = (internal_nodes, leaves);
+        Extra::DstQ { config, scene_box } => {
             let dstq = DstQ::from_parts(image, scene_box, config);
             AnyTree::DstQ(DstQTree {
                 stats: BuildStats::of_dstq(&dstq, 0.0),

@@ -416,12 +416,11 @@ pub(crate) fn check(tree: &AnyTree, extra: &Extra) -> Result<(), Violation> {
             ),
             _ => Err(kind_mismatch(kind)),
         },
-        Extra::DstQ {
-            internal_nodes,
-            leaves,
-            ..
-        } => match tree {
-            AnyTree::DstQ(q) => counts(q.dstq().check_structure(), internal_nodes, leaves),
+        Extra::DstQ { .. } => match tree {
+            AnyTree::DstQ(q) => q
+                .dstq()
+                .check_structure()
+                .map_err(|(word, what)| violation(word, what)),
             _ => Err(kind_mismatch(kind)),
         },
     }
