@@ -4,8 +4,7 @@
 //! document. Every Rust error becomes a `dualsplit.DualsplitError` carrying its message
 //! (with its causes, as the command line prints them); no panic crosses into Python.
 use dualsplit_accel::{
-    AccelKind, AnyTree, BuildConfig, Bvh2Tree, NoObserver, Structures,
-    TraversalSet, TreeKind,
+    AccelKind, AnyTree, BuildConfig, Bvh2Tree, NoObserver, Structures, TraversalSet, TreeKind,
 };
 use dualsplit_geometry::{Ray, Triangle, Vec3};
 use dualsplit_render::{RenderSettings, Workload};
