@@ -120,11 +120,13 @@ impl StructureStats {
     /// `convert_ms` is its encoding from the DST.
     pub fn of_dstq(q: &crate::dstq::DstQ, convert_ms: f64, bvh2_total: u64) -> Self {
         let bytes_total = q.bytes_total();
+        // One walk counts the records.
+        let s = q.stats();
         Self {
             name: "dst-q".to_string(),
-            nodes: (q.internal_nodes() + q.leaves()) as u64,
-            internal_nodes: q.internal_nodes() as u64,
-            leaves: q.leaves() as u64,
+            nodes: s.internal_nodes() + s.leaf_count(),
+            internal_nodes: s.internal_nodes(),
+            leaves: s.leaf_count(),
             bytes_nodes: bytes_total - q.image().index_bytes(),
             bytes_indices: q.image().index_bytes(),
             bytes_total,

@@ -194,11 +194,12 @@ impl BuildStats {
     }
 
     pub(crate) fn of_dstq(q: &DstQ, build_ms: f64) -> Self {
+        let s = q.stats();
         Self {
             kind: Some(TreeKind::DstQ),
             build_ms,
-            internal_nodes: q.internal_nodes() as u64,
-            leaves: q.leaves() as u64,
+            internal_nodes: s.internal_nodes(),
+            leaves: s.leaf_count(),
             node_bytes: q.image().node_bytes(),
             index_bytes: q.image().index_bytes(),
             triangles: q.image().triangle_slice().len() as u64,

@@ -1,6 +1,5 @@
-//! What the saved-tree format and the structure statistics need of a quantized DST
-//! (`crate::saved`, `crate::stats`): counts, a tree from the parts a file holds, and the
-//! check on load.
+//! What the saved-tree format needs of a quantized DST (`crate::saved`): a tree from the
+//! parts a file holds, and the check on load.
 
 use super::{DstQ, DstQConfig};
 use crate::image::MemoryImage;
@@ -11,18 +10,6 @@ impl DstQ {
     /// unchecked: the loader runs [`DstQ::check_structure`] on it before handing it out.
     pub(crate) fn from_parts(image: MemoryImage, scene_box: Aabb, config: DstQConfig) -> Self {
         Self::assemble(image, scene_box, config)
-    }
-
-    /// Internal-node records (splitting and carving nodes), counted by a walk.
-    pub fn internal_nodes(&self) -> usize {
-        self.stats().internal_nodes() as usize
-    }
-
-    /// Leaves: plain-leaf records and carving records acting as leaves (as the exact DST
-    /// counts them), counted by a walk.
-    pub fn leaves(&self) -> usize {
-        let s = self.stats();
-        (s.leaves + s.carving_leaves) as usize
     }
 
     /// The check on load of a saved quantized DST (`docs/tree-format.md`, "Checks on

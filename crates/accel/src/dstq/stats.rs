@@ -36,6 +36,12 @@ impl DstQStats {
         self.splitting + self.single_carving + self.dual_carving
     }
 
+    /// Leaves as the exact DST counts them: plain-leaf records and carving records acting
+    /// as leaves.
+    pub fn leaf_count(&self) -> u64 {
+        self.leaves + self.carving_leaves
+    }
+
     /// Records of every kind (internal nodes and plain leaves).
     pub fn nodes(&self) -> u64 {
         self.internal_nodes() + self.leaves
