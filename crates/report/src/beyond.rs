@@ -168,7 +168,7 @@ fn simulated(data: &ReportData, workload: Workload, tms: u32, notes: &mut Vec<St
                 notes.push(format!(
                     "{} {} at {tms} TMs on {}: not simulated{}.",
                     a.label(),
-                    workload_name(workload),
+                    workload.name(),
                     s.name,
                     s.sim_error().map_or(String::new(), |e| format!(" ({e})"))
                 ));
@@ -188,7 +188,7 @@ fn simulated(data: &ReportData, workload: Workload, tms: u32, notes: &mut Vec<St
         }
     }
     Table {
-        id: format!("beyond-{}-{tms}", workload_name(workload)),
+        id: format!("beyond-{}-{tms}", workload.name()),
         caption: format!(
             "{} at {tms} TMs (lin2020 chip otherwise), compiled kernels: frame time, energy and DRAM lines as % of BVH2 on the same chip; memory-stall share: the threads' cycles waiting for load data.",
             match workload {
@@ -248,7 +248,7 @@ pub fn summary(data: &ReportData) -> String {
                 lines.push(format!(
                     "{} {} at {tms} TMs: DST-Q {:.0}%, CWBVH {:.0}%, CWBVH+ {:.0}%, DST {:.0}% of BVH2",
                     s.name,
-                    workload_name(workload),
+                    workload.name(),
                     100.0 * q / b2,
                     100.0 * cw / b2,
                     100.0 * cwp / b2,
@@ -268,21 +268,12 @@ pub fn summary(data: &ReportData) -> String {
     out.join(" ")
 }
 
-fn label(k: AccelKind) -> &'static str {
+/// The table heading of a structure: its command-line name upper-cased (`DST-Q`), the DST
+/// under one name for both decoders.
+fn label(k: AccelKind) -> String {
     match k {
-        AccelKind::Bvh2 => "BVH2",
-        AccelKind::Bvh4 => "BVH4",
-        AccelKind::Bvh8 => "BVH8",
-        AccelKind::DstSw | AccelKind::Dst => "DST",
-        AccelKind::Cwbvh => "CWBVH",
-        AccelKind::DstQ => "DST-Q",
-    }
-}
-
-fn workload_name(w: Workload) -> &'static str {
-    match w {
-        Workload::Cast => "cast",
-        Workload::Path => "path",
+        AccelKind::DstSw => "DST".into(),
+        k => k.name().to_uppercase(),
     }
 }
 
