@@ -497,6 +497,25 @@ impl Hart {
         }
     }
 
+    /// `rt.boxn`'s tests of `n` boxes (`bx(k)`: box `k`'s six words): the entries to the box
+    /// latch, the hit mask returned.
+    #[inline(always)]
+    fn wide_box_test<'b>(
+        &mut self,
+        n: usize,
+        bx: impl Fn(usize) -> &'b [u32],
+        t_lo: f32,
+        t_hi: f32,
+    ) -> u32 {
+        let mut mask = 0;
+        for k in 0..n {
+            let (hit, entry, _) = self.box_test(bx(k), t_lo, t_hi);
+            mask |= (hit as u32) << k;
+            self.box_latch[k] = f32::from_bits(entry);
+        }
+        mask
+    }
+
     /// Executes one instruction at the pc (functionally) and returns what a timing model
     /// needs about it. After `ebreak` the thread is [`Hart::halted`] and the pc stays on
     /// the `ebreak`; stepping again retires it again.
@@ -747,12 +766,7 @@ impl Hart {
                 let n = imm as usize;
                 let mut w = [0u32; 48];
                 self.node_words(op == RtBoxNP, prog, mem, a!(), &mut w[..6 * n], &mut acc)?;
-                let mut mask = 0;
-                for k in 0..n {
-                    let (hit, entry, _) = self.box_test(&w[6 * k..6 * k + 6], fb!(), fc!());
-                    mask |= (hit as u32) << k;
-                    self.box_latch[k] = f32::from_bits(entry);
-                }
+                let mask = self.wide_box_test(n, |k| &w[6 * k..6 * k + 6], fb!(), fc!());
                 wx!(mask);
             }
             RtBoxGet => wf!(match imm {
@@ -802,13 +816,9 @@ impl Hart {
                 let mut w = [0u32; CW_NODE_WORDS];
                 self.node_words(op == RtQBoxNP, prog, mem, a!(), &mut w, &mut acc)?;
                 let node = CwNode::read(&w, 0);
-                let mut mask = 0;
-                for k in 0..8 {
-                    let b = node.box_words(k).map(f32::to_bits);
-                    let (hit, entry, _) = self.box_test(&b, fb!(), fc!());
-                    mask |= (hit as u32) << k;
-                    self.box_latch[k] = f32::from_bits(entry);
-                }
+                let boxes: [[u32; 6]; 8] =
+                    std::array::from_fn(|k| node.box_words(k).map(f32::to_bits));
+                let mask = self.wide_box_test(8, |k| &boxes[k], fb!(), fc!());
                 wx!(mask);
             }
             RtDstQP => {
