@@ -22,17 +22,7 @@ typedef struct Node8 Node;
 #error "BVH_ARITY must be 2, 4 or 8"
 #endif
 
-/* Entries of the traversal stack: the entry distance and the word of the child (its node, or
- * for a leaf its leaf word, with bit 31 set). */
-struct Entry {
-    float t;
-    uint32_t word;
-};
-
-#define ENTRY_LEAF 0x80000000u
-#define STACK_SIZE 256
-_Static_assert(STACK_SIZE * sizeof(struct Entry) <= LOCAL_STORE_BYTES * 5 / 8,
-               "the traversal stack leaves room for the renderer's frames");
+#include "bvh_common.h"
 
 static inline uint32_t node_offset(const Node *n)
 {
@@ -90,47 +80,13 @@ static inline int child_kind_no_box(const Node *n, int k)
 static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, struct Hit *best)
 {
     (void)pre;
-    struct Entry stack[STACK_SIZE];
-    int sp = 0;
-    int have = 0;
-    float best_t = ray->t_max;
-    float limit = cull_limit(best_t);
-    const float t_min = ray->t_min;
-    /* The current entry: the root node. */
-    int have_cur = 1;
-    struct Entry cur = {t_min, PARAMS->root};
+    BVH_TRAVERSE_BEGIN(ray);
     for (;;) {
         struct Entry e;
-        if (have_cur) {
-            e = cur;
-            have_cur = 0;
-        } else {
-            for (;;) {
-                if (sp == 0)
-                    return have;
-                e = stack[--sp];
-                if (e.t <= limit)
-                    break;
-            }
-        }
+        BVH_NEXT_ENTRY(e);
         if (e.word & ENTRY_LEAF) {
             uint32_t run = *WORD_ADDR(e.word & ~ENTRY_LEAF);
-            for (const uint32_t *idx = WORD_ADDR(run);; idx++) {
-                uint32_t entry = *idx;
-                uint32_t prim = entry & ~LAST_IN_RUN;
-                float t = RT_TRI(triangle(prim), t_min, best_t);
-                if (t == t && (!have || !closer_than(best, t, prim))) {
-                    best->t = t;
-                    best->prim = prim;
-                    have = 1;
-                    if (any)
-                        return 1;
-                    best_t = t;
-                    limit = cull_limit(best_t);
-                }
-                if (entry & LAST_IN_RUN)
-                    break;
-            }
+            BVH_TEST_RUN(run);
             continue;
         }
         const Node *node = (const Node *)WORD_ADDR(e.word);
@@ -149,27 +105,8 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
 #define BOX_ENTRY(k) RT_BOX(&node->box[k], t_min, limit)
 #endif
 /* A hit child (entry distance `entry`, slot kind `kind`, first word `addr`) joins the
- * traversal order: the nearest in `cur`, the others on the stack, nearest on top. */
-#define ORDER_HIT(entry, kind)                                                         \
-    do {                                                                               \
-        struct Entry c = {entry, kind == CHILD_LEAF ? addr | ENTRY_LEAF : addr};       \
-        if (!have_cur) {                                                               \
-            cur = c;                                                                   \
-            have_cur = 1;                                                              \
-        } else if (entry < cur.t) {                                                    \
-            /* A later slot is nearer only when strictly nearer. */                    \
-            stack[sp++] = cur;                                                         \
-            cur = c;                                                                   \
-        } else {                                                                       \
-            /* Below the stacked entries that are nearer or equally near. */           \
-            int j = sp++;                                                              \
-            while (j > base && stack[j - 1].t <= entry) {                              \
-                stack[j] = stack[j - 1];                                               \
-                j--;                                                                   \
-            }                                                                          \
-            stack[j] = c;                                                              \
-        }                                                                              \
-    } while (0)
+ * traversal order (BVH_ORDER). */
+#define ORDER_HIT(entry, kind) BVH_ORDER(entry, kind == CHILD_LEAF ? addr | ENTRY_LEAF : addr)
 #if KERNEL_PARITY
 /* Every slot's box is tested, empty slots included ("ray-box intersection tests are executed
  * serially for each box in a BVH node", Lin et al. 2020, §4), and the hits are ordered

@@ -1,7 +1,7 @@
 /* The renderer of a simulated thread: the paper's two workloads (Lin et al. 2020, §4.3 ray
  * casting with a shadow ray, §4.4 path tracing with 5 diffuse bounces and a shadow ray at
  * every hit), the same camera, random numbers and shading as crates/render/src/job.rs, on one
- * of the traversals (bvh.h, dst_sw.h, dst.h).
+ * of the traversals (bvh.h, dst_sw.h, dst.h, cwbvh.h, dstq.h).
  *
  * Build flags (Makefile):
  *   -DWORKLOAD_PATH=0|1         cast or path
