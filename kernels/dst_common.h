@@ -121,3 +121,35 @@ static inline int test_run(uint32_t first, float t_lo, int any, int *have, struc
             }                                                                             \
         }                                                                                 \
     } while (0)
+
+/* The return codes of the dual-split pipeline (rt.dst, rt.dstqp). */
+#define CODE_MISS 0u
+#define CODE_ONE_CHILD 1u
+#define CODE_BOTH_CHILDREN 2u
+#define CODE_LEAF 3u
+
+/* What a pipeline traversal (dst.h, dstq.h) does with a step's `code` and `next` (the next
+ * node, or the run's index entry), the rest read from the DST latch: continue at one child,
+ * push the far child and continue at the near one, or test the run; then pop. Uses the
+ * state declared by DST_TRAVERSE_BEGIN; `continue`s the traversal's loop. */
+#define DST_FOLLOW(code, next)                                                            \
+    if ((code) == CODE_ONE_CHILD) {                                                       \
+        node = (next);                                                                    \
+        t_min = rt_dst_tmin();                                                            \
+        t_max = rt_dst_tmax();                                                            \
+        continue;                                                                         \
+    }                                                                                     \
+    if ((code) == CODE_BOTH_CHILDREN) {                                                   \
+        if (sp == STACK_SIZE)                                                             \
+            kernel_fault(); /* deeper than any tree the converter makes */                \
+        stack[sp].node = rt_dst_offset_stack();                                           \
+        stack[sp].t_min = rt_dst_tmin();                                                  \
+        stack[sp].t_max = t_max;                                                          \
+        sp++;                                                                             \
+        node = (next);                                                                    \
+        t_max = rt_dst_tmax();                                                            \
+        continue;                                                                         \
+    }                                                                                     \
+    if ((code) == CODE_LEAF && test_run((next), ray->t_min, any, &have, best, &best_t))   \
+        return 1;                                                                         \
+    DST_POP_OR_RETURN()

@@ -11,11 +11,6 @@
  * PIPE_LOADS). */
 #include "dst_common.h"
 
-#define CODE_MISS 0u
-#define CODE_ONE_CHILD 1u
-#define CODE_BOTH_CHILDREN 2u
-#define CODE_LEAF 3u
-
 static int traverse(const struct Ray *ray, const struct RayPre *r, int any, struct Hit *best)
 {
     DST_TRAVERSE_BEGIN(ray, r);
@@ -37,25 +32,6 @@ static int traverse(const struct Ray *ray, const struct RayPre *r, int any, stru
         rt_ldph(6, w + 2);
         uint32_t next = rt_dstqp(node, t_min, t_max);
         uint32_t code = rt_dst_code();
-        if (code == CODE_ONE_CHILD) {
-            node = next;
-            t_min = rt_dst_tmin();
-            t_max = rt_dst_tmax();
-            continue;
-        }
-        if (code == CODE_BOTH_CHILDREN) {
-            if (sp == STACK_SIZE)
-                kernel_fault(); /* deeper than any tree the converter makes */
-            stack[sp].node = rt_dst_offset_stack();
-            stack[sp].t_min = rt_dst_tmin();
-            stack[sp].t_max = t_max;
-            sp++;
-            node = next;
-            t_max = rt_dst_tmax();
-            continue;
-        }
-        if (code == CODE_LEAF && test_run(next, ray->t_min, any, &have, best, &best_t))
-            return 1;
-        DST_POP_OR_RETURN();
+        DST_FOLLOW(code, next);
     }
 }
