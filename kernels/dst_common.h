@@ -1,6 +1,7 @@
-/* What both DST traversals share (crates/accel/src/dst/traverse.rs, `Tracer`): the clip to
+/* What the DST traversals share (crates/accel/src/dst/traverse.rs, `Tracer`): the clip to
  * the scene box, the triangle runs, the stack, the loop's start and the pop rule. Included
- * by dst_sw.h and dst.h. Each stack entry carries its node and its interval [t_min, t_max]. */
+ * by dst_sw.h, dst.h and dstq.h. Each stack entry carries its node and its interval
+ * [t_min, t_max]. */
 
 struct Entry {
     uint32_t node;
