@@ -18,10 +18,10 @@
 //! traversal finds, stays the same.
 
 use super::node::{CwNode, Meta};
-use crate::image::{MemoryImage, RUN_END};
+use crate::image::MemoryImage;
 use crate::observer::{NodeStep, Observer};
-use crate::wide::traverse::BoxSlab;
-use dualsplit_geometry::{Hit, PrimId, Ray, cull_limit};
+use crate::wide::traverse::{BoxSlab, RunOutcome, test_run};
+use dualsplit_geometry::{Hit, Ray, cull_limit};
 use std::cell::Cell;
 
 #[derive(Clone, Copy)]
@@ -85,32 +85,13 @@ fn traverse_with<O: Observer, const ANY: bool>(
         };
         if e.leaf {
             let run = e.word as usize;
-            let mut count = 0;
-            while words[run + count] & RUN_END == 0 {
-                count += 1;
-            }
-            count += 1;
-            obs.fetch(MemoryImage::addr(run), 4 * count as u32);
-            obs.step(NodeStep::Leaf {
-                count: count as u32,
-            });
-            for &entry in &words[run..run + count] {
-                let p = PrimId(entry & !RUN_END);
-                let tri = img.fetch_triangle(p, obs);
-                let Some(h) = tri.intersect(&r, ray.t_min, best_t) else {
-                    obs.triangle_test(p, false);
-                    continue;
-                };
-                let accept = Hit::keep_closest(&mut best, p, h);
-                obs.triangle_test(p, accept);
-                if accept {
-                    if ANY {
-                        return best;
-                    }
-                    best_t = h.t;
+            match test_run::<O, ANY>(img, run, &r, ray, obs, &mut best, &mut best_t) {
+                RunOutcome::AnyHit => return best,
+                RunOutcome::Closer => {
                     limit = cull_limit(best_t);
                     fast = !(ray.t_min - limit).is_nan();
                 }
+                RunOutcome::Same => {}
             }
             continue;
         }

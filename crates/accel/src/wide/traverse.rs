@@ -52,6 +52,61 @@ pub fn traverse<L: NodeLayout, O: Observer, const ANY: bool>(
     hit
 }
 
+/// What testing a leaf's run did to the traversal ([`test_run`]).
+pub(crate) enum RunOutcome {
+    /// An any-hit traversal found its hit: it returns.
+    AnyHit,
+    /// A closer hit was kept: `best_t` moved, and the cull limit with it.
+    Closer,
+    /// Nothing changed.
+    Same,
+}
+
+/// Tests the triangle-index run at word `run` of `img` (ended by [`RUN_END`]) on
+/// `[ray.t_min, best_t]`, keeping the closest hit by `(t, prim)` in `best` and its `t` in
+/// `best_t`, reporting the run's fetch, the leaf step, each triangle's fetch and test to
+/// `obs`. The leaf test of every BVH image traversal (this one and the compressed BVH8's).
+#[inline(always)]
+pub(crate) fn test_run<O: Observer, const ANY: bool>(
+    img: &MemoryImage,
+    run: usize,
+    r: &RayPre,
+    ray: &Ray,
+    obs: &mut O,
+    best: &mut Option<Hit>,
+    best_t: &mut f32,
+) -> RunOutcome {
+    let words = &img.words[..];
+    let mut count = 0;
+    while words[run + count] & RUN_END == 0 {
+        count += 1;
+    }
+    count += 1;
+    obs.fetch(MemoryImage::addr(run), 4 * count as u32);
+    obs.step(NodeStep::Leaf {
+        count: count as u32,
+    });
+    let mut outcome = RunOutcome::Same;
+    for &entry in &words[run..run + count] {
+        let p = PrimId(entry & !RUN_END);
+        let tri = img.fetch_triangle(p, obs);
+        let Some(h) = tri.intersect(r, ray.t_min, *best_t) else {
+            obs.triangle_test(p, false);
+            continue;
+        };
+        let accept = Hit::keep_closest(best, p, h);
+        obs.triangle_test(p, accept);
+        if accept {
+            if ANY {
+                return RunOutcome::AnyHit;
+            }
+            *best_t = h.t;
+            outcome = RunOutcome::Closer;
+        }
+    }
+    outcome
+}
+
 /// [`traverse`] with the stack's buffer given.
 #[inline(always)]
 fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
@@ -92,32 +147,13 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
             let w = e.word as usize;
             obs.fetch(MemoryImage::addr(w), 4);
             let run = words[w] as usize;
-            let mut count = 0;
-            while words[run + count] & RUN_END == 0 {
-                count += 1;
-            }
-            count += 1;
-            obs.fetch(MemoryImage::addr(run), 4 * count as u32);
-            obs.step(NodeStep::Leaf {
-                count: count as u32,
-            });
-            for &entry in &words[run..run + count] {
-                let p = PrimId(entry & !RUN_END);
-                let tri = img.fetch_triangle(p, obs);
-                let Some(h) = tri.intersect(&r, ray.t_min, best_t) else {
-                    obs.triangle_test(p, false);
-                    continue;
-                };
-                let accept = Hit::keep_closest(&mut best, p, h);
-                obs.triangle_test(p, accept);
-                if accept {
-                    if ANY {
-                        return best;
-                    }
-                    best_t = h.t;
+            match test_run::<O, ANY>(img, run, &r, ray, obs, &mut best, &mut best_t) {
+                RunOutcome::AnyHit => return best,
+                RunOutcome::Closer => {
                     limit = cull_limit(best_t);
                     fast = !(ray.t_min - limit).is_nan();
                 }
+                RunOutcome::Same => {}
             }
             continue;
         }
