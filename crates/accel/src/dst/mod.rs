@@ -42,7 +42,7 @@ mod header;
 pub mod pipeline;
 mod reference;
 mod stats;
-mod traverse;
+pub(crate) mod traverse;
 mod validate;
 
 pub use header::{AxisPair, Corner, HeaderOffset, OFFSET_LIMIT};

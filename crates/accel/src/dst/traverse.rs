@@ -82,8 +82,65 @@ pub(super) struct Tracer<'a> {
     pub stack: Stack,
 }
 
+/// Where a DST image's triangle runs are (the exact DST's and the quantized DST's: the same
+/// index and triangle regions).
+pub(crate) struct IndexRun<'a> {
+    /// The node and index regions' words.
+    pub words: &'a [u32],
+    /// Word of index entry 0.
+    pub index_base: usize,
+    /// Word of triangle 0.
+    pub tri_base: usize,
+    /// The triangles.
+    pub tris: &'a [Triangle],
+}
+
+impl IndexRun<'_> {
+    /// Intersects the run starting at index entry `first` on the ray's own interval
+    /// `[ray.t_min, best_t]`, keeping the closest hit by `(t, prim)` in `best` and its `t` in
+    /// `best_t` (any hit: `best` is the first hit and the traversal ends), reporting the leaf
+    /// step, each entry's and triangle's fetch and each test to `obs`.
+    #[inline(always)]
+    pub fn test<O: Observer, const ANY: bool>(
+        &self,
+        first: u32,
+        r: &RayPre,
+        best: &mut Option<Hit>,
+        best_t: &mut f32,
+        obs: &mut O,
+    ) -> RunResult {
+        let start = self.index_base + first as usize;
+        let count = self.words[start..]
+            .iter()
+            .position(|&e| e & RUN_END != 0)
+            .map_or(0, |p| p + 1);
+        obs.step(NodeStep::Leaf {
+            count: count as u32,
+        });
+        let t_lo = r.ray.t_min;
+        for i in start..start + count {
+            let e = self.words[i];
+            let p = PrimId(e & !RUN_END);
+            obs.fetch(MemoryImage::addr(i), 4);
+            obs.fetch(MemoryImage::addr(self.tri_base + 9 * p.index()), 36);
+            let h = self.tris[p.index()].intersect(r, t_lo, *best_t);
+            obs.triangle_test(p, h.is_some());
+            if let Some(h) = h {
+                if ANY {
+                    *best = Some(Hit::on(p, h));
+                    return RunResult::Occluded;
+                }
+                if Hit::keep_closest(best, p, h) {
+                    *best_t = h.t;
+                }
+            }
+        }
+        RunResult::Continue
+    }
+}
+
 /// What intersecting a triangle run found.
-pub(super) enum RunResult {
+pub(crate) enum RunResult {
     /// Nothing that ends the traversal.
     Continue,
     /// Any-hit mode: an accepted hit.
@@ -143,33 +200,13 @@ impl<'a> Tracer<'a> {
     /// `[ray.t_min, best_t]` (any hit: `[ray.t_min, ray.t_max]`).
     #[inline(always)]
     pub fn test_run<O: Observer, const ANY: bool>(&mut self, first: u32, obs: &mut O) -> RunResult {
-        let start = self.index_base + first as usize;
-        let count = self.words[start..]
-            .iter()
-            .position(|&e| e & RUN_END != 0)
-            .map_or(0, |p| p + 1);
-        obs.step(NodeStep::Leaf {
-            count: count as u32,
-        });
-        let t_lo = self.r.ray.t_min;
-        for i in start..start + count {
-            let e = self.words[i];
-            let p = PrimId(e & !RUN_END);
-            obs.fetch(MemoryImage::addr(i), 4);
-            obs.fetch(MemoryImage::addr(self.tri_base + 9 * p.index()), 36);
-            let h = self.tris[p.index()].intersect(&self.r, t_lo, self.best_t);
-            obs.triangle_test(p, h.is_some());
-            if let Some(h) = h {
-                if ANY {
-                    self.best = Some(Hit::on(p, h));
-                    return RunResult::Occluded;
-                }
-                if Hit::keep_closest(&mut self.best, p, h) {
-                    self.best_t = h.t;
-                }
-            }
-        }
-        RunResult::Continue
+        let run = IndexRun {
+            words: self.words,
+            index_base: self.index_base,
+            tri_base: self.tri_base,
+            tris: self.tris,
+        };
+        run.test::<O, ANY>(first, &self.r, &mut self.best, &mut self.best_t, obs)
     }
 
     /// Pops the next entry that can still hold a closer hit, clamping its `t_max`.
@@ -232,7 +269,7 @@ pub(super) fn split_next(
 /// plane iff its "lower bound" bit equals the ray's sign `neg` on its axis (Lin et al. 2020,
 /// Fig. 2); exit planes are widened (`widen_exit`) and clamp `hi`, entry planes raise `lo`.
 #[inline(always)]
-pub(super) fn dual_carve(
+pub(crate) fn dual_carve(
     neg: &[bool; 3],
     w: HeaderOffset,
     (ta, tb): (f32, f32),

@@ -15,9 +15,10 @@ use super::frame::Frame;
 use super::layout::{FRAME_WORDS, ROOT_BIT};
 use super::record::{ChildRef, QHeader, read_bits};
 use crate::dst::pipeline::{ReturnCode, le_or_nan};
-use crate::image::{MemoryImage, RUN_END};
+use crate::dst::traverse::{IndexRun, RunResult, dual_carve};
+use crate::image::MemoryImage;
 use crate::observer::{DstNodeKind, NodeStep, Observer};
-use dualsplit_geometry::{Hit, PrimId, Ray, cull_limit, widen_exit};
+use dualsplit_geometry::{Hit, Ray, cull_limit};
 
 /// A traversal-stack entry: a record (its cluster's word address and its bit position in
 /// the cluster) and its ray interval.
@@ -74,7 +75,12 @@ impl DstQ {
         let k = self.config.bits;
         let fmt = self.config.record_format();
         let cw = self.config.cluster_words() as usize;
-        let tris = self.triangles();
+        let runs = IndexRun {
+            words,
+            index_base: img.indices.start,
+            tri_base: img.triangles.start,
+            tris: self.triangles(),
+        };
         let mut best: Option<Hit> = None;
         let mut best_t = ray.t_max;
         let mut stack: Vec<Entry> = Vec::with_capacity(64);
@@ -163,17 +169,8 @@ impl DstQ {
                         (t_min.max(t2), t_max.min(t1))
                     } else {
                         let (a0, a1) = h.exact().axis_pair().axes();
-                        let c = h.exact().corner();
-                        let (mut lo, mut hi) = (t_min, t_max);
-                        for (a, slot, lower) in [(a0, 0, c.first_lower), (a1, 1, c.second_lower)] {
-                            let t = r.plane_t(a, plane(slot, a));
-                            if r.neg[a] == lower {
-                                hi = hi.min(widen_exit(t));
-                            } else {
-                                lo = lo.max(t);
-                            }
-                        }
-                        (lo, hi)
+                        let t = (r.plane_t(a0, plane(0, a0)), r.plane_t(a1, plane(1, a1)));
+                        dual_carve(&r.neg, h.exact(), t, t_min, t_max)
                     };
                     let hit = le_or_nan(lo, hi);
                     let leaf = h.is_leaf_flag();
@@ -194,28 +191,10 @@ impl DstQ {
             };
             if let Some(first) = run {
                 // The run on the ray's own interval [ray.t_min, best_t], as the exact DST.
-                let start = img.indices.start + first as usize;
-                let count = words[start..img.indices.end]
-                    .iter()
-                    .position(|&e| e & RUN_END != 0)
-                    .map_or(0, |p| p + 1);
-                obs.step(NodeStep::Leaf {
-                    count: count as u32,
-                });
-                for (i, &entry) in words.iter().enumerate().skip(start).take(count) {
-                    let p = PrimId(entry & !RUN_END);
-                    obs.fetch(MemoryImage::addr(i), 4);
-                    obs.fetch(MemoryImage::addr(img.triangles.start + 9 * p.index()), 36);
-                    let hit = tris[p.index()].intersect(&r, ray.t_min, best_t);
-                    obs.triangle_test(p, hit.is_some());
-                    if let Some(hh) = hit {
-                        if ANY {
-                            return Some(Hit::on(p, hh));
-                        }
-                        if Hit::keep_closest(&mut best, p, hh) {
-                            best_t = hh.t;
-                        }
-                    }
+                if let RunResult::Occluded =
+                    runs.test::<O, ANY>(first, &r, &mut best, &mut best_t, obs)
+                {
+                    return best;
                 }
             }
             // Pop the next entry that can still hold a closer hit, clamping its t_max.
