@@ -40,8 +40,12 @@ fn cost(mesh: &str, builds: usize, converts: usize) {
         bvh = Bvh2::build(std::hint::black_box(&boxes), &BuildConfig::default());
     }
     for _ in 0..converts {
-        let dst = Dst::from_bvh2(std::hint::black_box(&bvh), tris.clone(), &DstConfig::hardware())
-            .expect("conversion");
+        let dst = Dst::from_bvh2(
+            std::hint::black_box(&bvh),
+            tris.clone(),
+            &DstConfig::hardware(),
+        )
+        .expect("conversion");
         std::hint::black_box(dst);
     }
     println!("{mesh}: {builds} builds, {converts} conversions");
