@@ -215,6 +215,7 @@ struct Encoder<'a> {
 impl Encoder<'_> {
     /// Checks BVH node `n`'s box and child links, or a leaf's triangle range (what planning
     /// and emission index with); for a leaf entered with `chain`, returns its size.
+    #[inline(always)]
     fn check_node(&self, n: u32, chain: Chain) -> Result<Option<Size>, DstError> {
         let node = &self.bvh.nodes[n as usize];
         if !node.bounds.is_finite() {
@@ -284,7 +285,9 @@ impl Encoder<'_> {
 
     /// Plan pass, sequential: appends the records of `n`'s subtree to `recs` in depth-first
     /// order. `budget` counts the nodes still allowed (a cycle in a malformed BVH runs it
-    /// out instead of recursing forever).
+    /// out instead of recursing forever). Inlined into its caller, so that a leaf costs no
+    /// call: only internal nodes recurse ([`Encoder::plan_inner`]).
+    #[inline(always)]
     fn plan_seq(
         &self,
         n: u32,
@@ -298,9 +301,21 @@ impl Encoder<'_> {
             child: n,
             nodes: self.bvh.nodes.len(),
         })?;
-        if let Some(leaf) = self.check_node(n, chain)? {
-            return Ok(leaf);
+        match self.check_node(n, chain)? {
+            Some(leaf) => Ok(leaf),
+            None => self.plan_inner(n, chain, recs, budget, dps),
         }
+    }
+
+    /// [`Encoder::plan_seq`] for internal node `n`, already checked.
+    fn plan_inner(
+        &self,
+        n: u32,
+        chain: Chain,
+        recs: &mut Vec<Rec>,
+        budget: &mut usize,
+        dps: &mut [ChainDp; 2],
+    ) -> Result<Size, DstError> {
         let slot = recs.len();
         recs.push(self.new_rec(n, dps));
         let rec = &recs[slot];
@@ -413,7 +428,10 @@ impl Encoder<'_> {
     }
 
     /// Emits the subtree of BVH node `n` entered with `chain` into `slot`, sequentially;
-    /// the records of its internal nodes come from `recs` in depth-first order.
+    /// the records of its internal nodes come from `recs` in depth-first order. Inlined into
+    /// its caller, so that a leaf costs no call: only internal nodes recurse
+    /// ([`Encoder::emit_inner`]).
+    #[inline(always)]
     fn emit(
         &self,
         n: u32,
@@ -423,14 +441,27 @@ impl Encoder<'_> {
         recs: &mut std::slice::Iter<Rec>,
         stats: &mut DstStats,
     ) -> Result<(), DstError> {
-        if let Some(slot) = self.emit_head(n, chain, slot, cur, stats)? {
-            let rec = recs.next().expect("one record per internal node");
-            let [cl, cr] = rec.children(self.bvh, n);
-            let (pair, sl) = self.split_node(rec, [cl, cr], slot, cur, stats)?;
-            self.emit(cl, rec.chains[0], pair, cur, recs, stats)?;
-            self.emit(cr, rec.chains[1], pair + sl, cur, recs, stats)?;
+        match self.emit_head(n, chain, slot, cur, stats)? {
+            Some(slot) => self.emit_inner(n, slot, cur, recs, stats),
+            None => Ok(()),
         }
-        Ok(())
+    }
+
+    /// [`Encoder::emit`] for internal node `n` once its chain is written: its splitting
+    /// node into `slot`, then its two subtrees.
+    fn emit_inner(
+        &self,
+        n: u32,
+        slot: Slot,
+        cur: &mut Cursor,
+        recs: &mut std::slice::Iter<Rec>,
+        stats: &mut DstStats,
+    ) -> Result<(), DstError> {
+        let rec = recs.next().expect("one record per internal node");
+        let [cl, cr] = rec.children(self.bvh, n);
+        let (pair, sl) = self.split_node(rec, [cl, cr], slot, cur, stats)?;
+        self.emit(cl, rec.chains[0], pair, cur, recs, stats)?;
+        self.emit(cr, rec.chains[1], pair + sl, cur, recs, stats)
     }
 
     /// Writes the splitting node `rec` into `slot` and allocates its children's slots;

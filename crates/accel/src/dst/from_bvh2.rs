@@ -611,7 +611,9 @@ impl ChainDp {
     /// The state entered when the split carves face `f` of the child (if it is one of F).
     #[inline(always)]
     fn start(&self, carved_by_split: usize) -> usize {
-        self.bit_of[carved_by_split] as usize
+        // (A state bit is at most 1 << 5: the mask only spares the bounds checks of the
+        // lookups by state.)
+        self.bit_of[carved_by_split] as usize & 63
     }
 
     /// Cost of the chain when the split carves face `f`.
@@ -626,8 +628,8 @@ impl ChainDp {
         let full = (1usize << self.k) - 1;
         let mut chain = Chain::EMPTY;
         let mut s = self.start(carved_by_split);
-        while s != full && self.choice[s] != 0 {
-            let t = self.choice[s] as usize;
+        while s != full && self.choice[s & 63] != 0 {
+            let t = self.choice[s & 63] as usize;
             let i = t.trailing_zeros() as usize;
             let rest = t & !(1 << i);
             let mut faces = 1u64 << self.faces[i];
