@@ -65,15 +65,23 @@ fn equivalence_on(name: &str, scene: &dualsplit_scene::Scene, min_rays: usize) {
         "{name}: {} diffuse",
         rays.diffuse.len()
     );
-    // Copies with every instruction set, answers taken from the image where a copy declines
-    // the ray (`None`: NaN bounds).
+    // Copies with every instruction set (and, with the best one, without leaf merging),
+    // answers taken from the image where a copy declines the ray (`None`: NaN bounds).
     let levels = SimdLevel::available();
     let copies: Vec<(AccelKind, SimdLevel, CpuBvh)> =
         [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8]
             .into_iter()
             .flat_map(|kind| {
                 let b = s.encoded(kind).unwrap();
-                levels.iter().map(move |&l| (kind, l, b.cpu_copy(l)))
+                let unmerged = (
+                    kind,
+                    SimdLevel::detect(),
+                    b.cpu_copy_with(SimdLevel::detect(), 0),
+                );
+                levels
+                    .iter()
+                    .map(move |&l| (kind, l, b.cpu_copy(l)))
+                    .chain(std::iter::once(unmerged))
             })
             .collect();
     for (kind, level, c) in &copies {

@@ -383,3 +383,44 @@ fn report_dry_run_prints_the_plan_without_loading() {
         "{e}"
     );
 }
+
+/// `bench` refuses a malformed leaf-merging knob instead of quietly measuring the default.
+#[test]
+fn bench_refuses_a_malformed_merge_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    for bad in ["abc", "65", "-1"] {
+        let o = Command::new(env!("CARGO_BIN_EXE_dualsplit"))
+            .args(["bench", "builtin:cornell", "--res", "4", "--no-frame", "-q"])
+            .env("DUALSPLIT_MERGE_MAX", bad)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{bad}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("DUALSPLIT_MERGE_MAX") && stderr(&o).contains("from 0 to 64"),
+            "{bad}: {}",
+            stderr(&o)
+        );
+        assert!(stdout(&o).is_empty(), "{bad} did work: {}", stdout(&o));
+    }
+    let o = Command::new(env!("CARGO_BIN_EXE_dualsplit"))
+        .args([
+            "bench",
+            "builtin:cornell",
+            "--res",
+            "4x3",
+            "--min-seconds",
+            "0.001",
+        ])
+        .args(["--no-frame", "-q"])
+        .env("DUALSPLIT_MERGE_MAX", "0")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("subtrees of at most 0 triangles merged"),
+        "{}",
+        stdout(&o)
+    );
+}

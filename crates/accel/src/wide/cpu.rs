@@ -9,7 +9,8 @@
 //! the caller observes nothing ([`crate::Observer::OBSERVES_NOTHING`]); the simulator and
 //! every counting observer still read the image through [`super::traverse`]. One change of
 //! shape: an internal child whose subtree holds at most [`MERGE_MAX`] triangles becomes one
-//! leaf holding them all, under the same box. The answers are the image traversal's, ray
+//! leaf holding them all, under the same box ([`merge_limit`]: `DUALSPLIT_MERGE_MAX=0` keeps
+//! the image's leaves, for measuring). The answers are the image traversal's, ray
 //! for ray and bit for bit:
 //!
 //! * the box test is [`super::traverse`]'s arithmetic lane by lane: `(p - o) * inv`, far
@@ -62,7 +63,7 @@ pub(crate) use copy::pack_entries;
 pub use isa::SimdLevel;
 pub(crate) use isa::{PackedHit, avx2_token};
 pub use layout::{Chunk, Chunk8, EMPTY, LANES, LEAF, TriPacket};
-pub use merge::MERGE_MAX;
+pub use merge::{MERGE_LIMIT_MAX, MERGE_MAX, merge_limit, parse_merge_limit};
 pub(crate) use ray::RaySimd;
 pub(crate) use traverse::test_leaf;
 
@@ -102,16 +103,22 @@ impl CpuBvh {
 
     /// [`CpuBvh::from_image`] for the given instructions (SSE2 when this CPU lacks AVX2).
     pub fn with_level<L: NodeLayout>(img: &MemoryImage, level: SimdLevel) -> Self {
+        Self::with_options::<L>(img, level, merge_limit())
+    }
+
+    /// [`CpuBvh::with_level`] merging subtrees of at most `merge` triangles into one leaf
+    /// instead of [`merge_limit`]'s (0: the image's leaves).
+    pub fn with_options<L: NodeLayout>(img: &MemoryImage, level: SimdLevel, merge: usize) -> Self {
         let avx2 = level.token();
         if L::ARITY <= LANES {
-            let c = copy::<L, Chunk>(img);
+            let c = copy::<L, Chunk>(img, merge);
             Self {
                 nodes: CpuNodes::Four(Pages::from_slice(&c.nodes)),
                 packets: Pages::from_slice(&c.packets),
                 avx2,
             }
         } else {
-            let c = copy::<L, Chunk8>(img);
+            let c = copy::<L, Chunk8>(img, merge);
             Self {
                 nodes: CpuNodes::Eight(Pages::from_slice(&c.nodes)),
                 packets: Pages::from_slice(&c.packets),

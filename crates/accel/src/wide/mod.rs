@@ -196,10 +196,16 @@ impl BvhImage {
     /// A new CPU-side copy of the image whose traversal uses `level`'s instructions (SSE2
     /// when this CPU lacks them); for comparing levels.
     pub fn cpu_copy(&self, level: cpu::SimdLevel) -> cpu::CpuBvh {
+        self.cpu_copy_with(level, cpu::merge_limit())
+    }
+
+    /// [`BvhImage::cpu_copy`] merging subtrees of at most `merge` triangles into one leaf
+    /// (0: the image's leaves); for comparing merge limits.
+    pub fn cpu_copy_with(&self, level: cpu::SimdLevel, merge: usize) -> cpu::CpuBvh {
         match self.arity {
-            2 => cpu::CpuBvh::with_level::<Node2>(&self.image, level),
-            4 => cpu::CpuBvh::with_level::<Node4>(&self.image, level),
-            _ => cpu::CpuBvh::with_level::<Node8>(&self.image, level),
+            2 => cpu::CpuBvh::with_options::<Node2>(&self.image, level, merge),
+            4 => cpu::CpuBvh::with_options::<Node4>(&self.image, level, merge),
+            _ => cpu::CpuBvh::with_options::<Node8>(&self.image, level, merge),
         }
     }
 

@@ -95,6 +95,12 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             dualsplit_embree::STATUS
         );
     }
+    // The measuring knob of the CPU copies' leaf merging: refused here when malformed (the
+    // library would quietly keep its default).
+    dualsplit_accel::wide::cpu::parse_merge_limit(
+        std::env::var("DUALSPLIT_MERGE_MAX").ok().as_deref(),
+    )
+    .map_err(anyhow::Error::msg)?;
     let json = JsonOut::from_arg(args.json.as_deref())?;
     // JSON lines go out as they are measured on standard output, and all at the end to a
     // file.
@@ -148,7 +154,8 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         .as_ref()
         .map_or_else(rayon::current_num_threads, |p| p.current_num_threads());
     let line = format!(
-        "ray sets of a {}x{} {} frame: {} in {:.2} s; timing on {} threads",
+        "ray sets of a {}x{} {} frame: {} in {:.2} s; timing on {} threads; BVH copies: {:?}, \
+         subtrees of at most {} triangles merged",
         settings.width,
         settings.height,
         settings.workload.name(),
@@ -157,7 +164,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             .collect::<Vec<_>>()
             .join(", "),
         t.elapsed().as_secs_f64(),
-        threads
+        threads,
+        dualsplit_accel::wide::cpu::SimdLevel::detect(),
+        dualsplit_accel::wide::cpu::merge_limit(),
     );
     super::render::say(&line, json.is_some());
     let cfg = MeasureConfig {
@@ -415,6 +424,8 @@ impl PeerRun<'_> {
                     "scene": self.scene.name, "peer": EMBREE, "peer_version": peer.version(),
                     "peer_build_seconds": build_s,
                     "threads": threads, "method": "interleaved",
+                    "simd": format!("{:?}", dualsplit_accel::wide::cpu::SimdLevel::detect()),
+                    "merge_max": dualsplit_accel::wide::cpu::merge_limit(),
                     "agreement": agreement, "t_error": t_error,
                     "best": best, "ratio_best_to_peer": ratio,
                     "ratio_best_to_peer_fastest_pass": ratio_fastest,

@@ -1,7 +1,7 @@
 //! Copying a BVH image into the CPU-side nodes and triangle packets.
 
 use super::layout::{EMPTY, EMPTY_PACKET, LANES, LEAF, Lanes, TriPacket};
-use super::merge::{MERGE_MAX, gather};
+use super::merge::gather;
 use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
 use dualsplit_geometry::Triangle;
 
@@ -11,8 +11,9 @@ pub(super) struct Copied<N> {
     pub(super) packets: Vec<TriPacket>,
 }
 
-/// Copies the image of node layout `L` into nodes of type `N` (`N::W >= L::ARITY`).
-pub(super) fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage) -> Copied<N> {
+/// Copies the image of node layout `L` into nodes of type `N` (`N::W >= L::ARITY`), each
+/// internal child whose subtree holds at most `merge` triangles as one leaf.
+pub(super) fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage, merge: usize) -> Copied<N> {
     let words = &img.words[..];
     let triangles = img.triangle_slice();
     let mut out = Copied {
@@ -44,7 +45,8 @@ pub(super) fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage) -> Copied<N> {
                         .map_or(0, |p| p + 1);
                     Some(words[run..run + len].to_vec())
                 }
-                _ => gather::<L>(words, addr, MERGE_MAX),
+                _ if merge == 0 => None,
+                _ => gather::<L>(words, addr, merge),
             };
             let child = match entries {
                 // A subtree without triangles (only a forged saved tree has one) holds

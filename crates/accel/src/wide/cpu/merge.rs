@@ -7,9 +7,38 @@ use crate::image::{ChildKind, NodeLayout, RUN_END};
 /// The paper's BVH2 has small leaves (1.8 triangles on average on dragon_box, SAH with equal
 /// node and triangle costs), and each leaf visit is a cache miss on its packet; testing up
 /// to 16 triangles four at a time is cheaper than descending two more node levels. Chosen
-/// by measurement (docs/performance.md, "Leaf merging": 0, 4, 8, 12, 16, 24 and 32 on
+/// by measurement (docs/performance.md, "Leaf merging": with `DUALSPLIT_MERGE_MAX`, BVH8 on
 /// dragon_box and sponza_dabrovic); answers do not depend on it.
 pub const MERGE_MAX: usize = 16;
+
+/// The largest merge limit [`merge_limit`] accepts from the environment.
+pub const MERGE_LIMIT_MAX: usize = 64;
+
+/// The merge limit the copies use: [`MERGE_MAX`], unless the environment variable
+/// `DUALSPLIT_MERGE_MAX` holds an integer from 0 to [`MERGE_LIMIT_MAX`] (for measuring; 0
+/// keeps the image's leaves, the ones a DST converted from the same BVH2 has). Read once.
+pub fn merge_limit() -> usize {
+    static LIMIT: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *LIMIT.get_or_init(|| {
+        parse_merge_limit(std::env::var("DUALSPLIT_MERGE_MAX").ok().as_deref())
+            .ok()
+            .flatten()
+            .unwrap_or(MERGE_MAX)
+    })
+}
+
+/// `DUALSPLIT_MERGE_MAX`'s value: `Ok(None)` when unset, `Ok(Some(n))` for an integer `n`
+/// from 0 to [`MERGE_LIMIT_MAX`], otherwise an error saying what is accepted (the CLI
+/// refuses to run with one; the library then keeps [`MERGE_MAX`]).
+pub fn parse_merge_limit(value: Option<&str>) -> Result<Option<usize>, String> {
+    let Some(v) = value else { return Ok(None) };
+    match v.trim().parse::<usize>() {
+        Ok(n) if n <= MERGE_LIMIT_MAX => Ok(Some(n)),
+        _ => Err(format!(
+            "DUALSPLIT_MERGE_MAX is {v:?}: it must be an integer from 0 to {MERGE_LIMIT_MAX}"
+        )),
+    }
+}
 
 /// The index entries of the leaves of the subtree whose node is at image word `w` (a node's
 /// leaves, then its internal children's subtrees in child order), [`RUN_END`] on the last
@@ -48,4 +77,21 @@ pub(super) fn gather<L: NodeLayout>(words: &[u32], w: usize, limit: usize) -> Op
         *last |= RUN_END;
     }
     Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn merge_limit_values_are_checked() {
+        assert_eq!(parse_merge_limit(None), Ok(None));
+        assert_eq!(parse_merge_limit(Some("0")), Ok(Some(0)));
+        assert_eq!(parse_merge_limit(Some(" 16 ")), Ok(Some(16)));
+        assert_eq!(parse_merge_limit(Some("64")), Ok(Some(MERGE_LIMIT_MAX)));
+        for bad in ["65", "-1", "", "sixteen", "1e3"] {
+            let e = parse_merge_limit(Some(bad)).unwrap_err();
+            assert!(e.contains("from 0 to 64"), "{bad}: {e}");
+        }
+    }
 }
