@@ -72,7 +72,8 @@ use crate::image::{MemoryImage, NodeLayout, Pages};
 use copy::copy;
 use dualsplit_geometry::{Hit, Ray, cull_limit};
 use isa::dispatch;
-use traverse::STACK;
+use layout::Lanes;
+use traverse::{Entry, STACK};
 
 /// The nodes of a [`CpuBvh`], one per node of the image, the root first.
 #[derive(Clone, Debug)]
@@ -92,6 +93,16 @@ pub struct CpuBvh {
     pub packets: Pages<TriPacket>,
     /// The AVX2 token when the traversal uses AVX2.
     avx2: Option<Avx2>,
+    /// Stack entries a traversal can hold at once ([`stack_len`]).
+    stack_len: usize,
+}
+
+/// The most entries the traversal's stack holds at once in a copy of nodes `width` lanes
+/// wide whose deepest node has depth `depth`: at most `width - 1` unvisited siblings wait per
+/// level of the current path, and a node with `width` hit children stacks them all before
+/// taking the nearest.
+fn stack_len(depth: usize, width: usize) -> usize {
+    (depth + 1) * (width - 1) + width
 }
 
 impl CpuBvh {
@@ -116,6 +127,7 @@ impl CpuBvh {
                 nodes: CpuNodes::Four(Pages::from_slice(&c.nodes)),
                 packets: Pages::from_slice(&c.packets),
                 avx2,
+                stack_len: stack_len(c.depth, <Chunk as Lanes>::W),
             }
         } else {
             let c = copy::<L, Chunk8>(img, merge);
@@ -123,6 +135,7 @@ impl CpuBvh {
                 nodes: CpuNodes::Eight(Pages::from_slice(&c.nodes)),
                 packets: Pages::from_slice(&c.packets),
                 avx2,
+                stack_len: stack_len(c.depth, <Chunk8 as Lanes>::W),
             }
         }
     }
@@ -153,11 +166,14 @@ impl CpuBvh {
             return None;
         }
         let mut stack = STACK.take();
-        stack.clear();
+        if stack.len() < self.stack_len {
+            stack.resize(self.stack_len, Entry::UNUSED);
+        }
+        let buf = &mut stack[..self.stack_len];
         let packets = &self.packets[..];
         let hit = match &self.nodes {
-            CpuNodes::Four(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, &mut stack),
-            CpuNodes::Eight(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, &mut stack),
+            CpuNodes::Four(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, buf),
+            CpuNodes::Eight(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, buf),
         };
         STACK.set(stack);
         Some(hit)

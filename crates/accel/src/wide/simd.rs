@@ -7,28 +7,30 @@
 
 /// Hints the CPU to bring every cache line (64 bytes) that `*r` touches into all cache
 /// levels. No effect on results; a no-op on targets other than x86-64.
+///
+/// Straight-line code: one hint every 64 bytes from `r`'s first byte (each in a successive
+/// line) and one at its last byte, which together name every line `*r` touches whatever its
+/// alignment; the count is a constant, so the loop unrolls (a loop over the lines from the
+/// first line's start cost 16 M of 301 M instructions of a Sponza bench run).
 #[inline(always)]
 pub fn prefetch<T>(r: &T) {
     #[cfg(target_arch = "x86_64")]
     {
         let start = (r as *const T).cast::<i8>();
-        let first = start as usize & !63;
-        let end = start as usize + size_of::<T>();
-        let mut line = first;
-        while line < end {
+        let hint = |offset: usize| {
             // SAFETY: `_mm_prefetch` only needs SSE, which every x86-64 CPU has (it is in the
             // target's baseline features), and it never dereferences its pointer for the
-            // program: it is a hint that cannot fault, whatever the address. The address is
-            // within a line `*r` touches; `wrapping_byte_add` needs no bounds (the first
-            // line may start before `start`: the wrapped difference lands on it).
+            // program: it is a hint that cannot fault, whatever the address. The offsets
+            // are within `*r` (`wrapping_byte_add` needs no bounds anyway).
             unsafe {
                 use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-                _mm_prefetch::<_MM_HINT_T0>(
-                    start.wrapping_byte_add(line.wrapping_sub(start as usize)),
-                );
+                _mm_prefetch::<_MM_HINT_T0>(start.wrapping_byte_add(offset));
             }
-            line += 64;
+        };
+        for k in 0..size_of::<T>().div_ceil(64) {
+            hint(64 * k);
         }
+        hint(size_of::<T>().saturating_sub(1));
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = r;

@@ -9,6 +9,8 @@ use dualsplit_geometry::Triangle;
 pub(super) struct Copied<N> {
     pub(super) nodes: Vec<N>,
     pub(super) packets: Vec<TriPacket>,
+    /// The deepest node's depth (the root's is 0).
+    pub(super) depth: usize,
 }
 
 /// Copies the image of node layout `L` into nodes of type `N` (`N::W >= L::ARITY`), each
@@ -19,12 +21,14 @@ pub(super) fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage, merge: usize) -> 
     let mut out = Copied {
         nodes: vec![N::EMPTY],
         packets: Vec::new(),
+        depth: 0,
     };
-    // (image word of a node, node index it is copied to)
-    let mut todo: Vec<(usize, usize)> = vec![(0, 0)];
+    // (image word of a node, node index it is copied to, its depth)
+    let mut todo: Vec<(usize, usize, usize)> = vec![(0, 0, 0)];
     // Triangle slots used (4 per packet).
     let mut slots = 0usize;
-    while let Some((w, at)) = todo.pop() {
+    while let Some((w, at, depth)) = todo.pop() {
+        out.depth = out.depth.max(depth);
         let node = L::read(words, w);
         let mut addr = node.offset() as usize;
         let mut lane = 0;
@@ -73,7 +77,7 @@ pub(super) fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage, merge: usize) -> 
             let idx = out.nodes.len();
             out.nodes.push(N::EMPTY);
             out.nodes[at].set_child(l, idx as u32);
-            subtrees.push((cw, idx));
+            subtrees.push((cw, idx, depth + 1));
         }
         todo.extend(subtrees.into_iter().rev());
     }

@@ -110,7 +110,7 @@ pub(super) fn dispatch<N: Lanes, const ANY: bool>(
     nodes: &[N],
     packets: &[TriPacket],
     ray: &Ray,
-    stack: &mut Vec<Entry>,
+    stack: &mut [Entry],
 ) -> Option<Hit> {
     match avx2 {
         None => run::<N, Sse2, ANY>(Sse2, nodes, packets, ray, stack),
@@ -132,7 +132,7 @@ struct Run<'a, N, const ANY: bool> {
     nodes: &'a [N],
     packets: &'a [TriPacket],
     ray: &'a Ray,
-    stack: &'a mut Vec<Entry>,
+    stack: &'a mut [Entry],
 }
 
 impl<N: Lanes, const ANY: bool> Kernel for Run<'_, N, ANY> {

@@ -15,7 +15,7 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
     nodes: &[N],
     packets: &[TriPacket],
     ray: &Ray,
-    stack: &mut Vec<Entry>,
+    stack: &mut [Entry],
 ) -> Option<Hit> {
     let r = ray.precompute();
     let rs = RaySimd::new(&r);
@@ -23,13 +23,18 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
     let mut best_t = ray.t_max;
     let mut limit = cull_limit(best_t);
     let mut cur = 0u32;
+    // Entries in use: `stack[..sp]`, the top last. The caller sizes `stack` to the copy's
+    // bound (`stack_len`), so no push goes past its end.
+    let mut sp = 0usize;
     loop {
         if cur & LEAF == 0 {
             let node = &nodes[cur as usize];
             let (dv, mask) = node.test(isa, &rs, ray.t_min, limit);
-            let dist: [[f32; LANES]; 2] = dv.map(|v| v.to_array());
+            // Lane i's entry distance; lanes are below 8 (the mask's bits), which the
+            // `& 7` tells the compiler, so the lookup has no bounds check.
+            let dist: [f32; 2 * LANES] = bytemuck::cast(dv.map(|v| v.to_array()));
             let child = |i: usize| node.child(i);
-            let d = |i: usize| dist[i / LANES][i % LANES];
+            let d = |i: usize| dist[i & (2 * LANES - 1)];
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 let rest = mask & (mask - 1);
@@ -46,7 +51,8 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                         m &= m - 1;
                         let c = child(i);
                         prefetch_child(nodes, packets, c);
-                        stack.push(Entry { t: d(i), child: c });
+                        stack[sp] = Entry { t: d(i), child: c };
+                        sp += 1;
                     }
                     cur = child(first);
                     continue;
@@ -61,10 +67,11 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                     };
                     let c = child(far);
                     prefetch_child(nodes, packets, c);
-                    stack.push(Entry {
+                    stack[sp] = Entry {
                         t: d(far),
                         child: c,
-                    });
+                    };
+                    sp += 1;
                     cur = child(near);
                     continue;
                 }
@@ -78,14 +85,8 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                     m &= m - 1;
                     prefetch_child(nodes, packets, child(i));
                 }
-                let base = stack.len();
-                stack.resize(
-                    base + count,
-                    Entry {
-                        t: 0.0,
-                        child: EMPTY,
-                    },
-                );
+                let base = sp;
+                sp += count;
                 let mut m = mask;
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
@@ -107,7 +108,9 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                         child: child(i),
                     };
                 }
-                cur = stack.pop().map_or(EMPTY, |e| e.child);
+                // The nearest, just placed on top.
+                sp -= 1;
+                cur = stack[sp].child;
                 continue;
             }
         } else {
@@ -119,9 +122,11 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
         }
         // Next: the nearest stacked entry not beyond the limit.
         loop {
-            let Some(e) = stack.pop() else {
+            if sp == 0 {
                 return best;
-            };
+            }
+            sp -= 1;
+            let e = stack[sp];
             if e.t <= limit {
                 cur = e.child;
                 break;
@@ -221,6 +226,14 @@ pub(crate) fn test_leaf<const ANY: bool>(
 pub(super) struct Entry {
     pub(super) t: f32,
     pub(super) child: u32,
+}
+
+impl Entry {
+    /// What fills a stack slot before its first use.
+    pub(super) const UNUSED: Self = Self {
+        t: 0.0,
+        child: EMPTY,
+    };
 }
 
 thread_local! {
