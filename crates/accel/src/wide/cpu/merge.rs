@@ -7,8 +7,9 @@ use crate::image::{ChildKind, NodeLayout, RUN_END};
 /// The paper's BVH2 has small leaves (1.8 triangles on average on dragon_box, SAH with equal
 /// node and triangle costs), and each leaf visit is a cache miss on its packet; testing up
 /// to 16 triangles four at a time is cheaper than descending two more node levels. Chosen
-/// by measurement (docs/performance.md, "Leaf merging": with `DUALSPLIT_MERGE_MAX`, BVH8 on
-/// dragon_box and sponza_dabrovic); answers do not depend on it.
+/// by measuring 0, 4, 8, 12, 16, 24 and 32 on dragon_box and sponza_dabrovic (16 fastest on
+/// dragon_box, all within a few per cent on Sponza); docs/performance.md ("Leaf merging")
+/// compares 0 with 16 on the current code. Answers do not depend on it.
 pub const MERGE_MAX: usize = 16;
 
 /// The largest merge limit [`merge_limit`] accepts from the environment.
