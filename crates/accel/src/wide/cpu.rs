@@ -63,7 +63,7 @@ pub(crate) use copy::pack_entries;
 pub use isa::SimdLevel;
 pub(crate) use isa::{PackedHit, avx2_token};
 pub use layout::{Chunk, Chunk8, EMPTY, LANES, LEAF, TriPacket};
-pub use merge::{MERGE_LIMIT_MAX, MERGE_MAX, merge_limit, parse_merge_limit};
+pub use merge::{MERGE_LIMIT_MAX, MERGE_MAX, merge_limit, merge_limit_from_env};
 pub(crate) use ray::RaySimd;
 pub(crate) use traverse::test_leaf;
 

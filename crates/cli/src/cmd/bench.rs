@@ -97,10 +97,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     // The measuring knob of the CPU copies' leaf merging: refused here when malformed (the
     // library would quietly keep its default).
-    dualsplit_accel::wide::cpu::parse_merge_limit(
-        std::env::var("DUALSPLIT_MERGE_MAX").ok().as_deref(),
-    )
-    .map_err(anyhow::Error::msg)?;
+    dualsplit_accel::wide::cpu::merge_limit_from_env().map_err(anyhow::Error::msg)?;
     let json = JsonOut::from_arg(args.json.as_deref())?;
     // JSON lines go out as they are measured on standard output, and all at the end to a
     // file.

@@ -17,24 +17,24 @@ pub const MERGE_LIMIT_MAX: usize = 64;
 
 /// The merge limit the copies use: [`MERGE_MAX`], unless the environment variable
 /// `DUALSPLIT_MERGE_MAX` holds an integer from 0 to [`MERGE_LIMIT_MAX`] (for measuring; 0
-/// keeps the image's leaves, the ones a DST converted from the same BVH2 has). Read once.
+/// keeps the image's leaves, the ones a DST converted from the same BVH2 has). Read once; a
+/// malformed value keeps [`MERGE_MAX`] here ([`merge_limit_from_env`] reports it).
 pub fn merge_limit() -> usize {
     static LIMIT: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-    *LIMIT.get_or_init(|| {
-        parse_merge_limit(std::env::var("DUALSPLIT_MERGE_MAX").ok().as_deref())
-            .ok()
-            .flatten()
-            .unwrap_or(MERGE_MAX)
-    })
+    *LIMIT.get_or_init(|| merge_limit_from_env().unwrap_or(MERGE_MAX))
 }
 
-/// `DUALSPLIT_MERGE_MAX`'s value: `Ok(None)` when unset, `Ok(Some(n))` for an integer `n`
-/// from 0 to [`MERGE_LIMIT_MAX`], otherwise an error saying what is accepted (the CLI
-/// refuses to run with one; the library then keeps [`MERGE_MAX`]).
-pub fn parse_merge_limit(value: Option<&str>) -> Result<Option<usize>, String> {
-    let Some(v) = value else { return Ok(None) };
+/// The merge limit `DUALSPLIT_MERGE_MAX` asks for ([`MERGE_MAX`] when unset), or an error
+/// naming the variable, its value and what is accepted (the CLI refuses to run with one).
+pub fn merge_limit_from_env() -> Result<usize, String> {
+    parse_merge_limit(std::env::var("DUALSPLIT_MERGE_MAX").ok().as_deref())
+}
+
+/// [`merge_limit_from_env`] for the variable's value `value` (`None`: unset).
+fn parse_merge_limit(value: Option<&str>) -> Result<usize, String> {
+    let Some(v) = value else { return Ok(MERGE_MAX) };
     match v.trim().parse::<usize>() {
-        Ok(n) if n <= MERGE_LIMIT_MAX => Ok(Some(n)),
+        Ok(n) if n <= MERGE_LIMIT_MAX => Ok(n),
         _ => Err(format!(
             "DUALSPLIT_MERGE_MAX is {v:?}: it must be an integer from 0 to {MERGE_LIMIT_MAX}"
         )),
@@ -86,10 +86,10 @@ mod tests {
 
     #[test]
     fn merge_limit_values_are_checked() {
-        assert_eq!(parse_merge_limit(None), Ok(None));
-        assert_eq!(parse_merge_limit(Some("0")), Ok(Some(0)));
-        assert_eq!(parse_merge_limit(Some(" 16 ")), Ok(Some(16)));
-        assert_eq!(parse_merge_limit(Some("64")), Ok(Some(MERGE_LIMIT_MAX)));
+        assert_eq!(parse_merge_limit(None), Ok(MERGE_MAX));
+        assert_eq!(parse_merge_limit(Some("0")), Ok(0));
+        assert_eq!(parse_merge_limit(Some(" 16 ")), Ok(16));
+        assert_eq!(parse_merge_limit(Some("64")), Ok(MERGE_LIMIT_MAX));
         for bad in ["65", "-1", "", "sixteen", "1e3"] {
             let e = parse_merge_limit(Some(bad)).unwrap_err();
             assert!(e.contains("from 0 to 64"), "{bad}: {e}");
