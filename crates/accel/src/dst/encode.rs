@@ -212,6 +212,17 @@ struct Encoder<'a> {
     planner: Planner,
 }
 
+/// What the sequential plan pass carries down a subtree.
+struct SeqPlan {
+    /// The records of the internal nodes planned so far, depth-first.
+    recs: Vec<Rec>,
+    /// Nodes still allowed: a cycle in a malformed BVH runs it out instead of recursing
+    /// forever.
+    budget: usize,
+    /// The two children's chain DPs, reused from node to node.
+    dps: [ChainDp; 2],
+}
+
 impl Encoder<'_> {
     /// Checks BVH node `n`'s box and child links, or a leaf's triangle range (what planning
     /// and emission index with); for a leaf entered with `chain`, returns its size.
@@ -283,57 +294,45 @@ impl Encoder<'_> {
         })
     }
 
-    /// Plan pass, sequential: appends the records of `n`'s subtree to `recs` in depth-first
-    /// order. `budget` counts the nodes still allowed (a cycle in a malformed BVH runs it
-    /// out instead of recursing forever). Inlined into its caller, so that a leaf costs no
-    /// call: only internal nodes recurse ([`Encoder::plan_inner`]).
+    /// Plan pass, sequential: appends the records of `n`'s subtree to `s.recs` in
+    /// depth-first order. Inlined into its caller, so that a leaf costs no call: only
+    /// internal nodes recurse ([`Encoder::plan_inner`]).
     #[inline(always)]
-    fn plan_seq(
-        &self,
-        n: u32,
-        chain: Chain,
-        recs: &mut Vec<Rec>,
-        budget: &mut usize,
-        dps: &mut [ChainDp; 2],
-    ) -> Result<Size, DstError> {
-        *budget = budget.checked_sub(1).ok_or(DstError::BadBvhLink {
+    fn plan_seq(&self, n: u32, chain: Chain, s: &mut SeqPlan) -> Result<Size, DstError> {
+        s.budget = s.budget.checked_sub(1).ok_or(DstError::BadBvhLink {
             node: n,
             child: n,
             nodes: self.bvh.nodes.len(),
         })?;
         match self.check_node(n, chain)? {
             Some(leaf) => Ok(leaf),
-            None => self.plan_inner(n, chain, recs, budget, dps),
+            None => self.plan_inner(n, chain, s),
         }
     }
 
     /// [`Encoder::plan_seq`] for internal node `n`, already checked.
-    fn plan_inner(
-        &self,
-        n: u32,
-        chain: Chain,
-        recs: &mut Vec<Rec>,
-        budget: &mut usize,
-        dps: &mut [ChainDp; 2],
-    ) -> Result<Size, DstError> {
-        let slot = recs.len();
-        recs.push(self.new_rec(n, dps));
-        let rec = &recs[slot];
+    fn plan_inner(&self, n: u32, chain: Chain, s: &mut SeqPlan) -> Result<Size, DstError> {
+        let slot = s.recs.len();
+        let rec = self.new_rec(n, &mut s.dps);
+        s.recs.push(rec);
         let ([cl, cr], [ch_l, ch_r]) = (rec.children(self.bvh, n), rec.chains);
-        let l = self.plan_seq(cl, ch_l, recs, budget, dps)?;
-        let r = self.plan_seq(cr, ch_r, recs, budget, dps)?;
-        Ok(self.close(n, chain, &mut recs[slot], l, r))
+        let l = self.plan_seq(cl, ch_l, s)?;
+        let r = self.plan_seq(cr, ch_r, s)?;
+        Ok(self.close(n, chain, &mut s.recs[slot], l, r))
     }
 
     /// Plan pass: nodes above [`PARALLEL_DEPTH`] plan their two subtrees in parallel.
     fn plan(&self, n: u32, chain: Chain, depth: u32) -> Result<(Plan, Size), DstError> {
         if depth >= PARALLEL_DEPTH {
-            // About twice an even share of the internal nodes, so the records rarely move.
-            let mut recs = Vec::with_capacity(self.bvh.nodes.len() >> PARALLEL_DEPTH);
-            let mut budget = self.bvh.nodes.len();
-            let mut dps = [ChainDp::new(), ChainDp::new()];
-            let size = self.plan_seq(n, chain, &mut recs, &mut budget, &mut dps)?;
-            return Ok((Plan::Seq(recs), size));
+            let mut s = SeqPlan {
+                // About twice an even share of the internal nodes, so the records rarely
+                // move.
+                recs: Vec::with_capacity(self.bvh.nodes.len() >> PARALLEL_DEPTH),
+                budget: self.bvh.nodes.len(),
+                dps: [ChainDp::new(), ChainDp::new()],
+            };
+            let size = self.plan_seq(n, chain, &mut s)?;
+            return Ok((Plan::Seq(s.recs), size));
         }
         if let Some(leaf) = self.check_node(n, chain)? {
             return Ok((Plan::Seq(Vec::new()), leaf));
