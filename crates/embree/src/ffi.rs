@@ -104,8 +104,107 @@ const _: () = assert!(std::mem::size_of::<RTCHit>() == 32);
 const _: () = assert!(std::mem::size_of::<RTCRayHit>() == 80);
 const _: () = assert!(std::mem::size_of::<RTCIntersectContext>() == 24);
 
+/// `RTC_BUILD_QUALITY_MEDIUM` of `enum RTCBuildQuality` (binned SAH; the default).
+pub const RTC_BUILD_QUALITY_MEDIUM: c_uint = 1;
+/// `RTC_BUILD_MAX_PRIMITIVES_PER_LEAF`: the most primitives `rtcBuildBVH` puts in a leaf.
+pub const RTC_BUILD_MAX_PRIMITIVES_PER_LEAF: usize = 32;
+
+/// `RTCBVH`: an opaque handle owning a builder's memory.
+#[allow(clippy::upper_case_acronyms)]
+pub type RTCBVH = *mut c_void;
+/// `RTCThreadLocalAllocator`: an opaque handle.
+pub type RTCThreadLocalAllocator = *mut c_void;
+
+/// `struct RTCBounds` (16-byte aligned, 32 bytes).
+#[repr(C, align(16))]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RTCBounds {
+    pub lower_x: f32,
+    pub lower_y: f32,
+    pub lower_z: f32,
+    pub align0: f32,
+    pub upper_x: f32,
+    pub upper_y: f32,
+    pub upper_z: f32,
+    pub align1: f32,
+}
+
+/// `struct RTCBuildPrimitive` (32-byte aligned, 32 bytes).
+#[repr(C, align(32))]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RTCBuildPrimitive {
+    pub lower_x: f32,
+    pub lower_y: f32,
+    pub lower_z: f32,
+    pub geom_id: c_uint,
+    pub upper_x: f32,
+    pub upper_y: f32,
+    pub upper_z: f32,
+    pub prim_id: c_uint,
+}
+
+/// `RTCCreateNodeFunction`.
+pub type RTCCreateNodeFunction =
+    unsafe extern "C" fn(RTCThreadLocalAllocator, c_uint, *mut c_void) -> *mut c_void;
+/// `RTCSetNodeChildrenFunction`.
+pub type RTCSetNodeChildrenFunction =
+    unsafe extern "C" fn(*mut c_void, *mut *mut c_void, c_uint, *mut c_void);
+/// `RTCSetNodeBoundsFunction`.
+pub type RTCSetNodeBoundsFunction =
+    unsafe extern "C" fn(*mut c_void, *mut *const RTCBounds, c_uint, *mut c_void);
+/// `RTCCreateLeafFunction`.
+pub type RTCCreateLeafFunction = unsafe extern "C" fn(
+    RTCThreadLocalAllocator,
+    *const RTCBuildPrimitive,
+    usize,
+    *mut c_void,
+) -> *mut c_void;
+
+/// `struct RTCBuildArguments` (Embree 3.13's `rtcore_builder.h`), with the split-primitive
+/// and progress callbacks always null (no spatial splits, no progress).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct RTCBuildArguments {
+    pub byte_size: usize,
+    pub build_quality: c_uint,
+    pub build_flags: c_uint,
+    pub max_branching_factor: c_uint,
+    pub max_depth: c_uint,
+    pub sah_block_size: c_uint,
+    pub min_leaf_size: c_uint,
+    pub max_leaf_size: c_uint,
+    pub traversal_cost: f32,
+    pub intersection_cost: f32,
+    pub bvh: RTCBVH,
+    pub primitives: *mut RTCBuildPrimitive,
+    pub primitive_count: usize,
+    pub primitive_array_capacity: usize,
+    pub create_node: Option<RTCCreateNodeFunction>,
+    pub set_node_children: Option<RTCSetNodeChildrenFunction>,
+    pub set_node_bounds: Option<RTCSetNodeBoundsFunction>,
+    pub create_leaf: Option<RTCCreateLeafFunction>,
+    /// `RTCSplitPrimitiveFunction`, always null here.
+    pub split_primitive: *const c_void,
+    /// `RTCProgressMonitorFunction`, always null here.
+    pub build_progress: *const c_void,
+    pub user_ptr: *mut c_void,
+}
+
+const _: () = assert!(std::mem::size_of::<RTCBounds>() == 32);
+const _: () = assert!(std::mem::size_of::<RTCBuildPrimitive>() == 32);
+const _: () = assert!(std::mem::size_of::<RTCBuildArguments>() == 136);
+
 #[link(name = "embree3")]
 unsafe extern "C" {
+    pub fn rtcNewBVH(device: RTCDevice) -> RTCBVH;
+    pub fn rtcBuildBVH(args: *const RTCBuildArguments) -> *mut c_void;
+    pub fn rtcThreadLocalAlloc(
+        allocator: RTCThreadLocalAllocator,
+        bytes: usize,
+        align: usize,
+    ) -> *mut c_void;
+    pub fn rtcReleaseBVH(bvh: RTCBVH);
+
     pub fn rtcNewDevice(config: *const c_char) -> RTCDevice;
     pub fn rtcReleaseDevice(device: RTCDevice);
     pub fn rtcGetDeviceError(device: RTCDevice) -> c_uint;

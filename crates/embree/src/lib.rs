@@ -19,10 +19,13 @@ mod error;
 mod ffi;
 #[cfg(dualsplit_embree)]
 mod linked;
+#[cfg(dualsplit_embree)]
+mod linked_tree;
 #[cfg(not(dualsplit_embree))]
 mod missing;
 mod options;
 mod scene;
+pub mod tree;
 
 pub use agree::{Agreement, Differences, Verdict, classify};
 pub use check::{TErrors, agree_closest, agree_occluded, t_errors};

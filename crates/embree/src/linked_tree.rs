@@ -1,0 +1,253 @@
+//! [`crate::tree::build_tree`] on the linked library: `rtcBuildBVH` with callbacks that
+//! write nodes and leaves into Embree's thread-local memory, then one walk that copies them
+//! out before the memory is released.
+
+use crate::EmbreeError;
+use crate::ffi::{self, RTCBounds, RTCBuildPrimitive, RTCThreadLocalAllocator};
+use crate::tree::{BuiltTree, Child, TreeArgs};
+use dualsplit_geometry::{Aabb, Vec3};
+use std::ffi::{CString, c_uint, c_void};
+
+/// Most children of a node the callbacks store ([`TreeArgs::branching`] is checked).
+const MAX_CHILDREN: usize = 8;
+
+/// An internal node as the callbacks write it (tag 0).
+#[repr(C)]
+struct RawNode {
+    tag: u32,
+    count: u32,
+    children: [*mut c_void; MAX_CHILDREN],
+    bounds: [RTCBounds; MAX_CHILDREN],
+}
+
+/// A leaf as the callbacks write it (tag 1).
+#[repr(C)]
+struct RawLeaf {
+    tag: u32,
+    count: u32,
+    prims: [u32; ffi::RTC_BUILD_MAX_PRIMITIVES_PER_LEAF],
+}
+
+/// `RTCCreateNodeFunction`: a fresh [`RawNode`] in the builder's memory.
+unsafe extern "C" fn create_node(
+    alloc: RTCThreadLocalAllocator,
+    count: c_uint,
+    _: *mut c_void,
+) -> *mut c_void {
+    // SAFETY: `alloc` is the allocator Embree passes this callback; the block is sized and
+    // aligned for a `RawNode` and fully written before it is returned.
+    unsafe {
+        let p = ffi::rtcThreadLocalAlloc(
+            alloc,
+            std::mem::size_of::<RawNode>(),
+            std::mem::align_of::<RawNode>(),
+        )
+        .cast::<RawNode>();
+        if !p.is_null() {
+            p.write(RawNode {
+                tag: 0,
+                count: count.min(MAX_CHILDREN as u32),
+                children: [std::ptr::null_mut(); MAX_CHILDREN],
+                bounds: [RTCBounds::default(); MAX_CHILDREN],
+            });
+        }
+        p.cast()
+    }
+}
+
+/// `RTCSetNodeChildrenFunction`: the node's child pointers.
+unsafe extern "C" fn set_children(
+    node: *mut c_void,
+    children: *mut *mut c_void,
+    count: c_uint,
+    _: *mut c_void,
+) {
+    // SAFETY: `node` is a `RawNode` from `create_node` (Embree passes back what it returned)
+    // and `children` holds `count` pointers, at most the branching factor (≤ 8, checked).
+    unsafe {
+        let n = &mut *node.cast::<RawNode>();
+        for i in 0..(count as usize).min(MAX_CHILDREN) {
+            n.children[i] = *children.add(i);
+        }
+    }
+}
+
+/// `RTCSetNodeBoundsFunction`: the node's child boxes.
+unsafe extern "C" fn set_bounds(
+    node: *mut c_void,
+    bounds: *mut *const RTCBounds,
+    count: c_uint,
+    _: *mut c_void,
+) {
+    // SAFETY: as in `set_children`; `bounds` holds `count` pointers to valid boxes.
+    unsafe {
+        let n = &mut *node.cast::<RawNode>();
+        for i in 0..(count as usize).min(MAX_CHILDREN) {
+            n.bounds[i] = **bounds.add(i);
+        }
+    }
+}
+
+/// `RTCCreateLeafFunction`: a [`RawLeaf`] of the primitives' ids.
+unsafe extern "C" fn create_leaf(
+    alloc: RTCThreadLocalAllocator,
+    prims: *const RTCBuildPrimitive,
+    count: usize,
+    _: *mut c_void,
+) -> *mut c_void {
+    // SAFETY: `alloc` is Embree's allocator for this callback; `prims` holds `count`
+    // primitives, at most the leaf limit (≤ 32, checked), and the block is fully written.
+    unsafe {
+        let p = ffi::rtcThreadLocalAlloc(
+            alloc,
+            std::mem::size_of::<RawLeaf>(),
+            std::mem::align_of::<RawLeaf>(),
+        )
+        .cast::<RawLeaf>();
+        if !p.is_null() {
+            let count = count.min(ffi::RTC_BUILD_MAX_PRIMITIVES_PER_LEAF);
+            let mut leaf = RawLeaf {
+                tag: 1,
+                count: count as u32,
+                prims: [0; ffi::RTC_BUILD_MAX_PRIMITIVES_PER_LEAF],
+            };
+            for i in 0..count {
+                leaf.prims[i] = (*prims.add(i)).prim_id;
+            }
+            p.write(leaf);
+        }
+        p.cast()
+    }
+}
+
+/// The box of an `RTCBounds`.
+fn aabb(b: &RTCBounds) -> Aabb {
+    Aabb {
+        min: Vec3::new(b.lower_x, b.lower_y, b.lower_z),
+        max: Vec3::new(b.upper_x, b.upper_y, b.upper_z),
+    }
+}
+
+pub(crate) fn build_tree(boxes: &[Aabb], args: &TreeArgs) -> Result<BuiltTree, EmbreeError> {
+    let config = CString::new("verbose=0").expect("no NUL");
+    // SAFETY: `config` is NUL-terminated and outlives the call.
+    let device = unsafe { ffi::rtcNewDevice(config.as_ptr()) };
+    if device.is_null() {
+        return Err(EmbreeError::Call {
+            call: "rtcNewDevice",
+            code: crate::ErrorCode::Unknown,
+        });
+    }
+    let mut prims: Vec<RTCBuildPrimitive> = boxes
+        .iter()
+        .enumerate()
+        .map(|(i, b)| RTCBuildPrimitive {
+            lower_x: b.min.x,
+            lower_y: b.min.y,
+            lower_z: b.min.z,
+            geom_id: 0,
+            upper_x: b.max.x,
+            upper_y: b.max.y,
+            upper_z: b.max.z,
+            prim_id: i as u32,
+        })
+        .collect();
+    // SAFETY: `device` is live.
+    let bvh = unsafe { ffi::rtcNewBVH(device) };
+    let out = if bvh.is_null() {
+        Err(EmbreeError::Call {
+            call: "rtcNewBVH",
+            code: crate::ErrorCode::Unknown,
+        })
+    } else {
+        let a = ffi::RTCBuildArguments {
+            byte_size: std::mem::size_of::<ffi::RTCBuildArguments>(),
+            build_quality: ffi::RTC_BUILD_QUALITY_MEDIUM,
+            build_flags: 0,
+            max_branching_factor: args.branching,
+            max_depth: 64,
+            sah_block_size: args.sah_block,
+            min_leaf_size: args.min_leaf,
+            max_leaf_size: args.max_leaf,
+            traversal_cost: args.traversal_cost,
+            intersection_cost: args.intersection_cost,
+            bvh,
+            primitives: prims.as_mut_ptr(),
+            primitive_count: prims.len(),
+            primitive_array_capacity: prims.len(),
+            create_node: Some(create_node),
+            set_node_children: Some(set_children),
+            set_node_bounds: Some(set_bounds),
+            create_leaf: Some(create_leaf),
+            split_primitive: std::ptr::null(),
+            build_progress: std::ptr::null(),
+            user_ptr: std::ptr::null_mut(),
+        };
+        // SAFETY: `a` is a complete `RTCBuildArguments` whose primitive array (`prims`,
+        // 32-byte aligned elements) is live and exclusively lent for the call, and whose
+        // callbacks write only memory they allocated from Embree's allocator.
+        let root = unsafe { ffi::rtcBuildBVH(&a) };
+        let tree = if root.is_null() {
+            Err(EmbreeError::Call {
+                call: "rtcBuildBVH",
+                code: crate::ErrorCode::from_raw(
+                    // SAFETY: `device` is live.
+                    unsafe { ffi::rtcGetDeviceError(device) },
+                ),
+            })
+        } else {
+            // SAFETY: the nodes and leaves live in `bvh`'s memory until `rtcReleaseBVH`
+            // below; every pointer reached from `root` was returned by `create_node` or
+            // `create_leaf`.
+            Ok(unsafe { walk(root) })
+        };
+        // SAFETY: `bvh` is live and released once; nothing refers to its memory afterwards.
+        unsafe { ffi::rtcReleaseBVH(bvh) };
+        tree
+    };
+    // SAFETY: `device` is live and released once.
+    unsafe { ffi::rtcReleaseDevice(device) };
+    out
+}
+
+/// Copies the tree below `root` out of Embree's memory, nodes in depth-first order.
+///
+/// # Safety
+/// `root` and every child pointer below it must be a live [`RawNode`] or [`RawLeaf`].
+unsafe fn walk(root: *mut c_void) -> BuiltTree {
+    let mut t = BuiltTree {
+        nodes: Vec::new(),
+        leaves: Vec::new(),
+        root: Child::Leaf(0),
+    };
+    // (pointer, where its reference goes: the node and slot of its parent, or the root)
+    let mut todo: Vec<(*mut c_void, Option<(usize, usize)>)> = vec![(root, None)];
+    while let Some((p, parent)) = todo.pop() {
+        // SAFETY: the caller's contract; both kinds start with the `u32` tag.
+        let child = unsafe {
+            if *p.cast::<u32>() == 1 {
+                let l = &*p.cast::<RawLeaf>();
+                t.leaves.push(l.prims[..l.count as usize].to_vec());
+                Child::Leaf(t.leaves.len() as u32 - 1)
+            } else {
+                let n = &*p.cast::<RawNode>();
+                let at = t.nodes.len();
+                t.nodes.push(
+                    n.bounds[..n.count as usize]
+                        .iter()
+                        .map(|b| (aabb(b), Child::Leaf(u32::MAX)))
+                        .collect(),
+                );
+                for k in (0..n.count as usize).rev() {
+                    todo.push((n.children[k], Some((at, k))));
+                }
+                Child::Node(at as u32)
+            }
+        };
+        match parent {
+            Some((node, slot)) => t.nodes[node][slot].1 = child,
+            None => t.root = child,
+        }
+    }
+    t
+}

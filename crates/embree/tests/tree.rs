@@ -1,0 +1,116 @@
+//! Embree's builder wrapper (`tree::build_tree`): the tree it hands back holds every box
+//! once, in boxes that contain their subtrees, within the arguments' limits. Tests that need
+//! the library pass with a note when the crate was built without it (never under CI).
+
+use dualsplit_embree::tree::{BuiltTree, Child, TreeArgs, build_tree};
+use dualsplit_embree::{EmbreeError, available};
+use dualsplit_geometry::{Aabb, Vec3};
+use dualsplit_testkit::scenes::shipped_triangles;
+
+fn build(boxes: &[Aabb], args: &TreeArgs) -> Option<BuiltTree> {
+    match build_tree(boxes, args) {
+        Ok(t) => Some(t),
+        Err(EmbreeError::Missing(why)) => {
+            assert!(!available());
+            assert!(
+                std::env::var_os("CI").is_none(),
+                "Embree is missing under CI ({why})"
+            );
+            eprintln!("note: Embree is missing ({why}); test skipped");
+            None
+        }
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// The primitives below `c`, checking every node on the way: at most `args.branching`
+/// children, each child's box containing its primitives' boxes, leaves of 1 to
+/// `args.max_leaf` primitives.
+fn check(t: &BuiltTree, c: Child, boxes: &[Aabb], args: &TreeArgs, out: &mut Vec<u32>) -> Aabb {
+    match c {
+        Child::Leaf(l) => {
+            let ids = &t.leaves[l as usize];
+            assert!(
+                (1..=args.max_leaf as usize).contains(&ids.len()),
+                "leaf {l}: {ids:?}"
+            );
+            out.extend(ids);
+            ids.iter()
+                .fold(Aabb::EMPTY, |b, &p| b.union(boxes[p as usize]))
+        }
+        Child::Node(n) => {
+            let node = &t.nodes[n as usize];
+            assert!(
+                (1..=args.branching as usize).contains(&node.len()),
+                "node {n}"
+            );
+            let mut all = Aabb::EMPTY;
+            for &(b, child) in node {
+                let below = check(t, child, boxes, args, out);
+                assert!(
+                    b.contains_box(&below),
+                    "node {n}: {b:?} does not hold {below:?}"
+                );
+                all = all.union(below);
+            }
+            all
+        }
+    }
+}
+
+#[test]
+fn embree_tree_holds_every_triangle_once_in_containing_boxes() {
+    let tris = shipped_triangles("dragon_res4.ply.gz").expect("dragon_res4 is committed");
+    let boxes: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
+    for args in [
+        TreeArgs::bvh8_triangle4(),
+        TreeArgs {
+            branching: 2,
+            sah_block: 1,
+            min_leaf: 1,
+            max_leaf: 4,
+            ..TreeArgs::bvh8_triangle4()
+        },
+    ] {
+        let Some(t) = build(&boxes, &args) else {
+            return;
+        };
+        let mut prims = Vec::new();
+        check(&t, t.root, &boxes, &args, &mut prims);
+        prims.sort_unstable();
+        let want: Vec<u32> = (0..boxes.len() as u32).collect();
+        assert_eq!(prims, want, "{args:?}: every box once");
+        assert!(
+            t.nodes.len() > boxes.len() / (8 * args.max_leaf as usize),
+            "{args:?}: a real tree"
+        );
+    }
+}
+
+#[test]
+fn one_box_is_a_leaf_root_and_bad_arguments_are_refused() {
+    let b = Aabb {
+        min: Vec3::splat(0.0),
+        max: Vec3::splat(1.0),
+    };
+    if let Some(t) = build(&[b], &TreeArgs::bvh8_triangle4()) {
+        let mut prims = Vec::new();
+        check(&t, t.root, &[b], &TreeArgs::bvh8_triangle4(), &mut prims);
+        assert_eq!(prims, vec![0]);
+    }
+    for args in [
+        TreeArgs {
+            branching: 9,
+            ..TreeArgs::bvh8_triangle4()
+        },
+        TreeArgs {
+            max_leaf: 33,
+            ..TreeArgs::bvh8_triangle4()
+        },
+    ] {
+        let e = build_tree(&[b], &args).expect_err("out of range");
+        assert!(matches!(e, EmbreeError::Unsupported(_)), "{e}");
+    }
+    let e = build_tree(&[], &TreeArgs::bvh8_triangle4()).expect_err("no boxes");
+    assert!(matches!(e, EmbreeError::Unsupported(_)), "{e}");
+}
