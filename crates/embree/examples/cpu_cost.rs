@@ -1,0 +1,67 @@
+//! One pass of one of `bench`'s ray sets through our BVH8 copy, then through Embree: the
+//! program to run under callgrind for instructions, branches and mispredictions per ray.
+//!
+//! `cpu_cost SCENE RES SET` builds the structures of `SCENE`, records the ray sets of a
+//! RES×RES path-traced frame (as `dualsplit bench` does), and traces set `SET` (`primary`,
+//! `shadow` or `diffuse`) once with `bvh8`'s CPU copy (the queries `bench` times) and once
+//! with `rtcIntersect1` / `rtcOccluded1`. Each side's counts come from one callgrind run
+//! collecting only inside its traversal:
+//!
+//! ```sh
+//! cargo build --release -p dualsplit-embree --example cpu_cost
+//! run() { valgrind --tool=callgrind --branch-sim=yes --callgrind-out-file=/dev/null \
+//!     --toggle-collect="$1" target/release/examples/cpu_cost "${@:2}" 2>&1 | grep Collected; }
+//! S=sponza_dabrovic.ply.gz   # a shipped mesh's path, or builtin:NAME
+//! run 'dualsplit_accel::wide::simd::Avx2::vectorize::with_avx2*' $S 64 primary   # ours
+//! run rtcIntersect1 $S 64 primary   # Embree (rtcOccluded1 for the shadow set)
+//! ```
+//!
+//! "Collected" lists Ir, conditional branches and mispredicted ones; the program prints the
+//! set's ray count to divide by. (Our copy's traversal runs inside the AVX2 function that the
+//! toggle names when the CPU has AVX2; nothing else runs there in this program.)
+
+use dualsplit_accel::Structures;
+use dualsplit_embree::EmbreeScene;
+use dualsplit_render::bench::ray_sets;
+use dualsplit_render::{RayKind, RenderSettings, Workload};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let usage = "usage: cpu_cost SCENE RES primary|shadow|diffuse";
+    let mut args = std::env::args().skip(1);
+    let spec = args.next().ok_or(usage)?;
+    let res: u32 = args.next().ok_or(usage)?.parse()?;
+    let kind = args.next().ok_or(usage)?;
+    let scene = dualsplit_scene::load(&spec)?;
+    let s = Structures::try_build(&scene.triangles, &Default::default())?;
+    let sets = ray_sets(&scene, &s, &RenderSettings::new(res, res, Workload::Path))?;
+    let set = sets
+        .iter()
+        .find(|set| set.kind.name() == kind)
+        .ok_or(usage)?;
+    let copy = s.bvh8.cpu();
+    let embree = EmbreeScene::new(&scene.triangles)?;
+    let shadow = set.kind == RayKind::Shadow;
+    let mut hits = [0usize; 2];
+    for r in &set.rays {
+        let h = if shadow {
+            copy.traverse::<true>(r).map(|h| h.is_some())
+        } else {
+            copy.traverse::<false>(r).map(|h| h.is_some())
+        };
+        hits[0] += h.ok_or("a ray the CPU copy declines")? as usize;
+    }
+    for r in &set.rays {
+        hits[1] += if shadow {
+            embree.occluded(r)
+        } else {
+            embree.intersect(r).is_some()
+        } as usize;
+    }
+    println!(
+        "{spec}, {res}x{res} path frame, {} {kind} rays: {} hits (ours), {} (Embree)",
+        set.rays.len(),
+        hits[0],
+        hits[1]
+    );
+    Ok(())
+}
