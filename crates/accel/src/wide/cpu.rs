@@ -13,7 +13,8 @@
 //! the image's leaves, for measuring). The answers are the image traversal's, ray
 //! for ray and bit for bit:
 //!
-//! * the box test is [`super::traverse`]'s arithmetic lane by lane: `(p - o) * inv`, far
+//! * the box test is [`super::traverse`]'s arithmetic lane by lane: `(p - o) * inv`
+//!   (computed as `(o - p) * -inv`, the same bits up to the sign of a zero), far
 //!   planes multiplied by [`EXIT_WIDEN`], the interval clipped by compare-and-select (x86's
 //!   `maxps`/`minps` keep the running bound when a plane distance is NaN, exactly as the
 //!   scalar `if tn > entry`); rays whose interval ends are NaN take the image traversal;

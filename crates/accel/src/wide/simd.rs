@@ -87,8 +87,10 @@ impl Avx2 {
 
     /// Slab test of eight boxes stored plane by plane (`planes[p][lane]`, planes in the box
     /// word order min.x, min.y, min.z, max.x, max.y, max.z), the same arithmetic as the
-    /// 4-wide test lane by lane: near plane `p = near[a]` gives `(p - o[a]) * inv[a]`, far
-    /// plane `far[a]` the same times `widen`; the entry is the largest of `t_lo` and the
+    /// 4-wide test lane by lane: near plane `p = near[a]` gives `(o[a] - p) * neg_inv[a]`
+    /// (`neg_inv = -inv_dir`, so `(p - o[a]) * inv[a]` up to the sign of a zero, with the
+    /// plane's load folded into the subtraction), far plane `far[a]` the same times
+    /// `widen`; the entry is the largest of `t_lo` and the
     /// near distances, the exit the smallest of `t_hi` and the far ones, a NaN distance
     /// keeping the running bound (`vmaxps`/`vminps` return their second operand then).
     /// Returns the entry distances and the mask of lanes with `entry <= exit` whose child
@@ -102,7 +104,7 @@ impl Avx2 {
         near: [usize; 3],
         far: [usize; 3],
         o: [f32; 3],
-        inv: [f32; 3],
+        neg_inv: [f32; 3],
         t_lo: f32,
         t_hi: f32,
         widen: f32,
@@ -119,9 +121,9 @@ impl Avx2 {
                 let mut exit = _mm256_set1_ps(t_hi);
                 for a in 0..3 {
                     let oa = _mm256_set1_ps(o[a]);
-                    let ia = _mm256_set1_ps(inv[a]);
-                    let tn = _mm256_mul_ps(_mm256_sub_ps(row(near[a]), oa), ia);
-                    let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(row(far[a]), oa), ia), w);
+                    let ia = _mm256_set1_ps(neg_inv[a]);
+                    let tn = _mm256_mul_ps(_mm256_sub_ps(oa, row(near[a])), ia);
+                    let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(oa, row(far[a])), ia), w);
                     entry = _mm256_max_ps(tn, entry);
                     exit = _mm256_min_ps(tf, exit);
                 }
@@ -136,7 +138,7 @@ impl Avx2 {
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
-            let _ = (planes, child, near, far, o, inv, t_lo, t_hi, widen);
+            let _ = (planes, child, near, far, o, neg_inv, t_lo, t_hi, widen);
             unreachable!("no Avx2 token exists off x86-64")
         }
     }

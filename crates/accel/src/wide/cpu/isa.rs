@@ -41,7 +41,15 @@ impl Isa for Avx2 {
     #[inline(always)]
     fn test8(self, rs: &RaySimd, n: &Chunk8, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32) {
         let (e, m) = self.slab8(
-            &n.planes, &n.child, rs.near, rs.far, rs.os, rs.invs, t_lo, t_hi, EXIT_WIDEN,
+            &n.planes,
+            &n.child,
+            rs.near,
+            rs.far,
+            rs.os,
+            rs.neg_invs,
+            t_lo,
+            t_hi,
+            EXIT_WIDEN,
         );
         (bytemuck::cast(e), m)
     }
