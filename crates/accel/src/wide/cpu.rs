@@ -29,7 +29,7 @@
 //!   have led to (and more), so it can add no closer hit and lose none.
 //!
 //! Only the visiting order of a node's hit children differs (nearest first, the rest pushed
-//! by a rank computed from their entry distances, ties in either order; for shadow rays the
+//! sorted by entry distance, ties by slot; for shadow rays the
 //! first hit child first and the rest as they come), which changes no answer.
 //!
 //! Instructions ([`SimdLevel`]): with AVX2 (detected at run time) a BVH8 node is one 8-wide

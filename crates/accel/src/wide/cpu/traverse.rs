@@ -6,7 +6,7 @@ use super::ray::RaySimd;
 use crate::image::RUN_END;
 use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, Triangle, Vec3, cull_limit};
 use std::cell::Cell;
-use wide::{CmpEq, CmpLt, f32x4};
+use wide::f32x4;
 
 /// The traversal (see the [`super`] module docs) of `nodes` and `packets` with instructions `I`.
 #[inline(always)]
@@ -75,38 +75,26 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                     cur = child(near);
                     continue;
                 }
-                // Three or more: each goes to the stack slot of its rank (the number of
-                // hit children before it by entry distance, ties by slot), nearest on
-                // top; then the nearest is taken.
-                let count = ones(mask);
-                let mut m = mask;
-                while m != 0 {
-                    let i = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    prefetch_child(nodes, packets, child(i));
-                }
+                // Three or more, pushed in slot order, each inserted below the entries
+                // already pushed that are nearer or as near (ties by slot, the earlier
+                // nearer the top), so that the nearest ends on top; then it is taken.
                 let base = sp;
-                sp += count;
                 let mut m = mask;
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
                     m &= m - 1;
-                    let di = d(i);
-                    // The hit lanes nearer than `i`, or as near and in an earlier slot,
-                    // from one comparison per four lanes.
-                    let splat = f32x4::splat(di);
-                    let mut before = 0u32;
-                    for (c, v) in dv.iter().enumerate().take(N::W.div_ceil(LANES)) {
-                        let lt = v.cmp_lt(splat).move_mask() as u32;
-                        let eq = v.cmp_eq(splat).move_mask() as u32;
-                        let earlier = ((1u32 << i) - 1) >> (LANES * c);
-                        before |= (lt | (eq & earlier)) << (LANES * c);
-                    }
-                    let rank = ones(before & mask);
-                    stack[base + count - 1 - rank] = Entry {
-                        t: di,
+                    let e = Entry {
+                        t: d(i),
                         child: child(i),
                     };
+                    prefetch_child(nodes, packets, e.child);
+                    let mut j = sp;
+                    while j > base && stack[j - 1].t <= e.t {
+                        stack[j] = stack[j - 1];
+                        j -= 1;
+                    }
+                    stack[j] = e;
+                    sp += 1;
                 }
                 // The nearest, just placed on top.
                 sp -= 1;
@@ -133,22 +121,6 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
             }
         }
     }
-}
-
-/// Set bits of an 8-bit mask: the x86-64 baseline has no `popcnt`, and `count_ones` becomes
-/// a dozen instructions there; a 256-byte table is one load.
-#[inline(always)]
-fn ones(mask: u32) -> usize {
-    const TABLE: [u8; 256] = {
-        let mut t = [0u8; 256];
-        let mut i = 0;
-        while i < 256 {
-            t[i] = (i as u32).count_ones() as u8;
-            i += 1;
-        }
-        t
-    };
-    TABLE[(mask & 0xff) as usize] as usize
 }
 
 /// Prefetches the first line of child word `c`'s node or the first packet of its leaf.
