@@ -18,6 +18,31 @@ pub(super) struct Edges {
     pub(super) candidates: u32,
 }
 
+/// An axis, x, y or z: an index below 3 by its type, so that indexing a vertex's
+/// coordinates with it needs no bounds check.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub(super) enum Axis {
+    /// x (0).
+    X,
+    /// y (1).
+    Y,
+    /// z (2).
+    Z,
+}
+
+impl Axis {
+    /// Axis `a` (below 3).
+    #[inline(always)]
+    fn new(a: usize) -> Self {
+        match a {
+            0 => Self::X,
+            1 => Self::Y,
+            _ => Self::Z,
+        }
+    }
+}
+
 /// The ray's constants broadcast to all lanes, the plane rows its signs pick, and the
 /// watertight test's axes and shear.
 ///
@@ -38,7 +63,8 @@ pub(crate) struct RaySimd {
     /// Plane rows of the near and far planes per axis.
     pub(super) near: [usize; 3],
     pub(super) far: [usize; 3],
-    pub(super) k: [usize; 3],
+    /// The watertight test's axes `(kx, ky, kz)`.
+    pub(super) k: [Axis; 3],
     pub(super) sx: f32x4,
     pub(super) sy: f32x4,
 }
@@ -61,7 +87,7 @@ impl RaySimd {
             neg_invs: [-inv.x, -inv.y, -inv.z],
             near: [s(0), 1 + s(1), 2 + s(2)],
             far: [3 - s(0), 4 - s(1), 5 - s(2)],
-            k: r.k,
+            k: r.k.map(Axis::new),
             sx: f32x4::splat(r.shear.x),
             sy: f32x4::splat(r.shear.y),
         }
@@ -74,7 +100,7 @@ impl RaySimd {
     /// edge function is zero and their signs differ, which it rejects at that stage.
     #[inline(always)]
     pub(super) fn triangle_edges(&self, pk: &TriPacket) -> Edges {
-        let [kx, ky, kz] = self.k;
+        let [kx, ky, kz] = self.k.map(|a| a as usize);
         let rel = |vertex: usize, axis: usize| f32x4::new(pk.v[3 * vertex + axis]) - self.o[axis];
         let (ax, ay, az) = (rel(0, kx), rel(0, ky), rel(0, kz));
         let (bx, by, bz) = (rel(1, kx), rel(1, ky), rel(1, kz));

@@ -4,7 +4,7 @@ use super::isa::Isa;
 use super::layout::{EMPTY, LANES, LEAF, Lanes, TriPacket};
 use super::ray::RaySimd;
 use crate::image::RUN_END;
-use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, Triangle, Vec3, cull_limit};
+use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, Triangle, TriangleHit, Vec3, cull_limit};
 use std::cell::Cell;
 use wide::f32x4;
 
@@ -167,14 +167,15 @@ pub(crate) fn test_leaf<const ANY: bool>(
             let l = m.trailing_zeros() as usize;
             m &= m - 1;
             let p = PrimId(pk.prim[l] & !RUN_END);
-            // The triangle's own words, from the packet (already in cache).
-            let vertex =
-                |k: usize| Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l]);
-            let tri = Triangle::new(vertex(0), vertex(1), vertex(2));
             let h = if e.zero & (1 << l) != 0 {
-                tri.intersect(r, r.ray.t_min, *best_t)
+                intersect_lane(pk, l, r, *best_t)
             } else {
-                tri.intersect_from_edges(r, [e.u[l], e.v[l], e.w[l]], r.ray.t_min, *best_t)
+                lane_triangle(pk, l).intersect_from_edges(
+                    r,
+                    [e.u[l], e.v[l], e.w[l]],
+                    r.ray.t_min,
+                    *best_t,
+                )
             };
             if let Some(h) = h
                 && Hit::keep_closest(best, p, h)
@@ -191,6 +192,22 @@ pub(crate) fn test_leaf<const ANY: bool>(
         i += 1;
         from = 0b1111;
     }
+}
+
+/// Lane `l`'s triangle of `pk`: its own words, from the packet (already in cache).
+#[inline(always)]
+fn lane_triangle(pk: &TriPacket, l: usize) -> Triangle {
+    let vertex = |k: usize| Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l]);
+    Triangle::new(vertex(0), vertex(1), vertex(2))
+}
+
+/// [`Triangle::intersect`] of lane `l` of `pk` on `[ray.t_min, t_hi]`, for the rare lanes
+/// with an edge function equal to zero: out of line, so that the common path keeps the
+/// triangle in registers rather than in memory for this call.
+#[cold]
+#[inline(never)]
+fn intersect_lane(pk: &TriPacket, l: usize, r: &RayPre, t_hi: f32) -> Option<TriangleHit> {
+    lane_triangle(pk, l).intersect(r, r.ray.t_min, t_hi)
 }
 
 /// A stacked child: its entry distance and child word.
