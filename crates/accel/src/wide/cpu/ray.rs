@@ -116,8 +116,11 @@ impl RaySimd {
         let w = bx * ay - by * ax;
         let zero = f32x4::splat(0.0);
         let any_zero = (u.cmp_eq(zero) | v.cmp_eq(zero) | w.cmp_eq(zero)).move_mask() as u32;
-        let neg = u.cmp_lt(zero) | v.cmp_lt(zero) | w.cmp_lt(zero);
-        let pos = u.cmp_gt(zero) | v.cmp_gt(zero) | w.cmp_gt(zero);
+        // Some edge function negative and some positive: `keep_min` and `keep_max` return
+        // one of their arguments, so a negative smallest or positive largest is one of the
+        // three (a NaN one may be passed over, which can only keep a lane).
+        let neg = keep_min(u, keep_min(v, w)).cmp_lt(zero);
+        let pos = keep_max(u, keep_max(v, w)).cmp_gt(zero);
         let reject = (neg & pos).move_mask() as u32 & !any_zero;
         Edges {
             u: u.to_array(),
