@@ -65,6 +65,8 @@ pub(crate) struct RaySimd {
     pub(super) far: [usize; 3],
     /// The watertight test's axes `(kx, ky, kz)`.
     pub(super) k: [Axis; 3],
+    /// The origin's coordinates on those axes, `o[kx]`, `o[ky]`, `o[kz]`, broadcast.
+    pub(super) ok: [f32x4; 3],
     pub(super) sx: f32x4,
     pub(super) sy: f32x4,
 }
@@ -76,8 +78,10 @@ impl RaySimd {
         let o = r.ray.origin;
         let inv = r.inv_dir;
         let s = |a: usize| 3 * r.neg[a] as usize;
+        let o4 = [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)];
+        let k = r.k.map(Axis::new);
         Self {
-            o: [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)],
+            o: o4,
             neg_inv: [
                 f32x4::splat(-inv.x),
                 f32x4::splat(-inv.y),
@@ -87,7 +91,8 @@ impl RaySimd {
             neg_invs: [-inv.x, -inv.y, -inv.z],
             near: [s(0), 1 + s(1), 2 + s(2)],
             far: [3 - s(0), 4 - s(1), 5 - s(2)],
-            k: r.k.map(Axis::new),
+            k,
+            ok: k.map(|a| o4[a as usize]),
             sx: f32x4::splat(r.shear.x),
             sy: f32x4::splat(r.shear.y),
         }
@@ -101,10 +106,11 @@ impl RaySimd {
     #[inline(always)]
     pub(super) fn triangle_edges(&self, pk: &TriPacket) -> Edges {
         let [kx, ky, kz] = self.k.map(|a| a as usize);
-        let rel = |vertex: usize, axis: usize| f32x4::new(pk.v[3 * vertex + axis]) - self.o[axis];
-        let (ax, ay, az) = (rel(0, kx), rel(0, ky), rel(0, kz));
-        let (bx, by, bz) = (rel(1, kx), rel(1, ky), rel(1, kz));
-        let (cx, cy, cz) = (rel(2, kx), rel(2, ky), rel(2, kz));
+        let [ox, oy, oz] = self.ok;
+        let rel = |vertex: usize, axis: usize, o: f32x4| f32x4::new(pk.v[3 * vertex + axis]) - o;
+        let (ax, ay, az) = (rel(0, kx, ox), rel(0, ky, oy), rel(0, kz, oz));
+        let (bx, by, bz) = (rel(1, kx, ox), rel(1, ky, oy), rel(1, kz, oz));
+        let (cx, cy, cz) = (rel(2, kx, ox), rel(2, ky, oy), rel(2, kz, oz));
         let ax = ax - self.sx * az;
         let ay = ay - self.sy * az;
         let bx = bx - self.sx * bz;
