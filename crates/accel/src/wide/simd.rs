@@ -89,8 +89,9 @@ impl Avx2 {
     /// word order min.x, min.y, min.z, max.x, max.y, max.z), the same arithmetic as the
     /// 4-wide test lane by lane: near plane `p = near[a]` gives `(o[a] - p) * neg_inv[a]`
     /// (`neg_inv = -inv_dir`, so `(p - o[a]) * inv[a]` up to the sign of a zero, with the
-    /// plane's load folded into the subtraction), far plane `far[a]` the same times
-    /// `widen`; the entry is the largest of `t_lo` and the
+    /// plane's load folded into the subtraction), far plane `far[a]` gives
+    /// `(o[a] - p) * neg_inv_w[a]` (`neg_inv_w = -inv_dir * EXIT_WIDEN`, the exit widening
+    /// folded into the reciprocal); the entry is the largest of `t_lo` and the
     /// near distances, the exit the smallest of `t_hi` and the far ones, a NaN distance
     /// keeping the running bound (`vmaxps`/`vminps` return their second operand then).
     /// Returns the entry distances and the mask of lanes with `entry <= exit` whose child
@@ -105,9 +106,9 @@ impl Avx2 {
         far: [usize; 3],
         o: [f32; 3],
         neg_inv: [f32; 3],
+        neg_inv_w: [f32; 3],
         t_lo: f32,
         t_hi: f32,
-        widen: f32,
     ) -> ([f32; 8], u32) {
         #[cfg(target_arch = "x86_64")]
         {
@@ -116,14 +117,14 @@ impl Avx2 {
             // SAFETY: every intrinsic below needs at most AVX2, which `self` proves this CPU
             // has (`detect`); none touches memory (rows come in as values).
             unsafe {
-                let w = _mm256_set1_ps(widen);
                 let mut entry = _mm256_set1_ps(t_lo);
                 let mut exit = _mm256_set1_ps(t_hi);
                 for a in 0..3 {
                     let oa = _mm256_set1_ps(o[a]);
                     let ia = _mm256_set1_ps(neg_inv[a]);
                     let tn = _mm256_mul_ps(_mm256_sub_ps(oa, row(near[a])), ia);
-                    let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(oa, row(far[a])), ia), w);
+                    let iw = _mm256_set1_ps(neg_inv_w[a]);
+                    let tf = _mm256_mul_ps(_mm256_sub_ps(oa, row(far[a])), iw);
                     entry = _mm256_max_ps(tn, entry);
                     exit = _mm256_min_ps(tf, exit);
                 }
@@ -138,7 +139,7 @@ impl Avx2 {
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
-            let _ = (planes, child, near, far, o, neg_inv, t_lo, t_hi, widen);
+            let _ = (planes, child, near, far, o, neg_inv, neg_inv_w, t_lo, t_hi);
             unreachable!("no Avx2 token exists off x86-64")
         }
     }

@@ -5,7 +5,7 @@ use super::layout::{Chunk8, LANES, Lanes, TriPacket};
 use super::ray::RaySimd;
 use super::traverse::{Entry, run};
 use crate::wide::simd::{Avx2, Kernel};
-use dualsplit_geometry::{EXIT_WIDEN, Hit, Ray};
+use dualsplit_geometry::{Hit, Ray};
 use wide::f32x4;
 
 /// The instruction set a traversal runs with: [`Sse2`] (every x86-64 CPU; the portable
@@ -47,9 +47,9 @@ impl Isa for Avx2 {
             rs.far,
             rs.os,
             rs.neg_invs,
+            rs.neg_inv_ws,
             t_lo,
             t_hi,
-            EXIT_WIDEN,
         );
         (bytemuck::cast(e), m)
     }

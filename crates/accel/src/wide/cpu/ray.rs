@@ -60,6 +60,11 @@ pub(crate) struct RaySimd {
     /// The origin and negated reciprocal direction as scalars.
     pub(super) os: [f32; 3],
     pub(super) neg_invs: [f32; 3],
+    /// `-inv_dir * EXIT_WIDEN` per axis, broadcast and as scalars: far planes give
+    /// `(o - p) * (-inv * EXIT_WIDEN)`, the exit widened in the pre-multiplied form (see
+    /// the [`super`] module docs).
+    pub(super) neg_inv_w: [f32x4; 3],
+    pub(super) neg_inv_ws: [f32; 3],
     /// Plane rows of the near and far planes per axis.
     pub(super) near: [usize; 3],
     pub(super) far: [usize; 3],
@@ -89,6 +94,16 @@ impl RaySimd {
             ],
             os: [o.x, o.y, o.z],
             neg_invs: [-inv.x, -inv.y, -inv.z],
+            neg_inv_w: [
+                f32x4::splat(-inv.x * EXIT_WIDEN),
+                f32x4::splat(-inv.y * EXIT_WIDEN),
+                f32x4::splat(-inv.z * EXIT_WIDEN),
+            ],
+            neg_inv_ws: [
+                -inv.x * EXIT_WIDEN,
+                -inv.y * EXIT_WIDEN,
+                -inv.z * EXIT_WIDEN,
+            ],
             near: [s(0), 1 + s(1), 2 + s(2)],
             far: [3 - s(0), 4 - s(1), 5 - s(2)],
             k,
@@ -139,7 +154,7 @@ impl RaySimd {
 
     /// Entry distances of four boxes (`planes[p][lane]`) clipped to `[t_lo, t_hi]`, and the mask of
     /// the non-empty lanes the ray meets (`entry <= exit`). Plane distances are
-    /// `(o - p) * -inv` (see [`RaySimd`]).
+    /// `(o - p) * -inv` (see [`RaySimd`]), far ones `(o - p) * (-inv * EXIT_WIDEN)`.
     #[inline(always)]
     pub(super) fn test(
         &self,
@@ -162,10 +177,9 @@ impl RaySimd {
     ) -> (f32x4, u32) {
         let mut entry = f32x4::splat(t_lo);
         let mut exit = f32x4::splat(t_hi);
-        let widen = f32x4::splat(EXIT_WIDEN);
         for a in 0..3 {
             let tn = (self.o[a] - f32x4::new(row(self.near[a]))) * self.neg_inv[a];
-            let tf = (self.o[a] - f32x4::new(row(self.far[a]))) * self.neg_inv[a] * widen;
+            let tf = (self.o[a] - f32x4::new(row(self.far[a]))) * self.neg_inv_w[a];
             entry = keep_max(tn, entry);
             exit = keep_min(tf, exit);
         }
