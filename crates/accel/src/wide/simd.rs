@@ -36,6 +36,34 @@ pub fn prefetch<T>(r: &T) {
     let _ = r;
 }
 
+/// Where, in a node's eight-lane plane rows (`[[f32; 8]; 6]`, rows in the box word order
+/// min.x, min.y, min.z, max.x, max.y, max.z), the rows of a ray's near and far planes
+/// start, in bytes: per axis `a` the near plane is min (row `a`) and the far plane max (row
+/// `a + 3`), swapped when the ray travels toward −a. Made only from the signs, so every
+/// offset is a whole row's inside the array, and [`Avx2::slab8`] reads a row at its
+/// offset with no bounds check and no multiplication.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlaneRows8 {
+    /// Per axis, the near plane's row offset.
+    near: [usize; 3],
+    /// Per axis, the far plane's row offset.
+    far: [usize; 3],
+}
+
+impl PlaneRows8 {
+    /// The rows of a ray whose direction is negative (sign bit set) on axis `a` where
+    /// `neg[a]`.
+    #[inline(always)]
+    pub fn new(neg: [bool; 3]) -> Self {
+        const ROW: usize = size_of::<[f32; 8]>();
+        let s = |a: usize| 3 * neg[a] as usize;
+        Self {
+            near: [0, 1, 2].map(|a| (a + s(a)) * ROW),
+            far: [0, 1, 2].map(|a| (a + 3 - s(a)) * ROW),
+        }
+    }
+}
+
 /// Code that [`Avx2::vectorize`] runs compiled for AVX2 (a closure cannot carry the
 /// `#[inline(always)]` that makes its body part of the AVX2 function).
 pub trait Kernel {
@@ -102,8 +130,7 @@ impl Avx2 {
         self,
         planes: &[[f32; 8]; 6],
         child: &[u32; 8],
-        near: [usize; 3],
-        far: [usize; 3],
+        rows: PlaneRows8,
         o: [f32; 3],
         neg_inv: [f32; 3],
         neg_inv_w: [f32; 3],
@@ -113,18 +140,22 @@ impl Avx2 {
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::x86_64::*;
-            let row = |p: usize| -> __m256 { bytemuck::cast(planes[p]) };
+            let base = planes.as_ptr().cast::<u8>();
             // SAFETY: every intrinsic below needs at most AVX2, which `self` proves this CPU
-            // has (`detect`); none touches memory (rows come in as values).
+            // has (`detect`). The only memory read is `row`'s: 32 bytes from `off` bytes
+            // into `planes`, where `off` is one of `rows`' offsets, which by
+            // `PlaneRows8::new` is that of a whole row of the 192-byte `planes`; `loadu`
+            // needs no alignment.
             unsafe {
+                let row = |off: usize| -> __m256 { _mm256_loadu_ps(base.add(off).cast()) };
                 let mut entry = _mm256_set1_ps(t_lo);
                 let mut exit = _mm256_set1_ps(t_hi);
                 for a in 0..3 {
                     let oa = _mm256_set1_ps(o[a]);
                     let ia = _mm256_set1_ps(neg_inv[a]);
-                    let tn = _mm256_mul_ps(_mm256_sub_ps(oa, row(near[a])), ia);
+                    let tn = _mm256_mul_ps(_mm256_sub_ps(oa, row(rows.near[a])), ia);
                     let iw = _mm256_set1_ps(neg_inv_w[a]);
-                    let tf = _mm256_mul_ps(_mm256_sub_ps(oa, row(far[a])), iw);
+                    let tf = _mm256_mul_ps(_mm256_sub_ps(oa, row(rows.far[a])), iw);
                     entry = _mm256_max_ps(tn, entry);
                     exit = _mm256_min_ps(tf, exit);
                 }
@@ -139,7 +170,7 @@ impl Avx2 {
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
-            let _ = (planes, child, near, far, o, neg_inv, neg_inv_w, t_lo, t_hi);
+            let _ = (planes, child, rows, o, neg_inv, neg_inv_w, t_lo, t_hi);
             unreachable!("no Avx2 token exists off x86-64")
         }
     }

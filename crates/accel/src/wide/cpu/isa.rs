@@ -43,8 +43,7 @@ impl Isa for Avx2 {
         let (e, m) = self.slab8(
             &n.planes,
             &n.child,
-            rs.near,
-            rs.far,
+            rs.rows8,
             rs.os,
             rs.neg_invs,
             rs.neg_inv_ws,

@@ -3,6 +3,9 @@
 
 use super::layout::{LANES, TriPacket};
 #[cfg(doc)]
+use crate::wide::simd::Avx2;
+use crate::wide::simd::PlaneRows8;
+#[cfg(doc)]
 use dualsplit_geometry::Triangle;
 use dualsplit_geometry::{EXIT_WIDEN, RayPre};
 use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
@@ -68,6 +71,8 @@ pub(crate) struct RaySimd {
     /// Plane rows of the near and far planes per axis.
     pub(super) near: [usize; 3],
     pub(super) far: [usize; 3],
+    /// The same rows of a BVH8 node, for [`Avx2::slab8`].
+    pub(super) rows8: PlaneRows8,
     /// The watertight test's axes `(kx, ky, kz)`.
     pub(super) k: [Axis; 3],
     /// The origin's coordinates on those axes, `o[kx]`, `o[ky]`, `o[kz]`, broadcast.
@@ -106,6 +111,7 @@ impl RaySimd {
             ],
             near: [s(0), 1 + s(1), 2 + s(2)],
             far: [3 - s(0), 4 - s(1), 5 - s(2)],
+            rows8: PlaneRows8::new(r.neg),
             k,
             ok: k.map(|a| o4[a as usize]),
             sx: f32x4::splat(r.shear.x),
