@@ -21,6 +21,9 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
     let rs = RaySimd::new(&r);
     let mut best: Option<Hit> = None;
     let mut best_t = ray.t_max;
+    // Read once: the node loop then keeps it in a register or a stack slot rather than
+    // reloading the ray's address for it at every node.
+    let t_min = ray.t_min;
     let mut limit = cull_limit(best_t);
     let mut cur = 0u32;
     // Entries in use: `stack[..sp]`, the top last. The caller sizes `stack` to the copy's
@@ -29,7 +32,7 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
     loop {
         if cur & LEAF == 0 {
             let node = &nodes[cur as usize];
-            let (dv, mask) = node.test(isa, &rs, ray.t_min, limit);
+            let (dv, mask) = node.test(isa, &rs, t_min, limit);
             // Lane i's entry distance; lanes are below 8 (the mask's bits), which the
             // `& 7` tells the compiler, so the lookup has no bounds check.
             let dist: [f32; 2 * LANES] = bytemuck::cast(dv.map(|v| v.to_array()));
