@@ -13,10 +13,28 @@
 //! the image's leaves, for measuring). The answers are the image traversal's, ray
 //! for ray and bit for bit:
 //!
-//! * the box test is [`super::traverse`]'s arithmetic lane by lane: `(p - o) * inv`, far
-//!   planes multiplied by [`EXIT_WIDEN`], the interval clipped by compare-and-select (x86's
-//!   `maxps`/`minps` keep the running bound when a plane distance is NaN, exactly as the
-//!   scalar `if tn > entry`); rays whose interval ends are NaN take the image traversal;
+//! * the box test is [`super::traverse`]'s arithmetic lane by lane for entries: `(p - o) *
+//!   inv` (computed as `(o - p) * -inv`, the same bits up to the sign of a zero), the
+//!   interval clipped by compare-and-select (x86's `maxps`/`minps` keep the running bound
+//!   when a plane distance is NaN, exactly as the scalar `if tn > entry`); rays whose
+//!   interval ends are NaN take the image traversal. Far planes are widened by
+//!   [`EXIT_WIDEN`] in the pre-multiplied form `(p - o) * (inv * EXIT_WIDEN)`, one
+//!   multiplication per plane fewer than the image's `((p - o) * inv) * EXIT_WIDEN` (the
+//!   one exception to "the same single multiplication" of the geometry crate's rules).
+//!   The two can differ in the last bit (the roundings fall on different products), so
+//!   the copy may reach a leaf the image does not, or not reach one it does, when an entry
+//!   lies between the two exits. Both are the same product of the same four correctly
+//!   rounded factors (the subtraction, the reciprocal, the product with [`EXIT_WIDEN`],
+//!   the final product), so the bound behind [`EXIT_WIDEN`] (Ize 2013) holds for both: for
+//!   `t ≥ 0` each is at least the exact exit, and a box the exact ray meets on the
+//!   interval is reached by both. A zero direction component gives `inv = ±∞` and `inv *
+//!   EXIT_WIDEN = ±∞` (NaN at `p == o`), as before; a subnormal one (`|d| < 2.9e-39`) can
+//!   round `inv * EXIT_WIDEN` up to `±∞`, which makes a positive exit `+∞` (still
+//!   conservative) and a negative one `−∞` (a box behind the origin, a miss for `t_min ≥
+//!   0` either way). So where the two forms disagree the leaf holds no hit either
+//!   traversal would keep: this relies on the same property as merged leaves below (a hit
+//!   the triangle test accepts lies in a box the conservative test reaches), and it is
+//!   checked by the equivalence tests (`tests/bvh_scenes.rs`);
 //! * the triangle test is [`Triangle::intersect`] on the same triangle words (a SIMD first
 //!   stage computes its edge functions with the same operations, drops only triangles it
 //!   would reject at that stage, and the scalar [`Triangle::intersect_from_edges`] finishes
@@ -28,7 +46,7 @@
 //!   have led to (and more), so it can add no closer hit and lose none.
 //!
 //! Only the visiting order of a node's hit children differs (nearest first, the rest pushed
-//! by a rank computed from their entry distances, ties in either order; for shadow rays the
+//! sorted by entry distance, ties by slot; for shadow rays the
 //! first hit child first and the rest as they come), which changes no answer.
 //!
 //! Instructions ([`SimdLevel`]): with AVX2 (detected at run time) a BVH8 node is one 8-wide
@@ -189,12 +207,36 @@ mod tests {
     use crate::image::RUN_END;
     use crate::wide::traverse::tests::coord;
     use dualsplit_geometry::Pcg32;
-    use dualsplit_geometry::{PrimId, Triangle, Vec3};
+    use dualsplit_geometry::{EXIT_WIDEN, PrimId, RayPre, Triangle, Vec3};
     use wide::f32x4;
 
+    /// `RayPre::slab` with the copy's far planes, `(p - o) * (inv * EXIT_WIDEN)` (the
+    /// module docs): the entry is `slab`'s, the exit may differ from it in the last bit.
+    fn slab_premultiplied(r: &RayPre, lo: Vec3, hi: Vec3, t_lo: f32, t_hi: f32) -> (f32, f32) {
+        let (mut entry, mut exit) = (t_lo, t_hi);
+        for a in 0..3 {
+            let (n, f) = if r.neg[a] {
+                (hi[a], lo[a])
+            } else {
+                (lo[a], hi[a])
+            };
+            let (o, inv) = (r.ray.origin[a], r.inv_dir[a]);
+            let tn = (n - o) * inv;
+            let tf = (f - o) * (inv * EXIT_WIDEN);
+            if tn > entry {
+                entry = tn;
+            }
+            if tf < exit {
+                exit = tf;
+            }
+        }
+        (entry, exit)
+    }
+
     /// The box test of a node of type `N` with SSE2, and with AVX2 where this CPU has it,
-    /// gives lane by lane `RayPre::slab`'s hit or miss and entry distance (up to the sign of
-    /// a zero) for every non-NaN interval, empty lanes never hit; `cases` random nodes.
+    /// gives lane by lane `slab_premultiplied`'s hit or miss and `RayPre::slab`'s entry
+    /// distance (up to the sign of a zero) for every non-NaN interval, empty lanes never
+    /// hit; `cases` random nodes.
     fn node_tests_match_ray_slab<N: Lanes>(seed: (u64, u64), cases: usize) {
         let mut rng = Pcg32::new(seed.0, seed.1);
         let ends = [0.0, -0.0, 0.5, 1e-3, f32::INFINITY, f32::NEG_INFINITY, 3.0];
@@ -222,7 +264,8 @@ mod tests {
                 let entry: [f32; 8] = bytemuck::cast(dv);
                 let mut want = 0;
                 for &(l, lo, hi) in &boxes {
-                    let (e, x) = r.slab(lo, hi, t_lo, t_hi);
+                    let (e, x) = slab_premultiplied(&r, lo, hi, t_lo, t_hi);
+                    assert_eq!(e, r.slab(lo, hi, t_lo, t_hi).0, "case {case} lane {l}");
                     if e <= x {
                         want |= 1 << l;
                         assert_eq!(entry[l], e, "case {case} lane {l}");

@@ -11,7 +11,11 @@
 /// Straight-line code: one hint every 64 bytes from `r`'s first byte (each in a successive
 /// line) and one at its last byte, which together name every line `*r` touches whatever its
 /// alignment; the count is a constant, so the loop unrolls (a loop over the lines from the
-/// first line's start cost 16 M of 301 M instructions of a Sponza bench run).
+/// first line's start cost 16 M of 301 M instructions of a Sponza bench run). The last hint
+/// is left out where `T`'s alignment already puts the last byte in the line of the last
+/// 64-byte step: `*r` starts at most `64 - align` bytes into a line (`align` below 64), so
+/// with `n` steps the last byte is within them when `64 - align + size <= 64 n` (a BVH8
+/// node of the CPU copy: 224 bytes aligned to 32, four hints).
 #[inline(always)]
 pub fn prefetch<T>(r: &T) {
     #[cfg(target_arch = "x86_64")]
@@ -27,13 +31,45 @@ pub fn prefetch<T>(r: &T) {
                 _mm_prefetch::<_MM_HINT_T0>(start.wrapping_byte_add(offset));
             }
         };
-        for k in 0..size_of::<T>().div_ceil(64) {
+        let steps = size_of::<T>().div_ceil(64);
+        for k in 0..steps {
             hint(64 * k);
         }
-        hint(size_of::<T>().saturating_sub(1));
+        let align = align_of::<T>().min(64);
+        if 64 - align + size_of::<T>() > 64 * steps {
+            hint(size_of::<T>().saturating_sub(1));
+        }
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = r;
+}
+
+/// Where, in a node's eight-lane plane rows (`[[f32; 8]; 6]`, rows in the box word order
+/// min.x, min.y, min.z, max.x, max.y, max.z), the rows of a ray's near and far planes
+/// start, in bytes: per axis `a` the near plane is min (row `a`) and the far plane max (row
+/// `a + 3`), swapped when the ray travels toward −a. Made only from the signs, so every
+/// offset is a whole row's inside the array, and [`Avx2::slab8`] reads a row at its
+/// offset with no bounds check and no multiplication.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlaneRows8 {
+    /// Per axis, the near plane's row offset.
+    near: [usize; 3],
+    /// Per axis, the far plane's row offset.
+    far: [usize; 3],
+}
+
+impl PlaneRows8 {
+    /// The rows of a ray whose direction is negative (sign bit set) on axis `a` where
+    /// `neg[a]`.
+    #[inline(always)]
+    pub fn new(neg: [bool; 3]) -> Self {
+        const ROW: usize = size_of::<[f32; 8]>();
+        let s = |a: usize| 3 * neg[a] as usize;
+        Self {
+            near: [0, 1, 2].map(|a| (a + s(a)) * ROW),
+            far: [0, 1, 2].map(|a| (a + 3 - s(a)) * ROW),
+        }
+    }
 }
 
 /// Code that [`Avx2::vectorize`] runs compiled for AVX2 (a closure cannot carry the
@@ -87,8 +123,11 @@ impl Avx2 {
 
     /// Slab test of eight boxes stored plane by plane (`planes[p][lane]`, planes in the box
     /// word order min.x, min.y, min.z, max.x, max.y, max.z), the same arithmetic as the
-    /// 4-wide test lane by lane: near plane `p = near[a]` gives `(p - o[a]) * inv[a]`, far
-    /// plane `far[a]` the same times `widen`; the entry is the largest of `t_lo` and the
+    /// 4-wide test lane by lane: near plane `p = near[a]` gives `(o[a] - p) * neg_inv[a]`
+    /// (`neg_inv = -inv_dir`, so `(p - o[a]) * inv[a]` up to the sign of a zero, with the
+    /// plane's load folded into the subtraction), far plane `far[a]` gives
+    /// `(o[a] - p) * neg_inv_w[a]` (`neg_inv_w = -inv_dir * EXIT_WIDEN`, the exit widening
+    /// folded into the reciprocal); the entry is the largest of `t_lo` and the
     /// near distances, the exit the smallest of `t_hi` and the far ones, a NaN distance
     /// keeping the running bound (`vmaxps`/`vminps` return their second operand then).
     /// Returns the entry distances and the mask of lanes with `entry <= exit` whose child
@@ -99,29 +138,32 @@ impl Avx2 {
         self,
         planes: &[[f32; 8]; 6],
         child: &[u32; 8],
-        near: [usize; 3],
-        far: [usize; 3],
+        rows: PlaneRows8,
         o: [f32; 3],
-        inv: [f32; 3],
+        neg_inv: [f32; 3],
+        neg_inv_w: [f32; 3],
         t_lo: f32,
         t_hi: f32,
-        widen: f32,
     ) -> ([f32; 8], u32) {
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::x86_64::*;
-            let row = |p: usize| -> __m256 { bytemuck::cast(planes[p]) };
+            let base = planes.as_ptr().cast::<u8>();
             // SAFETY: every intrinsic below needs at most AVX2, which `self` proves this CPU
-            // has (`detect`); none touches memory (rows come in as values).
+            // has (`detect`). The only memory read is `row`'s: 32 bytes from `off` bytes
+            // into `planes`, where `off` is one of `rows`' offsets, which by
+            // `PlaneRows8::new` is that of a whole row of the 192-byte `planes`; `loadu`
+            // needs no alignment.
             unsafe {
-                let w = _mm256_set1_ps(widen);
+                let row = |off: usize| -> __m256 { _mm256_loadu_ps(base.add(off).cast()) };
                 let mut entry = _mm256_set1_ps(t_lo);
                 let mut exit = _mm256_set1_ps(t_hi);
                 for a in 0..3 {
                     let oa = _mm256_set1_ps(o[a]);
-                    let ia = _mm256_set1_ps(inv[a]);
-                    let tn = _mm256_mul_ps(_mm256_sub_ps(row(near[a]), oa), ia);
-                    let tf = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(row(far[a]), oa), ia), w);
+                    let ia = _mm256_set1_ps(neg_inv[a]);
+                    let tn = _mm256_mul_ps(_mm256_sub_ps(oa, row(rows.near[a])), ia);
+                    let iw = _mm256_set1_ps(neg_inv_w[a]);
+                    let tf = _mm256_mul_ps(_mm256_sub_ps(oa, row(rows.far[a])), iw);
                     entry = _mm256_max_ps(tn, entry);
                     exit = _mm256_min_ps(tf, exit);
                 }
@@ -136,7 +178,7 @@ impl Avx2 {
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
-            let _ = (planes, child, near, far, o, inv, t_lo, t_hi, widen);
+            let _ = (planes, child, rows, o, neg_inv, neg_inv_w, t_lo, t_hi);
             unreachable!("no Avx2 token exists off x86-64")
         }
     }

@@ -5,7 +5,7 @@ use super::layout::{Chunk8, LANES, Lanes, TriPacket};
 use super::ray::RaySimd;
 use super::traverse::{Entry, run};
 use crate::wide::simd::{Avx2, Kernel};
-use dualsplit_geometry::{EXIT_WIDEN, Hit, Ray};
+use dualsplit_geometry::{Hit, Ray};
 use wide::f32x4;
 
 /// The instruction set a traversal runs with: [`Sse2`] (every x86-64 CPU; the portable
@@ -41,7 +41,14 @@ impl Isa for Avx2 {
     #[inline(always)]
     fn test8(self, rs: &RaySimd, n: &Chunk8, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32) {
         let (e, m) = self.slab8(
-            &n.planes, &n.child, rs.near, rs.far, rs.os, rs.invs, t_lo, t_hi, EXIT_WIDEN,
+            &n.planes,
+            &n.child,
+            rs.rows8,
+            rs.os,
+            rs.neg_invs,
+            rs.neg_inv_ws,
+            t_lo,
+            t_hi,
         );
         (bytemuck::cast(e), m)
     }

@@ -3,6 +3,9 @@
 
 use super::layout::{LANES, TriPacket};
 #[cfg(doc)]
+use crate::wide::simd::Avx2;
+use crate::wide::simd::PlaneRows8;
+#[cfg(doc)]
 use dualsplit_geometry::Triangle;
 use dualsplit_geometry::{EXIT_WIDEN, RayPre};
 use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
@@ -18,18 +21,62 @@ pub(super) struct Edges {
     pub(super) candidates: u32,
 }
 
+/// An axis, x, y or z: an index below 3 by its type, so that indexing a vertex's
+/// coordinates with it needs no bounds check.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub(super) enum Axis {
+    /// x (0).
+    X,
+    /// y (1).
+    Y,
+    /// z (2).
+    Z,
+}
+
+impl Axis {
+    /// Axis `a` (below 3).
+    #[inline(always)]
+    fn new(a: usize) -> Self {
+        match a {
+            0 => Self::X,
+            1 => Self::Y,
+            _ => Self::Z,
+        }
+    }
+}
+
 /// The ray's constants broadcast to all lanes, the plane rows its signs pick, and the
 /// watertight test's axes and shear.
+///
+/// The box tests take the negated reciprocal `-inv` and compute a plane distance as
+/// `(o - p) * -inv`: IEEE subtraction and multiplication are symmetric in sign, so that is
+/// `(p - o) * inv` bit for bit, except where `p` and `o` are the same number: both
+/// differences are `+0` then, so the distance is the zero of the other sign (or NaN in both
+/// forms when `inv` is infinite), which every comparison treats as equal. With the plane as the
+/// subtrahend, its load from the node is an operand of the subtraction (x86 reads memory
+/// only for the second operand), one instruction fewer per plane.
 pub(crate) struct RaySimd {
     pub(super) o: [f32x4; 3],
-    pub(super) inv: [f32x4; 3],
-    /// The origin and reciprocal direction as scalars.
+    /// `-inv_dir` per axis.
+    pub(super) neg_inv: [f32x4; 3],
+    /// The origin and negated reciprocal direction as scalars.
     pub(super) os: [f32; 3],
-    pub(super) invs: [f32; 3],
+    pub(super) neg_invs: [f32; 3],
+    /// `-inv_dir * EXIT_WIDEN` per axis, broadcast and as scalars: far planes give
+    /// `(o - p) * (-inv * EXIT_WIDEN)`, the exit widened in the pre-multiplied form (see
+    /// the [`super`] module docs).
+    pub(super) neg_inv_w: [f32x4; 3],
+    pub(super) neg_inv_ws: [f32; 3],
     /// Plane rows of the near and far planes per axis.
     pub(super) near: [usize; 3],
     pub(super) far: [usize; 3],
-    pub(super) k: [usize; 3],
+    /// The same rows of a BVH8 node, for [`Avx2::slab8`].
+    pub(super) rows8: PlaneRows8,
+    /// The watertight test's axes `(kx, ky, kz)`.
+    pub(super) k: [Axis; 3],
+    /// The origin's coordinates on those axes, `o[kx]`, `o[ky]`, `o[kz]`, broadcast.
+    pub(super) ok: [f32x4; 3],
     pub(super) sx: f32x4,
     pub(super) sy: f32x4,
 }
@@ -41,18 +88,32 @@ impl RaySimd {
         let o = r.ray.origin;
         let inv = r.inv_dir;
         let s = |a: usize| 3 * r.neg[a] as usize;
+        let o4 = [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)];
+        let k = r.k.map(Axis::new);
         Self {
-            o: [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)],
-            inv: [
-                f32x4::splat(inv.x),
-                f32x4::splat(inv.y),
-                f32x4::splat(inv.z),
+            o: o4,
+            neg_inv: [
+                f32x4::splat(-inv.x),
+                f32x4::splat(-inv.y),
+                f32x4::splat(-inv.z),
             ],
             os: [o.x, o.y, o.z],
-            invs: [inv.x, inv.y, inv.z],
+            neg_invs: [-inv.x, -inv.y, -inv.z],
+            neg_inv_w: [
+                f32x4::splat(-inv.x * EXIT_WIDEN),
+                f32x4::splat(-inv.y * EXIT_WIDEN),
+                f32x4::splat(-inv.z * EXIT_WIDEN),
+            ],
+            neg_inv_ws: [
+                -inv.x * EXIT_WIDEN,
+                -inv.y * EXIT_WIDEN,
+                -inv.z * EXIT_WIDEN,
+            ],
             near: [s(0), 1 + s(1), 2 + s(2)],
             far: [3 - s(0), 4 - s(1), 5 - s(2)],
-            k: r.k,
+            rows8: PlaneRows8::new(r.neg),
+            k,
+            ok: k.map(|a| o4[a as usize]),
             sx: f32x4::splat(r.shear.x),
             sy: f32x4::splat(r.shear.y),
         }
@@ -65,11 +126,12 @@ impl RaySimd {
     /// edge function is zero and their signs differ, which it rejects at that stage.
     #[inline(always)]
     pub(super) fn triangle_edges(&self, pk: &TriPacket) -> Edges {
-        let [kx, ky, kz] = self.k;
-        let rel = |vertex: usize, axis: usize| f32x4::new(pk.v[3 * vertex + axis]) - self.o[axis];
-        let (ax, ay, az) = (rel(0, kx), rel(0, ky), rel(0, kz));
-        let (bx, by, bz) = (rel(1, kx), rel(1, ky), rel(1, kz));
-        let (cx, cy, cz) = (rel(2, kx), rel(2, ky), rel(2, kz));
+        let [kx, ky, kz] = self.k.map(|a| a as usize);
+        let [ox, oy, oz] = self.ok;
+        let rel = |vertex: usize, axis: usize, o: f32x4| f32x4::new(pk.v[3 * vertex + axis]) - o;
+        let (ax, ay, az) = (rel(0, kx, ox), rel(0, ky, oy), rel(0, kz, oz));
+        let (bx, by, bz) = (rel(1, kx, ox), rel(1, ky, oy), rel(1, kz, oz));
+        let (cx, cy, cz) = (rel(2, kx, ox), rel(2, ky, oy), rel(2, kz, oz));
         let ax = ax - self.sx * az;
         let ay = ay - self.sy * az;
         let bx = bx - self.sx * bz;
@@ -81,8 +143,11 @@ impl RaySimd {
         let w = bx * ay - by * ax;
         let zero = f32x4::splat(0.0);
         let any_zero = (u.cmp_eq(zero) | v.cmp_eq(zero) | w.cmp_eq(zero)).move_mask() as u32;
-        let neg = u.cmp_lt(zero) | v.cmp_lt(zero) | w.cmp_lt(zero);
-        let pos = u.cmp_gt(zero) | v.cmp_gt(zero) | w.cmp_gt(zero);
+        // Some edge function negative and some positive: `keep_min` and `keep_max` return
+        // one of their arguments, so a negative smallest or positive largest is one of the
+        // three (a NaN one may be passed over, which can only keep a lane).
+        let neg = keep_min(u, keep_min(v, w)).cmp_lt(zero);
+        let pos = keep_max(u, keep_max(v, w)).cmp_gt(zero);
         let reject = (neg & pos).move_mask() as u32 & !any_zero;
         Edges {
             u: u.to_array(),
@@ -94,7 +159,8 @@ impl RaySimd {
     }
 
     /// Entry distances of four boxes (`planes[p][lane]`) clipped to `[t_lo, t_hi]`, and the mask of
-    /// the non-empty lanes the ray meets (`entry <= exit`).
+    /// the non-empty lanes the ray meets (`entry <= exit`). Plane distances are
+    /// `(o - p) * -inv` (see [`RaySimd`]), far ones `(o - p) * (-inv * EXIT_WIDEN)`.
     #[inline(always)]
     pub(super) fn test(
         &self,
@@ -117,10 +183,9 @@ impl RaySimd {
     ) -> (f32x4, u32) {
         let mut entry = f32x4::splat(t_lo);
         let mut exit = f32x4::splat(t_hi);
-        let widen = f32x4::splat(EXIT_WIDEN);
         for a in 0..3 {
-            let tn = (f32x4::new(row(self.near[a])) - self.o[a]) * self.inv[a];
-            let tf = (f32x4::new(row(self.far[a])) - self.o[a]) * self.inv[a] * widen;
+            let tn = (self.o[a] - f32x4::new(row(self.near[a]))) * self.neg_inv[a];
+            let tf = (self.o[a] - f32x4::new(row(self.far[a]))) * self.neg_inv_w[a];
             entry = keep_max(tn, entry);
             exit = keep_min(tf, exit);
         }

@@ -4,9 +4,9 @@ use super::isa::Isa;
 use super::layout::{EMPTY, LANES, LEAF, Lanes, TriPacket};
 use super::ray::RaySimd;
 use crate::image::RUN_END;
-use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, Triangle, Vec3, cull_limit};
+use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, Triangle, TriangleHit, Vec3, cull_limit};
 use std::cell::Cell;
-use wide::{CmpEq, CmpLt, f32x4};
+use wide::f32x4;
 
 /// The traversal (see the [`super`] module docs) of `nodes` and `packets` with instructions `I`.
 #[inline(always)]
@@ -21,6 +21,9 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
     let rs = RaySimd::new(&r);
     let mut best: Option<Hit> = None;
     let mut best_t = ray.t_max;
+    // Read once: the node loop then keeps it in a register or a stack slot rather than
+    // reloading the ray's address for it at every node.
+    let t_min = ray.t_min;
     let mut limit = cull_limit(best_t);
     let mut cur = 0u32;
     // Entries in use: `stack[..sp]`, the top last. The caller sizes `stack` to the copy's
@@ -29,7 +32,7 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
     loop {
         if cur & LEAF == 0 {
             let node = &nodes[cur as usize];
-            let (dv, mask) = node.test(isa, &rs, ray.t_min, limit);
+            let (dv, mask) = node.test(isa, &rs, t_min, limit);
             // Lane i's entry distance; lanes are below 8 (the mask's bits), which the
             // `& 7` tells the compiler, so the lookup has no bounds check.
             let dist: [f32; 2 * LANES] = bytemuck::cast(dv.map(|v| v.to_array()));
@@ -75,38 +78,26 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                     cur = child(near);
                     continue;
                 }
-                // Three or more: each goes to the stack slot of its rank (the number of
-                // hit children before it by entry distance, ties by slot), nearest on
-                // top; then the nearest is taken.
-                let count = ones(mask);
-                let mut m = mask;
-                while m != 0 {
-                    let i = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    prefetch_child(nodes, packets, child(i));
-                }
+                // Three or more, pushed in slot order, each inserted below the entries
+                // already pushed that are nearer or as near (ties by slot, the earlier
+                // nearer the top), so that the nearest ends on top; then it is taken.
                 let base = sp;
-                sp += count;
                 let mut m = mask;
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
                     m &= m - 1;
-                    let di = d(i);
-                    // The hit lanes nearer than `i`, or as near and in an earlier slot,
-                    // from one comparison per four lanes.
-                    let splat = f32x4::splat(di);
-                    let mut before = 0u32;
-                    for (c, v) in dv.iter().enumerate().take(N::W.div_ceil(LANES)) {
-                        let lt = v.cmp_lt(splat).move_mask() as u32;
-                        let eq = v.cmp_eq(splat).move_mask() as u32;
-                        let earlier = ((1u32 << i) - 1) >> (LANES * c);
-                        before |= (lt | (eq & earlier)) << (LANES * c);
-                    }
-                    let rank = ones(before & mask);
-                    stack[base + count - 1 - rank] = Entry {
-                        t: di,
+                    let e = Entry {
+                        t: d(i),
                         child: child(i),
                     };
+                    prefetch_child(nodes, packets, e.child);
+                    let mut j = sp;
+                    while j > base && stack[j - 1].t <= e.t {
+                        stack[j] = stack[j - 1];
+                        j -= 1;
+                    }
+                    stack[j] = e;
+                    sp += 1;
                 }
                 // The nearest, just placed on top.
                 sp -= 1;
@@ -133,22 +124,6 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
             }
         }
     }
-}
-
-/// Set bits of an 8-bit mask: the x86-64 baseline has no `popcnt`, and `count_ones` becomes
-/// a dozen instructions there; a 256-byte table is one load.
-#[inline(always)]
-fn ones(mask: u32) -> usize {
-    const TABLE: [u8; 256] = {
-        let mut t = [0u8; 256];
-        let mut i = 0;
-        while i < 256 {
-            t[i] = (i as u32).count_ones() as u8;
-            i += 1;
-        }
-        t
-    };
-    TABLE[(mask & 0xff) as usize] as usize
 }
 
 /// Prefetches the first line of child word `c`'s node or the first packet of its leaf.
@@ -195,14 +170,15 @@ pub(crate) fn test_leaf<const ANY: bool>(
             let l = m.trailing_zeros() as usize;
             m &= m - 1;
             let p = PrimId(pk.prim[l] & !RUN_END);
-            // The triangle's own words, from the packet (already in cache).
-            let vertex =
-                |k: usize| Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l]);
-            let tri = Triangle::new(vertex(0), vertex(1), vertex(2));
             let h = if e.zero & (1 << l) != 0 {
-                tri.intersect(r, r.ray.t_min, *best_t)
+                intersect_lane(pk, l, r, *best_t)
             } else {
-                tri.intersect_from_edges(r, [e.u[l], e.v[l], e.w[l]], r.ray.t_min, *best_t)
+                lane_triangle(pk, l).intersect_from_edges(
+                    r,
+                    [e.u[l], e.v[l], e.w[l]],
+                    r.ray.t_min,
+                    *best_t,
+                )
             };
             if let Some(h) = h
                 && Hit::keep_closest(best, p, h)
@@ -219,6 +195,22 @@ pub(crate) fn test_leaf<const ANY: bool>(
         i += 1;
         from = 0b1111;
     }
+}
+
+/// Lane `l`'s triangle of `pk`: its own words, from the packet (already in cache).
+#[inline(always)]
+fn lane_triangle(pk: &TriPacket, l: usize) -> Triangle {
+    let vertex = |k: usize| Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l]);
+    Triangle::new(vertex(0), vertex(1), vertex(2))
+}
+
+/// [`Triangle::intersect`] of lane `l` of `pk` on `[ray.t_min, t_hi]`, for the rare lanes
+/// with an edge function equal to zero: out of line, so that the common path keeps the
+/// triangle in registers rather than in memory for this call.
+#[cold]
+#[inline(never)]
+fn intersect_lane(pk: &TriPacket, l: usize, r: &RayPre, t_hi: f32) -> Option<TriangleHit> {
+    lane_triangle(pk, l).intersect(r, r.ray.t_min, t_hi)
 }
 
 /// A stacked child: its entry distance and child word.
