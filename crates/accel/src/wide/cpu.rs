@@ -36,7 +36,8 @@
 //!   the triangle test accepts lies in a box the conservative test reaches), and it is
 //!   checked by the equivalence tests (`tests/bvh_scenes.rs`);
 //! * the triangle test is [`Triangle::intersect`] on the same triangle words (a SIMD first
-//!   stage computes its edge functions with the same operations, drops only triangles it
+//!   stage computes its edge functions with the same operations on the negated relative
+//!   coordinates `o - p`, the same bits wherever they are not zero, drops only triangles it
 //!   would reject at that stage, and the scalar [`Triangle::intersect_from_edges`] finishes
 //!   the others), and hits are kept by [`Hit::closer_than`]'s `(t, prim)` order, which makes
 //!   the closest hit independent of the order in which triangles are tested;

@@ -120,7 +120,9 @@ impl RaySimd {
     }
 
     /// The first stage of [`Triangle::intersect`] (shear, edge functions `u`, `v`, `w`, the
-    /// same IEEE operations in the same order) on the four triangles of `pk` at once: the
+    /// same IEEE operations in the same order on the negated relative coordinates, which
+    /// give the same bits wherever an edge function is not zero) on the four triangles of
+    /// `pk` at once: the
     /// edge functions, the lanes where one of them is zero (the scalar test recomputes
     /// those in f64), and the lanes the scalar test might accept: all but those where no
     /// edge function is zero and their signs differ, which it rejects at that stage.
@@ -128,7 +130,12 @@ impl RaySimd {
     pub(super) fn triangle_edges(&self, pk: &TriPacket) -> Edges {
         let [kx, ky, kz] = self.k.map(|a| a as usize);
         let [ox, oy, oz] = self.ok;
-        let rel = |vertex: usize, axis: usize, o: f32x4| f32x4::new(pk.v[3 * vertex + axis]) - o;
+        // The vertices relative to the origin negated, `o - p` (so that the packet's row is
+        // the subtraction's memory operand): `-(p - o)` bit for bit but for the sign of a
+        // zero, so the sheared coordinates are too, and every edge function, a difference
+        // of products of two of them, is the scalar test's bits wherever it is not zero
+        // (zero lanes go to the scalar test, which recomputes them).
+        let rel = |vertex: usize, axis: usize, o: f32x4| o - f32x4::new(pk.v[3 * vertex + axis]);
         let (ax, ay, az) = (rel(0, kx, ox), rel(0, ky, oy), rel(0, kz, oz));
         let (bx, by, bz) = (rel(1, kx, ox), rel(1, ky, oy), rel(1, kz, oz));
         let (cx, cy, cz) = (rel(2, kx, ox), rel(2, ky, oy), rel(2, kz, oz));
