@@ -62,7 +62,9 @@ impl Triangle {
     /// Returns a hit when the ray meets the triangle at `t` with `t_lo <= t <= t_hi`. Edge
     /// functions that evaluate to exactly zero are recomputed in double precision, so a ray
     /// through an edge shared by two triangles hits at least one of them, never neither.
-    /// Degenerate (zero-area) triangles are never hit.
+    /// Degenerate (zero-area) triangles are never hit, nor are triangles whose edge functions
+    /// underflow (a determinant below 2^-128 in magnitude: the ray's distance to the
+    /// triangle dwarfs the triangle by a factor of about 1e26 or more).
     #[inline]
     pub fn intersect(&self, r: &RayPre, t_lo: f32, t_hi: f32) -> Option<TriangleHit> {
         let [kx, ky, kz] = r.k;
@@ -107,14 +109,18 @@ impl Triangle {
             return None;
         }
         let det = u + v + w;
-        if det == 0.0 || !det.is_finite() {
+        // A determinant whose reciprocal overflows (|det| below 2^-128) means the edge
+        // functions have underflowed: they no longer say where the ray passes (a triangle
+        // ~1e26 times smaller than its distance from the origin can then "hit" a ray that
+        // misses its box), and the barycentrics would be NaN or infinite. No hit.
+        let inv_det = 1.0 / det;
+        if det == 0.0 || !det.is_finite() || !inv_det.is_finite() {
             return None;
         }
         let t = self.plane_t(r);
         if !t.is_finite() || t < t_lo || t > t_hi {
             return None;
         }
-        let inv_det = 1.0 / det;
         Some(TriangleHit {
             t,
             u: v * inv_det,

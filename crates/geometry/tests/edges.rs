@@ -204,3 +204,31 @@ fn widen_exit_rules() {
         );
     }
 }
+
+/// Edge functions that underflowed (a determinant whose reciprocal overflows) give no hit,
+/// whatever their signs, and an ordinary triangle still gives finite barycentrics.
+#[test]
+fn underflowed_edge_functions_never_hit() {
+    let tri = Triangle::new(
+        Vec3::new(-1.0, -1.0, 2.0),
+        Vec3::new(1.0, -1.0, 2.0),
+        Vec3::new(0.0, 1.0, 2.0),
+    );
+    let r = Ray::new(Vec3::ZERO, Vec3::Z).precompute();
+    for edges in [
+        [f32::from_bits(1), 0.0, 0.0],
+        [1e-39, 1e-40, 0.0],
+        [0.0, -1e-45, -1e-45],
+    ] {
+        assert!(
+            tri.intersect_from_edges(&r, edges, 0.0, f32::INFINITY)
+                .is_none(),
+            "{edges:?}"
+        );
+    }
+    let h = tri.intersect(&r, 0.0, f32::INFINITY).expect("hit");
+    assert!(h.u.is_finite() && h.v.is_finite(), "{h:?}");
+    // Just above the limit: 2^-127 has a finite reciprocal, so the edges decide.
+    let h = tri.intersect_from_edges(&r, [2f32.powi(-127), 0.0, 0.0], 0.0, f32::INFINITY);
+    assert!(h.is_some_and(|h| h.u == 0.0 && h.v == 0.0));
+}
