@@ -28,6 +28,9 @@
 //!   enters the box, as the watertight triangle test accepts the hit. Every structure
 //!   widens the same distances with the same single multiplication, and widening commutes
 //!   with `min`, so all structures still reach the same leaves and return bit-identical hits.
+//!   (The CPU-side copies of the BVH images, which plain queries traverse, fold the factor
+//!   into the reciprocal instead; their exits may differ in the last bit, which changes no
+//!   answer: `dualsplit_accel::wide::cpu`.)
 
 mod aabb;
 pub mod fmath;
