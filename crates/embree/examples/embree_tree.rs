@@ -168,6 +168,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
+    let mib = |c: &CpuBvh| c.bytes() as f64 / 1048576.0;
+    println!(
+        "copies: ours {:.2} MiB ({:.2} without merging), Embree's tree {:.2} MiB",
+        mib(&copies[0].1),
+        mib(&copies[1].1),
+        mib(&copies[2].1)
+    );
     println!(
         "every answer of the four copies equals BVH2's ({} rays); {level:?}, merge limit {merge}, 1 thread, {passes} alternated passes",
         sets.iter().map(|s| s.rays.len()).sum::<usize>()
