@@ -28,31 +28,39 @@ struct RawLeaf {
     prims: [u32; ffi::RTC_BUILD_MAX_PRIMITIVES_PER_LEAF],
 }
 
+/// Writes `value` into a block of Embree's thread-local memory sized and aligned for it;
+/// the block, or null when Embree has no memory.
+///
+/// # Safety
+/// `alloc` must be the allocator Embree passed the calling callback.
+unsafe fn place<T>(alloc: RTCThreadLocalAllocator, value: T) -> *mut c_void {
+    // SAFETY: the caller's contract; the block is sized and aligned for a `T` and written
+    // whole before it is returned.
+    unsafe {
+        let p =
+            ffi::rtcThreadLocalAlloc(alloc, std::mem::size_of::<T>(), std::mem::align_of::<T>())
+                .cast::<T>();
+        if !p.is_null() {
+            p.write(value);
+        }
+        p.cast()
+    }
+}
+
 /// `RTCCreateNodeFunction`: a fresh [`RawNode`] in the builder's memory.
 unsafe extern "C" fn create_node(
     alloc: RTCThreadLocalAllocator,
     count: c_uint,
     _: *mut c_void,
 ) -> *mut c_void {
-    // SAFETY: `alloc` is the allocator Embree passes this callback; the block is sized and
-    // aligned for a `RawNode` and fully written before it is returned.
-    unsafe {
-        let p = ffi::rtcThreadLocalAlloc(
-            alloc,
-            std::mem::size_of::<RawNode>(),
-            std::mem::align_of::<RawNode>(),
-        )
-        .cast::<RawNode>();
-        if !p.is_null() {
-            p.write(RawNode {
-                tag: 0,
-                count: count.min(MAX_CHILDREN as u32),
-                children: [std::ptr::null_mut(); MAX_CHILDREN],
-                bounds: [RTCBounds::default(); MAX_CHILDREN],
-            });
-        }
-        p.cast()
-    }
+    let node = RawNode {
+        tag: 0,
+        count: count.min(MAX_CHILDREN as u32),
+        children: [std::ptr::null_mut(); MAX_CHILDREN],
+        bounds: [RTCBounds::default(); MAX_CHILDREN],
+    };
+    // SAFETY: `alloc` is the allocator Embree passes this callback.
+    unsafe { place(alloc, node) }
 }
 
 /// `RTCSetNodeChildrenFunction`: the node's child pointers.
@@ -95,29 +103,18 @@ unsafe extern "C" fn create_leaf(
     count: usize,
     _: *mut c_void,
 ) -> *mut c_void {
-    // SAFETY: `alloc` is Embree's allocator for this callback; `prims` holds `count`
-    // primitives, at most the leaf limit (≤ 32, checked), and the block is fully written.
-    unsafe {
-        let p = ffi::rtcThreadLocalAlloc(
-            alloc,
-            std::mem::size_of::<RawLeaf>(),
-            std::mem::align_of::<RawLeaf>(),
-        )
-        .cast::<RawLeaf>();
-        if !p.is_null() {
-            let count = count.min(ffi::RTC_BUILD_MAX_PRIMITIVES_PER_LEAF);
-            let mut leaf = RawLeaf {
-                tag: 1,
-                count: count as u32,
-                prims: [0; ffi::RTC_BUILD_MAX_PRIMITIVES_PER_LEAF],
-            };
-            for i in 0..count {
-                leaf.prims[i] = (*prims.add(i)).prim_id;
-            }
-            p.write(leaf);
-        }
-        p.cast()
+    let count = count.min(ffi::RTC_BUILD_MAX_PRIMITIVES_PER_LEAF);
+    let mut leaf = RawLeaf {
+        tag: 1,
+        count: count as u32,
+        prims: [0; ffi::RTC_BUILD_MAX_PRIMITIVES_PER_LEAF],
+    };
+    for (i, id) in leaf.prims[..count].iter_mut().enumerate() {
+        // SAFETY: `prims` holds `count` primitives (at most the leaf limit, ≤ 32, checked).
+        *id = unsafe { (*prims.add(i)).prim_id };
     }
+    // SAFETY: `alloc` is the allocator Embree passes this callback.
+    unsafe { place(alloc, leaf) }
 }
 
 /// The box of an `RTCBounds`.
