@@ -25,8 +25,20 @@ unsafe impl Send for Scene {}
 // SAFETY: as for `Send`: shared references only issue concurrent read-only queries.
 unsafe impl Sync for Scene {}
 
-/// Owns a device until the scene takes it over, so every early return releases it.
-struct DeviceGuard(RTCDevice);
+/// Owns a device until a scene takes it over (or for the life of a tree build), so every
+/// early return releases it.
+pub(crate) struct DeviceGuard(pub(crate) RTCDevice);
+
+/// A new device with configuration `config` (`key=value` pairs, no NUL).
+pub(crate) fn new_device(config: &str) -> Result<DeviceGuard, EmbreeError> {
+    let config = CString::new(config).expect("the configuration string has no NUL");
+    // SAFETY: `config` is a NUL-terminated string that outlives the call.
+    let device = unsafe { ffi::rtcNewDevice(config.as_ptr()) };
+    if device.is_null() {
+        return Err(call_error(device, "rtcNewDevice"));
+    }
+    Ok(DeviceGuard(device))
+}
 
 impl Drop for DeviceGuard {
     fn drop(&mut self) {
@@ -51,7 +63,7 @@ fn check(device: RTCDevice, call: &'static str) -> Result<(), EmbreeError> {
     }
 }
 
-fn call_error(device: RTCDevice, call: &'static str) -> EmbreeError {
+pub(crate) fn call_error(device: RTCDevice, call: &'static str) -> EmbreeError {
     // SAFETY: as in `check`.
     let code = unsafe { ffi::rtcGetDeviceError(device) };
     EmbreeError::Call {
@@ -76,13 +88,7 @@ impl Scene {
             Some(n) => format!("threads={n},verbose=0"),
             None => "verbose=0".to_string(),
         };
-        let config = CString::new(config).expect("the configuration string has no NUL");
-        // SAFETY: `config` is a NUL-terminated string that outlives the call.
-        let device = unsafe { ffi::rtcNewDevice(config.as_ptr()) };
-        if device.is_null() {
-            return Err(call_error(device, "rtcNewDevice"));
-        }
-        let device = DeviceGuard(device);
+        let device = new_device(&config)?;
         let d = device.0;
 
         // SAFETY: `d` is a live device; property queries have no other precondition.

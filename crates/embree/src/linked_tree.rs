@@ -4,9 +4,10 @@
 
 use crate::EmbreeError;
 use crate::ffi::{self, RTCBounds, RTCBuildPrimitive, RTCThreadLocalAllocator};
+use crate::linked::{call_error, new_device};
 use crate::tree::{BuiltTree, Child, TreeArgs};
 use dualsplit_geometry::{Aabb, Vec3};
-use std::ffi::{CString, c_uint, c_void};
+use std::ffi::{c_uint, c_void};
 
 /// Most children of a node the callbacks store ([`TreeArgs::branching`] is checked).
 const MAX_CHILDREN: usize = 8;
@@ -126,15 +127,9 @@ fn aabb(b: &RTCBounds) -> Aabb {
 }
 
 pub(crate) fn build_tree(boxes: &[Aabb], args: &TreeArgs) -> Result<BuiltTree, EmbreeError> {
-    let config = CString::new("verbose=0").expect("no NUL");
-    // SAFETY: `config` is NUL-terminated and outlives the call.
-    let device = unsafe { ffi::rtcNewDevice(config.as_ptr()) };
-    if device.is_null() {
-        return Err(EmbreeError::Call {
-            call: "rtcNewDevice",
-            code: crate::ErrorCode::Unknown,
-        });
-    }
+    // Released when `guard` drops, after the tree is copied out.
+    let guard = new_device("verbose=0")?;
+    let device = guard.0;
     let mut prims: Vec<RTCBuildPrimitive> = boxes
         .iter()
         .enumerate()
@@ -151,60 +146,47 @@ pub(crate) fn build_tree(boxes: &[Aabb], args: &TreeArgs) -> Result<BuiltTree, E
         .collect();
     // SAFETY: `device` is live.
     let bvh = unsafe { ffi::rtcNewBVH(device) };
-    let out = if bvh.is_null() {
-        Err(EmbreeError::Call {
-            call: "rtcNewBVH",
-            code: crate::ErrorCode::Unknown,
-        })
-    } else {
-        let a = ffi::RTCBuildArguments {
-            byte_size: std::mem::size_of::<ffi::RTCBuildArguments>(),
-            build_quality: ffi::RTC_BUILD_QUALITY_MEDIUM,
-            build_flags: 0,
-            max_branching_factor: args.branching,
-            max_depth: 64,
-            sah_block_size: args.sah_block,
-            min_leaf_size: args.min_leaf,
-            max_leaf_size: args.max_leaf,
-            traversal_cost: args.traversal_cost,
-            intersection_cost: args.intersection_cost,
-            bvh,
-            primitives: prims.as_mut_ptr(),
-            primitive_count: prims.len(),
-            primitive_array_capacity: prims.len(),
-            create_node: Some(create_node),
-            set_node_children: Some(set_children),
-            set_node_bounds: Some(set_bounds),
-            create_leaf: Some(create_leaf),
-            split_primitive: std::ptr::null(),
-            build_progress: std::ptr::null(),
-            user_ptr: std::ptr::null_mut(),
-        };
-        // SAFETY: `a` is a complete `RTCBuildArguments` whose primitive array (`prims`,
-        // 32-byte aligned elements) is live and exclusively lent for the call, and whose
-        // callbacks write only memory they allocated from Embree's allocator.
-        let root = unsafe { ffi::rtcBuildBVH(&a) };
-        let tree = if root.is_null() {
-            Err(EmbreeError::Call {
-                call: "rtcBuildBVH",
-                code: crate::ErrorCode::from_raw(
-                    // SAFETY: `device` is live.
-                    unsafe { ffi::rtcGetDeviceError(device) },
-                ),
-            })
-        } else {
-            // SAFETY: the nodes and leaves live in `bvh`'s memory until `rtcReleaseBVH`
-            // below; every pointer reached from `root` was returned by `create_node` or
-            // `create_leaf`.
-            Ok(unsafe { walk(root) })
-        };
-        // SAFETY: `bvh` is live and released once; nothing refers to its memory afterwards.
-        unsafe { ffi::rtcReleaseBVH(bvh) };
-        tree
+    if bvh.is_null() {
+        return Err(call_error(device, "rtcNewBVH"));
+    }
+    let a = ffi::RTCBuildArguments {
+        byte_size: std::mem::size_of::<ffi::RTCBuildArguments>(),
+        build_quality: ffi::RTC_BUILD_QUALITY_MEDIUM,
+        build_flags: 0,
+        max_branching_factor: args.branching,
+        max_depth: 64,
+        sah_block_size: args.sah_block,
+        min_leaf_size: args.min_leaf,
+        max_leaf_size: args.max_leaf,
+        traversal_cost: args.traversal_cost,
+        intersection_cost: args.intersection_cost,
+        bvh,
+        primitives: prims.as_mut_ptr(),
+        primitive_count: prims.len(),
+        primitive_array_capacity: prims.len(),
+        create_node: Some(create_node),
+        set_node_children: Some(set_children),
+        set_node_bounds: Some(set_bounds),
+        create_leaf: Some(create_leaf),
+        split_primitive: std::ptr::null(),
+        build_progress: std::ptr::null(),
+        user_ptr: std::ptr::null_mut(),
     };
-    // SAFETY: `device` is live and released once.
-    unsafe { ffi::rtcReleaseDevice(device) };
-    out
+    // SAFETY: `a` is a complete `RTCBuildArguments` whose primitive array (`prims`,
+    // 32-byte aligned elements) is live and exclusively lent for the call, and whose
+    // callbacks write only memory they allocated from Embree's allocator.
+    let root = unsafe { ffi::rtcBuildBVH(&a) };
+    let tree = if root.is_null() {
+        Err(call_error(device, "rtcBuildBVH"))
+    } else {
+        // SAFETY: the nodes and leaves live in `bvh`'s memory until `rtcReleaseBVH`
+        // below; every pointer reached from `root` was returned by `create_node` or
+        // `create_leaf`.
+        Ok(unsafe { walk(root) })
+    };
+    // SAFETY: `bvh` is live and released once; nothing refers to its memory afterwards.
+    unsafe { ffi::rtcReleaseBVH(bvh) };
+    tree
 }
 
 /// Copies the tree below `root` out of Embree's memory, nodes in depth-first order.
