@@ -184,17 +184,17 @@ impl CpuBvh {
         if (ray.t_min - cull_limit(ray.t_max)).is_nan() {
             return None;
         }
-        let mut stack = STACK.take();
-        if stack.len() < self.stack_len {
-            stack.resize(self.stack_len, Entry::UNUSED);
-        }
-        let buf = &mut stack[..self.stack_len];
-        let packets = &self.packets[..];
-        let hit = match &self.nodes {
-            CpuNodes::Four(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, buf),
-            CpuNodes::Eight(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, buf),
-        };
-        STACK.set(stack);
+        let hit = STACK.with_borrow_mut(|stack| {
+            if stack.len() < self.stack_len {
+                stack.resize(self.stack_len, Entry::UNUSED);
+            }
+            let buf = &mut stack[..self.stack_len];
+            let packets = &self.packets[..];
+            match &self.nodes {
+                CpuNodes::Four(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, buf),
+                CpuNodes::Eight(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, buf),
+            }
+        });
         Some(hit)
     }
 }

@@ -120,7 +120,7 @@ pub(super) fn dispatch<N: Lanes, const ANY: bool>(
     stack: &mut [Entry],
 ) -> Option<Hit> {
     match avx2 {
-        None => run::<N, Sse2, ANY>(Sse2, nodes, packets, ray, stack),
+        None => run_sse2::<N, ANY>(nodes, packets, ray, stack),
         Some(isa) => isa
             .vectorize(Run::<N, ANY> {
                 isa,
@@ -131,6 +131,18 @@ pub(super) fn dispatch<N: Lanes, const ANY: bool>(
             })
             .unpack(),
     }
+}
+
+/// [`run`] with SSE2, out of line as the AVX2 path is (inside [`Avx2::vectorize`]): inlined,
+/// it made the caller of both a large function whose entry and exit every ray paid.
+#[inline(never)]
+fn run_sse2<N: Lanes, const ANY: bool>(
+    nodes: &[N],
+    packets: &[TriPacket],
+    ray: &Ray,
+    stack: &mut [Entry],
+) -> Option<Hit> {
+    run::<N, Sse2, ANY>(Sse2, nodes, packets, ray, stack)
 }
 
 /// [`run`] with AVX2, as a [`Kernel`] for [`Avx2::vectorize`].

@@ -5,7 +5,7 @@ use super::layout::{EMPTY, LANES, LEAF, Lanes, TriPacket};
 use super::ray::RaySimd;
 use crate::image::RUN_END;
 use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, Triangle, TriangleHit, Vec3, cull_limit};
-use std::cell::Cell;
+use std::cell::RefCell;
 use wide::f32x4;
 
 /// The traversal (see the [`super`] module docs) of `nodes` and `packets` with instructions `I`.
@@ -229,6 +229,8 @@ impl Entry {
 }
 
 thread_local! {
-    /// The traversal stack's buffer, one per thread, reused from ray to ray.
-    pub(super) static STACK: Cell<Vec<Entry>> = const { Cell::new(Vec::new()) };
+    /// The traversal stack's buffer, one per thread, reused from ray to ray (borrowed in
+    /// place: one thread-local access per ray, where taking the buffer out and putting it
+    /// back took two and moved it twice).
+    pub(super) static STACK: RefCell<Vec<Entry>> = const { RefCell::new(Vec::new()) };
 }
