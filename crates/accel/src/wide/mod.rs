@@ -188,7 +188,20 @@ impl BvhImage {
 
     /// The CPU-side copy of the image ([`cpu::CpuBvh`]) for this CPU's best instructions
     /// ([`cpu::SimdLevel::detect`]), made on the first call.
+    #[inline]
     pub fn cpu(&self) -> &cpu::CpuBvh {
+        // The made copy is one load and a check; making it is out of line (a per-ray call
+        // otherwise).
+        match self.cpu.get() {
+            Some(c) => c,
+            None => self.make_cpu(),
+        }
+    }
+
+    /// [`BvhImage::cpu`] on its first call.
+    #[cold]
+    #[inline(never)]
+    fn make_cpu(&self) -> &cpu::CpuBvh {
         self.cpu
             .get_or_init(|| std::sync::Arc::new(self.cpu_copy(cpu::SimdLevel::detect())))
     }
