@@ -3,25 +3,30 @@
 //!
 //! `cpu_cost SCENE RES SET` builds the structures of `SCENE`, records the ray sets of a
 //! RES×RES path-traced frame (as `dualsplit bench` does), and traces set `SET` (`primary`,
-//! `shadow` or `diffuse`) once with `bvh8`'s CPU copy (the queries `bench` times) and once
-//! with `rtcIntersect1` / `rtcOccluded1`. Each side's counts come from one callgrind run
-//! collecting only inside its traversal:
+//! `shadow` or `diffuse`) once with `bvh8`'s plain queries (the calls `bench` times) and once
+//! with `rtcIntersect1` / `rtcOccluded1`. Each side's per-ray call is one function of its own
+//! here (`cpu_cost::ours`, `cpu_cost::embree_query`: everything a ray costs, the entry into the
+//! library included); collecting only inside one of them, or only inside the traversal
+//! proper, gives that side's counts:
 //!
 //! ```sh
 //! cargo build --release -p dualsplit-embree --example cpu_cost
 //! run() { valgrind --tool=callgrind --branch-sim=yes --callgrind-out-file=/dev/null \
 //!     --toggle-collect="$1" target/release/examples/cpu_cost "${@:2}" 2>&1 | grep Collected; }
 //! S=sponza_dabrovic.ply.gz   # a shipped mesh's path, or builtin:NAME
-//! run 'dualsplit_accel::wide::simd::Avx2::vectorize::with_avx2*' $S 64 primary   # ours
-//! run rtcIntersect1 $S 64 primary   # Embree (rtcOccluded1 for the shadow set)
+//! run 'cpu_cost::ours' $S 64 primary      # our whole query
+//! run 'cpu_cost::embree_query' $S 64 primary   # Embree's whole query
+//! run 'dualsplit_accel::wide::simd::Avx2::vectorize::with_avx2*' $S 64 primary   # our traversal
+//! run rtcIntersect1 $S 64 primary   # Embree's (rtcOccluded1 for the shadow set)
 //! ```
 //!
 //! "Collected" lists Ir, conditional branches and mispredicted ones; the program prints the
 //! set's ray count to divide by. (Our copy's traversal runs inside the AVX2 function that the
-//! toggle names when the CPU has AVX2; nothing else runs there in this program.)
+//! third toggle names when the CPU has AVX2; nothing else runs there in this program.)
 
-use dualsplit_accel::Structures;
+use dualsplit_accel::{AccelKind, NoObserver, Structures};
 use dualsplit_embree::EmbreeScene;
+use dualsplit_geometry::Ray;
 use dualsplit_render::bench::ray_sets;
 use dualsplit_render::{RayKind, RenderSettings, Workload};
 
@@ -38,24 +43,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .find(|set| set.kind.name() == kind)
         .ok_or(usage)?;
-    let copy = s.bvh8.cpu();
+    // Made here, not by the first query, so that no side's counts include building.
+    s.bvh8.cpu();
     let embree = EmbreeScene::new(&scene.triangles)?;
     let shadow = set.kind == RayKind::Shadow;
     let mut hits = [0usize; 2];
     for r in &set.rays {
-        let h = if shadow {
-            copy.traverse::<true>(r).map(|h| h.is_some())
-        } else {
-            copy.traverse::<false>(r).map(|h| h.is_some())
-        };
-        hits[0] += h.ok_or("a ray the CPU copy declines")? as usize;
+        hits[0] += ours(&s, r, shadow) as usize;
     }
     for r in &set.rays {
-        hits[1] += if shadow {
-            embree.occluded(r)
-        } else {
-            embree.intersect(r).is_some()
-        } as usize;
+        hits[1] += embree_query(&embree, r, shadow) as usize;
     }
     println!(
         "{spec}, {res}x{res} path frame, {} {kind} rays: {} hits (ours), {} (Embree)",
@@ -64,4 +61,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         hits[1]
     );
     Ok(())
+}
+
+/// Our plain query of `r` on BVH8 (as `bench` makes it, through the structure set): a hit
+/// or, for a shadow ray, an occluder.
+#[inline(never)]
+fn ours(s: &Structures, r: &Ray, shadow: bool) -> bool {
+    if shadow {
+        s.any_hit(AccelKind::Bvh8, r, &mut NoObserver)
+    } else {
+        s.closest_hit(AccelKind::Bvh8, r, &mut NoObserver).is_some()
+    }
+}
+
+/// Embree's query of `r`, as `bench` makes it.
+#[inline(never)]
+fn embree_query(e: &EmbreeScene, r: &Ray, shadow: bool) -> bool {
+    if shadow {
+        e.occluded(r)
+    } else {
+        e.intersect(r).is_some()
+    }
 }
