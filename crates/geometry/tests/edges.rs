@@ -84,14 +84,19 @@ fn degenerate_triangle_never_hit() {
     assert!(t.intersect(&r, 0.0, f32::INFINITY).is_none());
 }
 
-#[test]
-fn interval_is_inclusive() {
+/// A triangle in the plane z = 2 and the ray along +z from the origin through its inside.
+fn facing_triangle() -> (Triangle, RayPre) {
     let t = Triangle::new(
         Vec3::new(-1.0, -1.0, 2.0),
         Vec3::new(1.0, -1.0, 2.0),
         Vec3::new(0.0, 1.0, 2.0),
     );
-    let r = Ray::new(Vec3::ZERO, Vec3::Z).precompute();
+    (t, Ray::new(Vec3::ZERO, Vec3::Z).precompute())
+}
+
+#[test]
+fn interval_is_inclusive() {
+    let (t, r) = facing_triangle();
     assert!(t.intersect(&r, 2.0, 2.0).is_some());
     assert!(t.intersect(&r, 0.0, 1.999).is_none());
 }
@@ -209,12 +214,7 @@ fn widen_exit_rules() {
 /// whatever their signs, and an ordinary triangle still gives finite barycentrics.
 #[test]
 fn underflowed_edge_functions_never_hit() {
-    let tri = Triangle::new(
-        Vec3::new(-1.0, -1.0, 2.0),
-        Vec3::new(1.0, -1.0, 2.0),
-        Vec3::new(0.0, 1.0, 2.0),
-    );
-    let r = Ray::new(Vec3::ZERO, Vec3::Z).precompute();
+    let (tri, r) = facing_triangle();
     for edges in [
         [f32::from_bits(1), 0.0, 0.0],
         [1e-39, 1e-40, 0.0],
