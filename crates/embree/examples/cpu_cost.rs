@@ -23,19 +23,28 @@
 //! "Collected" lists Ir, conditional branches and mispredicted ones; the program prints the
 //! set's ray count to divide by. (Our copy's traversal runs inside the AVX2 function that the
 //! third toggle names when the CPU has AVX2; nothing else runs there in this program.)
+//!
+//! `cpu_cost SCENE RES SET away` traces the set's rays moved to start beyond the scene's box
+//! and point away from it, so that every query ends at the root's box test: what a ray costs
+//! whatever it meets (entry into the library, set-up, one node test, return).
 
 use dualsplit_accel::{AccelKind, NoObserver, Structures};
 use dualsplit_embree::EmbreeScene;
-use dualsplit_geometry::Ray;
+use dualsplit_geometry::{Aabb, Ray, Vec3};
 use dualsplit_render::bench::ray_sets;
 use dualsplit_render::{RayKind, RenderSettings, Workload};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let usage = "usage: cpu_cost SCENE RES primary|shadow|diffuse";
+    let usage = "usage: cpu_cost SCENE RES primary|shadow|diffuse [away]";
     let mut args = std::env::args().skip(1);
     let spec = args.next().ok_or(usage)?;
     let res: u32 = args.next().ok_or(usage)?.parse()?;
     let kind = args.next().ok_or(usage)?;
+    let away = match args.next().as_deref() {
+        None => false,
+        Some("away") => true,
+        Some(_) => return Err(usage.into()),
+    };
     let scene = dualsplit_scene::load(&spec)?;
     let s = Structures::try_build(&scene.triangles, &Default::default())?;
     let sets = ray_sets(&scene, &s, &RenderSettings::new(res, res, Workload::Path))?;
@@ -47,11 +56,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     s.bvh8.cpu();
     let embree = EmbreeScene::new(&scene.triangles)?;
     let shadow = set.kind == RayKind::Shadow;
+    let mut rays = set.rays.clone();
+    if away {
+        let corner = scene
+            .triangles
+            .iter()
+            .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()))
+            .max;
+        let beyond = |c: f32| c + c.abs() + 1.0;
+        for r in &mut rays {
+            r.origin = Vec3::new(beyond(corner.x), beyond(corner.y), beyond(corner.z));
+            r.dir = Vec3::new(r.dir.x.abs() + 0.1, r.dir.y.abs() + 0.1, r.dir.z.abs() + 0.1);
+        }
+    }
     let mut hits = [0usize; 2];
-    for r in &set.rays {
+    for r in &rays {
         hits[0] += ours(&s, r, shadow) as usize;
     }
-    for r in &set.rays {
+    for r in &rays {
         hits[1] += embree_query(&embree, r, shadow) as usize;
     }
     println!(
