@@ -35,14 +35,10 @@ pub(super) enum Axis {
 }
 
 impl Axis {
-    /// Axis `a` (below 3).
+    /// Axis `a` (below 3; z for anything above): a lookup rather than compares.
     #[inline(always)]
     fn new(a: usize) -> Self {
-        match a {
-            0 => Self::X,
-            1 => Self::Y,
-            _ => Self::Z,
-        }
+        [Self::X, Self::Y, Self::Z, Self::Z][a.min(3)]
     }
 }
 
@@ -113,7 +109,7 @@ impl RaySimd {
             far: [3 - s(0), 4 - s(1), 5 - s(2)],
             rows8: PlaneRows8::new(r.neg),
             k,
-            ok: k.map(|a| o4[a as usize]),
+            ok: k.map(|a| f32x4::splat([o.x, o.y, o.z][a as usize])),
             sx: f32x4::splat(r.shear.x),
             sy: f32x4::splat(r.shear.y),
         }
