@@ -112,10 +112,9 @@ impl Triangle {
         // A determinant whose reciprocal overflows (|det| below 2^-128) means the edge
         // functions have underflowed: they no longer say where the ray passes (a triangle
         // ~1e26 times smaller than its distance from the origin can then "hit" a ray that
-        // misses its box), and the barycentrics would be NaN or infinite. No hit. (A zero
-        // determinant is one such: its reciprocal is infinite.)
+        // misses its box), and the barycentrics would be NaN or infinite. No hit.
         let inv_det = 1.0 / det;
-        if !det.is_finite() || !inv_det.is_finite() {
+        if det == 0.0 || !det.is_finite() || !inv_det.is_finite() {
             return None;
         }
         let t = self.plane_t(r);

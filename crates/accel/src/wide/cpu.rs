@@ -184,7 +184,7 @@ impl CpuBvh {
         if (ray.t_min - cull_limit(ray.t_max)).is_nan() {
             return None;
         }
-        let hit: PackedHit = STACK.with_borrow_mut(|stack| {
+        let hit = STACK.with_borrow_mut(|stack| {
             if stack.len() < self.stack_len {
                 stack.resize(self.stack_len, Entry::UNUSED);
             }
@@ -195,7 +195,7 @@ impl CpuBvh {
                 CpuNodes::Eight(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, buf),
             }
         });
-        Some(hit.unpack())
+        Some(hit)
     }
 }
 

@@ -110,9 +110,7 @@ pub(crate) fn avx2_token() -> Option<Avx2> {
     *TOKEN.get_or_init(|| SimdLevel::detect().token())
 }
 
-/// [`run`] with SSE2, or with AVX2 inside [`Avx2::vectorize`] when `avx2` holds the token;
-/// the answer packed, so that it comes back in registers from the function holding the
-/// stack too.
+/// [`run`] with SSE2, or with AVX2 inside [`Avx2::vectorize`] when `avx2` holds the token.
 #[inline(always)]
 pub(super) fn dispatch<N: Lanes, const ANY: bool>(
     avx2: Option<Avx2>,
@@ -120,16 +118,18 @@ pub(super) fn dispatch<N: Lanes, const ANY: bool>(
     packets: &[TriPacket],
     ray: &Ray,
     stack: &mut [Entry],
-) -> PackedHit {
+) -> Option<Hit> {
     match avx2 {
-        None => PackedHit::pack(run_sse2::<N, ANY>(nodes, packets, ray, stack)),
-        Some(isa) => isa.vectorize(Run::<N, ANY> {
-            isa,
-            nodes,
-            packets,
-            ray,
-            stack,
-        }),
+        None => run_sse2::<N, ANY>(nodes, packets, ray, stack),
+        Some(isa) => isa
+            .vectorize(Run::<N, ANY> {
+                isa,
+                nodes,
+                packets,
+                ray,
+                stack,
+            })
+            .unpack(),
     }
 }
 

@@ -35,10 +35,14 @@ pub(super) enum Axis {
 }
 
 impl Axis {
-    /// Axis `a` (below 3; z for anything above): a lookup rather than compares.
+    /// Axis `a` (below 3).
     #[inline(always)]
     fn new(a: usize) -> Self {
-        [Self::X, Self::Y, Self::Z, Self::Z][a.min(3)]
+        match a {
+            0 => Self::X,
+            1 => Self::Y,
+            _ => Self::Z,
+        }
     }
 }
 
@@ -109,7 +113,7 @@ impl RaySimd {
             far: [3 - s(0), 4 - s(1), 5 - s(2)],
             rows8: PlaneRows8::new(r.neg),
             k,
-            ok: k.map(|a| f32x4::splat([o.x, o.y, o.z][a as usize])),
+            ok: k.map(|a| o4[a as usize]),
             sx: f32x4::splat(r.shear.x),
             sy: f32x4::splat(r.shear.y),
         }
