@@ -66,7 +66,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let beyond = |c: f32| c + c.abs() + 1.0;
         for r in &mut rays {
             r.origin = Vec3::new(beyond(corner.x), beyond(corner.y), beyond(corner.z));
-            r.dir = Vec3::new(r.dir.x.abs() + 0.1, r.dir.y.abs() + 0.1, r.dir.z.abs() + 0.1);
+            r.dir = Vec3::new(
+                r.dir.x.abs() + 0.1,
+                r.dir.y.abs() + 0.1,
+                r.dir.z.abs() + 0.1,
+            );
         }
     }
     let mut hits = [0usize; 2];
