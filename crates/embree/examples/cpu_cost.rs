@@ -30,7 +30,7 @@
 
 use dualsplit_accel::{AccelKind, NoObserver, Structures};
 use dualsplit_embree::EmbreeScene;
-use dualsplit_geometry::{Aabb, Ray, Vec3};
+use dualsplit_geometry::{Ray, Vec3};
 use dualsplit_render::bench::ray_sets;
 use dualsplit_render::{RayKind, RenderSettings, Workload};
 
@@ -56,28 +56,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     s.bvh8.cpu();
     let embree = EmbreeScene::new(&scene.triangles)?;
     let shadow = set.kind == RayKind::Shadow;
-    let mut rays = set.rays.clone();
-    if away {
-        let corner = scene
-            .triangles
-            .iter()
-            .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()))
-            .max;
-        let beyond = |c: f32| c + c.abs() + 1.0;
-        for r in &mut rays {
-            r.origin = Vec3::new(beyond(corner.x), beyond(corner.y), beyond(corner.z));
-            r.dir = Vec3::new(
-                r.dir.x.abs() + 0.1,
-                r.dir.y.abs() + 0.1,
-                r.dir.z.abs() + 0.1,
-            );
-        }
-    }
+    // The root's box is the scene's.
+    let moved = away.then(|| moved_away(&set.rays, s.bvh2.nodes[0].bounds.max));
+    let rays = moved.as_deref().unwrap_or(&set.rays);
     let mut hits = [0usize; 2];
-    for r in &rays {
+    for r in rays {
         hits[0] += ours(&s, r, shadow) as usize;
     }
-    for r in &rays {
+    for r in rays {
         hits[1] += embree_query(&embree, r, shadow) as usize;
     }
     println!(
@@ -87,6 +73,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         hits[1]
     );
     Ok(())
+}
+
+/// `rays` moved to start beyond `corner`, the scene box's maximum, and to point away from it
+/// on every axis (their interval kept), so that none meets the scene's box.
+fn moved_away(rays: &[Ray], corner: Vec3) -> Vec<Ray> {
+    let beyond = |c: f32| c + c.abs() + 1.0;
+    let origin = Vec3::new(beyond(corner.x), beyond(corner.y), beyond(corner.z));
+    rays.iter()
+        .map(|r| Ray {
+            origin,
+            dir: Vec3::new(
+                r.dir.x.abs() + 0.1,
+                r.dir.y.abs() + 0.1,
+                r.dir.z.abs() + 0.1,
+            ),
+            ..*r
+        })
+        .collect()
 }
 
 /// Our plain query of `r` on BVH8 (as `bench` makes it, through the structure set): a hit
