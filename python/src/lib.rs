@@ -4,7 +4,7 @@
 //! document. Every Rust error becomes a `dualsplit.DualsplitError` carrying its message
 //! (with its causes, as the command line prints them); no panic crosses into Python.
 use dualsplit_accel::{
-    AccelKind, AnyTree, BuildConfig, Bvh2Tree, NoObserver, Structures, TraversalSet, TreeKind,
+    AccelKind, AnyTree, BuildConfig, Bvh2Tree, Structures, TraversalSet, TreeKind,
 };
 use dualsplit_geometry::{Ray, Triangle, Vec3};
 use dualsplit_render::{RenderSettings, Workload};
@@ -415,7 +415,7 @@ impl Tree {
         let rays = rays(origins, directions, tmin, tmax)?;
         let hits = py.detach(|| {
             rays.par_iter()
-                .map(|r| self.tree.closest_hit(kind, r, &mut NoObserver))
+                .map_init(|| self.tree.tracer(kind), |t, r| t.closest_hit(r))
                 .collect::<Vec<_>>()
         });
         let n = hits.len();
@@ -426,7 +426,7 @@ impl Tree {
             Vec::with_capacity(n),
         );
         for h in hits {
-            match h.flatten() {
+            match h {
                 Some(h) => {
                     t.push(h.t);
                     prim.push(i64::from(h.prim.0));
@@ -465,7 +465,7 @@ impl Tree {
         let rays = rays(origins, directions, tmin, tmax)?;
         let out = py.detach(|| {
             rays.par_iter()
-                .map(|r| self.tree.any_hit(kind, r, &mut NoObserver) == Some(true))
+                .map_init(|| self.tree.tracer(kind), |t, r| t.any_hit(r))
                 .collect::<Vec<bool>>()
         });
         Ok(PyArray1::from_vec(py, out))

@@ -76,13 +76,13 @@ pub use image::{ByteAddr, ImageError, MemoryImage, SharedTriangles};
 pub use observer::{CountingObserver, DstNodeKind, NoObserver, NodeStep, Observer};
 pub use stats::StructureStats;
 pub use validate::ValidationReport;
-pub use wide::{BvhImage, CollapseConfig, WideBvh};
+pub use wide::{BvhImage, BvhQuery, CollapseConfig, WideBvh};
 
 pub use dst::{Dst, DstConfig};
 pub use query::{DstPipeline, RayQuery};
 /// The rayon crate builds and batch queries run on (for [`rayon::ThreadPool`]).
 pub use rayon;
-pub use set::TraversalSet;
+pub use set::{Tracer, TraversalSet};
 pub use tree::{
     AnyTree, BuildStats, Bvh2Tree, BvhTree, CwbvhTree, DstDecoding, DstQTree, DstTree, TreeKind,
 };

@@ -93,7 +93,30 @@ macro_rules! query_by_traversal {
     };
 }
 
-query_by_traversal!(BvhImage, |s| s.image.triangle_slice());
+/// The batch forms trace each rayon job's rays through one [`BvhImage::query`] context.
+impl RayQuery for BvhImage {
+    #[inline]
+    fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+        self.closest_hit(ray, obs)
+    }
+    #[inline]
+    fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+        self.any_hit(ray, obs)
+    }
+    fn triangles(&self) -> &[Triangle] {
+        self.image.triangle_slice()
+    }
+    fn intersect_batch(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
+        rays.par_iter()
+            .map_init(|| self.query(), |q, r| q.closest_hit(r))
+            .collect()
+    }
+    fn occluded_batch(&self, rays: &[Ray]) -> Vec<bool> {
+        rays.par_iter()
+            .map_init(|| self.query(), |q, r| q.any_hit(r))
+            .collect()
+    }
+}
 query_by_traversal!(
     /// A [`Dst`] queried through its software decoder (the paper's DST\*,
     /// [`crate::AccelKind::DstSw`]): the fast CPU traversal.

@@ -26,8 +26,9 @@
 
 use crate::dstq::DstQConfig;
 use crate::image::MemoryImage;
-use crate::observer::Observer;
-use crate::tree::AnyTree;
+use crate::observer::{NoObserver, Observer};
+use crate::tree::{AnyTree, TreeKind};
+use crate::wide::{BvhImage, BvhQuery};
 use crate::{AccelKind, Structures};
 use dualsplit_geometry::{Aabb, Hit, Ray};
 
@@ -66,6 +67,23 @@ pub trait TraversalSet: Sync {
     /// (false for a kind the set lacks).
     fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool;
 
+    /// The BVH image traversal `kind` reads when `kind` is one of this set's BVH kinds
+    /// (BVH2, BVH4, BVH8), whose plain queries a [`Tracer`] runs through a [`BvhQuery`].
+    fn bvh(&self, kind: AccelKind) -> Option<&BvhImage>;
+
+    /// A query context for tracing rays of traversal `kind` one by one on one thread
+    /// ([`Tracer`]).
+    fn tracer(&self, kind: AccelKind) -> Tracer<'_, Self>
+    where
+        Self: Sized,
+    {
+        Tracer {
+            set: self,
+            kind,
+            bvh: self.bvh(kind).map(BvhImage::query),
+        }
+    }
+
     /// The memory image traversal `kind` reads (both DST kinds read the same image; a set
     /// of one tree has one image, whatever `kind` says).
     fn image(&self, kind: AccelKind) -> &MemoryImage;
@@ -91,6 +109,15 @@ impl TraversalSet for Structures {
     #[inline]
     fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool {
         Structures::any_hit(self, kind, ray, obs)
+    }
+
+    fn bvh(&self, kind: AccelKind) -> Option<&BvhImage> {
+        match kind {
+            AccelKind::Bvh2 => Some(&self.bvh2_image),
+            AccelKind::Bvh4 => Some(&self.bvh4),
+            AccelKind::Bvh8 => Some(&self.bvh8),
+            _ => None,
+        }
     }
 
     fn image(&self, kind: AccelKind) -> &MemoryImage {
@@ -121,6 +148,13 @@ impl TraversalSet for AnyTree {
         AnyTree::any_hit(self, kind, ray, obs).unwrap_or(false)
     }
 
+    fn bvh(&self, kind: AccelKind) -> Option<&BvhImage> {
+        match self {
+            AnyTree::Bvh(b) if TreeKind::of_accel(kind) == b.kind() => Some(&b.encoded),
+            _ => None,
+        }
+    }
+
     fn image(&self, _kind: AccelKind) -> &MemoryImage {
         AnyTree::image(self)
     }
@@ -143,6 +177,40 @@ impl TraversalSet for AnyTree {
         match self {
             AnyTree::DstQ(q) => Some(*q.dstq().config()),
             _ => None,
+        }
+    }
+}
+
+/// A query context over traversal `kind` of a [`TraversalSet`], for tracing rays one by one
+/// on one thread without observing them (a renderer's or benchmark's inner loop; the
+/// counterpart of Embree's `RTCIntersectContext`): the BVH kinds run through a
+/// [`BvhQuery`], which holds their CPU-side copy's arrays and a traversal stack, the others
+/// through the set's plain queries. The answers are [`TraversalSet::closest_hit`]'s and
+/// [`TraversalSet::any_hit`]'s with a [`NoObserver`], bit for bit. Made by
+/// [`TraversalSet::tracer`].
+pub struct Tracer<'a, S> {
+    set: &'a S,
+    kind: AccelKind,
+    bvh: Option<BvhQuery<'a>>,
+}
+
+impl<S: TraversalSet> Tracer<'_, S> {
+    /// Closest hit of `ray` (a miss for a kind the set lacks).
+    #[inline]
+    pub fn closest_hit(&mut self, ray: &Ray) -> Option<Hit> {
+        match &mut self.bvh {
+            Some(q) => q.closest_hit(ray),
+            None => self.set.closest_hit(self.kind, ray, &mut NoObserver),
+        }
+    }
+
+    /// True when `ray` hits any triangle within `[t_min, t_max]` (false for a kind the set
+    /// lacks).
+    #[inline]
+    pub fn any_hit(&mut self, ray: &Ray) -> bool {
+        match &mut self.bvh {
+            Some(q) => q.any_hit(ray),
+            None => self.set.any_hit(self.kind, ray, &mut NoObserver),
         }
     }
 }

@@ -720,6 +720,14 @@ macro_rules! query_via {
                 let $s = self;
                 RayQuery::triangles($inner)
             }
+            fn intersect_batch(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
+                let $s = self;
+                $inner.intersect_batch(rays)
+            }
+            fn occluded_batch(&self, rays: &[Ray]) -> Vec<bool> {
+                let $s = self;
+                $inner.occluded_batch(rays)
+            }
         }
     };
 }
@@ -742,5 +750,11 @@ impl RayQuery for AnyTree {
     }
     fn triangles(&self) -> &[Triangle] {
         self.image().triangle_slice()
+    }
+    fn intersect_batch(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
+        each_tree!(self, |t| t.intersect_batch(rays))
+    }
+    fn occluded_batch(&self, rays: &[Ray]) -> Vec<bool> {
+        each_tree!(self, |t| t.occluded_batch(rays))
     }
 }

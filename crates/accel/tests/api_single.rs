@@ -1,12 +1,13 @@
 //! Every structure built alone through the top-level API ([`Bvh2Tree`], [`BvhTree`],
 //! [`DstTree`]) answers every ray exactly as the same structure inside [`Structures`] does:
 //! closest hit (`t`, triangle id, barycentrics, all as bits) and shadow answer, ray by ray,
-//! plain, batched and observed, on builtin scenes and random rays with edge cases.
+//! plain, batched and observed, on builtin scenes and random rays with edge cases; and a
+//! [`Tracer`] reused over every ray answers as the set's plain queries do, on every kind.
 
 use dualsplit_accel::math::{Hit, Ray, Triangle};
 use dualsplit_accel::{
     AccelKind, AnyTree, BuildConfig, Bvh2Tree, BvhTree, CountingObserver, DstConfig, DstDecoding,
-    DstTree, NoObserver, RayQuery, Structures, TreeKind,
+    DstTree, NoObserver, RayQuery, Structures, Tracer, TraversalSet, TreeKind,
 };
 use dualsplit_geometry::Pcg32;
 use dualsplit_testkit::rays::random_rays;
@@ -55,11 +56,56 @@ fn same_as<Q: RayQuery>(q: &Q, s: &Structures, kind: AccelKind, rays: &[Ray], wh
     );
 }
 
+/// One [`Tracer`] of `set` over traversal `kind`, reused over every ray, answers as
+/// traversal `kind` of `s` does, closest hit and shadow answer, bit for bit: on `rays` and
+/// on copies of some of them whose bounds are NaN (which the BVHs' CPU-side copies decline,
+/// so the tracer's fallback answers them).
+fn tracer_same_as<S: TraversalSet>(
+    set: &S,
+    s: &Structures,
+    kind: AccelKind,
+    rays: &[Ray],
+    what: &str,
+) {
+    let mut t: Tracer<'_, S> = set.tracer(kind);
+    let nan = rays.iter().take(64).enumerate().map(|(i, r)| match i % 3 {
+        0 => Ray {
+            t_min: f32::NAN,
+            ..*r
+        },
+        1 => Ray {
+            t_max: f32::NAN,
+            ..*r
+        },
+        _ => Ray {
+            t_max: f32::INFINITY,
+            ..*r
+        },
+    });
+    for (i, r) in rays.iter().copied().chain(nan).enumerate() {
+        let want = s.closest_hit(kind, &r, &mut NoObserver);
+        assert_eq!(
+            bits(t.closest_hit(&r)),
+            bits(want),
+            "{what}: tracer, ray {i} {r:?}"
+        );
+        let want_any = s.any_hit(kind, &r, &mut NoObserver);
+        assert_eq!(
+            t.any_hit(&r),
+            want_any,
+            "{what}: tracer, shadow ray {i} {r:?}"
+        );
+    }
+}
+
 fn scene_case(spec: &str, cfg: &BuildConfig) {
     let scene = dualsplit_scene::load(spec).expect("builtin scene");
     let tris: &[Triangle] = &scene.triangles;
     let s = Structures::build(tris, cfg);
     let rays = rays_for(tris, 11);
+    for kind in AccelKind::ALL {
+        tracer_same_as(&s, &s, kind, &rays, &format!("{spec} {kind:?}"));
+    }
 
     let bvh2 = Bvh2Tree::build(tris, cfg).expect("bvh2");
     assert_eq!(
@@ -82,6 +128,17 @@ fn scene_case(spec: &str, cfg: &BuildConfig) {
         assert_eq!(t.stats().node_bytes, s.image(accel).node_bytes());
         same_as(&t, &s, accel, &rays, &format!("{spec} {kind}"));
         let any = AnyTree::from(t);
+        tracer_same_as(&any, &s, accel, &rays, &format!("{spec} AnyTree {kind}"));
+        let mut other = any.tracer(if accel == AccelKind::Bvh8 {
+            AccelKind::Bvh2
+        } else {
+            AccelKind::Bvh8
+        });
+        assert!(
+            rays.iter()
+                .all(|r| other.closest_hit(r).is_none() && !other.any_hit(r)),
+            "{spec} {kind}: a tracer of a kind the tree lacks misses"
+        );
         for &k in AccelKind::ALL.iter() {
             let r = &rays[0];
             let got = any.closest_hit(k, r, &mut NoObserver);
@@ -115,6 +172,9 @@ fn scene_case(spec: &str, cfg: &BuildConfig) {
         &format!("{spec} dst pipeline"),
     );
     let any = AnyTree::from(dst);
+    for kind in [AccelKind::DstSw, AccelKind::Dst] {
+        tracer_same_as(&any, &s, kind, &rays, &format!("{spec} AnyTree {kind:?}"));
+    }
     same_as(
         &any,
         &s,

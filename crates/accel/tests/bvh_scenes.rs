@@ -3,13 +3,16 @@
 //! path-traced pixel jobs on each scene's default camera: every BVH's plain query (its
 //! CPU-side copy, [`dualsplit_accel::wide::cpu`]) and its image traversal (what the
 //! simulator reads) against the BVH2's image traversal, hit for hit and bit for bit; the
-//! CPU-side copies with every instruction set this CPU has (SSE2, and AVX2 where present).
+//! CPU-side copies with every instruction set this CPU has (SSE2, and AVX2 where present),
+//! and through [`Tracer`]s, each reused over the rays of one rayon job.
 //!
 //! Release builds (`cargo test --release`, what CI runs) compare at least 100K rays of each
 //! kind per scene; debug builds compare 3K of each so that `cargo test` stays quick.
 
 use dualsplit_accel::wide::cpu::{CpuBvh, SimdLevel};
-use dualsplit_accel::{AccelKind, BuildConfig, CollapseConfig, NoObserver, Structures, WideBvh};
+use dualsplit_accel::{
+    AccelKind, BuildConfig, CollapseConfig, NoObserver, Structures, Tracer, TraversalSet, WideBvh,
+};
 use dualsplit_testkit::oracle::{hit_bits, key};
 use dualsplit_testkit::rays::record_rays;
 use dualsplit_testkit::scenes::shipped;
@@ -87,68 +90,89 @@ fn equivalence_on(name: &str, scene: &dualsplit_scene::Scene, min_rays: usize) {
     for (kind, level, c) in &copies {
         assert_eq!(c.level(), *level, "{name}: {kind:?}");
     }
+    const KINDS: [AccelKind; 3] = [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8];
+    let tracers = || -> [Tracer<'_, Structures>; 3] { KINDS.map(|k| s.tracer(k)) };
     for (what, set) in [("primary", &rays.primary), ("diffuse", &rays.diffuse)] {
-        set.par_iter().enumerate().for_each(|(i, ray)| {
-            let want = hit_bits(s.bvh2_image.closest_hit_image(ray, &mut NoObserver));
+        set.par_iter()
+            .enumerate()
+            .for_each_init(tracers, |tracers, (i, ray)| {
+                let want = hit_bits(s.bvh2_image.closest_hit_image(ray, &mut NoObserver));
+                for (kind, t) in KINDS.iter().zip(tracers.iter_mut()) {
+                    assert_eq!(
+                        hit_bits(t.closest_hit(ray)),
+                        want,
+                        "{name}: {what} ray {i} {ray:?} through {kind:?}'s tracer"
+                    );
+                }
+                for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+                    let b = s.encoded(kind).unwrap();
+                    let image = hit_bits(b.closest_hit_image(ray, &mut NoObserver));
+                    assert_eq!(
+                        image, want,
+                        "{name}: {what} ray {i} {ray:?} on {kind:?}'s image"
+                    );
+                    let got = s.closest_hit(kind, ray, &mut NoObserver);
+                    assert_eq!(
+                        hit_bits(got),
+                        want,
+                        "{name}: {what} ray {i} {ray:?} on {kind:?}"
+                    );
+                    assert_eq!(key(got).is_some(), want.is_some());
+                }
+                for (kind, level, c) in &copies {
+                    let got = c.traverse::<false>(ray).unwrap_or_else(|| {
+                        s.encoded(*kind)
+                            .unwrap()
+                            .closest_hit_image(ray, &mut NoObserver)
+                    });
+                    assert_eq!(
+                        hit_bits(got),
+                        want,
+                        "{name}: {what} ray {i} {ray:?} on {kind:?} with {level:?}"
+                    );
+                }
+            });
+    }
+    rays.shadow
+        .par_iter()
+        .enumerate()
+        .for_each_init(tracers, |tracers, (i, ray)| {
+            let want = s
+                .bvh2_image
+                .closest_hit_image(ray, &mut NoObserver)
+                .is_some();
+            for (kind, t) in KINDS.iter().zip(tracers.iter_mut()) {
+                assert_eq!(
+                    t.any_hit(ray),
+                    want,
+                    "{name}: shadow ray {i} {ray:?} through {kind:?}'s tracer"
+                );
+            }
             for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
                 let b = s.encoded(kind).unwrap();
-                let image = hit_bits(b.closest_hit_image(ray, &mut NoObserver));
+                let image = b.any_hit_image(ray, &mut NoObserver);
                 assert_eq!(
                     image, want,
-                    "{name}: {what} ray {i} {ray:?} on {kind:?}'s image"
+                    "{name}: shadow ray {i} {ray:?} on {kind:?}'s image"
                 );
-                let got = s.closest_hit(kind, ray, &mut NoObserver);
-                assert_eq!(
-                    hit_bits(got),
-                    want,
-                    "{name}: {what} ray {i} {ray:?} on {kind:?}"
-                );
-                assert_eq!(key(got).is_some(), want.is_some());
+                let got = s.any_hit(kind, ray, &mut NoObserver);
+                assert_eq!(got, want, "{name}: shadow ray {i} {ray:?} on {kind:?}");
             }
             for (kind, level, c) in &copies {
-                let got = c.traverse::<false>(ray).unwrap_or_else(|| {
-                    s.encoded(*kind)
-                        .unwrap()
-                        .closest_hit_image(ray, &mut NoObserver)
-                });
+                let got = c.traverse::<true>(ray).map_or_else(
+                    || {
+                        s.encoded(*kind)
+                            .unwrap()
+                            .any_hit_image(ray, &mut NoObserver)
+                    },
+                    |h| h.is_some(),
+                );
                 assert_eq!(
-                    hit_bits(got),
-                    want,
-                    "{name}: {what} ray {i} {ray:?} on {kind:?} with {level:?}"
+                    got, want,
+                    "{name}: shadow ray {i} {ray:?} on {kind:?} with {level:?}"
                 );
             }
         });
-    }
-    rays.shadow.par_iter().enumerate().for_each(|(i, ray)| {
-        let want = s
-            .bvh2_image
-            .closest_hit_image(ray, &mut NoObserver)
-            .is_some();
-        for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
-            let b = s.encoded(kind).unwrap();
-            let image = b.any_hit_image(ray, &mut NoObserver);
-            assert_eq!(
-                image, want,
-                "{name}: shadow ray {i} {ray:?} on {kind:?}'s image"
-            );
-            let got = s.any_hit(kind, ray, &mut NoObserver);
-            assert_eq!(got, want, "{name}: shadow ray {i} {ray:?} on {kind:?}");
-        }
-        for (kind, level, c) in &copies {
-            let got = c.traverse::<true>(ray).map_or_else(
-                || {
-                    s.encoded(*kind)
-                        .unwrap()
-                        .any_hit_image(ray, &mut NoObserver)
-                },
-                |h| h.is_some(),
-            );
-            assert_eq!(
-                got, want,
-                "{name}: shadow ray {i} {ray:?} on {kind:?} with {level:?}"
-            );
-        }
-    });
 }
 
 #[test]

@@ -10,7 +10,7 @@
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::{
-    AccelKind, AnyTree, BuildConfig, MemoryImage, Observer, Structures, TraversalSet,
+    AccelKind, AnyTree, BuildConfig, BvhImage, MemoryImage, Observer, Structures, TraversalSet,
 };
 use dualsplit_geometry::{Aabb, Hit, Ray};
 use dualsplit_scene::Scene;
@@ -160,6 +160,13 @@ impl TraversalSet for Loaded {
         match self {
             Loaded::Built { structures, .. } => structures.any_hit(kind, ray, obs),
             Loaded::Saved { tree, .. } => TraversalSet::any_hit(tree, kind, ray, obs),
+        }
+    }
+
+    fn bvh(&self, kind: AccelKind) -> Option<&BvhImage> {
+        match self {
+            Loaded::Built { structures, .. } => TraversalSet::bvh(structures, kind),
+            Loaded::Saved { tree, .. } => TraversalSet::bvh(tree, kind),
         }
     }
 

@@ -3,11 +3,11 @@
 //!
 //! `cpu_cost SCENE RES SET` builds the structures of `SCENE`, records the ray sets of a
 //! RES×RES path-traced frame (as `dualsplit bench` does), and traces set `SET` (`primary`,
-//! `shadow` or `diffuse`) once with `bvh8`'s plain queries (the calls `bench` times) and once
-//! with `rtcIntersect1` / `rtcOccluded1`. Each side's per-ray call is one function of its own
-//! here (`cpu_cost::ours`, `cpu_cost::embree_query`: everything a ray costs, the entry into the
-//! library included); collecting only inside one of them, or only inside the traversal
-//! proper, gives that side's counts:
+//! `shadow` or `diffuse`) once with `bvh8`'s plain queries through one [`Tracer`] (the calls
+//! `bench` times) and once with `rtcIntersect1` / `rtcOccluded1`. Each side's per-ray call is
+//! one function of its own here (`cpu_cost::ours`, `cpu_cost::embree_query`: everything a
+//! ray costs, the entry into the library included); collecting only inside one of them, or
+//! only inside the traversal proper, gives that side's counts:
 //!
 //! ```sh
 //! cargo build --release -p dualsplit-embree --example cpu_cost
@@ -28,7 +28,7 @@
 //! and point away from it, so that every query ends at the root's box test: what a ray costs
 //! whatever it meets (entry into the library, set-up, one node test, return).
 
-use dualsplit_accel::{AccelKind, NoObserver, Structures};
+use dualsplit_accel::{AccelKind, Structures, Tracer, TraversalSet};
 use dualsplit_embree::EmbreeScene;
 use dualsplit_geometry::{Ray, Vec3};
 use dualsplit_render::bench::ray_sets;
@@ -60,8 +60,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let moved = away.then(|| moved_away(&set.rays, s.bvh2.nodes[0].bounds.max));
     let rays = moved.as_deref().unwrap_or(&set.rays);
     let mut hits = [0usize; 2];
+    let mut tracer = s.tracer(AccelKind::Bvh8);
     for r in rays {
-        hits[0] += ours(&s, r, shadow) as usize;
+        hits[0] += ours(&mut tracer, r, shadow) as usize;
     }
     for r in rays {
         hits[1] += embree_query(&embree, r, shadow) as usize;
@@ -93,14 +94,14 @@ fn moved_away(rays: &[Ray], corner: Vec3) -> Vec<Ray> {
         .collect()
 }
 
-/// Our plain query of `r` on BVH8 (as `bench` makes it, through the structure set): a hit
-/// or, for a shadow ray, an occluder.
+/// Our plain query of `r` on BVH8, as `bench` makes it: through a [`Tracer`] made once for
+/// the whole set. A hit or, for a shadow ray, an occluder.
 #[inline(never)]
-fn ours(s: &Structures, r: &Ray, shadow: bool) -> bool {
+fn ours(t: &mut Tracer<'_, Structures>, r: &Ray, shadow: bool) -> bool {
     if shadow {
-        s.any_hit(AccelKind::Bvh8, r, &mut NoObserver)
+        t.any_hit(r)
     } else {
-        s.closest_hit(AccelKind::Bvh8, r, &mut NoObserver).is_some()
+        t.closest_hit(r).is_some()
     }
 }
 

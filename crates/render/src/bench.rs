@@ -198,18 +198,7 @@ pub fn measure<S: TraversalSet>(
         sink += set
             .rays
             .par_chunks(CHUNK)
-            .map(|chunk| {
-                chunk
-                    .iter()
-                    .map(|ray| {
-                        let q = RayQuery {
-                            ray: *ray,
-                            kind: set.kind,
-                        };
-                        trace_query(structures, kind, &q, &mut NoObserver).is_hit() as u64
-                    })
-                    .sum::<u64>()
-            })
+            .map(|chunk| trace_slice(structures, kind, set.kind, chunk))
             .sum::<u64>();
         repeats += 1;
         let s = start.elapsed().as_secs_f64();
@@ -328,15 +317,24 @@ pub fn trace_fn<S: TraversalSet>(
     kind: AccelKind,
     ray_kind: RayKind,
 ) -> impl Fn(&[Ray]) -> u64 + Sync + '_ {
-    move |rays: &[Ray]| {
-        rays.iter()
-            .map(|ray| {
-                let q = RayQuery {
-                    ray: *ray,
-                    kind: ray_kind,
-                };
-                trace_query(structures, kind, &q, &mut NoObserver).is_hit() as u64
-            })
-            .sum()
+    move |rays: &[Ray]| trace_slice(structures, kind, ray_kind, rays)
+}
+
+/// Traces every ray of `rays` (all of kind `ray_kind`) on structure `kind` through one
+/// [`Tracer`](dualsplit_accel::Tracer) and returns how many hit: the per-ray loop of a
+/// timing.
+#[inline]
+fn trace_slice<S: TraversalSet>(
+    structures: &S,
+    kind: AccelKind,
+    ray_kind: RayKind,
+    rays: &[Ray],
+) -> u64 {
+    let mut t = structures.tracer(kind);
+    match ray_kind {
+        RayKind::Shadow => rays.iter().map(|r| t.any_hit(r) as u64).sum(),
+        RayKind::Primary | RayKind::Diffuse => {
+            rays.iter().map(|r| t.closest_hit(r).is_some() as u64).sum()
+        }
     }
 }

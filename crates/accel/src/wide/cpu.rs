@@ -199,6 +199,55 @@ impl CpuBvh {
     }
 }
 
+/// The node array of a [`CpuQuery`].
+#[derive(Clone, Copy)]
+enum QueryNodes<'a> {
+    Four(&'a [Chunk]),
+    Eight(&'a [Chunk8]),
+}
+
+/// A query context over a [`CpuBvh`] for tracing many rays one by one on one thread (the
+/// counterpart of Embree's `RTCIntersectContext`): it holds the copy's arrays, its
+/// instruction set and a traversal stack of its own, so a ray's query starts with the
+/// traversal rather than with finding them ([`CpuBvh::traverse`] borrows a thread-local
+/// stack and dereferences the arrays per ray). Answers are [`CpuBvh::traverse`]'s.
+pub struct CpuQuery<'a> {
+    nodes: QueryNodes<'a>,
+    packets: &'a [TriPacket],
+    avx2: Option<Avx2>,
+    stack: Vec<Entry>,
+}
+
+impl CpuBvh {
+    /// A query context for tracing rays one by one ([`CpuQuery`]).
+    pub fn query(&self) -> CpuQuery<'_> {
+        CpuQuery {
+            nodes: match &self.nodes {
+                CpuNodes::Four(n) => QueryNodes::Four(n),
+                CpuNodes::Eight(n) => QueryNodes::Eight(n),
+            },
+            packets: &self.packets,
+            avx2: self.avx2,
+            stack: vec![Entry::UNUSED; self.stack_len],
+        }
+    }
+}
+
+impl CpuQuery<'_> {
+    /// [`CpuBvh::traverse`] with this context's stack.
+    #[inline]
+    pub fn traverse<const ANY: bool>(&mut self, ray: &Ray) -> Option<Option<Hit>> {
+        if (ray.t_min - cull_limit(ray.t_max)).is_nan() {
+            return None;
+        }
+        let stack = &mut self.stack[..];
+        Some(match self.nodes {
+            QueryNodes::Four(n) => dispatch::<_, ANY>(self.avx2, n, self.packets, ray, stack),
+            QueryNodes::Eight(n) => dispatch::<_, ANY>(self.avx2, n, self.packets, ray, stack),
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::isa::Sse2;

@@ -27,7 +27,7 @@ pub use node8::Node8;
 
 use crate::bvh2::Node2;
 use crate::image::{ImageError, MemoryImage};
-use crate::observer::Observer;
+use crate::observer::{NoObserver, Observer};
 use crate::validate::{ValidationReport, validate_image};
 use crate::{BuildConfig, Bvh2};
 use dualsplit_geometry::{Aabb, Hit, Ray};
@@ -265,6 +265,15 @@ impl BvhImage {
         self.any_hit_image(ray, obs)
     }
 
+    /// A query context for tracing rays one by one on one thread, through the CPU-side copy
+    /// ([`BvhQuery`]); made once per thread or batch of rays.
+    pub fn query(&self) -> BvhQuery<'_> {
+        BvhQuery {
+            bvh: self,
+            cpu: self.cpu().query(),
+        }
+    }
+
     /// Closest hit of `ray` (ordered by `(t, prim)`), reading the image and reporting every
     /// fetch and step to `obs`.
     #[inline]
@@ -299,5 +308,34 @@ impl BvhImage {
     /// Bytes of nodes plus triangle-index lists: the quantity of the paper's Table 3.
     pub fn bytes_total(&self) -> u64 {
         self.image.node_bytes() + self.image.index_bytes()
+    }
+}
+
+/// A query context over a [`BvhImage`] (its CPU-side copy's [`cpu::CpuQuery`]): the plain
+/// queries of [`BvhImage::closest_hit`] and [`BvhImage::any_hit`] with a [`NoObserver`], the
+/// same answers bit for bit, without finding the copy, its arrays and a stack per ray.
+/// Made by [`BvhImage::query`]; the counterpart of Embree's `RTCIntersectContext`.
+pub struct BvhQuery<'a> {
+    bvh: &'a BvhImage,
+    cpu: cpu::CpuQuery<'a>,
+}
+
+impl BvhQuery<'_> {
+    /// Closest hit of `ray` (ordered by `(t, prim)`).
+    #[inline]
+    pub fn closest_hit(&mut self, ray: &Ray) -> Option<Hit> {
+        match self.cpu.traverse::<false>(ray) {
+            Some(h) => h,
+            None => self.bvh.declined_closest(ray, &mut NoObserver),
+        }
+    }
+
+    /// True when any triangle is hit within `[ray.t_min, ray.t_max]`.
+    #[inline]
+    pub fn any_hit(&mut self, ray: &Ray) -> bool {
+        match self.cpu.traverse::<true>(ray) {
+            Some(h) => h.is_some(),
+            None => self.bvh.declined_any(ray, &mut NoObserver),
+        }
     }
 }
