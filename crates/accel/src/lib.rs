@@ -82,7 +82,7 @@ pub use dst::{Dst, DstConfig};
 pub use query::{DstPipeline, RayQuery};
 /// The rayon crate builds and batch queries run on (for [`rayon::ThreadPool`]).
 pub use rayon;
-pub use set::{Tracer, TraversalSet};
+pub use set::{Plain, Tracer, TraversalSet};
 pub use tree::{
     AnyTree, BuildStats, Bvh2Tree, BvhTree, CwbvhTree, DstDecoding, DstQTree, DstTree, TreeKind,
 };

@@ -24,6 +24,7 @@
 //! # Ok::<(), dualsplit_accel::AccelError>(())
 //! ```
 
+use crate::dst::{Dst, DstQuery};
 use crate::dstq::DstQConfig;
 use crate::image::MemoryImage;
 use crate::observer::{NoObserver, Observer};
@@ -67,9 +68,9 @@ pub trait TraversalSet: Sync {
     /// (false for a kind the set lacks).
     fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool;
 
-    /// The BVH image traversal `kind` reads when `kind` is one of this set's BVH kinds
-    /// (BVH2, BVH4, BVH8), whose plain queries a [`Tracer`] runs through a [`BvhQuery`].
-    fn bvh(&self, kind: AccelKind) -> Option<&BvhImage>;
+    /// The structure behind traversal `kind` when its plain queries have a query context
+    /// (the BVH kinds and the DST software decoder), which a [`Tracer`] then uses.
+    fn plain(&self, kind: AccelKind) -> Option<Plain<'_>>;
 
     /// A query context for tracing rays of traversal `kind` one by one on one thread
     /// ([`Tracer`]).
@@ -77,10 +78,15 @@ pub trait TraversalSet: Sync {
     where
         Self: Sized,
     {
+        let ctx = match self.plain(kind) {
+            Some(Plain::Bvh(b)) => Ctx::Bvh(b.query()),
+            Some(Plain::Dst(d)) => Ctx::Dst(d.query()),
+            None => Ctx::Set,
+        };
         Tracer {
             set: self,
             kind,
-            bvh: self.bvh(kind).map(BvhImage::query),
+            ctx,
         }
     }
 
@@ -111,11 +117,12 @@ impl TraversalSet for Structures {
         Structures::any_hit(self, kind, ray, obs)
     }
 
-    fn bvh(&self, kind: AccelKind) -> Option<&BvhImage> {
+    fn plain(&self, kind: AccelKind) -> Option<Plain<'_>> {
         match kind {
-            AccelKind::Bvh2 => Some(&self.bvh2_image),
-            AccelKind::Bvh4 => Some(&self.bvh4),
-            AccelKind::Bvh8 => Some(&self.bvh8),
+            AccelKind::Bvh2 => Some(Plain::Bvh(&self.bvh2_image)),
+            AccelKind::Bvh4 => Some(Plain::Bvh(&self.bvh4)),
+            AccelKind::Bvh8 => Some(Plain::Bvh(&self.bvh8)),
+            AccelKind::DstSw => Some(Plain::Dst(&self.dst)),
             _ => None,
         }
     }
@@ -148,9 +155,12 @@ impl TraversalSet for AnyTree {
         AnyTree::any_hit(self, kind, ray, obs).unwrap_or(false)
     }
 
-    fn bvh(&self, kind: AccelKind) -> Option<&BvhImage> {
-        match self {
-            AnyTree::Bvh(b) if TreeKind::of_accel(kind) == b.kind() => Some(&b.encoded),
+    fn plain(&self, kind: AccelKind) -> Option<Plain<'_>> {
+        match (self, kind) {
+            (AnyTree::Bvh(b), k) if TreeKind::of_accel(k) == b.kind() => {
+                Some(Plain::Bvh(&b.encoded))
+            }
+            (AnyTree::Dst(d), AccelKind::DstSw) => Some(Plain::Dst(d.dst())),
             _ => None,
         }
     }
@@ -181,26 +191,45 @@ impl TraversalSet for AnyTree {
     }
 }
 
+/// The structure behind a traversal whose plain queries have a query context
+/// ([`TraversalSet::plain`]).
+#[derive(Clone, Copy)]
+pub enum Plain<'a> {
+    /// A BVH image (its CPU-side copy's [`BvhQuery`]).
+    Bvh(&'a BvhImage),
+    /// A DST, traversed by its software decoder ([`DstQuery`]).
+    Dst(&'a Dst),
+}
+
+/// A [`Tracer`]'s context.
+enum Ctx<'a> {
+    Bvh(BvhQuery<'a>),
+    Dst(DstQuery<'a>),
+    /// None: the set's plain queries.
+    Set,
+}
+
 /// A query context over traversal `kind` of a [`TraversalSet`], for tracing rays one by one
 /// on one thread without observing them (a renderer's or benchmark's inner loop; the
 /// counterpart of Embree's `RTCIntersectContext`): the BVH kinds run through a
-/// [`BvhQuery`], which holds their CPU-side copy's arrays and a traversal stack, the others
-/// through the set's plain queries. The answers are [`TraversalSet::closest_hit`]'s and
-/// [`TraversalSet::any_hit`]'s with a [`NoObserver`], bit for bit. Made by
-/// [`TraversalSet::tracer`].
+/// [`BvhQuery`], which holds their CPU-side copy's arrays and a traversal stack, the DST
+/// software decoder through a [`DstQuery`], the others through the set's plain queries.
+/// The answers are [`TraversalSet::closest_hit`]'s and [`TraversalSet::any_hit`]'s with a
+/// [`NoObserver`], bit for bit. Made by [`TraversalSet::tracer`].
 pub struct Tracer<'a, S> {
     set: &'a S,
     kind: AccelKind,
-    bvh: Option<BvhQuery<'a>>,
+    ctx: Ctx<'a>,
 }
 
 impl<S: TraversalSet> Tracer<'_, S> {
     /// Closest hit of `ray` (a miss for a kind the set lacks).
     #[inline]
     pub fn closest_hit(&mut self, ray: &Ray) -> Option<Hit> {
-        match &mut self.bvh {
-            Some(q) => q.closest_hit(ray),
-            None => self.set.closest_hit(self.kind, ray, &mut NoObserver),
+        match &mut self.ctx {
+            Ctx::Bvh(q) => q.closest_hit(ray),
+            Ctx::Dst(q) => q.closest_hit(ray),
+            Ctx::Set => self.set.closest_hit(self.kind, ray, &mut NoObserver),
         }
     }
 
@@ -208,9 +237,10 @@ impl<S: TraversalSet> Tracer<'_, S> {
     /// lacks).
     #[inline]
     pub fn any_hit(&mut self, ray: &Ray) -> bool {
-        match &mut self.bvh {
-            Some(q) => q.any_hit(ray),
-            None => self.set.any_hit(self.kind, ray, &mut NoObserver),
+        match &mut self.ctx {
+            Ctx::Bvh(q) => q.any_hit(ray),
+            Ctx::Dst(q) => q.any_hit(ray),
+            Ctx::Set => self.set.any_hit(self.kind, ray, &mut NoObserver),
         }
     }
 }

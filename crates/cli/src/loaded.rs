@@ -10,7 +10,7 @@
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::{
-    AccelKind, AnyTree, BuildConfig, BvhImage, MemoryImage, Observer, Structures, TraversalSet,
+    AccelKind, AnyTree, BuildConfig, MemoryImage, Observer, Plain, Structures, TraversalSet,
 };
 use dualsplit_geometry::{Aabb, Hit, Ray};
 use dualsplit_scene::Scene;
@@ -163,10 +163,10 @@ impl TraversalSet for Loaded {
         }
     }
 
-    fn bvh(&self, kind: AccelKind) -> Option<&BvhImage> {
+    fn plain(&self, kind: AccelKind) -> Option<Plain<'_>> {
         match self {
-            Loaded::Built { structures, .. } => TraversalSet::bvh(structures, kind),
-            Loaded::Saved { tree, .. } => TraversalSet::bvh(tree, kind),
+            Loaded::Built { structures, .. } => TraversalSet::plain(structures, kind),
+            Loaded::Saved { tree, .. } => TraversalSet::plain(tree, kind),
         }
     }
 

@@ -15,8 +15,8 @@ use super::pipeline::le_or_nan;
 use super::traverse::{Stack, dual_carve, split_next};
 use crate::image::Pages;
 use crate::wide::cpu::{PackedHit, RaySimd, TriPacket, avx2_token, pack_entries, test_leaf};
-use crate::wide::simd::Kernel;
-use dualsplit_geometry::{Hit, Ray, cull_limit, widen_exit};
+use crate::wide::simd::{Avx2, Kernel};
+use dualsplit_geometry::{Aabb, Hit, Ray, cull_limit, widen_exit};
 use std::sync::Arc;
 
 impl Dst {
@@ -42,15 +42,58 @@ impl Dst {
     /// ([`crate::wide::cpu::SimdLevel::detect`]), the same answers.
     #[inline]
     pub(super) fn traverse_fast<const ANY: bool>(&self, ray: &Ray) -> Option<Hit> {
-        match avx2_token() {
-            Some(t) => t.vectorize(Fast::<ANY> { dst: self, ray }).unpack(),
+        self.query().traverse::<ANY>(ray)
+    }
+
+    /// A query context for tracing rays one by one with the plain decoder ([`DstQuery`]).
+    pub fn query(&self) -> DstQuery<'_> {
+        DstQuery {
+            words: &self.image.words[..],
+            packets: self.packets(),
+            scene_box: self.scene_box,
+            empty: self.is_empty(),
+            avx2: avx2_token(),
+        }
+    }
+}
+
+/// A query context over a [`Dst`] for its plain decoder: the image's words, the
+/// leaf-ordered triangle packets and the instruction set, found once rather than per ray
+/// (the DST counterpart of [`crate::BvhQuery`]; [`Dst::closest_hit`] and [`Dst::any_hit`]
+/// with a [`crate::NoObserver`] give the same answers). Made by [`Dst::query`].
+#[derive(Clone, Copy)]
+pub struct DstQuery<'a> {
+    words: &'a [u32],
+    packets: &'a [TriPacket],
+    scene_box: Aabb,
+    empty: bool,
+    avx2: Option<Avx2>,
+}
+
+impl DstQuery<'_> {
+    /// Closest hit of `ray` (ordered by `(t, prim)`).
+    #[inline]
+    pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        self.traverse::<false>(ray)
+    }
+
+    /// True when `ray` hits any triangle within `[t_min, t_max]`.
+    #[inline]
+    pub fn any_hit(&self, ray: &Ray) -> bool {
+        self.traverse::<true>(ray).is_some()
+    }
+
+    #[inline(always)]
+    fn traverse<const ANY: bool>(&self, ray: &Ray) -> Option<Hit> {
+        match self.avx2 {
+            Some(t) => t.vectorize(Fast::<ANY> { q: self, ray }).unpack(),
             None => self.fast::<ANY>(ray),
         }
     }
 
     #[inline(always)]
     fn fast<const ANY: bool>(&self, ray: &Ray) -> Option<Hit> {
-        if self.is_empty() {
+        if self.empty {
             return None;
         }
         let r = ray.precompute();
@@ -59,8 +102,7 @@ impl Dst {
         if t_min > t_max {
             return None;
         }
-        let words = &self.image.words[..];
-        let packets = self.packets();
+        let (words, packets) = (self.words, self.packets);
         let rs = RaySimd::new(&r);
         let o = r.ray.origin.to_array();
         let inv = r.inv_dir.to_array();
@@ -153,9 +195,9 @@ impl Dst {
     }
 }
 
-/// [`Dst::traverse_fast`]'s body as a [`Kernel`], to run compiled for AVX2.
+/// [`DstQuery::fast`] as a [`Kernel`], to run compiled for AVX2.
 struct Fast<'a, const ANY: bool> {
-    dst: &'a Dst,
+    q: &'a DstQuery<'a>,
     ray: &'a Ray,
 }
 
@@ -163,6 +205,6 @@ impl<const ANY: bool> Kernel for Fast<'_, ANY> {
     type Output = PackedHit;
     #[inline(always)]
     fn call(self) -> PackedHit {
-        PackedHit::pack(self.dst.fast::<ANY>(self.ray))
+        PackedHit::pack(self.q.fast::<ANY>(self.ray))
     }
 }

@@ -45,6 +45,7 @@ mod stats;
 pub(crate) mod traverse;
 mod validate;
 
+pub use fast::DstQuery;
 pub use header::{AxisPair, Corner, HeaderOffset, OFFSET_LIMIT};
 pub use stats::{DstStats, DstTraceStats, bvh2_size_bytes};
 pub use validate::DstValidation;
