@@ -38,7 +38,11 @@
 //!   the simulator uses). The plain and batch forms observe nothing, so they run the
 //!   CPU-side path ([`Observer::OBSERVES_NOTHING`]: [`wide::cpu`] for a BVH, the DST's plain
 //!   decoder), made from the image on first use, with the image traversal's answers bit for
-//!   bit; the `_observed` forms read the image.
+//!   bit; the `_observed` forms read the image. Tracing many rays one by one on a thread,
+//!   a query context made once for them skips finding the copy, its arrays and a stack per
+//!   ray: [`BvhImage::query`] ([`BvhQuery`]), [`dst::Dst::query`] ([`dst::DstQuery`]), or
+//!   [`TraversalSet::tracer`] ([`Tracer`]) for any traversal of a set. The batch forms use
+//!   one per rayon job.
 //! * DST traversals: [`DstDecoding::Software`] ([`AccelKind::DstSw`], `dst-sw`: the paper's
 //!   DST\*, the fast one on a CPU) and [`DstDecoding::Pipeline`] ([`AccelKind::Dst`], `dst`:
 //!   the hardware pipeline model). [`AccelKind::DST_SOFTWARE`] and

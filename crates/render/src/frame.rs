@@ -4,7 +4,7 @@
 //! stealing change nothing: the image and the counters are the same bits on any machine
 //! with the same float semantics.
 
-use crate::trace::run_job;
+use crate::trace::{run_job_by, trace_with};
 use crate::{Image, PixelJob, PixelRecord, RayCounts, RenderError, RenderSettings, trace_pixel};
 use dualsplit_accel::{AccelKind, NoObserver, TraversalSet};
 use dualsplit_scene::Scene;
@@ -171,14 +171,13 @@ pub fn render<S: TraversalSet>(
         .map(|(x0, y0, x1, y1)| {
             let mut counts = RayCounts::default();
             let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+            let mut tracer = structures.tracer(kind);
             for y in y0..y1 {
                 for x in x0..x1 {
                     let job = PixelJob::new(scene, settings, x, y);
-                    px.push(run_job(
+                    px.push(run_job_by(
                         job,
-                        structures,
-                        kind,
-                        &mut NoObserver,
+                        |q| trace_with(&mut tracer, q),
                         &mut counts,
                         |_, _| {},
                     ));

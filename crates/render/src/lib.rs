@@ -68,4 +68,6 @@ pub use job::{
     ALBEDO, AMBIENT, FrameConstants, PixelJob, RayKind, RayQuery, RenderSettings, SKY, TraceResult,
     Workload,
 };
-pub use trace::{PixelRecord, TracedRay, run_job, trace_pixel, trace_query};
+pub use trace::{
+    PixelRecord, TracedRay, run_job, run_job_by, trace_pixel, trace_query, trace_with,
+};

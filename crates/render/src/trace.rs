@@ -4,7 +4,7 @@
 //! pixel regenerated alone goes through exactly the code that rendered it in the frame.
 
 use crate::{PixelJob, RayCounts, RayKind, RayQuery, RenderSettings, TraceResult};
-use dualsplit_accel::{AccelKind, Observer, TraversalSet};
+use dualsplit_accel::{AccelKind, Observer, Tracer, TraversalSet};
 use dualsplit_scene::Scene;
 
 /// One traced ray and its answer.
@@ -78,19 +78,40 @@ pub fn trace_query<S: TraversalSet, O: Observer>(
     }
 }
 
+/// [`trace_query`] through a [`Tracer`] (no observer).
+#[inline]
+pub fn trace_with<S: TraversalSet>(tracer: &mut Tracer<'_, S>, query: &RayQuery) -> TraceResult {
+    match query.kind {
+        RayKind::Shadow => TraceResult::Occluded(tracer.any_hit(&query.ray)),
+        RayKind::Primary | RayKind::Diffuse => TraceResult::Closest(tracer.closest_hit(&query.ray)),
+    }
+}
+
 /// Runs `job` to completion on structure `kind`, counting every ray into `counts` and
 /// handing each (query, result) to `sink`; returns the pixel's radiance.
 #[inline]
 pub fn run_job<S: TraversalSet, O: Observer>(
-    mut job: PixelJob<'_>,
+    job: PixelJob<'_>,
     structures: &S,
     kind: AccelKind,
     obs: &mut O,
     counts: &mut RayCounts,
+    sink: impl FnMut(&RayQuery, &TraceResult),
+) -> f32 {
+    run_job_by(job, |q| trace_query(structures, kind, q, obs), counts, sink)
+}
+
+/// [`run_job`] with each query answered by `trace` (a [`Tracer`] through [`trace_with`],
+/// where nothing is observed).
+#[inline]
+pub fn run_job_by(
+    mut job: PixelJob<'_>,
+    mut trace: impl FnMut(&RayQuery) -> TraceResult,
+    counts: &mut RayCounts,
     mut sink: impl FnMut(&RayQuery, &TraceResult),
 ) -> f32 {
     while let Some(q) = job.next_ray() {
-        let r = trace_query(structures, kind, &q, obs);
+        let r = trace(&q);
         counts.record(q.kind, &r);
         sink(&q, &r);
         job.submit(r);
