@@ -72,9 +72,22 @@ pub trait RayQuery: Sync {
 }
 
 /// `RayQuery` for a structure whose `closest_hit` and `any_hit` take an [`Observer`]: the
-/// observed queries are those, the triangles `$tris`.
+/// observed queries are those, the triangles `$tris`. With `query`, the batch forms trace
+/// each rayon job's rays through one context of the structure's `query()`.
 macro_rules! query_by_traversal {
-    ($(#[$doc:meta])* $ty:ty, |$s:ident| $tris:expr) => {
+    (@batch query) => {
+        fn intersect_batch(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
+            rays.par_iter()
+                .map_init(|| self.query(), |q, r| q.closest_hit(r))
+                .collect()
+        }
+        fn occluded_batch(&self, rays: &[Ray]) -> Vec<bool> {
+            rays.par_iter()
+                .map_init(|| self.query(), |q, r| q.any_hit(r))
+                .collect()
+        }
+    };
+    ($(#[$doc:meta])* $ty:ty, |$s:ident| $tris:expr $(, $batch:ident)?) => {
         $(#[$doc])*
         impl RayQuery for $ty {
             #[inline]
@@ -89,39 +102,24 @@ macro_rules! query_by_traversal {
                 let $s = self;
                 $tris
             }
+            $(query_by_traversal!(@batch $batch);)?
         }
     };
 }
 
-/// The batch forms trace each rayon job's rays through one [`BvhImage::query`] context.
-impl RayQuery for BvhImage {
-    #[inline]
-    fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        self.closest_hit(ray, obs)
-    }
-    #[inline]
-    fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
-        self.any_hit(ray, obs)
-    }
-    fn triangles(&self) -> &[Triangle] {
-        self.image.triangle_slice()
-    }
-    fn intersect_batch(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
-        rays.par_iter()
-            .map_init(|| self.query(), |q, r| q.closest_hit(r))
-            .collect()
-    }
-    fn occluded_batch(&self, rays: &[Ray]) -> Vec<bool> {
-        rays.par_iter()
-            .map_init(|| self.query(), |q, r| q.any_hit(r))
-            .collect()
-    }
-}
+query_by_traversal!(
+    /// The batch forms trace each rayon job's rays through one [`BvhImage::query`] context.
+    BvhImage,
+    |s| s.image.triangle_slice(),
+    query
+);
 query_by_traversal!(
     /// A [`Dst`] queried through its software decoder (the paper's DST\*,
-    /// [`crate::AccelKind::DstSw`]): the fast CPU traversal.
+    /// [`crate::AccelKind::DstSw`]): the fast CPU traversal. The batch forms trace each
+    /// rayon job's rays through one [`Dst::query`] context.
     Dst,
-    |s| Dst::triangles(s)
+    |s| Dst::triangles(s),
+    query
 );
 query_by_traversal!(crate::cwbvh::Cwbvh, |s| s.image().triangle_slice());
 query_by_traversal!(crate::dstq::DstQ, |s| s.image().triangle_slice());

@@ -104,7 +104,7 @@ fn equivalence_on(name: &str, scene: &dualsplit_scene::Scene, min_rays: usize) {
                         "{name}: {what} ray {i} {ray:?} through {kind:?}'s tracer"
                     );
                 }
-                for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+                for kind in KINDS {
                     let b = s.encoded(kind).unwrap();
                     let image = hit_bits(b.closest_hit_image(ray, &mut NoObserver));
                     assert_eq!(
@@ -148,7 +148,7 @@ fn equivalence_on(name: &str, scene: &dualsplit_scene::Scene, min_rays: usize) {
                     "{name}: shadow ray {i} {ray:?} through {kind:?}'s tracer"
                 );
             }
-            for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+            for kind in KINDS {
                 let b = s.encoded(kind).unwrap();
                 let image = b.any_hit_image(ray, &mut NoObserver);
                 assert_eq!(
