@@ -50,6 +50,11 @@
 //! sorted by entry distance, ties by slot; for shadow rays the
 //! first hit child first and the rest as they come), which changes no answer.
 //!
+//! A ray's query either borrows a thread-local stack and finds the copy's arrays
+//! ([`CpuBvh::traverse`]) or runs in a [`CpuQuery`] ([`CpuBvh::query`]), which holds the
+//! arrays, the instruction set and a stack of its own across the rays of one thread (what
+//! [`Tracer`](crate::Tracer) and the batch queries use); the traversal is the same.
+//!
 //! Instructions ([`SimdLevel`]): with AVX2 (detected at run time) a BVH8 node is one 8-wide
 //! test and the whole traversal is compiled for AVX2 (`simd.rs`); otherwise SSE2, which
 //! every x86-64 CPU has (two 4-wide tests per BVH8 node), or `wide`'s portable code
