@@ -216,6 +216,18 @@ enum Ctx<'a> {
 /// software decoder through a [`DstQuery`], the others through the set's plain queries.
 /// The answers are [`TraversalSet::closest_hit`]'s and [`TraversalSet::any_hit`]'s with a
 /// [`NoObserver`], bit for bit. Made by [`TraversalSet::tracer`].
+///
+/// ```
+/// use dualsplit_accel::math::{Ray, Triangle, Vec3};
+/// use dualsplit_accel::{AccelKind, BuildConfig, Structures, TraversalSet};
+/// let tris = vec![Triangle::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0))];
+/// let s = Structures::build(&tris, &BuildConfig::default());
+/// let mut t = s.tracer(AccelKind::Bvh8); // once per thread or batch of rays
+/// let rays = [Ray::new(Vec3::ZERO, Vec3::Z), Ray::new(Vec3::ZERO, -Vec3::Z)];
+/// let hits: Vec<Option<f32>> = rays.iter().map(|r| t.closest_hit(r).map(|h| h.t)).collect();
+/// assert_eq!(hits, [Some(2.0), None]);
+/// assert!(t.any_hit(&rays[0]));
+/// ```
 pub struct Tracer<'a, S> {
     set: &'a S,
     kind: AccelKind,
