@@ -1,7 +1,9 @@
 //! Running one pixel to completion: [`trace_pixel`] and the per-ray record.
 //!
-//! The renderer, the tests and the throughput benchmark all run jobs through [`run_job`], so a
-//! pixel regenerated alone goes through exactly the code that rendered it in the frame.
+//! The renderer, the tests and the throughput benchmark all run jobs through [`run_job_by`]
+//! (the renderer with a [`Tracer`] per tile, the others through [`run_job`]), so a pixel
+//! regenerated alone goes through the job code that rendered it in the frame, and its rays
+//! get the same answers bit for bit (the tracer's are the plain queries').
 
 use crate::{PixelJob, RayCounts, RayKind, RayQuery, RenderSettings, TraceResult};
 use dualsplit_accel::{AccelKind, Observer, Tracer, TraversalSet};
