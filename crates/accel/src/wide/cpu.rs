@@ -186,22 +186,41 @@ impl CpuBvh {
     /// must take the image traversal instead (its `t_min` or cull limit is NaN).
     #[inline]
     pub fn traverse<const ANY: bool>(&self, ray: &Ray) -> Option<Option<Hit>> {
-        if (ray.t_min - cull_limit(ray.t_max)).is_nan() {
-            return None;
-        }
-        let hit = STACK.with_borrow_mut(|stack| {
+        STACK.with_borrow_mut(|stack| {
             if stack.len() < self.stack_len {
                 stack.resize(self.stack_len, Entry::UNUSED);
             }
             let buf = &mut stack[..self.stack_len];
-            let packets = &self.packets[..];
-            match &self.nodes {
-                CpuNodes::Four(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, buf),
-                CpuNodes::Eight(n) => dispatch::<_, ANY>(self.avx2, n, packets, ray, buf),
-            }
-        });
-        Some(hit)
+            traverse_on::<ANY>(self.query_nodes(), &self.packets, self.avx2, ray, buf)
+        })
     }
+
+    /// The nodes as a [`CpuQuery`] holds them.
+    #[inline(always)]
+    fn query_nodes(&self) -> QueryNodes<'_> {
+        match &self.nodes {
+            CpuNodes::Four(n) => QueryNodes::Four(n),
+            CpuNodes::Eight(n) => QueryNodes::Eight(n),
+        }
+    }
+}
+
+/// [`CpuBvh::traverse`] on `stack` (at least the copy's bound long), whichever holds it.
+#[inline(always)]
+fn traverse_on<const ANY: bool>(
+    nodes: QueryNodes<'_>,
+    packets: &[TriPacket],
+    avx2: Option<Avx2>,
+    ray: &Ray,
+    stack: &mut [Entry],
+) -> Option<Option<Hit>> {
+    if (ray.t_min - cull_limit(ray.t_max)).is_nan() {
+        return None;
+    }
+    Some(match nodes {
+        QueryNodes::Four(n) => dispatch::<_, ANY>(avx2, n, packets, ray, stack),
+        QueryNodes::Eight(n) => dispatch::<_, ANY>(avx2, n, packets, ray, stack),
+    })
 }
 
 /// The node array of a [`CpuQuery`].
@@ -227,10 +246,7 @@ impl CpuBvh {
     /// A query context for tracing rays one by one ([`CpuQuery`]).
     pub fn query(&self) -> CpuQuery<'_> {
         CpuQuery {
-            nodes: match &self.nodes {
-                CpuNodes::Four(n) => QueryNodes::Four(n),
-                CpuNodes::Eight(n) => QueryNodes::Eight(n),
-            },
+            nodes: self.query_nodes(),
             packets: &self.packets,
             avx2: self.avx2,
             stack: vec![Entry::UNUSED; self.stack_len],
@@ -242,14 +258,7 @@ impl CpuQuery<'_> {
     /// [`CpuBvh::traverse`] with this context's stack.
     #[inline]
     pub fn traverse<const ANY: bool>(&mut self, ray: &Ray) -> Option<Option<Hit>> {
-        if (ray.t_min - cull_limit(ray.t_max)).is_nan() {
-            return None;
-        }
-        let stack = &mut self.stack[..];
-        Some(match self.nodes {
-            QueryNodes::Four(n) => dispatch::<_, ANY>(self.avx2, n, self.packets, ray, stack),
-            QueryNodes::Eight(n) => dispatch::<_, ANY>(self.avx2, n, self.packets, ray, stack),
-        })
+        traverse_on::<ANY>(self.nodes, self.packets, self.avx2, ray, &mut self.stack)
     }
 }
 
