@@ -47,8 +47,10 @@
 //!   have led to (and more), so it can add no closer hit and lose none.
 //!
 //! Only the visiting order of a node's hit children differs (nearest first, the rest pushed
-//! sorted by entry distance, ties by slot; for shadow rays the
-//! first hit child first and the rest as they come), which changes no answer.
+//! sorted by entry distance, ties by slot; with AVX2, three or more hit children of a BVH8
+//! node are sorted by a vector network on a key that orders distances differing only in
+//! their last three bits by slot; for shadow rays the first hit child first and the rest as
+//! they come), which changes no answer.
 //!
 //! A ray's query either borrows a thread-local stack and finds the copy's arrays
 //! ([`CpuBvh::traverse`]) or runs in a [`CpuQuery`] ([`CpuBvh::query`]), which holds the

@@ -182,4 +182,163 @@ impl Avx2 {
             unreachable!("no Avx2 token exists off x86-64")
         }
     }
+
+    /// Orders the hit lanes of an eight-lane node for a traversal stack, without branches:
+    /// writes all eight lanes' `(distance bits, child word)` pairs to `out`, the lanes of
+    /// `mask` first, farthest first (so the nearest is last, on top of the stack when `out`
+    /// is its next eight slots), then the other lanes; returns how many lanes `mask` has and
+    /// the nearest of them (the lane last among them in `out`).
+    ///
+    /// The sort key of a lane is its distance's bits mapped to a signed integer of the same
+    /// order (the low 31 bits flipped for a negative sign), its low three bits replaced by
+    /// the lane number: distinct keys, ordered by distance except between distances that
+    /// differ only in those bits (then by lane, the lower lane nearer the top, as are equal
+    /// distances). Lanes outside `mask` take the key `i32::MIN`, below every such key (the
+    /// smallest, of −∞, is `0x807F_FFF8`), so they sort after the hit lanes. A bitonic
+    /// network of six compare-exchange stages sorts the eight keys in one register.
+    #[inline(always)]
+    pub fn sort_hits8(
+        self,
+        dist: [f32; 8],
+        child: &[u32; 8],
+        mask: u32,
+        out: &mut [[u32; 2]; 8],
+    ) -> (u32, u32) {
+        let nearest: u32;
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            // SAFETY: every intrinsic below needs at most AVX2, which `self` proves this CPU
+            // has (`detect`). The only memory writes are the two 32-byte `storeu`s, to the
+            // first and second halves of the 64-byte `out`, which `&mut` lends exclusively;
+            // `storeu` needs no alignment.
+            unsafe {
+                let d: __m256i = bytemuck::cast(dist);
+                let ord = _mm256_xor_si256(d, _mm256_srli_epi32::<1>(_mm256_srai_epi32::<31>(d)));
+                let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+                let key = _mm256_or_si256(_mm256_andnot_si256(_mm256_set1_epi32(7), ord), lane);
+                let bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+                let hit =
+                    _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(mask as i32), bit), bit);
+                // The nearest hit lane, the smallest key, found apart from the sort (three
+                // steps rather than six), so that the next node's address does not wait
+                // for the sort.
+                let near = _mm256_blendv_epi8(_mm256_set1_epi32(i32::MAX), key, hit);
+                let near = _mm256_min_epi32(near, _mm256_shuffle_epi32::<0x4E>(near));
+                let near = _mm256_min_epi32(near, _mm256_shuffle_epi32::<0xB1>(near));
+                let near = _mm256_min_epi32(near, _mm256_permute2x128_si256::<1>(near, near));
+                nearest = (_mm256_cvtsi256_si32(near) & 7) as u32;
+                let key = _mm256_blendv_epi8(_mm256_set1_epi32(i32::MIN), key, hit);
+                let key = sort8_desc(key);
+                let idx = _mm256_and_si256(key, _mm256_set1_epi32(7));
+                let t = _mm256_permutevar8x32_epi32(d, idx);
+                let c = _mm256_permutevar8x32_epi32(bytemuck::cast(*child), idx);
+                let lo = _mm256_unpacklo_epi32(t, c);
+                let hi = _mm256_unpackhi_epi32(t, c);
+                let p = out.as_mut_ptr().cast::<__m256i>();
+                _mm256_storeu_si256(p, _mm256_permute2x128_si256::<0x20>(lo, hi));
+                _mm256_storeu_si256(p.add(1), _mm256_permute2x128_si256::<0x31>(lo, hi));
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = (dist, child, out);
+            unreachable!("no Avx2 token exists off x86-64")
+        }
+        (mask.count_ones(), nearest)
+    }
+}
+
+/// The eight signed keys of `v` in descending order: a bitonic network, each stage a
+/// compare-exchange of lane pairs (the lower lane takes the larger key), given by the
+/// permutation that swaps each pair's lanes and the blend mask of the pairs' upper lanes.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn sort8_desc(v: std::arch::x86_64::__m256i) -> std::arch::x86_64::__m256i {
+    use std::arch::x86_64::*;
+    // SAFETY: called only from `Avx2::sort_hits8`, whose token proves AVX2 (the most
+    // these intrinsics need); no memory is touched.
+    unsafe {
+        macro_rules! stage {
+            ($v:expr, $p:expr, $upper:literal) => {{
+                let (v, p) = ($v, $p);
+                _mm256_blend_epi32::<$upper>(_mm256_max_epi32(v, p), _mm256_min_epi32(v, p))
+            }};
+        }
+        let reverse = _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0);
+        // Sorted pairs; then quadruples: (0,3)(1,2), (0,1)(2,3); then all eight:
+        // (0,7)(1,6)(2,5)(3,4), (0,2)(1,3), (0,1).
+        let v = stage!(v, _mm256_shuffle_epi32::<0xB1>(v), 0xAA);
+        let v = stage!(v, _mm256_shuffle_epi32::<0x1B>(v), 0xCC);
+        let v = stage!(v, _mm256_shuffle_epi32::<0xB1>(v), 0xAA);
+        let v = stage!(v, _mm256_permutevar8x32_epi32(v, reverse), 0xF0);
+        let v = stage!(v, _mm256_shuffle_epi32::<0x4E>(v), 0xCC);
+        stage!(v, _mm256_shuffle_epi32::<0xB1>(v), 0xAA)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Avx2;
+
+    /// The order [`Avx2::sort_hits8`] promises, computed lane by lane: the distance's bits
+    /// as a signed integer of the same order, the low three bits the lane.
+    fn key(d: f32, lane: usize) -> i32 {
+        let b = d.to_bits() as i32;
+        ((b ^ ((b >> 31) as u32 >> 1) as i32) & !7) | lane as i32
+    }
+
+    /// Every mask of eight lanes with distances drawn from a set full of ties, signed
+    /// zeros, infinities, negatives and near neighbours: the hit lanes come first, each
+    /// once with its own distance and child, in descending key order, and the nearest is
+    /// the last of them.
+    #[test]
+    fn sort_hits8_orders_every_mask() {
+        let Some(avx2) = Avx2::detect() else {
+            eprintln!("no AVX2 on this CPU: nothing to test");
+            return;
+        };
+        let pool = [
+            0.0,
+            -0.0,
+            1.0,
+            1.0,
+            f32::from_bits(1.0f32.to_bits() + 1),
+            f32::from_bits(1.0f32.to_bits() + 9),
+            2.5,
+            -3.0,
+            -3.5,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MIN_POSITIVE,
+            1e30,
+        ];
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for round in 0..64 {
+            let dist: [f32; 8] = std::array::from_fn(|_| pool[next() as usize % pool.len()]);
+            let child: [u32; 8] = std::array::from_fn(|l| 100 * round + l as u32);
+            for mask in 0..256u32 {
+                let mut out = [[0u32; 2]; 8];
+                let (k, near) = avx2.sort_hits8(dist, &child, mask, &mut out);
+                assert_eq!(k, mask.count_ones());
+                let mut want: Vec<usize> = (0..8).filter(|l| mask & (1 << l) != 0).collect();
+                want.sort_by_key(|&l| std::cmp::Reverse(key(dist[l], l)));
+                let got: Vec<[u32; 2]> = out[..k as usize].to_vec();
+                let expect: Vec<[u32; 2]> = want
+                    .iter()
+                    .map(|&l| [dist[l].to_bits(), child[l]])
+                    .collect();
+                assert_eq!(got, expect, "dist {dist:?} mask {mask:#010b}");
+                if let Some(&last) = want.last() {
+                    assert_eq!(near as usize, last, "dist {dist:?} mask {mask:#010b}");
+                }
+            }
+        }
+    }
 }

@@ -15,6 +15,9 @@ pub(crate) trait Isa: Copy {
     /// Entry distances (lanes 0–3, then 4–7) and the mask of the non-empty lanes of `n` that
     /// the ray meets on `[t_lo, t_hi]`.
     fn test8(self, rs: &RaySimd, n: &Chunk8, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32);
+
+    /// The AVX2 token when these are AVX2's instructions (for [`Avx2::sort_hits8`]).
+    fn avx2(self) -> Option<Avx2>;
 }
 
 /// Baseline x86-64 (SSE2), or the portable `wide` code on other targets: 4-wide vectors.
@@ -35,6 +38,11 @@ impl Isa for Sse2 {
         let ((e0, m0), (e1, m1)) = (half(0), half(1));
         ([e0, e1], m0 | m1 << LANES)
     }
+
+    #[inline(always)]
+    fn avx2(self) -> Option<Avx2> {
+        None
+    }
 }
 
 impl Isa for Avx2 {
@@ -51,6 +59,11 @@ impl Isa for Avx2 {
             t_hi,
         );
         (bytemuck::cast(e), m)
+    }
+
+    #[inline(always)]
+    fn avx2(self) -> Option<Avx2> {
+        Some(self)
     }
 }
 

@@ -78,7 +78,31 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                     cur = child(near);
                     continue;
                 }
-                // Three or more, pushed in slot order, each inserted below the entries
+                // Three or more: sorted by the vector unit where there is one (BVH8 with
+                // AVX2), without the data-dependent branches of an insertion sort. All
+                // eight lanes are written from `sp` on (the stack's bound counts a node's
+                // eight, `stack_len`); the hit ones, farthest first, are the first `k`, and
+                // the last of them, the nearest, is taken rather than kept. The stacked ones
+                // are prefetched.
+                if let (Some(avx2), Some(c8)) = (isa.avx2(), node.children8()) {
+                    let out: &mut [Entry; 8] = (&mut stack[sp..sp + 8])
+                        .try_into()
+                        .expect("a window of eight entries");
+                    let dist8: [f32; 8] = bytemuck::cast(dv);
+                    let (k, near) = avx2.sort_hits8(dist8, c8, mask, bytemuck::cast_mut(out));
+                    // The nearest is next; the others stay stacked, it is not.
+                    sp += k as usize - 1;
+                    let near = near as usize & 7;
+                    let mut m = mask & !(1 << near);
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        prefetch_child(nodes, packets, child(i));
+                    }
+                    cur = child(near);
+                    continue;
+                }
+                // Otherwise pushed in slot order, each inserted below the entries
                 // already pushed that are nearer or as near (ties by slot, the earlier
                 // nearer the top), so that the nearest ends on top; then it is taken.
                 let base = sp;
@@ -214,7 +238,8 @@ fn intersect_lane(pk: &TriPacket, l: usize, r: &RayPre, t_hi: f32) -> Option<Tri
 }
 
 /// A stacked child: its entry distance and child word.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub(super) struct Entry {
     pub(super) t: f32,
     pub(super) child: u32,
