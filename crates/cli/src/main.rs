@@ -3,6 +3,7 @@
 
 mod args;
 mod cmd;
+mod host;
 mod input;
 mod lists;
 mod loaded;

@@ -81,6 +81,18 @@ fn comma_lists_are_accepted() {
     assert!(accels.iter().any(|a| a == "bvh2"), "{accels:?}");
     assert!(accels.iter().any(|a| a == "dst"), "{accels:?}");
     assert!(!accels.iter().any(|a| a == "bvh4"), "{accels:?}");
+    // The machine is named beside the figures.
+    let host = stdout(&o)
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).expect("a JSON line"))
+        .find(|v| v.get("host").is_some())
+        .expect("a host line");
+    assert!(host["host"]["cpu"].is_string(), "{host}");
+    assert!(host["host"]["avx2"].is_boolean(), "{host}");
+    assert!(
+        host["host"]["cpus"].as_u64().is_some_and(|n| n >= 1),
+        "{host}"
+    );
 }
 
 #[test]

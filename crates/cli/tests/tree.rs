@@ -144,6 +144,9 @@ fn bench_measures_only_the_saved_structure() {
     );
     assert!(first["load_ms"].as_f64().unwrap() > 0.0, "{first}");
     assert!(first.get("build_ms").is_none(), "{first}");
+    // The second names the machine.
+    let host: serde_json::Value = serde_json::from_str(lines.next().unwrap()).unwrap();
+    assert!(host["host"]["cpu"].is_string(), "{host}");
     for line in lines {
         let v: serde_json::Value = serde_json::from_str(line).expect("JSON lines");
         let a = v["accel"].as_str().expect("accel").to_string();

@@ -139,6 +139,8 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     let structures = get_structures(&scene, args.tree.as_deref(), ctx, json.is_some())?;
     json_line(structures.timing_json(&scene).to_string());
+    let host = crate::host::Host::detect();
+    json_line(serde_json::json!({ "host": host }).to_string());
     let accels = structures.kinds_or_all(&args.accel)?;
     let sp = ctx.spinner(format!(
         "generating rays on {}",
@@ -151,8 +153,8 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         .as_ref()
         .map_or_else(rayon::current_num_threads, |p| p.current_num_threads());
     let line = format!(
-        "ray sets of a {}x{} {} frame: {} in {:.2} s; timing on {} threads; BVH copies: {:?}, \
-         subtrees of at most {} triangles merged",
+        "ray sets of a {}x{} {} frame: {} in {:.2} s; timing on {} threads of {host}; BVH \
+         copies: {:?}, subtrees of at most {} triangles merged",
         settings.width,
         settings.height,
         settings.workload.name(),
