@@ -313,15 +313,10 @@ mod tests {
             f32::MIN_POSITIVE,
             1e30,
         ];
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rng = dualsplit_geometry::Pcg32::new(8, 1);
         for round in 0..64 {
-            let dist: [f32; 8] = std::array::from_fn(|_| pool[next() as usize % pool.len()]);
+            let dist: [f32; 8] =
+                std::array::from_fn(|_| pool[rng.next_u32() as usize % pool.len()]);
             let child: [u32; 8] = std::array::from_fn(|l| 100 * round + l as u32);
             for mask in 0..256u32 {
                 let mut out = [[0u32; 2]; 8];
