@@ -33,6 +33,18 @@ fn missing_library_is_reported_as_missing() {
     }
 }
 
+/// Asserts that Embree's hit distance `t` is `want` to within 4 ulps. Embree does not
+/// promise the exact distance: its AVX2 kernels divide by an approximate reciprocal refined
+/// by one Newton step (2.0 comes back as 1.9999999 on a Zen 3 host), where its AVX-512
+/// kernels gave 2.0 exactly; 4 ulps bounds that refinement's error and the product's
+/// rounding with room to spare, and is still far below any distance between two surfaces
+/// these scenes hold.
+#[track_caller]
+fn assert_t(t: f32, want: f32) {
+    let ulps = (t.to_bits() as i64 - want.to_bits() as i64).abs();
+    assert!(ulps <= 4, "t = {t}, want {want} ({ulps} ulps apart)");
+}
+
 #[test]
 fn closest_hit_names_the_nearer_triangle_and_its_t() {
     let mut tris = quad_at(5.0).to_vec();
@@ -42,7 +54,7 @@ fn closest_hit_names_the_nearer_triangle_and_its_t() {
     assert!(s.version().starts_with("3."), "{}", s.version());
     let ray = Ray::new(Vec3::new(0.5, -0.25, 0.0), Vec3::Z);
     let hit = s.intersect(&ray).expect("the ray hits the near quad");
-    assert_eq!(hit.t, 2.0);
+    assert_t(hit.t, 2.0);
     // The point (0.5, -0.25) lies in the first triangle of the near quad (id 2).
     assert_eq!(hit.prim, PrimId(2));
     let ours = tris[2]
@@ -55,7 +67,8 @@ fn closest_hit_names_the_nearer_triangle_and_its_t() {
     let far = s
         .intersect(&Ray::segment(ray.origin, Vec3::Z, 3.0, 10.0))
         .unwrap();
-    assert_eq!((far.t, far.prim), (5.0, PrimId(0)));
+    assert_eq!(far.prim, PrimId(0));
+    assert_t(far.t, 5.0);
 }
 
 #[test]
@@ -79,7 +92,7 @@ fn scene_is_shared_across_threads() {
             sc.spawn(move || {
                 let x = -0.9 + 0.4 * i as f32;
                 let h = s.intersect(&Ray::new(Vec3::new(x, 0.0, 0.0), Vec3::Z));
-                assert_eq!(h.map(|h| h.t), Some(2.0));
+                assert_t(h.expect("the ray hits the quad").t, 2.0);
             });
         }
     });
