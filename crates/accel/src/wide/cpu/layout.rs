@@ -71,14 +71,17 @@ pub(crate) trait Lanes: bytemuck::Pod + Send + Sync + std::fmt::Debug {
     /// Sets lane `l`'s child word.
     fn set_child(&mut self, l: usize, child: u32);
     /// The eight child words of a BVH8 node ([`Chunk8`]); `None` for narrower nodes.
-    fn children8(&self) -> Option<&[u32; 8]>;
+    #[inline(always)]
+    fn children8(&self) -> Option<&[u32; 8]> {
+        None
+    }
     /// Entry distances (lanes 0–3 in the first vector, 4–7 in the second) and the mask of
     /// the non-empty lanes the ray meets on `[t_lo, t_hi]`.
     fn test<I: Isa>(&self, isa: I, rs: &RaySimd, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32);
 }
 
 macro_rules! lanes_impl {
-    ($t:ty, $w:expr, |$n:ident, $isa:ident, $rs:ident, $lo:ident, $hi:ident| $test:expr, $c8:expr) => {
+    ($t:ty, $w:expr, |$n:ident, $isa:ident, $rs:ident, $lo:ident, $hi:ident| $test:expr $(, $more:item)*) => {
         impl Lanes for $t {
             const W: usize = $w;
             const EMPTY: Self = Self {
@@ -108,11 +111,6 @@ macro_rules! lanes_impl {
                 self.child[l] = child;
             }
             #[inline(always)]
-            fn children8(&self) -> Option<&[u32; 8]> {
-                let c8: fn(&Self) -> Option<&[u32; 8]> = $c8;
-                c8(self)
-            }
-            #[inline(always)]
             fn test<I: Isa>(
                 &self,
                 $isa: I,
@@ -123,21 +121,20 @@ macro_rules! lanes_impl {
                 let $n = self;
                 $test
             }
+            $($more)*
         }
     };
 }
-lanes_impl!(
-    Chunk,
-    LANES,
-    |n, _isa, rs, t_lo, t_hi| {
-        let (e, m) = rs.test(&n.planes, &n.child, t_lo, t_hi);
-        ([e, f32x4::splat(0.0)], m)
-    },
-    |_| None
-);
+lanes_impl!(Chunk, LANES, |n, _isa, rs, t_lo, t_hi| {
+    let (e, m) = rs.test(&n.planes, &n.child, t_lo, t_hi);
+    ([e, f32x4::splat(0.0)], m)
+});
 lanes_impl!(
     Chunk8,
     8,
     |n, isa, rs, t_lo, t_hi| isa.test8(rs, n, t_lo, t_hi),
-    |n| Some(&n.child)
+    #[inline(always)]
+    fn children8(&self) -> Option<&[u32; 8]> {
+        Some(&self.child)
+    }
 );
