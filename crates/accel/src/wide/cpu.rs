@@ -383,24 +383,38 @@ mod tests {
 
     /// A packet lane's answer (no answer outside the candidates; the full scalar test where
     /// an edge function is zero; else the scalar test finished from the packet's edge
-    /// functions) is `Triangle::intersect`'s, bit for bit, on rays and triangles with
-    /// coordinates from a small set and random ones, on random `t` ranges.
+    /// functions, or with AVX2 the packet's completion) is `Triangle::intersect`'s, bit for
+    /// bit, on rays and triangles with coordinates from a small set and random ones, and
+    /// with coordinates over f32's whole range, on random `t` ranges.
     #[test]
     fn packet_answers_are_intersect_answers() {
+        let avx2 = crate::wide::simd::Avx2::detect();
         let mut rng = Pcg32::new(17, 2);
         let ends = [0.0, 0.5, 1.0, 2.0, f32::INFINITY];
         let (mut hits, mut from_edges) = (0, 0);
-        for case in 0..100_000 {
-            let v = |rng: &mut Pcg32| Vec3::new(coord(rng), coord(rng), coord(rng));
+        for case in 0..200_000 {
+            // Every other case spans f32's range: exponents from −130 (subnormal) to 127,
+            // so that the f64 plane distance overflows, underflows and divides by zero.
+            let c = |rng: &mut Pcg32| {
+                if case % 2 == 0 {
+                    coord(rng)
+                } else {
+                    let m = rng.range_f32(-2.0, 2.0);
+                    m * 2f32.powi(rng.below(258) as i32 - 130)
+                }
+            };
+            let v = |rng: &mut Pcg32| Vec3::new(c(rng), c(rng), c(rng));
             let r = Ray::new(v(&mut rng), v(&mut rng)).precompute();
             let tris: Vec<Triangle> = (0..LANES)
                 .map(|_| Triangle::new(v(&mut rng), v(&mut rng), v(&mut rng)))
                 .collect();
             let (mut packets, mut slots) = (Vec::new(), 0);
             pack_entries(&mut packets, &mut slots, [0, 1, 2, 3 | RUN_END], &tris);
-            let e = RaySimd::new(&r).triangle_edges(&packets[0]);
+            let rs = RaySimd::new(&r);
+            let e = rs.triangle_edges(&packets[0]);
             let lo = ends[rng.below(2) as usize];
             let hi = ends[rng.below(ends.len() as u32) as usize];
+            let done = avx2.map(|a| rs.complete(a, &packets[0], &e, &r, lo));
             let bits = |h: Option<dualsplit_geometry::TriangleHit>| {
                 h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits()))
             };
@@ -416,6 +430,23 @@ mod tests {
                 };
                 hits += want.is_some() as u32;
                 assert_eq!(bits(got), bits(want), "case {case} lane {l}: {t:?} {r:?}");
+                // The AVX2 completion, on the lanes it is used for.
+                if let Some(c) = &done
+                    && e.candidates & !e.zero & (1 << l) != 0
+                {
+                    let got = (c.ok & (1 << l) != 0 && c.t[l] <= hi).then_some(
+                        dualsplit_geometry::TriangleHit {
+                            t: c.t[l],
+                            u: c.u[l],
+                            v: c.v[l],
+                        },
+                    );
+                    assert_eq!(
+                        bits(got),
+                        bits(want),
+                        "AVX2, case {case} lane {l}: {t:?} {r:?}"
+                    );
+                }
             }
         }
         assert!(

@@ -183,6 +183,74 @@ impl Avx2 {
         }
     }
 
+    /// Where the ray meets the planes of four triangles, `Triangle::plane_t`'s f64
+    /// arithmetic on four lanes at once: vertex `i`'s coordinate on axis `a` of lane `l` is
+    /// `v[3 i + a][l]`, `o` the ray's origin, `k` the watertight test's axes `(kx, ky, kz)`
+    /// (each below 3) and `shear` its constants `(Sx, Sy, Sz)`. Every operation is the scalar
+    /// code's, in its order, on the same widened values (f32 to f64 is exact; AVX's packed
+    /// subtraction, multiplication and division round as the scalar ones do, and nothing is
+    /// fused), and the result is rounded to f32 once, by the same rounding mode, so each
+    /// lane is the scalar function's bits.
+    #[inline(always)]
+    pub fn plane_t4(
+        self,
+        v: &[[f32; 4]; 9],
+        o: [f32; 3],
+        k: [usize; 3],
+        shear: [f32; 3],
+    ) -> [f32; 4] {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            // SAFETY: every intrinsic below needs at most AVX, which `self` proves this CPU
+            // has (`detect`). The only memory reads are the nine 16-byte `loadu`s of `v`'s
+            // rows, each a whole `[f32; 4]` that `v` borrows; `loadu` needs no alignment.
+            unsafe {
+                let wide = |i: usize| _mm256_cvtps_pd(_mm_loadu_ps(v[i].as_ptr()));
+                let (sub, mul) = (|a, b| _mm256_sub_pd(a, b), |a, b| _mm256_mul_pd(a, b));
+                let add = |a, b| _mm256_add_pd(a, b);
+                let splat = |x: f32| _mm256_set1_pd(x as f64);
+                // (Written out: `array::map` with these closures stayed out of line.)
+                let p0 = [wide(0), wide(1), wide(2)];
+                let e1 = [
+                    sub(wide(3), p0[0]),
+                    sub(wide(4), p0[1]),
+                    sub(wide(5), p0[2]),
+                ];
+                let e2 = [
+                    sub(wide(6), p0[0]),
+                    sub(wide(7), p0[1]),
+                    sub(wide(8), p0[2]),
+                ];
+                // Padded to four, so that an axis `& 3` indexes it without a bounds check.
+                let n = [
+                    sub(mul(e1[1], e2[2]), mul(e1[2], e2[1])),
+                    sub(mul(e1[2], e2[0]), mul(e1[0], e2[2])),
+                    sub(mul(e1[0], e2[1]), mul(e1[1], e2[0])),
+                    _mm256_setzero_pd(),
+                ];
+                let w = [
+                    sub(p0[0], splat(o[0])),
+                    sub(p0[1], splat(o[1])),
+                    sub(p0[2], splat(o[2])),
+                ];
+                let num = add(add(mul(n[0], w[0]), mul(n[1], w[1])), mul(n[2], w[2]));
+                let [kx, ky, kz] = [k[0] & 3, k[1] & 3, k[2] & 3];
+                let den = add(
+                    add(mul(n[kx], splat(shear[0])), mul(n[ky], splat(shear[1]))),
+                    n[kz],
+                );
+                let t = mul(_mm256_div_pd(num, den), splat(shear[2]));
+                bytemuck::cast(_mm256_cvtpd_ps(t))
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = (v, o, k, shear);
+            unreachable!("no Avx2 token exists off x86-64")
+        }
+    }
+
     /// Orders the hit lanes of an eight-lane node for a traversal stack, without branches:
     /// writes all eight lanes' `(distance bits, child word)` pairs to `out`, the lanes of
     /// `mask` first, farthest first (so the nearest is last, on top of the stack when `out`

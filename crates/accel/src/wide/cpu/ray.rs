@@ -2,13 +2,11 @@
 //! and the first stage of the watertight test on a packet of four triangles.
 
 use super::layout::{LANES, TriPacket};
-#[cfg(doc)]
-use crate::wide::simd::Avx2;
-use crate::wide::simd::PlaneRows8;
+use crate::wide::simd::{Avx2, PlaneRows8};
 #[cfg(doc)]
 use dualsplit_geometry::Triangle;
 use dualsplit_geometry::{EXIT_WIDEN, RayPre};
-use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
+use wide::{CmpEq, CmpGe, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
 
 /// What [`RaySimd::triangle_edges`] finds for the four triangles of a packet.
 pub(super) struct Edges {
@@ -19,6 +17,19 @@ pub(super) struct Edges {
     pub(super) zero: u32,
     /// Lanes [`Triangle::intersect`] might accept.
     pub(super) candidates: u32,
+}
+
+/// What [`RaySimd::complete`] finds for the four triangles of a packet: the rest of
+/// [`Triangle::intersect_from_edges`] but the comparison of `t` with the range's end.
+pub(super) struct Completed {
+    /// The distance to each triangle's plane, as [`Triangle::intersect`] computes it.
+    pub(super) t: [f32; LANES],
+    /// The barycentrics a hit reports.
+    pub(super) u: [f32; LANES],
+    pub(super) v: [f32; LANES],
+    /// Lanes that pass the sign test and the determinant's checks, with a finite `t` not
+    /// below the range's start: hits wherever `t` is at most the range's end.
+    pub(super) ok: u32,
 }
 
 /// An axis, x, y or z: an index below 3 by its type, so that indexing a vertex's
@@ -162,6 +173,50 @@ impl RaySimd {
             w: w.to_array(),
             zero: any_zero,
             candidates: 0b1111 & !reject,
+        }
+    }
+
+    /// [`Triangle::intersect_from_edges`] on the four lanes of `pk` from the edge functions
+    /// `e` (lanes with an edge function equal to zero excepted: the scalar test recomputes
+    /// those in f64), but for the comparison of `t` with the range's end, which the caller
+    /// makes as its closest hit moves: the same sign test, determinant, reciprocal and
+    /// checks in f32 lane by lane, and `t` from [`Avx2::plane_t4`], the scalar test's f64
+    /// arithmetic on four lanes. IEEE operations lane by lane are the scalar ones, so every
+    /// lane's answer is the scalar test's bits.
+    #[inline(always)]
+    pub(super) fn complete(
+        &self,
+        avx2: Avx2,
+        pk: &TriPacket,
+        e: &Edges,
+        r: &RayPre,
+        t_lo: f32,
+    ) -> Completed {
+        let o = r.ray.origin;
+        let t = f32x4::new(avx2.plane_t4(
+            &pk.v,
+            [o.x, o.y, o.z],
+            r.k,
+            [r.shear.x, r.shear.y, r.shear.z],
+        ));
+        let (u, v, w) = (f32x4::new(e.u), f32x4::new(e.v), f32x4::new(e.w));
+        let zero = f32x4::splat(0.0);
+        // `(u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)` rejects; a NaN compares
+        // false, as in the scalar test.
+        let neg = u.cmp_lt(zero) | v.cmp_lt(zero) | w.cmp_lt(zero);
+        let pos = u.cmp_gt(zero) | v.cmp_gt(zero) | w.cmp_gt(zero);
+        let det = u + v + w;
+        let inv_det = f32x4::splat(1.0) / det;
+        // `|x| < ∞` exactly when `x` is finite (a NaN compares false).
+        let finite = |x: f32x4| x.abs().cmp_lt(f32x4::splat(f32::INFINITY));
+        let det_ok = !det.cmp_eq(zero) & finite(det) & finite(inv_det);
+        let t_ok = finite(t) & t.cmp_ge(f32x4::splat(t_lo));
+        let ok = (!(neg & pos) & det_ok & t_ok).move_mask() as u32;
+        Completed {
+            t: t.to_array(),
+            u: (v * inv_det).to_array(),
+            v: (w * inv_det).to_array(),
+            ok,
         }
     }
 

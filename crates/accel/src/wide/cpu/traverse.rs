@@ -4,6 +4,7 @@ use super::isa::Isa;
 use super::layout::{EMPTY, LANES, LEAF, Lanes, TriPacket};
 use super::ray::RaySimd;
 use crate::image::RUN_END;
+use crate::wide::simd::Avx2;
 use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, Triangle, TriangleHit, Vec3, cull_limit};
 use std::cell::RefCell;
 use wide::f32x4;
@@ -130,7 +131,7 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
             }
         } else {
             let slot = (cur & !LEAF) as usize;
-            if test_leaf::<ANY>(packets, slot, &rs, &r, &mut best, &mut best_t) {
+            if test_leaf::<ANY>(isa.avx2(), packets, slot, &rs, &r, &mut best, &mut best_t) {
                 return best;
             }
             limit = cull_limit(best_t);
@@ -163,9 +164,10 @@ fn prefetch_child<N>(nodes: &[N], packets: &[TriPacket], c: u32) {
 /// Tests the leaf whose first triangle is at `slot` of `packets` (it ends at the first id
 /// from there with [`RUN_END`]) on `[ray.t_min, best_t]`, keeping the closest hit by
 /// [`Hit::closer_than`] in `best` and `best_t`. Returns true when `ANY` and a hit was
-/// accepted.
+/// accepted. `avx2`: the token when the caller runs compiled for AVX2.
 #[inline(always)]
 pub(crate) fn test_leaf<const ANY: bool>(
+    avx2: Option<Avx2>,
     packets: &[TriPacket],
     slot: usize,
     rs: &RaySimd,
@@ -186,16 +188,34 @@ pub(crate) fn test_leaf<const ANY: bool>(
         } else {
             from & ((ends & ends.wrapping_neg()) << 1).wrapping_sub(1)
         };
-        // Lanes the scalar test could accept; it decides each of them, from the edge
-        // functions computed here unless one is zero (then it recomputes them in f64).
+        // Lanes the scalar test could accept. For shadow rays with AVX2 the rest of the
+        // test runs on all four lanes at once, and only the lanes it keeps and those with
+        // an edge function equal to zero (which the scalar test recomputes in f64) are
+        // visited; otherwise the scalar test decides each candidate from the edge
+        // functions computed here. (For closest-hit rays the four-lane completion measured
+        // slower on Sponza's diffuse rays, `docs/cpu-traversal.md`.)
         let e = rs.triangle_edges(pk);
         let mut m = e.candidates & lanes;
+        let done = match avx2 {
+            Some(avx2) if ANY && m & !e.zero != 0 => {
+                let c = rs.complete(avx2, pk, &e, r, r.ray.t_min);
+                m &= c.ok | e.zero;
+                Some(c)
+            }
+            _ => None,
+        };
         while m != 0 {
             let l = m.trailing_zeros() as usize;
             m &= m - 1;
             let p = PrimId(pk.prim[l] & !RUN_END);
             let h = if e.zero & (1 << l) != 0 {
                 intersect_lane(pk, l, r, *best_t)
+            } else if let Some(c) = &done {
+                (c.t[l] <= *best_t).then_some(TriangleHit {
+                    t: c.t[l],
+                    u: c.u[l],
+                    v: c.v[l],
+                })
             } else {
                 lane_triangle(pk, l).intersect_from_edges(
                     r,
