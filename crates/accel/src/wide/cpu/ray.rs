@@ -6,7 +6,7 @@ use crate::wide::simd::{Avx2, PlaneRows8};
 #[cfg(doc)]
 use dualsplit_geometry::Triangle;
 use dualsplit_geometry::{EXIT_WIDEN, RayPre};
-use wide::{CmpEq, CmpGe, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
+use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
 
 /// What [`RaySimd::triangle_edges`] finds for the four triangles of a packet.
 pub(super) struct Edges {
@@ -28,7 +28,7 @@ pub(super) struct Completed {
     pub(super) u: [f32; LANES],
     pub(super) v: [f32; LANES],
     /// Lanes that pass the sign test and the determinant's checks, with a finite `t` not
-    /// below the range's start: hits wherever `t` is at most the range's end.
+    /// below the range's start: hits wherever `t` is not above the range's end.
     pub(super) ok: u32,
 }
 
@@ -210,7 +210,8 @@ impl RaySimd {
         // `|x| < ∞` exactly when `x` is finite (a NaN compares false).
         let finite = |x: f32x4| x.abs().cmp_lt(f32x4::splat(f32::INFINITY));
         let det_ok = !det.cmp_eq(zero) & finite(det) & finite(inv_det);
-        let t_ok = finite(t) & t.cmp_ge(f32x4::splat(t_lo));
+        // `t < t_lo` rejects: a NaN start rejects nothing, as in the scalar test.
+        let t_ok = finite(t) & !t.cmp_lt(f32x4::splat(t_lo));
         let ok = (!(neg & pos) & det_ok & t_ok).move_mask() as u32;
         Completed {
             t: t.to_array(),

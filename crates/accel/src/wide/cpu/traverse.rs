@@ -211,11 +211,16 @@ pub(crate) fn test_leaf<const ANY: bool>(
             let h = if e.zero & (1 << l) != 0 {
                 intersect_lane(pk, l, r, *best_t)
             } else if let Some(c) = &done {
-                (c.t[l] <= *best_t).then_some(TriangleHit {
-                    t: c.t[l],
-                    u: c.u[l],
-                    v: c.v[l],
-                })
+                // `t > t_hi` rejects, as in the scalar test (a NaN end rejects nothing).
+                if c.t[l] > *best_t {
+                    None
+                } else {
+                    Some(TriangleHit {
+                        t: c.t[l],
+                        u: c.u[l],
+                        v: c.v[l],
+                    })
+                }
             } else {
                 lane_triangle(pk, l).intersect_from_edges(
                     r,
