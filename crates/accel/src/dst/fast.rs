@@ -86,20 +86,13 @@ impl DstQuery<'_> {
     #[inline(always)]
     fn traverse<const ANY: bool>(&self, ray: &Ray) -> Option<Hit> {
         match self.avx2 {
-            Some(t) => t
-                .vectorize(Fast::<ANY> {
-                    avx2: t,
-                    q: self,
-                    ray,
-                })
-                .unpack(),
-            None => self.fast::<ANY>(None, ray),
+            Some(t) => t.vectorize(Fast::<ANY> { q: self, ray }).unpack(),
+            None => self.fast::<ANY>(ray),
         }
     }
 
-    /// The traversal; `avx2` is the token when it runs compiled for AVX2.
     #[inline(always)]
-    fn fast<const ANY: bool>(&self, avx2: Option<Avx2>, ray: &Ray) -> Option<Hit> {
+    fn fast<const ANY: bool>(&self, ray: &Ray) -> Option<Hit> {
         if self.empty {
             return None;
         }
@@ -184,7 +177,8 @@ impl DstQuery<'_> {
             };
             if let Some(first) = run
                 && test_leaf::<ANY>(
-                    avx2,
+                    // Some exactly when this runs inside `vectorize` (`traverse`).
+                    self.avx2,
                     packets,
                     first as usize,
                     &rs,
@@ -212,7 +206,6 @@ impl DstQuery<'_> {
 
 /// [`DstQuery::fast`] as a [`Kernel`], to run compiled for AVX2.
 struct Fast<'a, const ANY: bool> {
-    avx2: Avx2,
     q: &'a DstQuery<'a>,
     ray: &'a Ray,
 }
@@ -221,6 +214,6 @@ impl<const ANY: bool> Kernel for Fast<'_, ANY> {
     type Output = PackedHit;
     #[inline(always)]
     fn call(self) -> PackedHit {
-        PackedHit::pack(self.q.fast::<ANY>(Some(self.avx2), self.ray))
+        PackedHit::pack(self.q.fast::<ANY>(self.ray))
     }
 }
