@@ -385,9 +385,11 @@ struct DpInputs<'a> {
     full: usize,
     /// [`TABLE_START`] of the chain length.
     first: usize,
+    /// Cost of a lone-face node: every option's weight when every pair is cheap.
+    c_lone: f32,
     /// Surface area of the region in each state.
     sa: &'a [f32; 64],
-    /// Node cost by option mask.
+    /// Node cost by option mask (not written when every pair is cheap).
     weight: &'a [f32; 64],
     /// For a lone-face option mask: the faces whose pair node is no dearer.
     cheap_partner: &'a [u8; 64],
@@ -523,23 +525,26 @@ impl ChainDp {
         // node), and for each lone face the partners whose pair node costs no more than a
         // lone-face node: while such a partner remains, carving the face alone is dominated
         // (the DP cost never grows when more faces are already carved), so it is skipped.
+        // Every pair is cheap exactly when both node types cost the same (then every option
+        // weighs `c_lone`, and no lone option is dominated, so neither table is read).
         let pairs_cheap = costs.single_carve <= c_lone && costs.dual_carve <= c_lone;
-        for i in 0..k {
-            weight[1 << i] = c_lone;
-            cheap_partner[1 << i] = 0;
-        }
-        for i in 0..k {
-            for j in i + 1..k {
-                let c = if dp.faces[i] >> 1 == dp.faces[j] >> 1 {
-                    costs.single_carve
-                } else {
-                    costs.dual_carve
-                };
-                weight[1 << i | 1 << j] = c;
-                // (Not read when every pair is cheap: no lone option is then dominated.)
-                if !pairs_cheap && c <= c_lone {
-                    cheap_partner[1 << i] |= 1 << j;
-                    cheap_partner[1 << j] |= 1 << i;
+        if !pairs_cheap {
+            for i in 0..k {
+                weight[1 << i] = c_lone;
+                cheap_partner[1 << i] = 0;
+            }
+            for i in 0..k {
+                for j in i + 1..k {
+                    let c = if dp.faces[i] >> 1 == dp.faces[j] >> 1 {
+                        costs.single_carve
+                    } else {
+                        costs.dual_carve
+                    };
+                    weight[1 << i | 1 << j] = c;
+                    if c <= c_lone {
+                        cheap_partner[1 << i] |= 1 << j;
+                        cheap_partner[1 << j] |= 1 << i;
+                    }
                 }
             }
         }
@@ -549,6 +554,7 @@ impl ChainDp {
         let inputs = DpInputs {
             full,
             first: TABLE_START[k],
+            c_lone,
             sa,
             weight,
             cheap_partner,
@@ -594,7 +600,12 @@ impl ChainDp {
                 table.range[d.first + s + 1] as usize,
             );
             for &t in &table.masks[lo..hi] {
-                let c = d.weight[t as usize] * sa + cost[s | t as usize];
+                let w = if PAIRS_CHEAP {
+                    d.c_lone
+                } else {
+                    d.weight[t as usize]
+                };
+                let c = w * sa + cost[s | t as usize];
                 let allowed = PAIRS_CHEAP || rem & d.cheap_partner[t as usize] == 0;
                 let better = (c < best_c) & allowed;
                 // A chain that may not stop takes its first allowed option when no cost is
