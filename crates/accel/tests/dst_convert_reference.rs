@@ -4,7 +4,7 @@
 //! on the shipped scenes under every preset, on random BVHs under random node costs, and on
 //! random subtrees of a shipped scene under random node costs.
 
-use dualsplit_accel::dst::{Dst, DstConfig, DstCosts, Partitioning};
+use dualsplit_accel::dst::{Dst, DstConfig, DstCosts, DstError, Partitioning};
 use dualsplit_accel::{BuildConfig, Bvh2, Bvh2Node, SharedTriangles};
 use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3};
 use dualsplit_testkit::scenes::shipped_triangles;
@@ -87,6 +87,64 @@ fn same_image_for_any_thread_count() {
             want.image().words,
             "{threads} threads: image differs"
         );
+    }
+}
+
+/// A leaf naming a triangle the scene does not have, or an id with the index list's run-end
+/// bit, is refused with the leaf and the id, by both converters alike, wherever in the
+/// leaf's run the bad id is.
+#[test]
+fn bad_triangle_ids_are_refused() {
+    let b = |lo: f32, hi: f32| Aabb {
+        min: Vec3::new(lo, 0.0, 0.0),
+        max: Vec3::new(hi, 1.0, 1.0),
+    };
+    let two_leaves = |left: Vec<u32>, right: Vec<u32>| {
+        Tree::Inner(
+            b(0.0, 2.0),
+            Box::new([
+                Tree::Leaf(b(0.0, 1.0), left),
+                Tree::Leaf(b(1.0, 2.0), right),
+            ]),
+        )
+        .into_bvh2()
+    };
+    let tris = dummy_triangles(4);
+    let cfg = DstConfig::hardware();
+    // The tree is laid out depth-first: the root is node 0, its leaves nodes 1 and 2.
+    for (left, right, want) in [
+        (
+            vec![0, 1],
+            vec![2, 4],
+            DstError::PrimOutOfRange {
+                node: 2,
+                prim: 4,
+                triangles: 4,
+            },
+        ),
+        (
+            vec![9, 1],
+            vec![2, 3],
+            DstError::PrimOutOfRange {
+                node: 1,
+                prim: 9,
+                triangles: 4,
+            },
+        ),
+        (
+            vec![0],
+            vec![1 << 31 | 2, 3],
+            DstError::PrimOutOfRange {
+                node: 2,
+                prim: 1 << 31 | 2,
+                triangles: 4,
+            },
+        ),
+    ] {
+        let bvh = two_leaves(left.clone(), right.clone());
+        assert_same(&bvh, &tris, &cfg, &format!("leaves {left:?} {right:?}"));
+        let got = Dst::from_bvh2(&bvh, tris.clone(), &cfg).err();
+        assert_eq!(got, Some(want), "leaves {left:?} {right:?}");
     }
 }
 

@@ -160,7 +160,8 @@ impl<'w> Cursor<'w> {
     /// Writes a 12-byte node (header-offset word, P0, P1) into `slot`.
     #[inline(always)]
     fn put(&mut self, slot: Slot, h: HeaderOffset, p0: f32, p1: f32) {
-        self.slot(slot)[..3].copy_from_slice(&[h.bits(), p0.to_bits(), p1.to_bits()]);
+        let node: &mut [u32; 3] = (&mut self.slot(slot)[..3]).try_into().expect("3 words");
+        *node = [h.bits(), p0.to_bits(), p1.to_bits()];
     }
 
     /// Splits what is left after the pair of child slots at `pair` (`sl` + `sr` words) into
@@ -280,12 +281,13 @@ impl Encoder<'_> {
         }
     }
 
-    /// Completes internal node `n`'s record once its subtrees are planned (`l`, `r`: their
-    /// sizes) and returns the size of its own subtree: its chain's words, both children's
-    /// slots, and everything below.
-    fn close(&self, n: u32, chain: Chain, rec: &mut Rec, l: Size, r: Size) -> Size {
+    /// Completes the record of an internal node entered with `chain`, whose DST children
+    /// are BVH nodes `[cl, cr]`, once its subtrees are planned (`l`, `r`: their sizes), and
+    /// returns the size of its own subtree: its chain's words, both children's slots, and
+    /// everything below.
+    #[inline(always)]
+    fn close(&self, chain: Chain, [cl, cr]: [u32; 2], rec: &mut Rec, l: Size, r: Size) -> Size {
         rec.set_left(l);
-        let [cl, cr] = rec.children(self.bvh, n);
         let [ch_l, ch_r] = rec.chains;
         let own = 3 * chain.len() + slot_size(self.bvh, cl, ch_l) + slot_size(self.bvh, cr, ch_r);
         l.add(r).add(Size {
@@ -318,7 +320,7 @@ impl Encoder<'_> {
         let ([cl, cr], [ch_l, ch_r]) = (rec.children(self.bvh, n), rec.chains);
         let l = self.plan_seq(cl, ch_l, s)?;
         let r = self.plan_seq(cr, ch_r, s)?;
-        Ok(self.close(n, chain, &mut s.recs[slot], l, r))
+        Ok(self.close(chain, [cl, cr], &mut s.recs[slot], l, r))
     }
 
     /// Plan pass: nodes above [`PARALLEL_DEPTH`] plan their two subtrees in parallel.
@@ -344,7 +346,7 @@ impl Encoder<'_> {
             || self.plan(cr, rec.chains[1], depth + 1),
         );
         let ((lp, l), (rp, r)) = (l?, r?);
-        let size = self.close(n, chain, &mut rec, l, r);
+        let size = self.close(chain, [cl, cr], &mut rec, l, r);
         Ok((Plan::Par(rec, Box::new([lp, rp])), size))
     }
 
@@ -357,24 +359,37 @@ impl Encoder<'_> {
         let ids = &self.bvh.prim_ids[first..first + count];
         let at = cur.entry_addr();
         let run = &mut cur.out.entries[cur.next_entry..cur.next_entry + count];
-        for (i, (&p, e)) in ids.iter().zip(run).enumerate() {
-            if p as usize >= self.triangles {
-                return Err(DstError::PrimOutOfRange {
-                    node: n,
-                    prim: p,
-                    triangles: self.triangles,
-                });
+        for (&p, e) in ids.iter().zip(run.iter_mut()) {
+            // One branch for both checks; which one failed is sorted out off the hot path.
+            if (p as usize >= self.triangles) | (p & RUN_END != 0) {
+                return Err(self.bad_prim(n, p));
             }
-            if p & RUN_END != 0 {
-                return Err(DstError::TriangleIdOverflow {
-                    given: p as u64,
-                    limit: RUN_END as u64,
-                });
-            }
-            *e = if i + 1 == count { p | RUN_END } else { p };
+            *e = p;
+        }
+        // A leaf holds at least one triangle (`count > 0` is what makes it a leaf).
+        if let Some(last) = run.last_mut() {
+            *last |= RUN_END;
         }
         cur.next_entry += count;
         Ok(at)
+    }
+
+    /// The error for triangle id `p` of leaf `n`, which is out of range or has the run-end
+    /// bit set (checked in that order).
+    #[cold]
+    fn bad_prim(&self, n: u32, p: u32) -> DstError {
+        if p as usize >= self.triangles {
+            DstError::PrimOutOfRange {
+                node: n,
+                prim: p,
+                triangles: self.triangles,
+            }
+        } else {
+            DstError::TriangleIdOverflow {
+                given: p as u64,
+                limit: RUN_END as u64,
+            }
+        }
     }
 
     /// Emits BVH node `n`'s incoming `chain` into `slot` (and, for a leaf, the leaf
@@ -410,7 +425,7 @@ impl Encoder<'_> {
                 stats.single_carving += 1;
             }
             let h = step.header.carve_pointing_at(fold, offset)?;
-            let [p0, p1] = step.planes.map(|p| planes[p as usize]);
+            let [p0, p1] = step.planes.map(|p| planes[p as usize & 7]);
             cur.put(slot, h, p0, p1);
             slot = child;
         }

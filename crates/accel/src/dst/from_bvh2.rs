@@ -633,6 +633,12 @@ impl ChainDp {
         self.cost[self.start(carved_by_split)] + self.base
     }
 
+    /// [`ChainDp::cost`] of every face.
+    #[inline(always)]
+    pub fn face_costs(&self) -> [f32; 6] {
+        std::array::from_fn(|f| self.cost(f))
+    }
+
     /// The cheapest chain when the split carves face `f`, outermost node first.
     #[inline(always)]
     pub fn chain(&self, carved_by_split: usize) -> Chain {
@@ -692,11 +698,12 @@ pub(super) fn plan_split(bvh: &Bvh2, n: u32, cfg: &DstConfig, dps: &mut [ChainDp
     let [dx, dy] = dps;
     dx.solve(&b, &bx, &cfg.costs, leaf_tris(bvh, x, cfg));
     dy.solve(&b, &by, &cfg.costs, leaf_tris(bvh, y, cfg));
+    let (cx, cy) = (dx.face_costs(), dy.face_costs());
     let mut best = (f32::INFINITY, 0usize, false);
     for axis in 0..3 {
         for swap in [false, true] {
-            let (lo, hi) = if swap { (&*dy, &*dx) } else { (&*dx, &*dy) };
-            let c = lo.cost(max_face(axis)) + hi.cost(min_face(axis));
+            let (lo, hi) = if swap { (&cy, &cx) } else { (&cx, &cy) };
+            let c = lo[max_face(axis)] + hi[min_face(axis)];
             if c < best.0 {
                 best = (c, axis, swap);
             }
