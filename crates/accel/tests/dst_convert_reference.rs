@@ -111,35 +111,16 @@ fn bad_triangle_ids_are_refused() {
     };
     let tris = dummy_triangles(4);
     let cfg = DstConfig::hardware();
+    let out_of_range = |node, prim| DstError::PrimOutOfRange {
+        node,
+        prim,
+        triangles: 4,
+    };
     // The tree is laid out depth-first: the root is node 0, its leaves nodes 1 and 2.
     for (left, right, want) in [
-        (
-            vec![0, 1],
-            vec![2, 4],
-            DstError::PrimOutOfRange {
-                node: 2,
-                prim: 4,
-                triangles: 4,
-            },
-        ),
-        (
-            vec![9, 1],
-            vec![2, 3],
-            DstError::PrimOutOfRange {
-                node: 1,
-                prim: 9,
-                triangles: 4,
-            },
-        ),
-        (
-            vec![0],
-            vec![1 << 31 | 2, 3],
-            DstError::PrimOutOfRange {
-                node: 2,
-                prim: 1 << 31 | 2,
-                triangles: 4,
-            },
-        ),
+        (vec![0, 1], vec![2, 4], out_of_range(2, 4)),
+        (vec![9, 1], vec![2, 3], out_of_range(1, 9)),
+        (vec![0], vec![1 << 31 | 2, 3], out_of_range(2, 1 << 31 | 2)),
     ] {
         let bvh = two_leaves(left.clone(), right.clone());
         assert_same(&bvh, &tris, &cfg, &format!("leaves {left:?} {right:?}"));
