@@ -436,3 +436,73 @@ fn bench_refuses_a_malformed_merge_limit() {
         stdout(&o)
     );
 }
+
+/// `bench --peer embree,embree-robust` checks both Embree scenes and times them with ours
+/// in one interleaved run: every ray kind gets a timing per contender and each peer a
+/// summary with our best structure's ratio to it. Without Embree, the peer is named in the
+/// error.
+#[test]
+fn bench_compares_with_both_embree_modes_in_one_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dualsplit(
+        &[
+            "bench",
+            "builtin:cornell",
+            "--res",
+            "8",
+            "--accel",
+            "bvh2,bvh8",
+            "--peer",
+            "embree,embree-robust,embree",
+            "--threads",
+            "1",
+            "--min-seconds",
+            "0.001",
+            "--no-frame",
+            "-q",
+            "--json",
+        ],
+        dir.path(),
+    );
+    if !dualsplit_embree::available() {
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        assert!(stderr(&o).contains("--peer embree"), "{}", stderr(&o));
+        return;
+    }
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lines: Vec<serde_json::Value> = stdout(&o)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let kinds = ["primary", "shadow", "diffuse"];
+    for name in ["bvh2", "bvh8", "embree", "embree-robust"] {
+        for kind in kinds {
+            let n = lines
+                .iter()
+                .filter(|l| l["accel"] == name && l["ray_kind"] == kind)
+                .filter(|l| l["mrays_per_s"].as_f64().is_some_and(|m| m > 0.0))
+                .count();
+            assert_eq!(n, 1, "{name} {kind}: {}", stdout(&o));
+        }
+    }
+    let summaries: Vec<&serde_json::Value> = lines
+        .iter()
+        .filter(|l| l.get("ratio_best_to_peer").is_some())
+        .collect();
+    let peers: Vec<&str> = summaries
+        .iter()
+        .map(|l| l["peer"].as_str().unwrap())
+        .collect();
+    // The repeated peer is measured once.
+    assert_eq!(peers, ["embree", "embree-robust"], "{}", stdout(&o));
+    for s in summaries {
+        for kind in kinds {
+            let r = s["ratio_best_to_peer"][kind].as_f64().unwrap_or(f64::NAN);
+            assert!(r.is_finite() && r > 0.0, "{kind}: {s}");
+            assert!(
+                s["agreement"][kind]["rays"].as_u64() > Some(0),
+                "{kind}: {s}"
+            );
+        }
+    }
+}

@@ -5,7 +5,9 @@
 //! With `--peer embree` the same ray sets are also traced on Intel Embree 3 (single-ray
 //! `rtcIntersect1` / `rtcOccluded1`): its answers are compared with ours first (differences
 //! must be explained as ties, grazing or interval-boundary hits, see `dualsplit_embree::agree`),
-//! then ours and Embree's are timed interleaved, pass after pass, in one run.
+//! then ours and Embree's are timed interleaved, pass after pass, in one run. `--peer
+//! embree,embree-robust` adds Embree built in its robust mode, the watertight guarantee
+//! our traversals always give, timed in the same interleaved passes.
 //!
 //! With `--tree FILE` the saved structure is measured instead of building: its traversals
 //! only (`--accel` must name one of them), on rays recorded with its own first traversal
@@ -17,7 +19,9 @@ use crate::output::JsonOut;
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::{AccelKind, NoObserver, TraversalSet};
-use dualsplit_embree::{Agreement, EmbreeScene, TErrors, agree_closest, agree_occluded, t_errors};
+use dualsplit_embree::{
+    Agreement, EmbreeOptions, EmbreeScene, TErrors, agree_closest, agree_occluded, t_errors,
+};
 use dualsplit_geometry::Ray;
 use dualsplit_render::bench::{
     Contender, MeasureConfig, RaySet, Throughput, Timing, measure, measure_interleaved, ray_sets,
@@ -33,8 +37,30 @@ use std::time::Instant;
 /// A tracer to compare ours with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Peer {
-    /// Intel Embree 3 (Debian's libembree-dev), single rays.
+    /// Intel Embree 3 (Debian's libembree-dev), single rays, built as a new user gets it
+    /// (medium quality, no robust mode).
     Embree,
+    /// The same in Embree's robust (watertight) mode: the guarantee our traversals always
+    /// give, at Embree's cost for it.
+    EmbreeRobust,
+}
+
+impl Peer {
+    /// The peer's name in the results.
+    fn name(self) -> &'static str {
+        match self {
+            Self::Embree => "embree",
+            Self::EmbreeRobust => "embree-robust",
+        }
+    }
+
+    /// How its Embree scene is built.
+    fn options(self) -> EmbreeOptions {
+        EmbreeOptions {
+            robust: self == Self::EmbreeRobust,
+            ..EmbreeOptions::default()
+        }
+    }
 }
 
 /// Arguments of `dualsplit bench`.
@@ -69,10 +95,10 @@ pub struct Args {
     /// Skip the full-frame render timing.
     #[arg(long)]
     no_frame: bool,
-    /// Also trace the rays on a peer (embree), check that it agrees with ours, and time ours
-    /// and the peer interleaved in one run.
-    #[arg(long, value_enum)]
-    peer: Option<Peer>,
+    /// Also trace the rays on peers, comma-separated (embree, embree-robust), check that
+    /// each agrees with ours, and time ours and the peers interleaved in one run.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    peer: Vec<Peer>,
     /// Threads the timed traversals run on (default: every core). Loading, building and
     /// the checks use every core whatever this says.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
@@ -89,11 +115,20 @@ pub const MAX_BENCH_PIXELS: u64 = 1 << 24;
 
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
-    if args.peer == Some(Peer::Embree) && !dualsplit_embree::available() {
+    if let Some(p) = args.peer.first()
+        && !dualsplit_embree::available()
+    {
         anyhow::bail!(
-            "--peer embree: the Embree peer is missing: {}",
+            "--peer {}: the Embree peer is missing: {}",
+            p.name(),
             dualsplit_embree::STATUS
         );
+    }
+    let mut peers: Vec<Peer> = Vec::new();
+    for &p in &args.peer {
+        if !peers.contains(&p) {
+            peers.push(p);
+        }
     }
     // The measuring knob of the CPU copies' leaf merging: refused here when malformed (the
     // library would quietly keep its default).
@@ -182,12 +217,12 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         ctx,
         pool: pool.as_ref(),
     };
-    if args.peer == Some(Peer::Embree) {
-        for l in peer_run.run_embree()? {
+    if !peers.is_empty() {
+        for l in peer_run.run(&peers)? {
             json_line(l);
         }
     }
-    let show_rays = args.peer.is_none();
+    let show_rays = peers.is_empty();
     if json.is_none() && (show_rays || !args.no_frame) {
         println!(
             "{:<8} {:>16} {:>16} {:>16} {:>14}",
@@ -272,25 +307,37 @@ struct PeerRun<'a> {
     pool: Option<&'a rayon::ThreadPool>,
 }
 
-/// The name of the peer in the results.
-const EMBREE: &str = "embree";
+/// A peer's Embree scene, built.
+struct Built {
+    peer: Peer,
+    scene: EmbreeScene,
+    build_s: f64,
+}
 
 impl PeerRun<'_> {
-    /// Builds Embree's scene, checks agreement on every set, then times ours and Embree's
-    /// interleaved on the current rayon pool and prints both with the ratios (as a table),
-    /// or returns them as JSON lines.
-    fn run_embree(&self) -> anyhow::Result<Vec<String>> {
-        let mut lines = Vec::new();
-        let sp = self.ctx.spinner("building the Embree scene");
-        let t = Instant::now();
-        let peer = EmbreeScene::new(&self.scene.triangles).context("--peer embree")?;
-        sp.finish_and_clear();
-        let build_s = t.elapsed().as_secs_f64();
+    /// Builds each peer's Embree scene, checks its agreement on every set, then times ours
+    /// and the peers' interleaved on the current rayon pool and prints them with our best
+    /// structure's ratio to each peer (as a table), or returns them as JSON lines (the
+    /// timings, then one summary line per peer).
+    fn run(&self, peers: &[Peer]) -> anyhow::Result<Vec<String>> {
+        let mut built = Vec::new();
+        for &peer in peers {
+            let sp = self
+                .ctx
+                .spinner(format!("building the {} scene", peer.name()));
+            let t = Instant::now();
+            let scene = EmbreeScene::with_options(&self.scene.triangles, &peer.options())
+                .with_context(|| format!("--peer {}", peer.name()))?;
+            sp.finish_and_clear();
+            built.push(Built {
+                peer,
+                scene,
+                build_s: t.elapsed().as_secs_f64(),
+            });
+        }
         let sets: Vec<&RaySet> = self.sets.iter().filter(|s| !s.rays.is_empty()).collect();
 
-        // 1. Our structures against BVH2 (bit for bit), then BVH2 against Embree.
-        let mut agreement: BTreeMap<&str, Agreement> = BTreeMap::new();
-        let mut t_error: BTreeMap<&str, BTreeMap<&str, TErrors>> = BTreeMap::new();
+        // 1. Our structures against BVH2 (bit for bit), then BVH2 against each peer.
         for set in &sets {
             let sp = self
                 .ctx
@@ -298,63 +345,26 @@ impl PeerRun<'_> {
             for &kind in self.accels {
                 verify(self.structures, kind, set)?;
             }
-            agreement.insert(set.kind.name(), self.agree(&peer, set));
-            if set.kind != RayKind::Shadow {
-                t_error.insert(set.kind.name(), self.t_errors(&peer, set));
-            }
             sp.finish_and_clear();
         }
-        if !self.json {
-            println!(
-                "embree {}: scene built in {build_s:.2} s; agreement with {} (every structure \
-                 above equals it bit for bit):",
-                peer.version(),
-                self.structures.reference().name()
-            );
-            for set in &sets {
-                print_agreement(set.kind.name(), &agreement[set.kind.name()]);
-            }
-            println!("hit distance t against f64 (relative error, p99.9 / max):");
-            for (kind, e) in sets
-                .iter()
-                .filter_map(|s| t_error.get_key_value(s.kind.name()))
-            {
-                println!(
-                    "  {kind:<8} ours {:.1e} / {:.1e}; embree {:.1e} / {:.1e}",
-                    e["ours"].p999, e["ours"].max, e[EMBREE].p999, e[EMBREE].max
-                );
-            }
-        }
-        if let Some((kind, a)) = agreement.iter().find(|(_, a)| !a.is_explained()) {
-            if self.json {
-                println!(
-                    "{}",
-                    serde_json::json!({"peer": EMBREE, "agreement": agreement})
-                );
-            }
-            anyhow::bail!(
-                "embree and {} disagree on {} {kind} rays that no tie, grazing or \
-                 boundary hit explains ({} hit against miss, {} other triangle; the first: \
-                 {}); refusing to time them",
-                self.structures.reference().name(),
-                a.hit_miss.unexplained + a.triangle.unexplained,
-                a.hit_miss.unexplained,
-                a.triangle.unexplained,
-                a.first_unexplained.as_deref().unwrap_or("-")
-            );
+        let mut checks = Vec::new();
+        for b in &built {
+            checks.push(self.check(b, &sets)?);
         }
 
         // 2. Timing, interleaved.
+        let peer_names: Vec<&str> = built.iter().map(|b| b.peer.name()).collect();
         let mut timings: Vec<Timing> = Vec::new();
         for set in &sets {
             let sp = self.ctx.spinner(format!(
-                "timing {} rays on {} and embree, interleaved",
+                "timing {} rays on {} and {}, interleaved",
                 set.kind.name(),
                 self.accels
                     .iter()
                     .map(|a| a.name())
                     .collect::<Vec<_>>()
-                    .join(", ")
+                    .join(", "),
+                peer_names.join(", ")
             ));
             let ours: Vec<_> = self
                 .accels
@@ -362,14 +372,22 @@ impl PeerRun<'_> {
                 .map(|&a| trace_fn(self.structures, a, set.kind))
                 .collect();
             let ray_kind = set.kind;
-            let peer_trace = |rays: &[Ray]| -> u64 {
-                match ray_kind {
-                    RayKind::Shadow => rays.iter().filter(|r| peer.occluded(r)).count() as u64,
-                    RayKind::Primary | RayKind::Diffuse => {
-                        rays.iter().filter(|r| peer.intersect(r).is_some()).count() as u64
+            let theirs: Vec<_> = built
+                .iter()
+                .map(|b| {
+                    let peer = &b.scene;
+                    move |rays: &[Ray]| -> u64 {
+                        match ray_kind {
+                            RayKind::Shadow => {
+                                rays.iter().filter(|r| peer.occluded(r)).count() as u64
+                            }
+                            RayKind::Primary | RayKind::Diffuse => {
+                                rays.iter().filter(|r| peer.intersect(r).is_some()).count() as u64
+                            }
+                        }
                     }
-                }
-            };
+                })
+                .collect();
             let mut contenders: Vec<Contender<'_>> = self
                 .accels
                 .iter()
@@ -379,10 +397,9 @@ impl PeerRun<'_> {
                     trace: f,
                 })
                 .collect();
-            contenders.push(Contender {
-                name: EMBREE,
-                trace: &peer_trace,
-            });
+            for (name, f) in peer_names.iter().zip(&theirs) {
+                contenders.push(Contender { name, trace: f });
+            }
             let timed = || measure_interleaved(set, &contenders, self.cfg);
             timings.extend(match self.pool {
                 Some(p) => p.install(timed),
@@ -391,64 +408,142 @@ impl PeerRun<'_> {
             sp.finish_and_clear();
         }
 
-        // 3. Ratios: our fastest structure over Embree, per ray kind.
-        let mut ratio = BTreeMap::new();
-        let mut ratio_fastest = BTreeMap::new();
+        // 3. Ratios: our fastest structure over each peer, per ray kind.
+        let is_ours = |t: &&Timing| !peer_names.contains(&t.accel.as_str());
         let mut best = BTreeMap::new();
-        for set in &sets {
-            let of_kind = || timings.iter().filter(|t| t.ray_kind == set.kind);
-            let peer_t = of_kind().find(|t| t.accel == EMBREE);
-            let ours = of_kind()
-                .filter(|t| t.accel != EMBREE)
-                .max_by(|a, b| a.mrays_per_s.total_cmp(&b.mrays_per_s));
-            if let (Some(p), Some(o)) = (peer_t, ours) {
-                ratio.insert(set.kind.name(), o.mrays_per_s / p.mrays_per_s);
-                best.insert(set.kind.name(), o.accel.clone());
+        let mut ratios = Vec::new();
+        for b in &built {
+            let mut ratio = BTreeMap::new();
+            let mut ratio_fastest = BTreeMap::new();
+            for set in &sets {
+                let of_kind = || timings.iter().filter(|t| t.ray_kind == set.kind);
+                let peer_t = of_kind().find(|t| t.accel == b.peer.name());
+                let ours = of_kind()
+                    .filter(is_ours)
+                    .max_by(|a, b| a.mrays_per_s.total_cmp(&b.mrays_per_s));
+                if let (Some(p), Some(o)) = (peer_t, ours) {
+                    ratio.insert(set.kind.name(), o.mrays_per_s / p.mrays_per_s);
+                    best.insert(set.kind.name(), o.accel.clone());
+                }
+                let ours_fastest = of_kind()
+                    .filter(is_ours)
+                    .map(|t| t.best_pass_mrays_per_s)
+                    .max_by(f64::total_cmp);
+                if let (Some(p), Some(o)) = (peer_t, ours_fastest) {
+                    ratio_fastest.insert(set.kind.name(), o / p.best_pass_mrays_per_s);
+                }
             }
-            let ours_fastest = of_kind()
-                .filter(|t| t.accel != EMBREE)
-                .map(|t| t.best_pass_mrays_per_s)
-                .max_by(f64::total_cmp);
-            if let (Some(p), Some(o)) = (peer_t, ours_fastest) {
-                ratio_fastest.insert(set.kind.name(), o / p.best_pass_mrays_per_s);
-            }
+            ratios.push((b.peer.name(), ratio, ratio_fastest));
         }
         let threads = timings.first().map_or(0, |t| t.threads);
+        let mut lines = Vec::new();
         if self.json {
             for t in &timings {
                 lines.push(serde_json::to_string(t)?);
             }
-            lines.push(
-                serde_json::json!({
-                    "scene": self.scene.name, "peer": EMBREE, "peer_version": peer.version(),
-                    "peer_build_seconds": build_s,
-                    "threads": threads, "method": "interleaved",
-                    "simd": format!("{:?}", dualsplit_accel::wide::cpu::SimdLevel::detect()),
-                    "merge_max": dualsplit_accel::wide::cpu::merge_limit(),
-                    "agreement": agreement, "t_error": t_error,
-                    "best": best, "ratio_best_to_peer": ratio,
-                    "ratio_best_to_peer_fastest_pass": ratio_fastest,
-                })
-                .to_string(),
-            );
+            for ((b, (agreement, t_error)), (_, ratio, ratio_fastest)) in
+                built.iter().zip(&checks).zip(&ratios)
+            {
+                lines.push(
+                    serde_json::json!({
+                        "scene": self.scene.name, "peer": b.peer.name(),
+                        "peer_version": b.scene.version(), "peer_build_seconds": b.build_s,
+                        "threads": threads, "method": "interleaved",
+                        "simd": format!("{:?}", dualsplit_accel::wide::cpu::SimdLevel::detect()),
+                        "merge_max": dualsplit_accel::wide::cpu::merge_limit(),
+                        "agreement": agreement, "t_error": t_error,
+                        "best": best, "ratio_best_to_peer": ratio,
+                        "ratio_best_to_peer_fastest_pass": ratio_fastest,
+                    })
+                    .to_string(),
+                );
+            }
         } else {
-            print_timings(&timings, &best, &[&ratio, &ratio_fastest], threads);
+            print_timings(&timings, &best, &ratios, threads);
         }
         Ok(lines)
     }
 
-    /// Relative errors of our and Embree's hit distances on `set` against f64.
-    fn t_errors(&self, peer: &EmbreeScene, set: &RaySet) -> BTreeMap<&'static str, TErrors> {
+    /// Checks peer `b` against BVH2 on `sets`: the agreement of its answers and (for
+    /// closest-hit sets) the errors of both sides' hit distances, printed unless JSON.
+    /// Fails when a difference is unexplained.
+    #[allow(clippy::type_complexity)]
+    fn check(
+        &self,
+        b: &Built,
+        sets: &[&RaySet],
+    ) -> anyhow::Result<(
+        BTreeMap<&'static str, Agreement>,
+        BTreeMap<&'static str, BTreeMap<&'static str, TErrors>>,
+    )> {
+        let name = b.peer.name();
+        let mut agreement = BTreeMap::new();
+        let mut t_error = BTreeMap::new();
+        for set in sets {
+            let sp = self
+                .ctx
+                .spinner(format!("checking {} rays on {name}", set.kind.name()));
+            agreement.insert(set.kind.name(), self.agree(&b.scene, set));
+            if set.kind != RayKind::Shadow {
+                t_error.insert(set.kind.name(), self.t_errors(b, set));
+            }
+            sp.finish_and_clear();
+        }
+        if !self.json {
+            println!(
+                "{name} {}: scene built in {:.2} s; agreement with {} (every structure \
+                 above equals it bit for bit):",
+                b.scene.version(),
+                b.build_s,
+                self.structures.reference().name()
+            );
+            for set in sets {
+                print_agreement(set.kind.name(), &agreement[set.kind.name()]);
+            }
+            println!("hit distance t against f64 (relative error, p99.9 / max):");
+            for (kind, e) in sets
+                .iter()
+                .filter_map(|s| t_error.get_key_value(s.kind.name()))
+            {
+                println!(
+                    "  {kind:<8} ours {:.1e} / {:.1e}; {name} {:.1e} / {:.1e}",
+                    e["ours"].p999, e["ours"].max, e[name].p999, e[name].max
+                );
+            }
+        }
+        if let Some((kind, a)) = agreement.iter().find(|(_, a)| !a.is_explained()) {
+            if self.json {
+                println!(
+                    "{}",
+                    serde_json::json!({"peer": name, "agreement": agreement})
+                );
+            }
+            anyhow::bail!(
+                "{name} and {} disagree on {} {kind} rays that no tie, grazing or \
+                 boundary hit explains ({} hit against miss, {} other triangle; the first: \
+                 {}); refusing to time them",
+                self.structures.reference().name(),
+                a.hit_miss.unexplained + a.triangle.unexplained,
+                a.hit_miss.unexplained,
+                a.triangle.unexplained,
+                a.first_unexplained.as_deref().unwrap_or("-")
+            );
+        }
+        Ok((agreement, t_error))
+    }
+
+    /// Relative errors of our and peer `b`'s hit distances on `set` against f64.
+    fn t_errors(&self, b: &Built, set: &RaySet) -> BTreeMap<&'static str, TErrors> {
         let tris = &self.scene.triangles;
         let ours = closest_hits(set);
-        let theirs: Vec<_> = set.rays.par_iter().map(|r| peer.intersect(r)).collect();
+        let theirs: Vec<_> = set.rays.par_iter().map(|r| b.scene.intersect(r)).collect();
         BTreeMap::from([
             ("ours", t_errors(tris, &set.rays, &ours)),
-            (EMBREE, t_errors(tris, &set.rays, &theirs)),
+            (b.peer.name(), t_errors(tris, &set.rays, &theirs)),
         ])
     }
 
-    /// Agreement of Embree with BVH2's answers on `set`.
+    /// Agreement of a peer's Embree scene with BVH2's answers on `set`.
     fn agree(&self, peer: &EmbreeScene, set: &RaySet) -> Agreement {
         let tris = &self.scene.triangles;
         match set.kind {
@@ -498,10 +593,14 @@ fn print_agreement(kind: &str, a: &Agreement) {
     );
 }
 
+/// Our best structure's ratio to one peer per ray kind: over all passes, and fastest pass
+/// to fastest pass.
+type Ratios<'a> = (&'a str, BTreeMap<&'a str, f64>, BTreeMap<&'a str, f64>);
+
 fn print_timings(
     timings: &[Timing],
     best: &BTreeMap<&str, String>,
-    ratios: &[&BTreeMap<&str, f64>; 2],
+    ratios: &[Ratios<'_>],
     threads: usize,
 ) {
     let mut passes: Vec<String> = Vec::new();
@@ -516,7 +615,7 @@ fn print_timings(
         passes.join(", ")
     );
     println!(
-        "{:<12} {:>18} {:>18} {:>18}",
+        "{:<19} {:>18} {:>18} {:>18}",
         "accel", "primary", "shadow", "diffuse"
     );
     let mut names: Vec<&str> = Vec::new();
@@ -534,21 +633,23 @@ fn print_timings(
                 .unwrap_or_else(|| "-".into())
         };
         println!(
-            "{name:<12} {:>18} {:>18} {:>18}",
+            "{name:<19} {:>18} {:>18} {:>18}",
             cell(RayKind::Primary),
             cell(RayKind::Shadow),
             cell(RayKind::Diffuse)
         );
     }
-    let cell = |k: RayKind| match (ratios[0].get(k.name()), ratios[1].get(k.name())) {
-        (Some(r), Some(f)) => format!("{r:.2} ({f:.2}) {}", best[k.name()]),
-        _ => "-".into(),
-    };
-    println!(
-        "{:<12} {:>18} {:>18} {:>18}",
-        "best/embree",
-        cell(RayKind::Primary),
-        cell(RayKind::Shadow),
-        cell(RayKind::Diffuse)
-    );
+    for (peer, ratio, fastest) in ratios {
+        let cell = |k: RayKind| match (ratio.get(k.name()), fastest.get(k.name())) {
+            (Some(r), Some(f)) => format!("{r:.2} ({f:.2}) {}", best[k.name()]),
+            _ => "-".into(),
+        };
+        println!(
+            "{:<19} {:>18} {:>18} {:>18}",
+            format!("best/{peer}"),
+            cell(RayKind::Primary),
+            cell(RayKind::Shadow),
+            cell(RayKind::Diffuse)
+        );
+    }
 }
