@@ -48,14 +48,16 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                 }
                 if ANY {
                     // Any hit ends the ray: no order is better than another, so the
-                    // first hit child is next and the others are pushed unsorted.
+                    // first hit child is next and the others are pushed unsorted. Their
+                    // entry distances are not kept: the limit they passed is the one they
+                    // are popped under (see below).
                     let mut m = rest;
                     while m != 0 {
                         let i = m.trailing_zeros() as usize;
                         m &= m - 1;
                         let c = child(i);
                         prefetch_child(nodes, packets, c);
-                        stack[sp] = Entry { t: d(i), child: c };
+                        stack[sp] = Entry { t: 0.0, child: c };
                         sp += 1;
                     }
                     cur = child(first);
@@ -136,14 +138,16 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
             }
             limit = cull_limit(best_t);
         }
-        // Next: the nearest stacked entry not beyond the limit.
+        // Next: the nearest stacked entry not beyond the limit. A shadow ray's limit never
+        // moves (its first hit ends it), and every entry was pushed because its entry
+        // distance was within it, so none of its entries is skipped.
         loop {
             if sp == 0 {
                 return best;
             }
             sp -= 1;
             let e = stack[sp];
-            if e.t <= limit {
+            if ANY || e.t <= limit {
                 cur = e.child;
                 break;
             }
