@@ -316,6 +316,28 @@ impl Avx2 {
         }
         (mask.count_ones(), nearest)
     }
+
+    /// Lane `i & 7` of `v`, picked in registers (one `vpermps`) rather than by storing `v`
+    /// and loading the lane back.
+    #[inline(always)]
+    pub fn lane8(self, v: [f32; 8], i: usize) -> f32 {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            // SAFETY: every intrinsic below needs at most AVX2, which `self` proves this CPU
+            // has (`detect`); no memory is touched. `vpermps` reads only the low three bits
+            // of each index lane.
+            unsafe {
+                let idx = _mm256_castsi128_si256(_mm_cvtsi32_si128(i as i32));
+                _mm256_cvtss_f32(_mm256_permutevar8x32_ps(bytemuck::cast(v), idx))
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = (v, i);
+            unreachable!("no Avx2 token exists off x86-64")
+        }
+    }
 }
 
 /// The eight signed keys of `v` in descending order: a bitonic network, each stage a
@@ -355,6 +377,29 @@ mod tests {
     fn key(d: f32, lane: usize) -> i32 {
         let b = d.to_bits() as i32;
         ((b ^ ((b >> 31) as u32 >> 1) as i32) & !7) | lane as i32
+    }
+
+    /// `lane8` gives each lane's bits, signed zeros and NaN included, and reads only an
+    /// index's low three bits.
+    #[test]
+    fn lane8_picks_each_lane() {
+        let Some(avx2) = Avx2::detect() else {
+            eprintln!("no AVX2 on this CPU: nothing to test");
+            return;
+        };
+        let v = [
+            1.5,
+            -0.0,
+            0.0,
+            f32::NAN,
+            f32::INFINITY,
+            -2.25,
+            f32::MIN_POSITIVE,
+            7.0,
+        ];
+        for i in 0..16 {
+            assert_eq!(avx2.lane8(v, i).to_bits(), v[i & 7].to_bits(), "lane {i}");
+        }
     }
 
     /// Every mask of eight lanes with distances drawn from a set full of ties, signed

@@ -18,6 +18,10 @@ pub(crate) trait Isa: Copy {
 
     /// The AVX2 token when these are AVX2's instructions (for [`Avx2::sort_hits8`]).
     fn avx2(self) -> Option<Avx2>;
+
+    /// Lane `i` (below 8) of the entry distances `dv` of [`Isa::test8`] or of a 4-wide
+    /// node's test.
+    fn lane(self, dv: [f32x4; 2], i: usize) -> f32;
 }
 
 /// Baseline x86-64 (SSE2), or the portable `wide` code on other targets: 4-wide vectors.
@@ -43,6 +47,14 @@ impl Isa for Sse2 {
     fn avx2(self) -> Option<Avx2> {
         None
     }
+
+    #[inline(always)]
+    fn lane(self, dv: [f32x4; 2], i: usize) -> f32 {
+        let dist: [f32; 2 * LANES] = bytemuck::cast(dv);
+        // Lanes are below 8 (the mask's bits), which the `& 7` tells the compiler, so the
+        // lookup has no bounds check.
+        dist[i & (2 * LANES - 1)]
+    }
 }
 
 impl Isa for Avx2 {
@@ -64,6 +76,11 @@ impl Isa for Avx2 {
     #[inline(always)]
     fn avx2(self) -> Option<Avx2> {
         Some(self)
+    }
+
+    #[inline(always)]
+    fn lane(self, dv: [f32x4; 2], i: usize) -> f32 {
+        self.lane8(bytemuck::cast(dv), i)
     }
 }
 

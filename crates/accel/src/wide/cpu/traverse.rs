@@ -34,11 +34,9 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
         if cur & LEAF == 0 {
             let node = &nodes[cur as usize];
             let (dv, mask) = node.test(isa, &rs, t_min, limit);
-            // Lane i's entry distance; lanes are below 8 (the mask's bits), which the
-            // `& 7` tells the compiler, so the lookup has no bounds check.
-            let dist: [f32; 2 * LANES] = bytemuck::cast(dv.map(|v| v.to_array()));
+            // Lane i's entry distance.
             let child = |i: usize| node.child(i);
-            let d = |i: usize| dist[i & (2 * LANES - 1)];
+            let d = |i: usize| isa.lane(dv, i);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 let rest = mask & (mask - 1);
