@@ -314,6 +314,14 @@ struct Built {
     build_s: f64,
 }
 
+/// What [`PeerRun::check`] finds for one peer, per ray kind.
+struct Checked {
+    /// Its agreement with BVH2's answers.
+    agreement: BTreeMap<&'static str, Agreement>,
+    /// Ours and its hit distances' errors against f64 (closest-hit kinds only).
+    t_error: BTreeMap<&'static str, BTreeMap<&'static str, TErrors>>,
+}
+
 impl PeerRun<'_> {
     /// Builds each peer's Embree scene, checks its agreement on every set, then times ours
     /// and the peers' interleaved on the current rayon pool and prints them with our best
@@ -441,9 +449,7 @@ impl PeerRun<'_> {
             for t in &timings {
                 lines.push(serde_json::to_string(t)?);
             }
-            for ((b, (agreement, t_error)), (_, ratio, ratio_fastest)) in
-                built.iter().zip(&checks).zip(&ratios)
-            {
+            for ((b, c), (_, ratio, ratio_fastest)) in built.iter().zip(&checks).zip(&ratios) {
                 lines.push(
                     serde_json::json!({
                         "scene": self.scene.name, "peer": b.peer.name(),
@@ -451,7 +457,7 @@ impl PeerRun<'_> {
                         "threads": threads, "method": "interleaved",
                         "simd": format!("{:?}", dualsplit_accel::wide::cpu::SimdLevel::detect()),
                         "merge_max": dualsplit_accel::wide::cpu::merge_limit(),
-                        "agreement": agreement, "t_error": t_error,
+                        "agreement": c.agreement, "t_error": c.t_error,
                         "best": best, "ratio_best_to_peer": ratio,
                         "ratio_best_to_peer_fastest_pass": ratio_fastest,
                     })
@@ -467,15 +473,7 @@ impl PeerRun<'_> {
     /// Checks peer `b` against BVH2 on `sets`: the agreement of its answers and (for
     /// closest-hit sets) the errors of both sides' hit distances, printed unless JSON.
     /// Fails when a difference is unexplained.
-    #[allow(clippy::type_complexity)]
-    fn check(
-        &self,
-        b: &Built,
-        sets: &[&RaySet],
-    ) -> anyhow::Result<(
-        BTreeMap<&'static str, Agreement>,
-        BTreeMap<&'static str, BTreeMap<&'static str, TErrors>>,
-    )> {
+    fn check(&self, b: &Built, sets: &[&RaySet]) -> anyhow::Result<Checked> {
         let name = b.peer.name();
         let mut agreement = BTreeMap::new();
         let mut t_error = BTreeMap::new();
@@ -529,7 +527,7 @@ impl PeerRun<'_> {
                 a.first_unexplained.as_deref().unwrap_or("-")
             );
         }
-        Ok((agreement, t_error))
+        Ok(Checked { agreement, t_error })
     }
 
     /// Relative errors of our and peer `b`'s hit distances on `set` against f64.
