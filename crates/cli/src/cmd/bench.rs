@@ -416,29 +416,39 @@ impl PeerRun<'_> {
             sp.finish_and_clear();
         }
 
-        // 3. Ratios: our fastest structure over each peer, per ray kind.
+        // 3. Ratios: our fastest structure over each peer, per ray kind. Ours are found
+        // once: the structure with the most Mrays/s over all passes, and the fastest pass
+        // of any structure.
         let is_ours = |t: &&Timing| !peer_names.contains(&t.accel.as_str());
         let mut best = BTreeMap::new();
+        let mut ours = Vec::new();
+        for set in &sets {
+            let of_kind = timings
+                .iter()
+                .filter(|t| t.ray_kind == set.kind)
+                .filter(is_ours);
+            let top = of_kind
+                .clone()
+                .max_by(|a, b| a.mrays_per_s.total_cmp(&b.mrays_per_s));
+            let fastest = of_kind
+                .map(|t| t.best_pass_mrays_per_s)
+                .max_by(f64::total_cmp);
+            if let (Some(top), Some(fastest)) = (top, fastest) {
+                best.insert(set.kind.name(), top.accel.clone());
+                ours.push((set.kind, top.mrays_per_s, fastest));
+            }
+        }
         let mut ratios = Vec::new();
         for b in &built {
             let mut ratio = BTreeMap::new();
             let mut ratio_fastest = BTreeMap::new();
-            for set in &sets {
-                let of_kind = || timings.iter().filter(|t| t.ray_kind == set.kind);
-                let peer_t = of_kind().find(|t| t.accel == b.peer.name());
-                let ours = of_kind()
-                    .filter(is_ours)
-                    .max_by(|a, b| a.mrays_per_s.total_cmp(&b.mrays_per_s));
-                if let (Some(p), Some(o)) = (peer_t, ours) {
-                    ratio.insert(set.kind.name(), o.mrays_per_s / p.mrays_per_s);
-                    best.insert(set.kind.name(), o.accel.clone());
-                }
-                let ours_fastest = of_kind()
-                    .filter(is_ours)
-                    .map(|t| t.best_pass_mrays_per_s)
-                    .max_by(f64::total_cmp);
-                if let (Some(p), Some(o)) = (peer_t, ours_fastest) {
-                    ratio_fastest.insert(set.kind.name(), o / p.best_pass_mrays_per_s);
+            for &(kind, mrays, fastest) in &ours {
+                let peer_t = timings
+                    .iter()
+                    .find(|t| t.ray_kind == kind && t.accel == b.peer.name());
+                if let Some(p) = peer_t {
+                    ratio.insert(kind.name(), mrays / p.mrays_per_s);
+                    ratio_fastest.insert(kind.name(), fastest / p.best_pass_mrays_per_s);
                 }
             }
             ratios.push((b.peer.name(), ratio, ratio_fastest));
