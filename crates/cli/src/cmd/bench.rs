@@ -355,9 +355,18 @@ impl PeerRun<'_> {
             }
             sp.finish_and_clear();
         }
+        // Our hit distances' errors against f64, the same beside every peer.
+        let ours_t: BTreeMap<&str, TErrors> = sets
+            .iter()
+            .filter(|set| set.kind != RayKind::Shadow)
+            .map(|set| {
+                let ours = t_errors(&self.scene.triangles, &set.rays, &closest_hits(set));
+                (set.kind.name(), ours)
+            })
+            .collect();
         let mut checks = Vec::new();
         for b in &built {
-            checks.push(self.check(b, &sets)?);
+            checks.push(self.check(b, &sets, &ours_t)?);
         }
 
         // 2. Timing, interleaved.
@@ -480,10 +489,16 @@ impl PeerRun<'_> {
         Ok(lines)
     }
 
-    /// Checks peer `b` against BVH2 on `sets`: the agreement of its answers and (for
-    /// closest-hit sets) the errors of both sides' hit distances, printed unless JSON.
-    /// Fails when a difference is unexplained.
-    fn check(&self, b: &Built, sets: &[&RaySet]) -> anyhow::Result<Checked> {
+    /// Checks peer `b` against BVH2 on `sets`: the agreement of its answers and, for the
+    /// closest-hit sets (those `ours_t` holds our hit distances' errors for), the errors of
+    /// its hit distances beside ours, printed unless JSON. Fails when a difference is
+    /// unexplained.
+    fn check(
+        &self,
+        b: &Built,
+        sets: &[&RaySet],
+        ours_t: &BTreeMap<&str, TErrors>,
+    ) -> anyhow::Result<Checked> {
         let name = b.peer.name();
         let mut agreement = BTreeMap::new();
         let mut t_error = BTreeMap::new();
@@ -492,8 +507,13 @@ impl PeerRun<'_> {
                 .ctx
                 .spinner(format!("checking {} rays on {name}", set.kind.name()));
             agreement.insert(set.kind.name(), self.agree(&b.scene, set));
-            if set.kind != RayKind::Shadow {
-                t_error.insert(set.kind.name(), self.t_errors(b, set));
+            if let Some(&ours) = ours_t.get(set.kind.name()) {
+                let theirs: Vec<_> = set.rays.par_iter().map(|r| b.scene.intersect(r)).collect();
+                let theirs = t_errors(&self.scene.triangles, &set.rays, &theirs);
+                t_error.insert(
+                    set.kind.name(),
+                    BTreeMap::from([("ours", ours), (name, theirs)]),
+                );
             }
             sp.finish_and_clear();
         }
@@ -538,17 +558,6 @@ impl PeerRun<'_> {
             );
         }
         Ok(Checked { agreement, t_error })
-    }
-
-    /// Relative errors of our and peer `b`'s hit distances on `set` against f64.
-    fn t_errors(&self, b: &Built, set: &RaySet) -> BTreeMap<&'static str, TErrors> {
-        let tris = &self.scene.triangles;
-        let ours = closest_hits(set);
-        let theirs: Vec<_> = set.rays.par_iter().map(|r| b.scene.intersect(r)).collect();
-        BTreeMap::from([
-            ("ours", t_errors(tris, &set.rays, &ours)),
-            (b.peer.name(), t_errors(tris, &set.rays, &theirs)),
-        ])
     }
 
     /// Agreement of a peer's Embree scene with BVH2's answers on `set`.
