@@ -226,3 +226,52 @@ fn identical_leaves_in_all_three() {
         assert!(w8.nodes.len() < w4.nodes.len());
     }
 }
+
+/// Rays whose direction or origin holds NaN or an infinity: a plane distance that is NaN
+/// keeps the running interval, so such a ray can meet every lane of a node, empty ones
+/// included (whose words name the copy's sentinel leaf). Every copy answers as its own
+/// image traversal does, closest hit and shadow, without a panic.
+#[test]
+fn non_finite_rays_answer_as_the_image() {
+    let scene = dualsplit_scene::load("builtin:cornell").expect("builtin scene");
+    let s = Structures::build(&scene.triangles, &BuildConfig::default());
+    let values = [
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        0.0,
+        -0.0,
+        1.0,
+        -0.3,
+    ];
+    let mut rays = Vec::new();
+    for &x in &values {
+        for &y in &values {
+            for &z in &values {
+                let dir = dualsplit_geometry::Vec3::new(x, y, z);
+                let inside = dualsplit_geometry::Vec3::new(0.1, 0.2, 0.3);
+                rays.push(dualsplit_geometry::Ray::new(inside, dir));
+                rays.push(dualsplit_geometry::Ray::new(dir, inside));
+            }
+        }
+    }
+    for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+        let b = s.encoded(kind).unwrap();
+        for level in SimdLevel::available() {
+            for c in [b.cpu_copy(level), b.cpu_copy_with(level, 0)] {
+                for ray in &rays {
+                    let want = hit_bits(b.closest_hit_image(ray, &mut NoObserver));
+                    let got = c
+                        .traverse::<false>(ray)
+                        .unwrap_or_else(|| b.closest_hit_image(ray, &mut NoObserver));
+                    assert_eq!(hit_bits(got), want, "{ray:?} on {kind:?} with {level:?}");
+                    let want = b.any_hit_image(ray, &mut NoObserver);
+                    let got = c
+                        .traverse::<true>(ray)
+                        .map_or_else(|| b.any_hit_image(ray, &mut NoObserver), |h| h.is_some());
+                    assert_eq!(got, want, "{ray:?} on {kind:?} with {level:?}");
+                }
+            }
+        }
+    }
+}

@@ -131,14 +131,14 @@ impl Avx2 {
     /// folded into the reciprocal); the entry is the largest of `t_lo` and the
     /// near distances, the exit the smallest of `t_hi` and the far ones, a NaN distance
     /// keeping the running bound (`vmaxps`/`vminps` return their second operand then).
-    /// Returns the entry distances and the mask of lanes with `entry <= exit` whose child
-    /// word is not `u32::MAX` (an empty lane).
+    /// Returns the entry distances and the mask of lanes with `entry <= exit` (an empty
+    /// lane's box, min `+∞` and max `−∞`, has none for a finite origin and direction: its
+    /// near distances are `+∞` and its far ones `−∞`).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub fn slab8(
         self,
         planes: &[[f32; 8]; 6],
-        child: &[u32; 8],
         rows: PlaneRows8,
         o: [f32; 3],
         neg_inv: [f32; 3],
@@ -169,17 +169,12 @@ impl Avx2 {
                     exit = _mm256_min_ps(tf, exit);
                 }
                 let hit = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(entry, exit)) as u32;
-                let words: __m256i = bytemuck::cast(*child);
-                let empty = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
-                    words,
-                    _mm256_set1_epi32(-1),
-                ))) as u32;
-                (bytemuck::cast(entry), hit & !empty)
+                (bytemuck::cast(entry), hit)
             }
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
-            let _ = (planes, child, rows, o, neg_inv, neg_inv_w, t_lo, t_hi);
+            let _ = (planes, rows, o, neg_inv, neg_inv_w, t_lo, t_hi);
             unreachable!("no Avx2 token exists off x86-64")
         }
     }
@@ -317,6 +312,67 @@ impl Avx2 {
         (mask.count_ones(), nearest)
     }
 
+    /// [`RayPre::new`]'s values for `ray`, bit for bit, with vector instructions and no
+    /// branch: the reciprocal, the signs and the axes as there (the same comparisons), then
+    /// `d / d[kz]` in one division whose lanes are `Sx`, `Sy` and `Sz = 1 / d[kz]` (the
+    /// same correctly rounded quotients as its scalar lanes and `inv_dir[kz]`), gathered by
+    /// one `vpermilps` with the axes from a table, where `RayPre::new` picks each value by
+    /// comparisons and jumps.
+    ///
+    /// [`RayPre::new`]: dualsplit_geometry::RayPre::new
+    #[inline(always)]
+    pub fn ray_pre(self, ray: &dualsplit_geometry::Ray) -> dualsplit_geometry::RayPre {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use dualsplit_geometry::{RayPre, Vec3};
+            use std::arch::x86_64::*;
+            /// `[kx, ky, kz, 3]` per `2 kz + swap`: `(kx, ky) = (kz + 1, kz + 2) mod 3`,
+            /// swapped when `d[kz] < 0` (lane 3 picks the fourth lane, `1 / d[kz]`).
+            const K: [[i32; 4]; 6] = [
+                [1, 2, 0, 3],
+                [2, 1, 0, 3],
+                [2, 0, 1, 3],
+                [0, 2, 1, 3],
+                [0, 1, 2, 3],
+                [1, 0, 2, 3],
+            ];
+            let d = ray.dir;
+            let a = d.abs();
+            let x_max = (a.x >= a.y) & (a.x >= a.z);
+            let y_max = a.y >= a.z;
+            let kz = (!x_max) as usize * (1 + (!y_max) as usize);
+            // SAFETY: every intrinsic below needs at most AVX, which `self` proves this CPU
+            // has (`detect`); no memory is touched but `K`'s row, read by value. `vpermilps`
+            // reads only the low two bits of each index lane.
+            unsafe {
+                let d4 = _mm_setr_ps(d.x, d.y, d.z, 1.0);
+                let inv = _mm_div_ps(_mm_set1_ps(1.0), d4);
+                let dkz = _mm_permutevar_ps(d4, _mm_set1_epi32(kz as i32));
+                let swap = (_mm_cvtss_f32(dkz) < 0.0) as usize;
+                let k = K[(2 * kz + swap) % K.len()];
+                let s = _mm_permutevar_ps(_mm_div_ps(d4, dkz), bytemuck::cast(k));
+                let inv: [f32; 4] = bytemuck::cast(inv);
+                let s: [f32; 4] = bytemuck::cast(s);
+                RayPre {
+                    ray: *ray,
+                    inv_dir: Vec3::new(inv[0], inv[1], inv[2]),
+                    neg: [
+                        d.x.is_sign_negative(),
+                        d.y.is_sign_negative(),
+                        d.z.is_sign_negative(),
+                    ],
+                    k: [k[0] as usize, k[1] as usize, kz],
+                    shear: Vec3::new(s[0], s[1], s[3]),
+                }
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = ray;
+            unreachable!("no Avx2 token exists off x86-64")
+        }
+    }
+
     /// Lane `i & 7` of `v`, picked in registers (one `vpermps`) rather than by storing `v`
     /// and loading the lane back.
     #[inline(always)]
@@ -399,6 +455,54 @@ mod tests {
         ];
         for i in 0..16 {
             assert_eq!(avx2.lane8(v, i).to_bits(), v[i & 7].to_bits(), "lane {i}");
+        }
+    }
+
+    /// `ray_pre` gives `RayPre::new`'s bits on directions full of ties, signed zeros,
+    /// infinities, NaN and subnormals, and on random ones.
+    #[test]
+    fn ray_pre_matches_scalar() {
+        use dualsplit_geometry::{Ray, Vec3};
+        let Some(avx2) = Avx2::detect() else {
+            eprintln!("no AVX2 on this CPU: nothing to test");
+            return;
+        };
+        let pool = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            2.0,
+            -2.0,
+            f32::from_bits(1.0f32.to_bits() + 1),
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            f32::MIN_POSITIVE / 8.0,
+            -3e38,
+        ];
+        let mut rng = dualsplit_geometry::Pcg32::new(9, 4);
+        let mut cases: Vec<Vec3> = Vec::new();
+        for x in pool {
+            for y in pool {
+                for z in pool {
+                    cases.push(Vec3::new(x, y, z));
+                }
+            }
+        }
+        for _ in 0..100_000 {
+            let mut c = || rng.range_f32(-4.0, 4.0);
+            cases.push(Vec3::new(c(), c(), c()));
+        }
+        let bits = |v: Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+        for d in cases {
+            let ray = Ray::new(Vec3::new(0.5, -1.0, 2.0), d);
+            let (want, got) = (ray.precompute(), avx2.ray_pre(&ray));
+            assert_eq!(bits(got.inv_dir), bits(want.inv_dir), "{d:?}");
+            assert_eq!(got.neg, want.neg, "{d:?}");
+            assert_eq!(got.k, want.k, "{d:?}");
+            assert_eq!(bits(got.shear), bits(want.shear), "{d:?}");
+            assert_eq!(bytemuck::bytes_of(&got.ray), bytemuck::bytes_of(&ray));
         }
     }
 

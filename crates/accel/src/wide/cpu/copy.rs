@@ -81,6 +81,17 @@ pub(super) fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage, merge: usize) -> 
         }
         todo.extend(subtrees.into_iter().rev());
     }
+    // Empty lanes name the sentinel: a last packet of padding lanes, a leaf of one triangle
+    // that no ray hits (see `Lanes::EMPTY`).
+    out.packets.push(EMPTY_PACKET);
+    let sentinel = LEAF | (LANES * (out.packets.len() - 1)) as u32;
+    for n in &mut out.nodes {
+        for l in 0..N::W {
+            if n.child(l) == EMPTY {
+                n.set_child(l, sentinel);
+            }
+        }
+    }
     out
 }
 

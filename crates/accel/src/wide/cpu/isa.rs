@@ -12,8 +12,8 @@ use wide::f32x4;
 /// `wide` code elsewhere) or [`Avx2`] (one 8-wide box test per BVH8 node, and the whole
 /// traversal compiled for AVX2). Answers are the same bits with either.
 pub(crate) trait Isa: Copy {
-    /// Entry distances (lanes 0–3, then 4–7) and the mask of the non-empty lanes of `n` that
-    /// the ray meets on `[t_lo, t_hi]`.
+    /// Entry distances (lanes 0–3, then 4–7) and the mask of the lanes of `n` that the ray
+    /// meets on `[t_lo, t_hi]` (never an empty one, for a finite origin and direction).
     fn test8(self, rs: &RaySimd, n: &Chunk8, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32);
 
     /// The AVX2 token when these are AVX2's instructions (for [`Avx2::sort_hits8`]).
@@ -31,14 +31,7 @@ pub(crate) struct Sse2;
 impl Isa for Sse2 {
     #[inline(always)]
     fn test8(self, rs: &RaySimd, n: &Chunk8, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32) {
-        let half = |h: usize| {
-            rs.test_rows(
-                |p| half_of(&n.planes[p], h),
-                half_of(&n.child, h),
-                t_lo,
-                t_hi,
-            )
-        };
+        let half = |h: usize| rs.test_rows(|p| half_of(&n.planes[p], h), t_lo, t_hi);
         let ((e0, m0), (e1, m1)) = (half(0), half(1));
         ([e0, e1], m0 | m1 << LANES)
     }
@@ -62,7 +55,6 @@ impl Isa for Avx2 {
     fn test8(self, rs: &RaySimd, n: &Chunk8, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32) {
         let (e, m) = self.slab8(
             &n.planes,
-            &n.child,
             rs.rows8,
             rs.os,
             rs.neg_invs,

@@ -12,18 +12,30 @@ pub const LANES: usize = 4;
 /// [`CpuBvh::packets`](super::CpuBvh::packets) (`4 · packet + lane`).
 pub const LEAF: u32 = 1 << 31;
 
-/// Child word of an empty lane.
+/// Child word of an empty lane while the copy is made, and of an unused stack entry. The
+/// finished copy replaces it by the sentinel's word (see [`Chunk`]).
 pub const EMPTY: u32 = u32::MAX;
 
 /// A BVH2 or BVH4 node of the copy: its children's boxes plane by plane, then their child
 /// words.
+///
+/// An empty lane holds the degenerate box, min `+∞` and max `−∞`, which a ray with a finite
+/// origin and direction never meets (its near plane distances are `+∞` and its far ones
+/// `−∞`: `1 / d` is never 0 for a finite `d`), so the box test needs no check of the child
+/// word. For other rays (a NaN distance keeps the running bound) the word is still safe:
+/// it names the sentinel, a leaf of one padding lane in the copy's last packet (all
+/// vertices 0, id [`EMPTY`]), a zero-area triangle that [`Triangle::intersect`] never
+/// hits.
+///
+/// [`Triangle::intersect`]: dualsplit_geometry::Triangle::intersect
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(16))]
 pub struct Chunk {
     /// `planes[p][lane]`: plane `p` of the lane's box, in the image's box-word order
     /// (min.x, min.y, min.z, max.x, max.y, max.z). Empty lanes hold the degenerate box.
     pub planes: [[f32; LANES]; 6],
-    /// Per lane: a node (its index), a leaf ([`LEAF`] | first triangle) or [`EMPTY`].
+    /// Per lane: a node (its index) or a leaf ([`LEAF`] | first triangle); an empty lane
+    /// names the sentinel leaf.
     pub child: [u32; LANES],
 }
 
@@ -34,15 +46,15 @@ pub struct Chunk {
 pub struct Chunk8 {
     /// `planes[p][lane]`, as [`Chunk::planes`].
     pub planes: [[f32; 8]; 6],
-    /// Per lane, as in [`Chunk`]: a node, a leaf or [`EMPTY`].
+    /// Per lane, as in [`Chunk`]: a node or a leaf (the sentinel for an empty lane).
     pub child: [u32; 8],
 }
 
 /// Four consecutive triangles of the leaf-ordered triangle list, vertex coordinates lane by
 /// lane, with their ids. Leaves follow one another without padding: a leaf starts at any
 /// lane (its child word names the slot `4 · packet + lane`) and ends at the first lane from
-/// there whose id has [`RUN_END`](crate::image::RUN_END) set; the last packet is padded
-/// with [`EMPTY`] lanes.
+/// there whose id has [`RUN_END`](crate::image::RUN_END) set; the last packet of triangles
+/// is padded with [`EMPTY`] lanes, and one packet of them follows it (the sentinel).
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(16))]
 pub struct TriPacket {
@@ -62,7 +74,8 @@ pub(crate) const EMPTY_PACKET: TriPacket = TriPacket {
 pub(crate) trait Lanes: bytemuck::Pod + Send + Sync + std::fmt::Debug {
     /// Children per node.
     const W: usize;
-    /// A node with every lane empty (degenerate boxes, [`EMPTY`] words).
+    /// A node with every lane empty (degenerate boxes, [`EMPTY`] words until the copy names
+    /// the sentinel).
     const EMPTY: Self;
     /// Sets lane `l`'s box words (image order) and child word.
     fn set(&mut self, l: usize, boxw: [f32; 6], child: u32);
@@ -76,7 +89,8 @@ pub(crate) trait Lanes: bytemuck::Pod + Send + Sync + std::fmt::Debug {
         None
     }
     /// Entry distances (lanes 0–3 in the first vector, 4–7 in the second) and the mask of
-    /// the non-empty lanes the ray meets on `[t_lo, t_hi]`.
+    /// the lanes the ray meets on `[t_lo, t_hi]`; for a finite origin and direction, never
+    /// an empty one (its box has min `+∞` and max `−∞`).
     fn test<I: Isa>(&self, isa: I, rs: &RaySimd, t_lo: f32, t_hi: f32) -> ([f32x4; 2], u32);
 }
 
@@ -126,7 +140,7 @@ macro_rules! lanes_impl {
     };
 }
 lanes_impl!(Chunk, LANES, |n, _isa, rs, t_lo, t_hi| {
-    let (e, m) = rs.test(&n.planes, &n.child, t_lo, t_hi);
+    let (e, m) = rs.test(&n.planes, t_lo, t_hi);
     ([e, f32x4::splat(0.0)], m)
 });
 lanes_impl!(

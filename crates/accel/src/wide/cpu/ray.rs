@@ -6,7 +6,7 @@ use crate::wide::simd::{Avx2, PlaneRows8};
 #[cfg(doc)]
 use dualsplit_geometry::Triangle;
 use dualsplit_geometry::{EXIT_WIDEN, RayPre};
-use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4, i32x4};
+use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4};
 
 /// What [`RaySimd::triangle_edges`] finds for the four triangles of a packet.
 pub(super) struct Edges {
@@ -222,17 +222,12 @@ impl RaySimd {
     }
 
     /// Entry distances of four boxes (`planes[p][lane]`) clipped to `[t_lo, t_hi]`, and the mask of
-    /// the non-empty lanes the ray meets (`entry <= exit`). Plane distances are
-    /// `(o - p) * -inv` (see [`RaySimd`]), far ones `(o - p) * (-inv * EXIT_WIDEN)`.
+    /// the lanes the ray meets (`entry <= exit`; an empty lane's box, min `+∞` and max `−∞`,
+    /// has none for a finite origin and direction). Plane distances are `(o - p) * -inv`
+    /// (see [`RaySimd`]), far ones `(o - p) * (-inv * EXIT_WIDEN)`.
     #[inline(always)]
-    pub(super) fn test(
-        &self,
-        planes: &[[f32; LANES]; 6],
-        child: &[u32; LANES],
-        t_lo: f32,
-        t_hi: f32,
-    ) -> (f32x4, u32) {
-        self.test_rows(|p| planes[p], *child, t_lo, t_hi)
+    pub(super) fn test(&self, planes: &[[f32; LANES]; 6], t_lo: f32, t_hi: f32) -> (f32x4, u32) {
+        self.test_rows(|p| planes[p], t_lo, t_hi)
     }
 
     /// [`RaySimd::test`] with plane `p`'s row given by `row(p)`.
@@ -240,7 +235,6 @@ impl RaySimd {
     pub(super) fn test_rows(
         &self,
         row: impl Fn(usize) -> [f32; LANES],
-        child: [u32; LANES],
         t_lo: f32,
         t_hi: f32,
     ) -> (f32x4, u32) {
@@ -252,11 +246,7 @@ impl RaySimd {
             entry = keep_max(tn, entry);
             exit = keep_min(tf, exit);
         }
-        let hit = entry.cmp_le(exit).move_mask() as u32;
-        let empty = i32x4::new(bytemuck::cast::<[u32; LANES], [i32; LANES]>(child))
-            .cmp_eq(i32x4::splat(-1))
-            .move_mask() as u32;
-        (entry, hit & !empty)
+        (entry, entry.cmp_le(exit).move_mask() as u32)
     }
 }
 

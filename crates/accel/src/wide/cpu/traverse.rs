@@ -18,7 +18,13 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
     ray: &Ray,
     stack: &mut [Entry],
 ) -> Option<Hit> {
-    let r = ray.precompute();
+    // The same constants either way. For shadow rays the vector form measured worse: their
+    // node loop then kept its plane-row offsets on the stack rather than in registers (Sponza,
+    // 889 → 909 instructions per ray; `docs/cpu-traversal.md`).
+    let r = match isa.avx2() {
+        Some(avx2) if !ANY => avx2.ray_pre(ray),
+        _ => ray.precompute(),
+    };
     let rs = RaySimd::new(&r);
     let mut best: Option<Hit> = None;
     let mut best_t = ray.t_max;
