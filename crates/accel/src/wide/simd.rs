@@ -6,27 +6,30 @@
 //! leaf module allows it, and every block carries a SAFETY note.
 #![allow(unsafe_code)]
 
-/// Hints the CPU to bring every cache line (64 bytes) that `*r` touches into all cache
-/// levels. No effect on results; a no-op on targets other than x86-64.
+/// Hints the CPU to bring every cache line (64 bytes) that a `T` at `p` touches into all
+/// cache levels. No effect on results; a no-op on targets other than x86-64. `p` need not
+/// point into any allocation: a prefetch hint never faults and is never a read for the
+/// program, so a caller can name an element of a slice without the bounds check that
+/// indexing costs (`slice.as_ptr().wrapping_add(i)`).
 ///
-/// Straight-line code: one hint every 64 bytes from `r`'s first byte (each in a successive
-/// line) and one at its last byte, which together name every line `*r` touches whatever its
-/// alignment; the count is a constant, so the loop unrolls (a loop over the lines from the
-/// first line's start cost 16 M of 301 M instructions of a Sponza bench run). The last hint
-/// is left out where `T`'s alignment already puts the last byte in the line of the last
-/// 64-byte step: `*r` starts at most `64 - align` bytes into a line (`align` below 64), so
-/// with `n` steps the last byte is within them when `64 - align + size <= 64 n` (a BVH8
-/// node of the CPU copy: 224 bytes aligned to 32, four hints).
+/// Straight-line code: one hint every 64 bytes from `p`'s first byte (each in a successive
+/// line) and one at its last byte, which together name every line a `T` there touches
+/// whatever its alignment; the count is a constant, so the loop unrolls (a loop over the
+/// lines from the first line's start cost 16 M of 301 M instructions of a Sponza bench
+/// run). The last hint is left out where `T`'s alignment already puts the last byte in the
+/// line of the last 64-byte step: an aligned `T` starts at most `64 - align` bytes into a
+/// line (`align` below 64), so with `n` steps the last byte is within them when `64 - align
+/// + size <= 64 n` (a BVH8 node of the CPU copy: 224 bytes aligned to 32, four hints).
 #[inline(always)]
-pub fn prefetch<T>(r: &T) {
+pub fn prefetch<T>(p: *const T) {
     #[cfg(target_arch = "x86_64")]
     {
-        let start = (r as *const T).cast::<i8>();
+        let start = p.cast::<i8>();
         let hint = |offset: usize| {
             // SAFETY: `_mm_prefetch` only needs SSE, which every x86-64 CPU has (it is in the
             // target's baseline features), and it never dereferences its pointer for the
-            // program: it is a hint that cannot fault, whatever the address. The offsets
-            // are within `*r` (`wrapping_byte_add` needs no bounds anyway).
+            // program: it is a hint that cannot fault, whatever the address
+            // (`wrapping_byte_add` needs no bounds either).
             unsafe {
                 use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
                 _mm_prefetch::<_MM_HINT_T0>(start.wrapping_byte_add(offset));
@@ -42,7 +45,7 @@ pub fn prefetch<T>(r: &T) {
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = r;
+    let _ = p;
 }
 
 /// Where, in a node's eight-lane plane rows (`[[f32; 8]; 6]`, rows in the box word order

@@ -20,7 +20,7 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
 ) -> Option<Hit> {
     // The same constants either way. For shadow rays the vector form measured worse: their
     // node loop then kept its plane-row offsets on the stack rather than in registers (Sponza,
-    // 889 → 909 instructions per ray; `docs/cpu-traversal.md`).
+    // 885 → 898 instructions per ray; `docs/cpu-traversal.md`).
     let r = match isa.avx2() {
         Some(avx2) if !ANY => avx2.ray_pre(ray),
         _ => ray.precompute(),
@@ -159,13 +159,15 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
     }
 }
 
-/// Prefetches the first line of child word `c`'s node or the first packet of its leaf.
+/// Prefetches child word `c`'s node or the first packet of its leaf (every line of it).
+/// The address is computed without a bounds check: a prefetch hint reads nothing for the
+/// program and cannot fault.
 #[inline(always)]
 fn prefetch_child<N>(nodes: &[N], packets: &[TriPacket], c: u32) {
     if c & LEAF == 0 {
-        crate::wide::simd::prefetch(&nodes[c as usize]);
+        crate::wide::simd::prefetch(nodes.as_ptr().wrapping_add(c as usize));
     } else {
-        crate::wide::simd::prefetch(&packets[(c & !LEAF) as usize / LANES]);
+        crate::wide::simd::prefetch(packets.as_ptr().wrapping_add((c & !LEAF) as usize / LANES));
     }
 }
 
