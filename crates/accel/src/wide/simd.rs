@@ -438,14 +438,20 @@ mod tests {
         ((b ^ ((b >> 31) as u32 >> 1) as i32) & !7) | lane as i32
     }
 
+    /// The AVX2 token; without AVX2, `None` after saying that there is nothing to test.
+    fn token() -> Option<Avx2> {
+        let t = Avx2::detect();
+        if t.is_none() {
+            eprintln!("no AVX2 on this CPU: nothing to test");
+        }
+        t
+    }
+
     /// `lane8` gives each lane's bits, signed zeros and NaN included, and reads only an
     /// index's low three bits.
     #[test]
     fn lane8_picks_each_lane() {
-        let Some(avx2) = Avx2::detect() else {
-            eprintln!("no AVX2 on this CPU: nothing to test");
-            return;
-        };
+        let Some(avx2) = token() else { return };
         let v = [
             1.5,
             -0.0,
@@ -466,10 +472,7 @@ mod tests {
     #[test]
     fn ray_pre_matches_scalar() {
         use dualsplit_geometry::{Ray, Vec3};
-        let Some(avx2) = Avx2::detect() else {
-            eprintln!("no AVX2 on this CPU: nothing to test");
-            return;
-        };
+        let Some(avx2) = token() else { return };
         let pool = [
             0.0,
             -0.0,
@@ -515,10 +518,7 @@ mod tests {
     /// the last of them.
     #[test]
     fn sort_hits8_orders_every_mask() {
-        let Some(avx2) = Avx2::detect() else {
-            eprintln!("no AVX2 on this CPU: nothing to test");
-            return;
-        };
+        let Some(avx2) = token() else { return };
         let pool = [
             0.0,
             -0.0,
