@@ -124,8 +124,7 @@ impl RayPre {
     /// are random) and with the five divisions done two vectors at a time; every value is
     /// the one the scalar definition gives (IEEE division is correctly rounded lane by lane,
     /// and `Sz = 1 / d[kz]` is `inv_dir[kz]`):
-    /// `kz` is x when `|dx| >= |dy|` and `|dx| >= |dz|`, else y when `|dy| >= |dz|`, else z
-    /// (so z when a component is NaN); `(kx, ky)` follow it cyclically, swapped when
+    /// `kz` is [`RayPre::major_axis`]; `(kx, ky)` follow it cyclically, swapped when
     /// `d[kz] < 0` to keep the winding; `Sx = d[kx] / d[kz]`, `Sy = d[ky] / d[kz]`.
     #[inline]
     pub fn new(ray: &Ray) -> Self {
@@ -136,10 +135,7 @@ impl RayPre {
             d.y.is_sign_negative(),
             d.z.is_sign_negative(),
         ];
-        let a = d.abs();
-        let x_max = (a.x >= a.y) & (a.x >= a.z);
-        let y_max = a.y >= a.z;
-        let kz = (!x_max) as usize * (1 + (!y_max) as usize);
+        let kz = Self::major_axis(d);
         let dkz = pick([d.x, d.y, d.z], kz);
         // (kx, ky) = (kz + 1, kz + 2) mod 3, two bits per kz in a constant.
         let (kx, ky) = ((0b00_10_01 >> (2 * kz)) & 3, (0b01_00_10 >> (2 * kz)) & 3);
@@ -154,6 +150,17 @@ impl RayPre {
             k: [kx, ky, kz],
             shear: Vec3::new(pick(s, kx), pick(s, ky), pick([inv.x, inv.y, inv.z], kz)),
         }
+    }
+
+    /// The watertight test's `kz` for direction `d`: x when `|dx| >= |dy|` and `|dx| >=
+    /// |dz|`, else y when `|dy| >= |dz|`, else z (so z when a component is NaN), by
+    /// comparisons without jumps.
+    #[inline(always)]
+    pub fn major_axis(d: Vec3) -> usize {
+        let a = d.abs();
+        let x_max = (a.x >= a.y) & (a.x >= a.z);
+        let y_max = a.y >= a.z;
+        (!x_max) as usize * (1 + (!y_max) as usize)
     }
 
     /// Ray parameter where the ray meets the plane `x[axis] = p`: `(p - o[axis]) * inv[axis]`.

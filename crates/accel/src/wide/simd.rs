@@ -316,7 +316,7 @@ impl Avx2 {
     }
 
     /// [`RayPre::new`]'s values for `ray`, bit for bit, with vector instructions and no
-    /// branch: the reciprocal, the signs and the axes as there (the same comparisons), then
+    /// branch: the reciprocal, the signs and `kz` as there (`RayPre::major_axis`), then
     /// `d / d[kz]` in one division whose lanes are `Sx`, `Sy` and `Sz = 1 / d[kz]` (the
     /// same correctly rounded quotients as its scalar lanes and `inv_dir[kz]`), gathered by
     /// one `vpermilps` with the axes from a table, where `RayPre::new` picks each value by
@@ -340,10 +340,7 @@ impl Avx2 {
                 [1, 0, 2, 3],
             ];
             let d = ray.dir;
-            let a = d.abs();
-            let x_max = (a.x >= a.y) & (a.x >= a.z);
-            let y_max = a.y >= a.z;
-            let kz = (!x_max) as usize * (1 + (!y_max) as usize);
+            let kz = RayPre::major_axis(d);
             // SAFETY: every intrinsic below needs at most AVX, which `self` proves this CPU
             // has (`detect`); no memory is touched but `K`'s row, read by value. `vpermilps`
             // reads only the low two bits of each index lane.
