@@ -47,7 +47,7 @@ use crate::observer::Observer;
 use dualsplit_geometry::{Aabb, PrimId, Triangle, Vec3};
 use std::ops::Range;
 use std::sync::Arc;
-pub use words::{MAPPED_MIN_BYTES, Pages, Words};
+pub use words::{MAPPED_MIN_BYTES, PAGES_MIN_BYTES, Pages, Words};
 
 /// Bit 31 of an index-run entry: set on the last triangle id of a leaf's run, in every
 /// structure's image (BVH2, BVH4, BVH8 and DST). Triangle ids are therefore below 2^31.

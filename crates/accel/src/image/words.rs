@@ -8,6 +8,13 @@
 //! mapping with 2 MiB pages where it can (27 faults for the same image). Where huge pages
 //! are unavailable or the mapping fails, the words simply live in a `Vec`; the contents and
 //! every reader are the same either way (readers see a `&[u32]`).
+//!
+//! A huge page only backs a 2 MiB-aligned, 2 MiB range that lies wholly inside an advised
+//! mapping, and `mmap` aligns to 4 KiB only: a mapping of exactly the data's bytes leaves its
+//! ends, and all of a mapping below 4 MiB that happens to straddle a 2 MiB boundary, in 4
+//! KiB pages. So the data starts at the mapping's first 2 MiB boundary, and what it covers
+//! is advised in whole huge pages ([`HugeMap`]): the mapping is up to 2 MiB longer (address
+//! space, never touched) and the last huge page holds up to 2 MiB of zeros beyond the data.
 
 use memmap2::MmapMut;
 use std::fmt;
@@ -16,13 +23,49 @@ use std::ops::{Deref, DerefMut};
 /// Images of at least this many bytes are mapped with the huge-page advice (one huge page).
 pub const MAPPED_MIN_BYTES: usize = 2 << 20;
 
+/// The size of a transparent huge page on x86-64 and most other Linux targets.
+const HUGE_PAGE: usize = 2 << 20;
+
+/// An anonymous mapping holding `bytes` bytes from its first 2 MiB boundary on, those whole
+/// huge pages advised `MADV_HUGEPAGE` (see the module docs). Zero-filled.
+struct HugeMap {
+    map: MmapMut,
+    /// Where the data starts: the first 2 MiB boundary of `map`.
+    off: usize,
+    /// Bytes of data.
+    bytes: usize,
+}
+
+impl HugeMap {
+    /// `bytes` zeroed bytes, or `None` if the mapping fails.
+    fn new(bytes: usize) -> Option<Self> {
+        let covered = bytes.checked_next_multiple_of(HUGE_PAGE)?;
+        let map = MmapMut::map_anon(covered.checked_add(HUGE_PAGE)?).ok()?;
+        let off = map.as_ptr().align_offset(HUGE_PAGE);
+        // Advice is a hint: a kernel without transparent huge pages keeps 4 KiB pages.
+        #[cfg(target_os = "linux")]
+        let _ = map.advise_range(memmap2::Advice::HugePage, off, covered);
+        Some(Self { map, off, bytes })
+    }
+
+    #[inline(always)]
+    fn bytes(&self) -> &[u8] {
+        &self.map[self.off..self.off + self.bytes]
+    }
+
+    #[inline(always)]
+    fn bytes_mut(&mut self) -> &mut [u8] {
+        &mut self.map[self.off..self.off + self.bytes]
+    }
+}
+
 /// The words of a [`super::MemoryImage`]; dereferences to `[u32]`.
 pub struct Words(Buf);
 
 enum Buf {
     Heap(Vec<u32>),
-    /// An anonymous mapping of exactly `4 · len` bytes (page-aligned, zero-filled).
-    Mapped(MmapMut),
+    /// `4 · len` bytes in huge pages (2 MiB-aligned, zero-filled).
+    Mapped(HugeMap),
 }
 
 impl Words {
@@ -30,11 +73,8 @@ impl Words {
     /// the transparent-huge-page advice, falling back to a vector if mapping fails.
     pub fn zeroed(n: usize) -> Words {
         if n.saturating_mul(4) >= MAPPED_MIN_BYTES
-            && let Ok(map) = MmapMut::map_anon(n * 4)
+            && let Some(map) = HugeMap::new(n * 4)
         {
-            // Advice is a hint: a kernel without transparent huge pages keeps 4 KiB pages.
-            #[cfg(target_os = "linux")]
-            let _ = map.advise(memmap2::Advice::HugePage);
             return Words(Buf::Mapped(map));
         }
         Words(Buf::Heap(vec![0; n]))
@@ -60,8 +100,8 @@ impl Deref for Words {
     fn deref(&self) -> &[u32] {
         match &self.0 {
             Buf::Heap(v) => v,
-            // Page-aligned and 4·len bytes long, so the cast cannot fail.
-            Buf::Mapped(m) => bytemuck::cast_slice(&m[..]),
+            // 2 MiB-aligned and 4·len bytes long, so the cast cannot fail.
+            Buf::Mapped(m) => bytemuck::cast_slice(m.bytes()),
         }
     }
 }
@@ -71,7 +111,7 @@ impl DerefMut for Words {
     fn deref_mut(&mut self) -> &mut [u32] {
         match &mut self.0 {
             Buf::Heap(v) => v,
-            Buf::Mapped(m) => bytemuck::cast_slice_mut(&mut m[..]),
+            Buf::Mapped(m) => bytemuck::cast_slice_mut(m.bytes_mut()),
         }
     }
 }
@@ -114,36 +154,44 @@ impl fmt::Debug for Words {
     }
 }
 
-/// An array of plain data that, when large ([`MAPPED_MIN_BYTES`]), lives in an anonymous
-/// mapping advised to use transparent huge pages, as [`Words`] does; dereferences to `[T]`.
+/// An array of plain data that, when large ([`PAGES_MIN_BYTES`]), lives in 2 MiB-aligned
+/// transparent huge pages, as [`Words`] does; dereferences to `[T]`.
 ///
 /// For data read at random, such as the CPU-side copies of the traversal
 /// ([`crate::wide::cpu`]): with 4 KiB pages nearly every node of a large scene costs a TLB
 /// miss (a two-level page walk under virtualisation); 2 MiB pages cover it with a few
-/// hundred entries. The contents are the same either way.
+/// entries. The contents are the same either way. Figures: `docs/cpu-traversal.md`.
 pub struct Pages<T: bytemuck::Pod>(PagesBuf<T>);
+
+/// Arrays of [`Pages`] from this many bytes on live in huge pages: beyond 64 pages of 4 KiB,
+/// the reach of a Zen 3 core's first-level data TLB (AMD's Software Optimization Guide for
+/// family 19h, 2.11), at the cost of up to one huge page of zeros after the data.
+pub const PAGES_MIN_BYTES: usize = 256 << 10;
 
 enum PagesBuf<T> {
     Heap(Vec<T>),
-    /// A page-aligned anonymous mapping of `len · size_of::<T>()` bytes.
-    Mapped(MmapMut, usize),
+    /// `len · size_of::<T>()` bytes in huge pages.
+    Mapped(HugeMap, std::marker::PhantomData<T>),
 }
 
 impl<T: bytemuck::Pod> Pages<T> {
     /// A copy of `items`.
     pub fn from_slice(items: &[T]) -> Self {
         let bytes = std::mem::size_of_val(items);
-        // A page-aligned mapping suits any alignment of `T` up to a page.
-        if bytes >= MAPPED_MIN_BYTES
-            && std::mem::align_of::<T>() <= 4096
-            && let Ok(mut map) = MmapMut::map_anon(bytes)
+        // A 2 MiB-aligned start suits any alignment of `T` up to that.
+        if bytes >= PAGES_MIN_BYTES
+            && std::mem::align_of::<T>() <= HUGE_PAGE
+            && let Some(mut map) = HugeMap::new(bytes)
         {
-            #[cfg(target_os = "linux")]
-            let _ = map.advise(memmap2::Advice::HugePage);
-            map.copy_from_slice(bytemuck::cast_slice(items));
-            return Pages(PagesBuf::Mapped(map, items.len()));
+            map.bytes_mut().copy_from_slice(bytemuck::cast_slice(items));
+            return Pages(PagesBuf::Mapped(map, std::marker::PhantomData));
         }
         Pages(PagesBuf::Heap(items.to_vec()))
+    }
+
+    /// Whether the array lives in a memory mapping (large arrays) rather than a vector.
+    pub fn is_mapped(&self) -> bool {
+        matches!(self.0, PagesBuf::Mapped(..))
     }
 }
 
@@ -153,7 +201,7 @@ impl<T: bytemuck::Pod> Deref for Pages<T> {
     fn deref(&self) -> &[T] {
         match &self.0 {
             PagesBuf::Heap(v) => v,
-            PagesBuf::Mapped(m, len) => &bytemuck::cast_slice(&m[..])[..*len],
+            PagesBuf::Mapped(m, _) => bytemuck::cast_slice(m.bytes()),
         }
     }
 }
@@ -175,7 +223,7 @@ impl<T: bytemuck::Pod> fmt::Debug for Pages<T> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("Pages")
             .field("len", &self.len())
-            .field("mapped", &matches!(self.0, PagesBuf::Mapped(..)))
+            .field("mapped", &self.is_mapped())
             .finish()
     }
 }
@@ -192,7 +240,11 @@ mod tests {
         let n = MAPPED_MIN_BYTES / 4 + 3;
         let mut big = Words::zeroed(n);
         #[cfg(unix)]
-        assert!(big.is_mapped());
+        {
+            assert!(big.is_mapped());
+            // The data starts a huge page, so the kernel can back all of it with them.
+            assert_eq!(big.as_ptr() as usize % HUGE_PAGE, 0);
+        }
         assert_eq!(big.len(), n);
         assert!(big.iter().all(|&w| w == 0));
         big[n - 1] = 7;
@@ -208,12 +260,21 @@ mod tests {
     fn pages_copy_small_and_large_slices() {
         let small: Vec<[u32; 4]> = (0..10).map(|i| [i, i + 1, i + 2, i + 3]).collect();
         assert_eq!(&Pages::from_slice(&small)[..], &small[..]);
+        assert!(!Pages::from_slice(&small).is_mapped());
+        // Below one huge page, and several huge pages with a partial last one.
+        for n in [PAGES_MIN_BYTES / 16 + 1, 3 * HUGE_PAGE / 16 + 5] {
+            let big: Vec<[u32; 4]> = (0..n as u32).map(|i| [i, !i, i ^ 7, 3]).collect();
+            let pages = Pages::from_slice(&big);
+            assert_eq!(&pages[..], &big[..]);
+            #[cfg(unix)]
+            {
+                assert!(format!("{pages:?}").contains("mapped: true"));
+                assert_eq!(pages.as_ptr() as usize % HUGE_PAGE, 0);
+            }
+        }
         let n = MAPPED_MIN_BYTES / 16 + 5;
         let big: Vec<[u32; 4]> = (0..n as u32).map(|i| [i, !i, i ^ 7, 3]).collect();
         let pages = Pages::from_slice(&big);
-        assert_eq!(&pages[..], &big[..]);
-        #[cfg(unix)]
-        assert!(format!("{pages:?}").contains("mapped: true"));
         assert_eq!(&pages.clone()[..], &big[..]);
         assert!(Pages::<u32>::default().is_empty());
     }

@@ -61,8 +61,9 @@
 //! test and the whole traversal is compiled for AVX2 (`simd.rs`); otherwise SSE2, which
 //! every x86-64 CPU has (two 4-wide tests per BVH8 node), or `wide`'s portable code
 //! elsewhere. Hit children about to be pushed are prefetched (every line of the node or
-//! packet), and nodes and packets live in transparent huge pages ([`Pages`]). Figures:
-//! `docs/performance.md`, "CPU traversal".
+//! packet), and node and packet arrays of [`PAGES_MIN_BYTES`] or more live in transparent
+//! huge pages from their first byte ([`Pages`]). Figures: `docs/performance.md`, "CPU
+//! traversal".
 //!
 //! | file | what it holds |
 //! |---|---|
@@ -77,6 +78,7 @@
 //! [`Triangle::intersect`]: dualsplit_geometry::Triangle::intersect
 //! [`Triangle::intersect_from_edges`]: dualsplit_geometry::Triangle::intersect_from_edges
 //! [`Hit::closer_than`]: dualsplit_geometry::Hit::closer_than
+//! [`PAGES_MIN_BYTES`]: crate::image::PAGES_MIN_BYTES
 
 mod copy;
 mod isa;
