@@ -10,11 +10,12 @@
 //! every reader are the same either way (readers see a `&[u32]`).
 //!
 //! A huge page only backs a 2 MiB-aligned, 2 MiB range that lies wholly inside an advised
-//! mapping, and `mmap` aligns to 4 KiB only: a mapping of exactly the data's bytes leaves its
-//! ends, and all of a mapping below 4 MiB that happens to straddle a 2 MiB boundary, in 4
-//! KiB pages. So the data starts at the mapping's first 2 MiB boundary, and what it covers
-//! is advised in whole huge pages ([`HugeMap`]): the mapping is up to 2 MiB longer (address
-//! space, never touched) and the last huge page holds up to 2 MiB of zeros beyond the data.
+//! mapping, and `mmap` aligns to 4 KiB only: a mapping of exactly the data's bytes keeps its
+//! unaligned ends in 4 KiB pages, and one below 4 MiB may hold no whole aligned range at all
+//! (Sponza's BVH8 copy had no huge page). So the data starts at the mapping's first 2 MiB
+//! boundary, and what it covers is advised in whole huge pages ([`HugeMap`]): the mapping is
+//! up to 2 MiB longer (address space, never touched) and the last huge page holds up to 2 MiB
+//! of zeros beyond the data.
 
 use memmap2::MmapMut;
 use std::fmt;
@@ -164,8 +165,9 @@ impl fmt::Debug for Words {
 pub struct Pages<T: bytemuck::Pod>(PagesBuf<T>);
 
 /// Arrays of [`Pages`] from this many bytes on live in huge pages: beyond 64 pages of 4 KiB,
-/// the reach of a Zen 3 core's first-level data TLB (AMD's Software Optimization Guide for
-/// family 19h, 2.11), at the cost of up to one huge page of zeros after the data.
+/// the reach of a Zen 3 core's first-level data TLB (64 entries; AMD's Software
+/// Optimization Guide for family 19h), at the cost of up to one huge page of zeros after the
+/// data.
 pub const PAGES_MIN_BYTES: usize = 256 << 10;
 
 enum PagesBuf<T> {
