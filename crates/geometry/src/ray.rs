@@ -38,7 +38,8 @@ pub fn widen_exit(t: f32) -> f32 {
 ///
 /// Plain data (`repr(C)`, [`bytemuck::Pod`]): 32 bytes, eight little-endian `f32` on the
 /// usual targets in the order origin.xyz, dir.xyz, t_min, t_max, so a file of rays can be
-/// read in bulk with [`bytemuck::cast_slice`] (or [`bytemuck::pod_read_unaligned`] per ray when the bytes are not 4-aligned).
+/// read in bulk with [`bytemuck::cast_slice`] (or [`bytemuck::pod_read_unaligned`] per ray
+/// when the bytes are not 4-aligned).
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C)]
 pub struct Ray {

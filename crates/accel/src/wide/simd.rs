@@ -1,9 +1,10 @@
 //! The one place in this crate with `unsafe` code: cache prefetch hints, and the AVX2 path
 //! of the CPU traversal (a token proving the CPU has AVX2, a way to run code compiled for
 //! it, the ray's constants, the 8-wide box test, the sort of a node's hit children, a lane
-//! picked from a register and the f64 plane distances of a triangle packet), which `std::arch` offers only through `unsafe` calls from
-//! code not itself compiled for AVX2. The crate denies `unsafe_code` (its `Cargo.toml`); this
-//! leaf module allows it, and every block carries a SAFETY note.
+//! picked from a register and the f64 plane distances of a triangle packet), which
+//! `std::arch` offers only through `unsafe` calls from code not itself compiled for AVX2.
+//! The crate denies `unsafe_code` (its `Cargo.toml`); this leaf module allows it, and every
+//! block carries a SAFETY note.
 #![allow(unsafe_code)]
 
 /// Hints the CPU to bring every cache line (64 bytes) that a `T` at `p` touches into all
