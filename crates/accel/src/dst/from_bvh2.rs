@@ -32,6 +32,8 @@ use super::header::{AxisPair, Corner, HeaderOffset};
 use super::{Dst, DstConfig, DstCosts, DstError, Partitioning};
 use crate::build::Bvh2;
 use crate::image::SharedTriangles;
+use crate::wide::cpu::avx2_token;
+use crate::wide::simd::{Avx2, Kernel};
 use dualsplit_geometry::{Aabb, Vec3};
 
 impl Dst {
@@ -295,6 +297,35 @@ pub(super) struct ChainDp {
     base: f32,
     /// Working arrays of [`ChainDp::solve`].
     scratch: Scratch,
+    /// The AVX2 token when [`ChainDp::solve`] runs compiled for AVX2 (the same operations,
+    /// so the same results; fewer instructions with VEX encodings and BMI2 shifts).
+    avx2: Option<Avx2>,
+}
+
+/// [`ChainDp::solve`]'s arguments, run by [`Avx2::vectorize`].
+struct Solve<'a> {
+    avx2: Avx2,
+    dp: &'a mut ChainDp,
+    region: &'a Aabb,
+    target: &'a Aabb,
+    costs: &'a DstCosts,
+    leaf_tris: Option<u32>,
+}
+
+impl Kernel for Solve<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn call(self) {
+        let Solve {
+            avx2,
+            dp,
+            region,
+            target,
+            costs,
+            leaf_tris,
+        } = self;
+        dp.solve_with(region, target, costs, leaf_tris, Some(avx2));
+    }
 }
 
 /// Working arrays of one DP, kept between solves so that no array is cleared per BVH node
@@ -401,14 +432,16 @@ struct DpInputs<'a> {
 /// s carved from `region` to `target`) into `sa[s]`, and in the full state when `with_full`
 /// (only a leaf's triangle cost reads it, in similar partitioning): the extents of each axis
 /// for its four carve codes, the states' face masks by doubling, then x·y + y·z + z·x per
-/// state.
+/// state, eight states at a time with AVX2 ([`Avx2::areas8`], the same bits) from three
+/// faces on (the entries past the full state that a chunk of eight writes are never read).
 #[inline(always)]
 fn state_areas<const K: usize>(
     faces: &[usize; 6],
     region: &Aabb,
     target: &Aabb,
     with_full: bool,
-    sa: &mut [f32],
+    sa: &mut [f32; 64],
+    avx2: Option<Avx2>,
 ) {
     // ext[a][c]: the region's extent on axis a with carve code c (bit 0: min face carved to
     // `target`, bit 1: max face carved).
@@ -423,15 +456,32 @@ fn state_areas<const K: usize>(
             (th - tl).max(0.0),
         ];
     }
-    let mut fm = [0usize; 64];
+    let mut fm = [0u32; 64];
     for (i, &f) in faces[..K].iter().enumerate() {
         let b = 1 << i;
         for s in 0..b {
             fm[s | b] = fm[s] | 1 << f;
         }
     }
-    let area = |m: usize| {
-        let (x, y, z) = (ext[0][m & 3], ext[1][m >> 2 & 3], ext[2][m >> 4 & 3]);
+    if let Some(avx2) = avx2
+        && K >= 3
+    {
+        for (codes, out) in fm
+            .chunks_exact(8)
+            .zip(sa.chunks_exact_mut(8))
+            .take((1 << K) / 8)
+        {
+            let codes: &[u32; 8] = codes.try_into().expect("a chunk of eight");
+            out.copy_from_slice(&avx2.areas8(&ext, codes));
+        }
+        return;
+    }
+    let area = |m: u32| {
+        let (x, y, z) = (
+            ext[0][(m & 3) as usize],
+            ext[1][(m >> 2 & 3) as usize],
+            ext[2][(m >> 4 & 3) as usize],
+        );
         x * y + y * z + z * x
     };
     let full = (1 << K) - 1;
@@ -444,9 +494,16 @@ fn state_areas<const K: usize>(
 }
 
 impl ChainDp {
-    /// A DP ready for [`ChainDp::solve`] (reused across nodes).
+    /// A DP ready for [`ChainDp::solve`] (reused across nodes), compiled for AVX2 where
+    /// the traversal's instruction level is AVX2 ([`crate::wide::cpu::SimdLevel`]).
     pub fn new() -> Self {
+        Self::with_avx2(avx2_token())
+    }
+
+    /// [`ChainDp::new`] with AVX2 code when `avx2` holds the token, baseline code otherwise.
+    pub fn with_avx2(avx2: Option<Avx2>) -> Self {
         ChainDp {
+            avx2,
             faces: [0; 6],
             bit_of: [0; 6],
             k: 0,
@@ -468,13 +525,49 @@ impl ChainDp {
     /// each node is tested.
     // Out of line: one copy serves both children (inlined twice, the split choice is 45 KB
     // of code; out of line about 17 KB and a few percent faster, single-thread bench).
-    #[inline(never)]
+    #[inline(always)]
     pub fn solve(
         &mut self,
         region: &Aabb,
         target: &Aabb,
         costs: &DstCosts,
         leaf_tris: Option<u32>,
+    ) {
+        match self.avx2 {
+            Some(avx2) => avx2.vectorize(Solve {
+                avx2,
+                dp: self,
+                region,
+                target,
+                costs,
+                leaf_tris,
+            }),
+            None => self.solve_base(region, target, costs, leaf_tris),
+        }
+    }
+
+    /// [`ChainDp::solve`] in baseline code.
+    #[inline(never)]
+    fn solve_base(
+        &mut self,
+        region: &Aabb,
+        target: &Aabb,
+        costs: &DstCosts,
+        leaf_tris: Option<u32>,
+    ) {
+        self.solve_with(region, target, costs, leaf_tris, None);
+    }
+
+    /// [`ChainDp::solve`]'s body, compiled into each instruction set's function (`avx2`:
+    /// the token inside the AVX2 one).
+    #[inline(always)]
+    fn solve_with(
+        &mut self,
+        region: &Aabb,
+        target: &Aabb,
+        costs: &DstCosts,
+        leaf_tris: Option<u32>,
+        avx2: Option<Avx2>,
     ) {
         let dp = self;
         dp.k = 0;
@@ -488,13 +581,13 @@ impl ChainDp {
         }
         // Compiled once per chain length: the loops over the 2^k states unroll.
         match dp.k {
-            0 => dp.fill::<0>(region, target, costs, leaf_tris),
-            1 => dp.fill::<1>(region, target, costs, leaf_tris),
-            2 => dp.fill::<2>(region, target, costs, leaf_tris),
-            3 => dp.fill::<3>(region, target, costs, leaf_tris),
-            4 => dp.fill::<4>(region, target, costs, leaf_tris),
-            5 => dp.fill::<5>(region, target, costs, leaf_tris),
-            _ => dp.fill::<6>(region, target, costs, leaf_tris),
+            0 => dp.fill::<0>(region, target, costs, leaf_tris, avx2),
+            1 => dp.fill::<1>(region, target, costs, leaf_tris, avx2),
+            2 => dp.fill::<2>(region, target, costs, leaf_tris, avx2),
+            3 => dp.fill::<3>(region, target, costs, leaf_tris, avx2),
+            4 => dp.fill::<4>(region, target, costs, leaf_tris, avx2),
+            5 => dp.fill::<5>(region, target, costs, leaf_tris, avx2),
+            _ => dp.fill::<6>(region, target, costs, leaf_tris, avx2),
         }
     }
 
@@ -506,6 +599,7 @@ impl ChainDp {
         target: &Aabb,
         costs: &DstCosts,
         leaf_tris: Option<u32>,
+        avx2: Option<Avx2>,
     ) {
         let dp = self;
         let k = K;
@@ -519,7 +613,7 @@ impl ChainDp {
             weight,
             cheap_partner,
         } = &mut dp.scratch;
-        state_areas::<K>(&dp.faces, region, target, leaf_tris.is_some(), sa);
+        state_areas::<K>(&dp.faces, region, target, leaf_tris.is_some(), sa, avx2);
         dp.base = leaf_cost(sa[full]).unwrap_or(0.0);
         // Option weights by option mask (one face = a lone-face node, two faces = a pair
         // node), and for each lone face the partners whose pair node costs no more than a
@@ -716,5 +810,86 @@ pub(super) fn plan_split(bvh: &Bvh2, n: u32, cfg: &DstConfig, dps: &mut [ChainDp
         swap,
         left_chain: lo.chain(max_face(axis)),
         right_chain: hi.chain(min_face(axis)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dualsplit_geometry::Pcg32;
+
+    /// A random child box inside `region` with each face equal to the region's with
+    /// probability one half (so every chain length 0–6 occurs), sometimes flat.
+    fn child(rng: &mut Pcg32, region: &Aabb) -> Aabb {
+        let mut b = *region;
+        for a in 0..3 {
+            let (lo, hi) = (region.min[a], region.max[a]);
+            let mut t = [rng.next_f32(), rng.next_f32()];
+            t.sort_by(f32::total_cmp);
+            if rng.below(8) == 0 {
+                t[1] = t[0];
+            }
+            if rng.below(2) == 0 {
+                b.min[a] = lo + (hi - lo) * t[0];
+            }
+            if rng.below(2) == 0 {
+                b.max[a] = (lo + (hi - lo) * t[1]).max(b.min[a]);
+            }
+        }
+        b
+    }
+
+    /// The AVX2 code of [`ChainDp::solve`] finds the baseline code's costs (bit for bit),
+    /// choices and leaf cost in every state, under the presets' and random node costs, with
+    /// and without an early stop above a leaf, for boxes up to 1e30 across (whose areas
+    /// overflow to +∞).
+    #[test]
+    fn avx2_solve_is_the_baseline_solve() {
+        let Some(avx2) = Avx2::detect() else {
+            eprintln!("no AVX2 on this CPU: only the baseline code runs here");
+            return;
+        };
+        let mut rng = Pcg32::new(0x5eed, 7);
+        let (mut base, mut vec) = (ChainDp::with_avx2(None), ChainDp::with_avx2(Some(avx2)));
+        let mut lengths = [0usize; 7];
+        for case in 0..40_000 {
+            let costs = match case % 3 {
+                0 => DstConfig::hardware().costs,
+                1 => DstConfig::software().costs,
+                _ => DstCosts {
+                    split: 1.0,
+                    single_carve: rng.range_f32(0.1, 2.0),
+                    dual_carve: rng.range_f32(0.1, 2.0),
+                    triangle: rng.range_f32(0.1, 4.0),
+                },
+            };
+            let scale = [1.0, 1e3, 1e19, 1e30][rng.below(4) as usize];
+            let p = |rng: &mut Pcg32| rng.range_f32(-scale, scale);
+            let (a, b) = (
+                Vec3::new(p(&mut rng), p(&mut rng), p(&mut rng)),
+                Vec3::new(p(&mut rng), p(&mut rng), p(&mut rng)),
+            );
+            let region = Aabb::new(a.min(b), a.max(b));
+            let target = child(&mut rng, &region);
+            let leaf_tris = (rng.below(2) == 0).then(|| 1 + rng.below(8));
+            base.solve(&region, &target, &costs, leaf_tris);
+            vec.solve(&region, &target, &costs, leaf_tris);
+            assert_eq!(base.k, vec.k);
+            lengths[base.k] += 1;
+            let states = 1 << base.k;
+            let bits = |c: &[f32; 64]| c[..states].iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            let what = format!("case {case}: {region:?} → {target:?}, {costs:?}, {leaf_tris:?}");
+            assert_eq!(bits(&base.cost), bits(&vec.cost), "{what}: costs");
+            assert_eq!(
+                base.choice[..states],
+                vec.choice[..states],
+                "{what}: choices"
+            );
+            assert_eq!(base.base.to_bits(), vec.base.to_bits(), "{what}: leaf cost");
+        }
+        assert!(
+            lengths.iter().all(|&n| n > 0),
+            "every chain length: {lengths:?}"
+        );
     }
 }

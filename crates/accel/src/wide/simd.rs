@@ -183,6 +183,38 @@ impl Avx2 {
         }
     }
 
+    /// The surface areas `x·y + y·z + z·x` of eight boxes whose extents come from a table:
+    /// box `i`'s extent on axis `a` is `ext[a][(codes[i] >> 2a) & 3]` (the DST converter's
+    /// chain states, `dst::from_bvh2`). The lookup is one `vpermilps` per axis (it reads the
+    /// low two bits of each index), and the products and sums are the scalar expression's,
+    /// in its order, unfused: each lane is the scalar area's bits.
+    #[inline(always)]
+    pub fn areas8(self, ext: &[[f32; 4]; 3], codes: &[u32; 8]) -> [f32; 8] {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            // SAFETY: every intrinsic below needs at most AVX2, which `self` proves this CPU
+            // has (`detect`). The loads read `ext[a]` (16 bytes) and `codes` (32 bytes)
+            // through references to them; `loadu` needs no alignment.
+            unsafe {
+                let c = _mm256_loadu_si256(codes.as_ptr().cast());
+                let axis = |a: usize| {
+                    let table = _mm_loadu_ps(ext[a].as_ptr());
+                    let idx = _mm256_srlv_epi32(c, _mm256_set1_epi32(2 * a as i32));
+                    _mm256_permutevar_ps(_mm256_set_m128(table, table), idx)
+                };
+                let (x, y, z) = (axis(0), axis(1), axis(2));
+                let xy_yz = _mm256_add_ps(_mm256_mul_ps(x, y), _mm256_mul_ps(y, z));
+                bytemuck::cast(_mm256_add_ps(xy_yz, _mm256_mul_ps(z, x)))
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = (ext, codes);
+            unreachable!("no Avx2 token exists off x86-64")
+        }
+    }
+
     /// Where the ray meets the planes of four triangles, `Triangle::plane_t`'s f64
     /// arithmetic on four lanes at once: vertex `i`'s coordinate on axis `a` of lane `l` is
     /// `v[3 i + a][l]`, `o` the ray's origin, `k` the watertight test's axes `(kx, ky, kz)`
