@@ -25,7 +25,10 @@
 //! a table built at compile time ([`OPTIONS`]) in the reference's loop order, and the
 //! cheapest is selected without branches, with the same strict `<` and the same float
 //! expressions, so every decision (ties included) is the reference's
-//! (`tests/dst_convert_reference.rs`).
+//! (`tests/dst_convert_reference.rs`). Where the CPU has AVX2 (the traversal's
+//! [`SimdLevel`](crate::wide::cpu::SimdLevel)), the DP runs compiled for it and computes
+//! its state areas eight at a time ([`Avx2::areas8`]), with the same operations in the same
+//! order: the same bits (unit test `avx2_solve_is_the_baseline_solve`).
 
 use super::encode::{Planner, encode};
 use super::header::{AxisPair, Corner, HeaderOffset};
