@@ -526,8 +526,10 @@ impl ChainDp {
     /// partitioning is on: the chain may then stop early, paying `C_tri · n · SA` of the
     /// looser region instead. Costs are SAH-weighted by the area of the region in which
     /// each node is tested.
-    // Out of line: one copy serves both children (inlined twice, the split choice is 45 KB
-    // of code; out of line about 17 KB and a few percent faster, single-thread bench).
+    // A dispatcher only: the body is out of line once per instruction set (`solve_base`, and
+    // `Avx2::vectorize`'s function for `Solve`), so that one copy serves both children
+    // (inlined twice, the split choice was 45 KB of code; out of line about 17 KB and a few
+    // percent faster, single-thread bench).
     #[inline(always)]
     pub fn solve(
         &mut self,
