@@ -1,8 +1,9 @@
 //! The one place in this crate with `unsafe` code: cache prefetch hints, and the AVX2 path
 //! of the CPU traversal (a token proving the CPU has AVX2, a way to run code compiled for
 //! it, the ray's constants, the 8-wide box test, the sort of a node's hit children, a lane
-//! picked from a register and the f64 plane distances of a triangle packet), which
-//! `std::arch` offers only through `unsafe` calls from code not itself compiled for AVX2.
+//! picked from a register and the f64 plane distances of a triangle packet; and the DST
+//! converter's chain-state areas), which `std::arch` offers only through `unsafe` calls from
+//! code not itself compiled for AVX2.
 //! The crate denies `unsafe_code` (its `Cargo.toml`); this leaf module allows it, and every
 //! block carries a SAFETY note.
 #![allow(unsafe_code)]
