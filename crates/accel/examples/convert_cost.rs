@@ -24,17 +24,23 @@ use dualsplit_accel::{BuildConfig, Bvh2, SharedTriangles};
 use dualsplit_geometry::Aabb;
 use dualsplit_testkit::scenes::shipped_triangles;
 use sha2::{Digest, Sha256};
+use std::error::Error;
+use std::io::{self, Write};
 
-fn load(mesh: &str) -> (SharedTriangles, Vec<Aabb>) {
+type Res<T> = Result<T, Box<dyn Error + Send + Sync>>;
+
+const USAGE: &str = "usage: convert_cost cost MESH BUILDS CONVERTS | convert_cost hash [MESH…]";
+
+fn load(mesh: &str) -> Res<(SharedTriangles, Vec<Aabb>)> {
     let tris: SharedTriangles = shipped_triangles(mesh)
-        .unwrap_or_else(|| panic!("{mesh} not found"))
+        .ok_or_else(|| format!("{mesh}: no such shipped mesh"))?
         .into();
     let boxes = tris.iter().map(|t| t.bounds()).collect();
-    (tris, boxes)
+    Ok((tris, boxes))
 }
 
-fn cost(mesh: &str, builds: usize, converts: usize) {
-    let (tris, boxes) = load(mesh);
+fn cost(mesh: &str, builds: usize, converts: usize) -> Res<()> {
+    let (tris, boxes) = load(mesh)?;
     let mut bvh = Bvh2::build(&boxes, &BuildConfig::default());
     for _ in 1..builds {
         bvh = Bvh2::build(std::hint::black_box(&boxes), &BuildConfig::default());
@@ -44,14 +50,18 @@ fn cost(mesh: &str, builds: usize, converts: usize) {
             std::hint::black_box(&bvh),
             tris.clone(),
             &DstConfig::hardware(),
-        )
-        .expect("conversion");
+        )?;
         std::hint::black_box(dst);
     }
-    println!("{mesh}: {builds} builds, {converts} conversions");
+    writeln!(
+        io::stdout(),
+        "{mesh}: {builds} builds, {converts} conversions"
+    )?;
+    Ok(())
 }
 
-fn hash(meshes: &[String]) {
+fn hash(meshes: &[String]) -> Res<()> {
+    let out = &mut io::stdout().lock();
     let presets = [
         ("hardware", DstConfig::hardware()),
         ("software", DstConfig::software()),
@@ -65,10 +75,10 @@ fn hash(meshes: &[String]) {
         ),
     ];
     for mesh in meshes {
-        let (tris, boxes) = load(mesh);
+        let (tris, boxes) = load(mesh)?;
         let bvh = Bvh2::build(&boxes, &BuildConfig::default());
         for (name, cfg) in &presets {
-            let dst = Dst::from_bvh2(&bvh, tris.clone(), cfg).expect("conversion");
+            let dst = Dst::from_bvh2(&bvh, tris.clone(), cfg)?;
             let img = dst.image();
             let mut h = Sha256::new();
             for region in [img.nodes.clone(), img.indices.clone()] {
@@ -78,22 +88,22 @@ fn hash(meshes: &[String]) {
                 }
             }
             let digest: String = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
-            println!("{mesh} {name} {digest}");
+            writeln!(out, "{mesh} {name} {digest}")?;
         }
     }
+    Ok(())
 }
 
-fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("a one-thread pool");
+fn run(args: &[String]) -> Res<()> {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     match args.first().map(String::as_str) {
         Some("cost") if args.len() == 4 => {
-            let n = |s: &str| s.parse::<usize>().expect("a count");
-            let (builds, converts) = (n(&args[2]).max(1), n(&args[3]));
-            pool.install(|| cost(&args[1], builds, converts));
+            let n = |s: &str| {
+                s.parse::<usize>()
+                    .map_err(|e| format!("{s:?} is not a count ({e}); {USAGE}"))
+            };
+            let (builds, converts) = (n(&args[2])?.max(1), n(&args[3])?);
+            pool.install(|| cost(&args[1], builds, converts))
         }
         Some("hash") => {
             let meshes = if args.len() > 1 {
@@ -103,10 +113,22 @@ fn main() {
                     .map(|m| format!("{m}.ply.gz"))
                     .to_vec()
             };
-            pool.install(|| hash(&meshes));
+            pool.install(|| hash(&meshes))
         }
-        _ => {
-            eprintln!("usage: convert_cost cost MESH BUILDS CONVERTS | convert_cost hash [MESH…]");
+        _ => Err(USAGE.into()),
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match run(&args) {
+        Ok(()) => {}
+        // A reader that stopped early (`| head`) is not an error.
+        Err(e)
+            if e.downcast_ref::<io::Error>().map(io::Error::kind)
+                == Some(io::ErrorKind::BrokenPipe) => {}
+        Err(e) => {
+            eprintln!("convert_cost: {e}");
             std::process::exit(2);
         }
     }
