@@ -5,8 +5,12 @@
 
 use dualsplit_accel::math::{Ray, Triangle, Vec3};
 use dualsplit_accel::{AnyTree, BuildConfig, Bvh2Tree, DstConfig, DstTree, RayQuery};
+use std::io::Write;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    // Written with `?`: a reader that stops early (`| head`) ends the example with an
+    // error, not a panic.
+    let mut out = std::io::stdout().lock();
     // A small grid of triangles in the plane z = 4.
     let mut tris = Vec::new();
     for i in 0..16 {
@@ -21,7 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let bvh2 = Bvh2Tree::build(&tris[..], &BuildConfig::default())?;
     let dst = DstTree::from_bvh2(&bvh2, &DstConfig::hardware())?;
-    println!("DST: {:?}", dst.stats());
+    writeln!(out, "DST: {:?}", dst.stats())?;
 
     let dir = std::env::temp_dir().join(format!("dualsplit-example-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
@@ -41,11 +45,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Err("expected a DST".into());
     };
     assert_eq!(hits, d.pipeline().intersect_batch(&rays));
-    println!(
+    writeln!(
+        out,
         "{} of {} rays hit; first: {:?}",
         hits.iter().flatten().count(),
         rays.len(),
         hits[0]
-    );
+    )?;
     Ok(())
 }

@@ -5,8 +5,12 @@
 
 use dualsplit_accel::math::{Ray, Triangle, Vec3};
 use dualsplit_accel::{BuildConfig, Bvh2Tree, BvhTree, RayQuery};
+use std::io::Write;
 
-fn main() -> Result<(), dualsplit_accel::AccelError> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    // Written with `?`: a reader that stops early (`| head`) ends the example with an
+    // error, not a panic.
+    let mut out = std::io::stdout().lock();
     // A floor and a wall.
     let tris = vec![
         Triangle::new(
@@ -22,16 +26,17 @@ fn main() -> Result<(), dualsplit_accel::AccelError> {
     ];
     let bvh2 = Bvh2Tree::build(tris, &BuildConfig::default())?;
     let bvh8 = BvhTree::bvh8_from(&bvh2)?;
-    println!("BVH8: {:?}", bvh8.stats());
+    writeln!(out, "BVH8: {:?}", bvh8.stats())?;
 
     let down = Ray::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, -1.0, 0.0));
     let hit = bvh8.intersect(&down).expect("the floor is below");
-    println!(
+    writeln!(
+        out,
         "down: t = {}, triangle {}, normal {:?}",
         hit.t,
         hit.prim,
         bvh8.hit_normal(&hit)
-    );
+    )?;
     assert_eq!((hit.t, hit.prim.0), (1.0, 0));
 
     let rays: Vec<Ray> = (0..8)
@@ -47,11 +52,12 @@ fn main() -> Result<(), dualsplit_accel::AccelError> {
     for (h, s) in hits.iter().zip(&shadows) {
         assert_eq!(h.is_some(), *s);
     }
-    println!(
+    writeln!(
+        out,
         "batch: {} of {} rays hit the wall",
         hits.iter().flatten().count(),
         rays.len()
-    );
+    )?;
     assert_eq!(hits.iter().flatten().count(), 4);
     Ok(())
 }

@@ -22,6 +22,7 @@ use dualsplit_embree::tree::{BuiltTree, Child, TreeArgs, build_tree};
 use dualsplit_geometry::Aabb;
 use dualsplit_render::bench::{RaySet, ray_sets};
 use dualsplit_render::{RayKind, RenderSettings, TraceResult, Workload};
+use std::io::Write;
 use std::time::{Duration, Instant};
 
 /// Embree's tree as a BVH8 over leaf runs: the wide tree and the primitive ids its leaves
@@ -100,6 +101,9 @@ fn work(img: &BvhImage, set: &RaySet) -> [f64; 3] {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    // Written with `?`: a reader that stops early (`| head`) ends the example with an
+    // error, not a panic.
+    let mut out = std::io::stdout().lock();
     let mut args = std::env::args().skip(1);
     let spec = args
         .next()
@@ -128,7 +132,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let leaves = tree.leaves.len().max(1) as f64;
     let tris: usize = tree.leaves.iter().map(Vec::len).sum();
-    println!(
+    writeln!(
+        out,
         "{spec}: {} triangles; Embree's BVH8 ({:?}): {} nodes, {} leaves of {:.2} triangles, built in {:.0} ms; ours: {} nodes, {} leaves",
         scene.triangles.len(),
         TreeArgs::bvh8_triangle4(),
@@ -138,7 +143,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         build.as_secs_f64() * 1e3,
         s.bvh8.internal_nodes,
         s.bvh8.leaves,
-    );
+    )?;
 
     let level = SimdLevel::detect();
     let merge = merge_limit();
@@ -169,24 +174,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let mib = |c: &CpuBvh| c.bytes() as f64 / 1048576.0;
-    println!(
+    writeln!(
+        out,
         "copies: ours {:.2} MiB ({:.2} without merging), Embree's tree {:.2} MiB",
         mib(&copies[0].1),
         mib(&copies[1].1),
         mib(&copies[2].1)
-    );
-    println!(
+    )?;
+    writeln!(
+        out,
         "every answer of the four copies equals BVH2's ({} rays); {level:?}, merge limit {merge}, 1 thread, {passes} alternated passes",
         sets.iter().map(|s| s.rays.len()).sum::<usize>()
-    );
+    )?;
 
-    println!(
+    writeln!(
+        out,
         "{:8} {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8}  (per ray: BVH8 node steps, box tests, triangle tests on each image)",
         "rays", "ours", "", "", "Embree's", "", ""
-    );
+    )?;
     for set in &sets {
         let (a, b) = (work(&s.bvh8, set), work(&theirs, set));
-        println!(
+        writeln!(
+            out,
             "{:8} {:8.2} {:8.1} {:8.2} | {:8.2} {:8.1} {:8.2}",
             set.kind.name(),
             a[0],
@@ -195,15 +204,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             b[0],
             b[1],
             b[2]
-        );
+        )?;
     }
 
-    println!("Mrays/s, medians:");
+    writeln!(out, "Mrays/s, medians:")?;
     print!("{:8}", "rays");
     for (name, _) in &tracers {
         print!(" {name:>24}");
     }
-    println!();
+    writeln!(out)?;
     for set in &sets {
         let mut times = vec![Vec::new(); tracers.len()];
         for _ in 0..passes {
@@ -221,7 +230,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let med: Duration = ts[ts.len() / 2];
             print!(" {:>24.2}", set.rays.len() as f64 / med.as_secs_f64() / 1e6);
         }
-        println!();
+        writeln!(out)?;
     }
     Ok(())
 }

@@ -8,19 +8,24 @@
 
 use dualsplit_accel::{AccelKind, CountingObserver, Structures};
 use dualsplit_render::{RayKind, RenderSettings, Workload, bench::ray_sets};
+use std::io::Write;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    // Written with `?`: a reader that stops early (`| head`) ends the example with an
+    // error, not a panic.
+    let mut out = std::io::stdout().lock();
     let mut args = std::env::args().skip(1);
     let spec = args.next().ok_or("usage: work_per_ray SCENE [RES]")?;
     let res: u32 = args.next().map_or(Ok(256), |r| r.parse())?;
     let scene = dualsplit_scene::load(&spec)?;
     let s = Structures::try_build(&scene.triangles, &Default::default())?;
     let sets = ray_sets(&scene, &s, &RenderSettings::new(res, res, Workload::Path))?;
-    println!("{spec}, {res}x{res} path frame; per ray:");
-    println!(
+    writeln!(out, "{spec}, {res}x{res} path frame; per ray:")?;
+    writeln!(
+        out,
         "{:8} {:8} {:>8} {:>7} {:>7} {:>7} {:>7}",
         "rays", "accel", "nodes", "leaves", "boxes", "planes", "tris"
-    );
+    )?;
     for set in &sets {
         for kind in AccelKind::ALL {
             let mut obs = CountingObserver::default();
@@ -33,7 +38,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             let n = set.rays.len().max(1) as f64;
             let per = |c: u64| c as f64 / n;
-            println!(
+            writeln!(
+                out,
                 "{:8} {:8} {:8.1} {:7.2} {:7.1} {:7.1} {:7.2}",
                 set.kind.name(),
                 kind.name(),
@@ -42,7 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 per(obs.box_tests),
                 per(obs.plane_tests),
                 per(obs.triangle_tests)
-            );
+            )?;
         }
     }
     Ok(())
