@@ -227,6 +227,57 @@ fn identical_leaves_in_all_three() {
     }
 }
 
+/// Every leaf of every copy, merged or not, lies in as few triangle packets as its size
+/// allows: a leaf that would straddle one packet more starts at a packet's first lane
+/// (the copy pads the lanes it skips).
+#[test]
+fn copy_leaves_span_fewest_packets() {
+    use dualsplit_accel::image::RUN_END;
+    use dualsplit_accel::wide::cpu::{CpuNodes, LANES, LEAF};
+    let mut scenes = vec![(
+        "builtin:cornell".to_string(),
+        dualsplit_scene::load("builtin:cornell").expect("builtin scene"),
+    )];
+    scenes.extend(shipped("dragon_res4.ply.gz").map(|s| ("dragon_res4".to_string(), s)));
+    for (name, scene) in &scenes {
+        let s = Structures::build(&scene.triangles, &BuildConfig::default());
+        for kind in [AccelKind::Bvh2, AccelKind::Bvh4, AccelKind::Bvh8] {
+            for merge in [0, 4, 16] {
+                let c = s
+                    .encoded(kind)
+                    .unwrap()
+                    .cpu_copy_with(SimdLevel::detect(), merge);
+                let words: Vec<u32> = match &c.nodes {
+                    CpuNodes::Four(n) => n.iter().flat_map(|n| n.child).collect(),
+                    CpuNodes::Eight(n) => n.iter().flat_map(|n| n.child).collect(),
+                };
+                let mut leaves = 0;
+                for w in words.into_iter().filter(|w| w & LEAF != 0) {
+                    let slot = (w & !LEAF) as usize;
+                    // The leaf's triangles: up to the first id with bit 31 set (RUN_END on
+                    // its last, or a padding lane).
+                    let ids = c.packets.iter().flat_map(|p| p.prim).skip(slot);
+                    let mut n = 0;
+                    for id in ids {
+                        n += 1;
+                        if id & RUN_END != 0 {
+                            break;
+                        }
+                    }
+                    let spanned = (slot % LANES + n).div_ceil(LANES);
+                    assert_eq!(
+                        spanned,
+                        n.div_ceil(LANES),
+                        "{name} {kind:?} merge {merge}: leaf at slot {slot} of {n} triangles"
+                    );
+                    leaves += 1;
+                }
+                assert!(leaves > 0, "{name} {kind:?}");
+            }
+        }
+    }
+}
+
 /// Rays whose direction or origin holds NaN or an infinity: a plane distance that is NaN
 /// keeps the running interval, so such a ray can meet every lane of a node, empty ones
 /// included (whose words name the copy's sentinel leaf). Every copy answers as its own

@@ -57,6 +57,14 @@ pub(super) fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage, merge: usize) -> 
                 // nothing to hit.
                 Some(e) if e.is_empty() => EMPTY,
                 Some(e) => {
+                    // A leaf that would span one packet more than its size needs starts
+                    // at the next packet's first lane (the lanes skipped stay padding):
+                    // each packet a leaf spans is a test of four lanes and up to three
+                    // cache lines (`docs/cpu-traversal.md`, Experiments).
+                    let lane = slots % LANES;
+                    if lane != 0 && (lane + e.len()).div_ceil(LANES) > e.len().div_ceil(LANES) {
+                        slots += LANES - lane;
+                    }
                     let first = slots as u32;
                     assert!(first < LEAF, "too many triangle references");
                     pack_entries(&mut out.packets, &mut slots, e, triangles);

@@ -51,10 +51,12 @@ pub struct Chunk8 {
 }
 
 /// Four consecutive triangles of the leaf-ordered triangle list, vertex coordinates lane by
-/// lane, with their ids. Leaves follow one another without padding: a leaf starts at any
-/// lane (its child word names the slot `4 · packet + lane`) and ends at the first lane from
-/// there whose id has [`RUN_END`](crate::image::RUN_END) set; the last packet of triangles
-/// is padded with [`EMPTY`] lanes, and one packet of them follows it (the sentinel).
+/// lane, with their ids. A leaf starts at a lane (its child word names the slot `4 · packet
+/// + lane`) and ends at the first lane from there whose id has
+/// [`RUN_END`](crate::image::RUN_END) set. Leaves follow one another, except that a leaf
+/// which would span one packet more than its size needs (`⌈n / 4⌉`) starts at the next
+/// packet's first lane: the lanes skipped, like the rest of the last packet of triangles,
+/// are [`EMPTY`] padding, and one packet of them follows it (the sentinel).
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(16))]
 pub struct TriPacket {
