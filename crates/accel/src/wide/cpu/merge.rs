@@ -8,8 +8,10 @@ use crate::image::{ChildKind, NodeLayout, RUN_END};
 /// node and triangle costs), and each leaf visit is a cache miss on its packet; testing up
 /// to 16 triangles four at a time is cheaper than descending two more node levels. Chosen
 /// by measuring 0, 4, 8, 12, 16, 24 and 32 on dragon_box and sponza_dabrovic (16 fastest on
-/// dragon_box, all within a few per cent on Sponza); docs/performance.md ("Leaf merging")
-/// compares 0 with 16 on the current code. Answers do not depend on it.
+/// dragon_box, all within a few per cent on Sponza), and again once leaves started at a
+/// packet's first lane where that saves a packet (4 and 8 fewer instructions but 5–13 %
+/// slower on dragon_box; docs/cpu-traversal.md, Experiments); docs/performance.md ("Leaf
+/// merging") compares 0 with 16. Answers do not depend on it.
 pub const MERGE_MAX: usize = 16;
 
 /// The largest merge limit [`merge_limit`] accepts from the environment.
