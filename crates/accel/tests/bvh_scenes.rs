@@ -251,19 +251,16 @@ fn copy_leaves_span_fewest_packets() {
                     CpuNodes::Four(n) => n.iter().flat_map(|n| n.child).collect(),
                     CpuNodes::Eight(n) => n.iter().flat_map(|n| n.child).collect(),
                 };
+                let ids: Vec<u32> = c.packets.iter().flat_map(|p| p.prim).collect();
                 let mut leaves = 0;
                 for w in words.into_iter().filter(|w| w & LEAF != 0) {
                     let slot = (w & !LEAF) as usize;
                     // The leaf's triangles: up to the first id with bit 31 set (RUN_END on
                     // its last, or a padding lane).
-                    let ids = c.packets.iter().flat_map(|p| p.prim).skip(slot);
-                    let mut n = 0;
-                    for id in ids {
-                        n += 1;
-                        if id & RUN_END != 0 {
-                            break;
-                        }
-                    }
+                    let n = 1 + ids[slot..]
+                        .iter()
+                        .position(|id| id & RUN_END != 0)
+                        .expect("every leaf ends");
                     let spanned = (slot % LANES + n).div_ceil(LANES);
                     assert_eq!(
                         spanned,
