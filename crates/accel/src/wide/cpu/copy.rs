@@ -62,7 +62,7 @@ pub(super) fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage, merge: usize) -> 
                     // each packet a leaf spans is a test of four lanes and up to three
                     // cache lines (`docs/cpu-traversal.md`, Experiments).
                     let lane = slots % LANES;
-                    if lane != 0 && (lane + e.len()).div_ceil(LANES) > e.len().div_ceil(LANES) {
+                    if (lane + e.len()).div_ceil(LANES) > e.len().div_ceil(LANES) {
                         slots += LANES - lane;
                     }
                     let first = slots as u32;
