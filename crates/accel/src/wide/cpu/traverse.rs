@@ -198,16 +198,14 @@ pub(crate) fn test_leaf<const ANY: bool>(
         } else {
             from & ((ends & ends.wrapping_neg()) << 1).wrapping_sub(1)
         };
-        // Lanes the scalar test could accept. For shadow rays with AVX2 the rest of the
-        // test runs on all four lanes at once, and only the lanes it keeps and those with
-        // an edge function equal to zero (which the scalar test recomputes in f64) are
-        // visited; otherwise the scalar test decides each candidate from the edge
-        // functions computed here. (For closest-hit rays the four-lane completion measured
-        // slower on Sponza's diffuse rays, `docs/cpu-traversal.md`.)
+        // Lanes the scalar test could accept. With AVX2 the rest of the test runs on all
+        // four lanes at once, and only the lanes it keeps and those with an edge function
+        // equal to zero (which the scalar test recomputes in f64) are visited; otherwise
+        // the scalar test decides each candidate from the edge functions computed here.
         let e = rs.triangle_edges(pk);
         let mut m = e.candidates & lanes;
         let done = match avx2 {
-            Some(avx2) if ANY && m & !e.zero != 0 => {
+            Some(avx2) if m & !e.zero != 0 => {
                 let c = rs.complete(avx2, pk, &e, r, r.ray.t_min);
                 m &= c.ok | e.zero;
                 Some(c)
