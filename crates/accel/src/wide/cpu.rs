@@ -46,11 +46,13 @@
 //!   whenever its subtree's root would be, and then tests every triangle the subtree could
 //!   have led to (and more), so it can add no closer hit and lose none.
 //!
-//! Only the visiting order of a node's hit children differs (nearest first, the rest pushed
-//! sorted by entry distance, ties by slot; with AVX2, three or more hit children of a BVH8
-//! node are sorted by a vector network on a key that orders distances differing only in
-//! their last three bits by slot; for shadow rays the first hit child first and the rest as
-//! they come), which changes no answer.
+//! Two more changes of order, none of answers: a node's children sit in its lanes by their
+//! chance of stopping a shadow ray, largest first ([`order`](self::order): `min(SA, 2A)`
+//! of the child's box and triangles), and the visiting order of a node's hit children
+//! differs (nearest first, the rest pushed sorted by entry distance, ties by slot, the later
+//! first; with AVX2, three or more hit children of a BVH8 node are sorted by a vector
+//! network on a key that orders distances differing only in their last three bits by slot,
+//! the later first; for shadow rays the hit children in slot order).
 //!
 //! A ray's query either borrows a thread-local stack and finds the copy's arrays
 //! ([`CpuBvh::traverse`]) or runs in a [`CpuQuery`] ([`CpuBvh::query`]), which holds the
@@ -70,6 +72,7 @@
 //! | `layout.rs` | the nodes ([`Chunk`], [`Chunk8`]), child words and triangle packets |
 //! | `copy.rs` | copying the image into them |
 //! | `merge.rs` | leaf merging: subtrees of at most [`MERGE_MAX`] triangles as one leaf |
+//! | `order.rs` | the order of a node's children: the likeliest to stop a shadow ray first |
 //! | `isa.rs` | the instruction sets ([`SimdLevel`]) and the dispatch of a ray to one |
 //! | `traverse.rs` | the traversal loop, its stack and the leaf test |
 //! | `ray.rs` | the ray's SIMD constants, the 4-wide box test and the packet's first stage |
@@ -84,6 +87,7 @@ mod copy;
 mod isa;
 mod layout;
 mod merge;
+mod order;
 mod ray;
 mod traverse;
 

@@ -292,9 +292,11 @@ impl Avx2 {
     ///
     /// The sort key of a lane is its distance's bits mapped to a signed integer of the same
     /// order (the low 31 bits flipped for a negative sign), its low three bits replaced by
-    /// the lane number: distinct keys, ordered by distance except between distances that
-    /// differ only in those bits (then by lane, the lower lane nearer the top, as are equal
-    /// distances). Lanes outside `mask` take the key `i32::MIN`, below every such key (the
+    /// 7 minus the lane number: distinct keys, ordered by distance except between distances
+    /// that differ only in those bits (then by lane, the higher lane nearer the top, as are
+    /// equal distances: the copy puts a node's likeliest occluder in its first lane, and a
+    /// closest-hit ray inside several boxes at once, which all give it the same entry
+    /// distance, measured faster taking the last first; `docs/cpu-traversal.md`). Lanes outside `mask` take the key `i32::MIN`, below every such key (the
     /// smallest, of −∞, is `0x807F_FFF8`), so they sort after the hit lanes. A bitonic
     /// network of six compare-exchange stages sorts the eight keys in one register.
     #[inline(always)]
@@ -316,8 +318,9 @@ impl Avx2 {
             unsafe {
                 let d: __m256i = bytemuck::cast(dist);
                 let ord = _mm256_xor_si256(d, _mm256_srli_epi32::<1>(_mm256_srai_epi32::<31>(d)));
-                let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-                let key = _mm256_or_si256(_mm256_andnot_si256(_mm256_set1_epi32(7), ord), lane);
+                let seven = _mm256_set1_epi32(7);
+                let lane = _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0);
+                let key = _mm256_or_si256(_mm256_andnot_si256(seven, ord), lane);
                 let bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
                 let hit =
                     _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(mask as i32), bit), bit);
@@ -328,10 +331,10 @@ impl Avx2 {
                 let near = _mm256_min_epi32(near, _mm256_shuffle_epi32::<0x4E>(near));
                 let near = _mm256_min_epi32(near, _mm256_shuffle_epi32::<0xB1>(near));
                 let near = _mm256_min_epi32(near, _mm256_permute2x128_si256::<1>(near, near));
-                nearest = (_mm256_cvtsi256_si32(near) & 7) as u32;
+                nearest = ((_mm256_cvtsi256_si32(near) & 7) ^ 7) as u32;
                 let key = _mm256_blendv_epi8(_mm256_set1_epi32(i32::MIN), key, hit);
                 let key = sort8_desc(key);
-                let idx = _mm256_and_si256(key, _mm256_set1_epi32(7));
+                let idx = _mm256_xor_si256(_mm256_and_si256(key, seven), seven);
                 let t = _mm256_permutevar8x32_epi32(d, idx);
                 let c = _mm256_permutevar8x32_epi32(bytemuck::cast(*child), idx);
                 let lo = _mm256_unpacklo_epi32(t, c);
@@ -466,7 +469,7 @@ mod tests {
     /// as a signed integer of the same order, the low three bits the lane.
     fn key(d: f32, lane: usize) -> i32 {
         let b = d.to_bits() as i32;
-        ((b ^ ((b >> 31) as u32 >> 1) as i32) & !7) | lane as i32
+        ((b ^ ((b >> 31) as u32 >> 1) as i32) & !7) | (7 - lane) as i32
     }
 
     /// The AVX2 token; without AVX2, `None` after saying that there is nothing to test.

@@ -2,6 +2,7 @@
 
 use super::layout::{EMPTY, EMPTY_PACKET, LANES, LEAF, Lanes, TriPacket};
 use super::merge::gather;
+use super::order::order_lanes;
 use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
 use dualsplit_geometry::Triangle;
 
@@ -14,7 +15,8 @@ pub(super) struct Copied<N> {
 }
 
 /// Copies the image of node layout `L` into nodes of type `N` (`N::W >= L::ARITY`), each
-/// internal child whose subtree holds at most `merge` triangles as one leaf.
+/// internal child whose subtree holds at most `merge` triangles as one leaf, then puts
+/// each node's children in the order of [`order_lanes`].
 pub(super) fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage, merge: usize) -> Copied<N> {
     let words = &img.words[..];
     let triangles = img.triangle_slice();
@@ -100,6 +102,7 @@ pub(super) fn copy<L: NodeLayout, N: Lanes>(img: &MemoryImage, merge: usize) -> 
             }
         }
     }
+    order_lanes(&mut out.nodes, &out.packets);
     out
 }
 

@@ -83,6 +83,8 @@ pub(crate) trait Lanes: bytemuck::Pod + Send + Sync + std::fmt::Debug {
     fn set(&mut self, l: usize, boxw: [f32; 6], child: u32);
     /// Lane `l`'s child word.
     fn child(&self, l: usize) -> u32;
+    /// Lane `l`'s box words (image order).
+    fn lane_box(&self, l: usize) -> [f32; 6];
     /// Sets lane `l`'s child word.
     fn set_child(&mut self, l: usize, child: u32);
     /// The eight child words of a BVH8 node ([`Chunk8`]); `None` for narrower nodes.
@@ -121,6 +123,10 @@ macro_rules! lanes_impl {
             #[inline(always)]
             fn child(&self, l: usize) -> u32 {
                 self.child[l]
+            }
+            #[inline]
+            fn lane_box(&self, l: usize) -> [f32; 6] {
+                std::array::from_fn(|p| self.planes[p][l])
             }
             #[inline]
             fn set_child(&mut self, l: usize, child: u32) {

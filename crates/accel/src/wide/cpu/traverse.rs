@@ -51,14 +51,16 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                     continue;
                 }
                 if ANY {
-                    // Any hit ends the ray: no order is better than another, so the
-                    // first hit child is next and the others are pushed unsorted. Their
-                    // entry distances are not kept: the limit they passed is the one they
-                    // are popped under (see below).
+                    // Any hit ends the ray, so the hit children are visited in slot
+                    // order, which the copy makes the order of their chances of stopping
+                    // the ray (`order.rs`): the first is next, the others are pushed last
+                    // slot first, so that they pop in slot order. Their entry distances
+                    // are not kept: the limit they passed is the one they are popped under
+                    // (see below).
                     let mut m = rest;
                     while m != 0 {
-                        let i = m.trailing_zeros() as usize;
-                        m &= m - 1;
+                        let i = 31 - m.leading_zeros() as usize;
+                        m &= !(1 << i);
                         let c = child(i);
                         prefetch_child(nodes, packets, c);
                         stack[sp] = Entry { t: 0.0, child: c };
@@ -69,8 +71,9 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                 }
                 let second = rest.trailing_zeros() as usize;
                 if rest & (rest - 1) == 0 {
-                    // Two hits: the nearer next, the other on the stack.
-                    let (near, far) = if d(second) < d(first) {
+                    // Two hits: the nearer next, the other on the stack; at equal
+                    // distances the later slot (as `Avx2::sort_hits8`).
+                    let (near, far) = if d(second) <= d(first) {
                         (second, first)
                     } else {
                         (first, second)
@@ -110,8 +113,8 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                     continue;
                 }
                 // Otherwise pushed in slot order, each inserted below the entries
-                // already pushed that are nearer or as near (ties by slot, the earlier
-                // nearer the top), so that the nearest ends on top; then it is taken.
+                // already pushed that are nearer (ties by slot, the later nearer the top,
+                // as `Avx2::sort_hits8`), so that the nearest ends on top; then it is taken.
                 let base = sp;
                 let mut m = mask;
                 while m != 0 {
@@ -123,7 +126,7 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                     };
                     prefetch_child(nodes, packets, e.child);
                     let mut j = sp;
-                    while j > base && stack[j - 1].t <= e.t {
+                    while j > base && stack[j - 1].t < e.t {
                         stack[j] = stack[j - 1];
                         j -= 1;
                     }
