@@ -47,12 +47,12 @@
 //!   have led to (and more), so it can add no closer hit and lose none.
 //!
 //! Two more changes of order, none of answers: a node's children sit in its lanes by their
-//! chance of stopping a shadow ray, largest first ([`order`](self::order): `min(SA, 2A)`
-//! of the child's box and triangles), and the visiting order of a node's hit children
-//! differs (nearest first, the rest pushed sorted by entry distance, ties by slot, the later
-//! first; with AVX2, three or more hit children of a BVH8 node are sorted by a vector
-//! network on a key that orders distances differing only in their last three bits by slot,
-//! the later first; for shadow rays the hit children in slot order).
+//! chance of stopping a shadow ray, largest first (`order.rs`: `min(SA, 2A)` of the child's
+//! box and triangles), and the visiting order of a node's hit children differs (nearest
+//! first, the rest pushed sorted by entry distance, ties by slot, the later first; with
+//! AVX2, three or more hit children of a BVH8 node are sorted by a vector network on a key
+//! that orders distances differing only in their last three bits by slot, the later first;
+//! for shadow rays the hit children in slot order).
 //!
 //! A ray's query either borrows a thread-local stack and finds the copy's arrays
 //! ([`CpuBvh::traverse`]) or runs in a [`CpuQuery`] ([`CpuBvh::query`]), which holds the
