@@ -296,9 +296,10 @@ impl Avx2 {
     /// that differ only in those bits (then by lane, the higher lane nearer the top, as are
     /// equal distances: the copy puts a node's likeliest occluder in its first lane, and a
     /// closest-hit ray inside several boxes at once, which all give it the same entry
-    /// distance, measured faster taking the last first; `docs/cpu-traversal.md`). Lanes outside `mask` take the key `i32::MIN`, below every such key (the
-    /// smallest, of −∞, is `0x807F_FFF8`), so they sort after the hit lanes. A bitonic
-    /// network of six compare-exchange stages sorts the eight keys in one register.
+    /// distance, measured faster taking the last first; `docs/cpu-traversal.md`). Lanes
+    /// outside `mask` take the key `i32::MIN`, below every such key (the smallest, of −∞,
+    /// is `0x807F_FFF8`), so they sort after the hit lanes. A bitonic network of six
+    /// compare-exchange stages sorts the eight keys in one register.
     #[inline(always)]
     pub fn sort_hits8(
         self,
@@ -466,7 +467,7 @@ mod tests {
     use super::Avx2;
 
     /// The order [`Avx2::sort_hits8`] promises, computed lane by lane: the distance's bits
-    /// as a signed integer of the same order, the low three bits the lane.
+    /// as a signed integer of the same order, the low three bits 7 minus the lane.
     fn key(d: f32, lane: usize) -> i32 {
         let b = d.to_bits() as i32;
         ((b ^ ((b >> 31) as u32 >> 1) as i32) & !7) | (7 - lane) as i32
