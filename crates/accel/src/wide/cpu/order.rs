@@ -19,8 +19,9 @@
 //! likeliest occluder first".
 
 use super::layout::{LANES, LEAF, Lanes, TriPacket};
+use super::traverse::lane_triangle;
 use crate::image::RUN_END;
-use dualsplit_geometry::{Triangle, Vec3};
+use dualsplit_geometry::Triangle;
 
 /// Puts the children of every node of a finished copy (`nodes`, whose children have larger
 /// indices than their parent, as [`copy`](super::copy::copy) makes them, over `packets`)
@@ -60,8 +61,7 @@ fn leaf_area(packets: &[TriPacket], mut slot: usize) -> f64 {
     let mut a = 0.0;
     while let Some(pk) = packets.get(slot / LANES) {
         let l = slot % LANES;
-        let v = |k: usize| Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l]);
-        a += triangle_area(&Triangle::new(v(0), v(1), v(2)));
+        a += triangle_area(&lane_triangle(pk, l));
         if pk.prim[l] & RUN_END != 0 {
             break;
         }
@@ -97,7 +97,7 @@ mod tests {
     use super::super::CpuNodes;
     use super::*;
     use crate::Structures;
-    use dualsplit_geometry::Pcg32;
+    use dualsplit_geometry::{Pcg32, Vec3};
 
     /// The triangle area under child word `c` of a copy, walking the copy from `c` down.
     fn copy_area<N: Lanes>(nodes: &[N], packets: &[TriPacket], c: u32) -> f64 {

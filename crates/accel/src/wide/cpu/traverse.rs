@@ -259,7 +259,7 @@ pub(crate) fn test_leaf<const ANY: bool>(
 
 /// Lane `l`'s triangle of `pk`: its own words, from the packet (already in cache).
 #[inline(always)]
-fn lane_triangle(pk: &TriPacket, l: usize) -> Triangle {
+pub(super) fn lane_triangle(pk: &TriPacket, l: usize) -> Triangle {
     let vertex = |k: usize| Vec3::new(pk.v[3 * k][l], pk.v[3 * k + 1][l], pk.v[3 * k + 2][l]);
     Triangle::new(vertex(0), vertex(1), vertex(2))
 }
