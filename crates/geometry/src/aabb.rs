@@ -85,6 +85,14 @@ impl Aabb {
         self.surface_area() * 0.5
     }
 
+    /// [`Aabb::half_area`] in f64, which does not overflow for f32 boxes (0 for an empty
+    /// box).
+    #[inline]
+    pub fn half_area64(&self) -> f64 {
+        let e = (self.max.as_dvec3() - self.min.as_dvec3()).max(glam::DVec3::ZERO);
+        e.x * e.y + e.y * e.z + e.z * e.x
+    }
+
     /// Index of the longest axis (0 = x, 1 = y, 2 = z).
     pub fn largest_axis(&self) -> usize {
         let e = self.extent();

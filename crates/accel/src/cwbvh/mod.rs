@@ -78,12 +78,6 @@ pub struct QuantizationStats {
     pub mean_extent_growth: f64,
 }
 
-/// Half surface area in f64 (no overflow for f32 boxes).
-fn half_area64(b: &Aabb) -> f64 {
-    let e = (b.max.as_dvec3() - b.min.as_dvec3()).max(glam::DVec3::ZERO);
-    e.x * e.y + e.y * e.z + e.z * e.x
-}
-
 impl Cwbvh {
     /// Encodes the BVH8 `wide` (arity 8, from [`WideBvh::collapse_bvh8`] of `bvh`): the
     /// same nodes, children in slot order, the same leaves. `time` is the collapse time
@@ -237,7 +231,7 @@ impl Cwbvh {
         };
         let (mut area_n, mut ext_n) = (0usize, 0usize);
         for sb in &slots {
-            let (ad, ax) = (half_area64(&sb.decoded), half_area64(&sb.exact));
+            let (ad, ax) = (sb.decoded.half_area64(), sb.exact.half_area64());
             if ax > 0.0 && ax.is_finite() && ad.is_finite() {
                 let g = ad / ax - 1.0;
                 s.mean_area_growth += g;

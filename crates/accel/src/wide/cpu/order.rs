@@ -20,7 +20,7 @@
 
 use super::layout::{LANES, LEAF, Lanes, TriPacket};
 use super::traverse::lane_triangle;
-use crate::image::RUN_END;
+use crate::image::{RUN_END, words_box};
 use dualsplit_geometry::Triangle;
 
 /// Puts the children of every node of a finished copy (`nodes`, whose children have larger
@@ -71,25 +71,17 @@ fn leaf_area(packets: &[TriPacket], mut slot: usize) -> f64 {
 }
 
 /// The area of `t`, in f64 (finite for any finite f32 vertices); 0 if it is not finite.
-pub(super) fn triangle_area(t: &Triangle) -> f64 {
-    let v = t.v.map(|p| [p.x as f64, p.y as f64, p.z as f64]);
-    let e1 = [0, 1, 2].map(|i| v[1][i] - v[0][i]);
-    let e2 = [0, 1, 2].map(|i| v[2][i] - v[0][i]);
-    let n = [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ];
-    let a = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-    if a.is_finite() { a } else { 0.0 }
+fn triangle_area(t: &Triangle) -> f64 {
+    let [a, b, c] = t.v.map(|p| p.as_dvec3());
+    let area = 0.5 * (b - a).cross(c - a).length();
+    if area.is_finite() { area } else { 0.0 }
 }
 
 /// The ordering key of a child with box words `b` (min.xyz, max.xyz) over triangles of
-/// total area `area`: `min(SA(B), 2A)`, in f64.
-pub(super) fn key(b: &[f32; 6], area: f64) -> f64 {
-    let e = [0, 1, 2].map(|i| (b[3 + i] as f64 - b[i] as f64).max(0.0));
-    let sa = 2.0 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
-    sa.min(2.0 * area)
+/// total area `area`: `min(SA(B), 2A)`, in f64 (an f32 box area overflows near f32's range,
+/// which would tie every large child).
+fn key(b: &[f32; 6], area: f64) -> f64 {
+    (2.0 * words_box(b).half_area64()).min(2.0 * area)
 }
 
 #[cfg(test)]
