@@ -437,12 +437,12 @@ fn bench_refuses_a_malformed_merge_limit() {
     );
 }
 
-/// `bench --peer embree,embree-robust` checks both Embree scenes and times them with ours
-/// in one interleaved run: every ray kind gets a timing per contender and each peer a
-/// summary with our best structure's ratio to it. Without Embree, the peer is named in the
-/// error (and under CI, where `.ci/run` installs it, the test fails).
+/// `bench --peer embree,embree-robust,embree-avx2` checks the three Embree scenes and times
+/// them with ours in one interleaved run: every ray kind gets a timing per contender and
+/// each peer a summary with our best structure's ratio to it. Without Embree, the peer is
+/// named in the error (and under CI, where `.ci/run` installs it, the test fails).
 #[test]
-fn bench_compares_with_both_embree_modes_in_one_run() {
+fn bench_compares_with_every_embree_peer_in_one_run() {
     let dir = tempfile::tempdir().unwrap();
     let o = dualsplit(
         &[
@@ -453,7 +453,7 @@ fn bench_compares_with_both_embree_modes_in_one_run() {
             "--accel",
             "bvh2,bvh8",
             "--peer",
-            "embree,embree-robust,embree",
+            "embree,embree-robust,embree-avx2,embree",
             "--threads",
             "1",
             "--min-seconds",
@@ -479,7 +479,7 @@ fn bench_compares_with_both_embree_modes_in_one_run() {
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
     let kinds = ["primary", "shadow", "diffuse"];
-    for name in ["bvh2", "bvh8", "embree", "embree-robust"] {
+    for name in ["bvh2", "bvh8", "embree", "embree-robust", "embree-avx2"] {
         for kind in kinds {
             let n = lines
                 .iter()
@@ -498,7 +498,12 @@ fn bench_compares_with_both_embree_modes_in_one_run() {
         .map(|l| l["peer"].as_str().unwrap())
         .collect();
     // The repeated peer is measured once.
-    assert_eq!(peers, ["embree", "embree-robust"], "{}", stdout(&o));
+    assert_eq!(
+        peers,
+        ["embree", "embree-robust", "embree-avx2"],
+        "{}",
+        stdout(&o)
+    );
     for s in summaries {
         for kind in kinds {
             let r = s["ratio_best_to_peer"][kind].as_f64().unwrap_or(f64::NAN);

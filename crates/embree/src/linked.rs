@@ -29,6 +29,18 @@ unsafe impl Sync for Scene {}
 /// early return releases it.
 pub(crate) struct DeviceGuard(pub(crate) RTCDevice);
 
+/// The device configuration of a scene built with `options` (Embree's `key=value` pairs).
+fn device_config(options: &EmbreeOptions) -> String {
+    let mut config = "verbose=0".to_string();
+    if let Some(n) = options.build_threads {
+        config += &format!(",threads={n}");
+    }
+    if options.avx2_at_most {
+        config += ",max_isa=avx2";
+    }
+    config
+}
+
 /// A new device with configuration `config` (`key=value` pairs, no NUL).
 pub(crate) fn new_device(config: &str) -> Result<DeviceGuard, EmbreeError> {
     let config = CString::new(config).expect("the configuration string has no NUL");
@@ -84,11 +96,7 @@ impl Scene {
             .ok_or(EmbreeError::TooLarge {
                 triangles: triangles.len(),
             })?;
-        let config = match options.build_threads {
-            Some(n) => format!("threads={n},verbose=0"),
-            None => "verbose=0".to_string(),
-        };
-        let device = new_device(&config)?;
+        let device = new_device(&device_config(options))?;
         let d = device.0;
 
         // SAFETY: `d` is a live device; property queries have no other precondition.
@@ -293,4 +301,20 @@ fn rtc_ray(ray: &Ray) -> ffi::RTCRay {
 
 fn version_string(v: isize) -> String {
     format!("{}.{}.{}", v / 10000, v / 100 % 100, v % 100)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn device_config_names_each_option() {
+        assert_eq!(device_config(&EmbreeOptions::default()), "verbose=0");
+        let o = EmbreeOptions {
+            build_threads: Some(3),
+            avx2_at_most: true,
+            ..EmbreeOptions::default()
+        };
+        assert_eq!(device_config(&o), "verbose=0,threads=3,max_isa=avx2");
+    }
 }

@@ -10,6 +10,10 @@ pub struct EmbreeOptions {
     pub robust: bool,
     /// `RTC_BUILD_QUALITY_HIGH` (spatial splits) instead of the default medium quality.
     pub high_quality: bool,
+    /// `max_isa=avx2` of the device configuration: Embree's kernels limited to AVX2. On a
+    /// CPU with AVX-512 Embree otherwise runs its AVX-512 kernels (`avx512::` intersectors
+    /// over the same BVH8), where our traversals use AVX2 at most.
+    pub avx2_at_most: bool,
     /// Threads Embree's builder may use (`threads=N` of the device configuration); `None`:
     /// every core. Tracing runs on the caller's threads whatever this says.
     pub build_threads: Option<usize>,

@@ -7,7 +7,9 @@
 //! must be explained as ties, grazing or interval-boundary hits, see `dualsplit_embree::agree`),
 //! then ours and Embree's are timed interleaved, pass after pass, in one run. `--peer
 //! embree,embree-robust` adds Embree built in its robust mode, the watertight guarantee
-//! our traversals always give, timed in the same interleaved passes.
+//! our traversals always give, timed in the same interleaved passes; `embree-avx2` adds
+//! Embree with its kernels limited to AVX2, the instruction set our traversals use at most
+//! (on a CPU with AVX-512 Embree otherwise runs its AVX-512 kernels).
 //!
 //! With `--tree FILE` the saved structure is measured instead of building: its traversals
 //! only (`--accel` must name one of them), on rays recorded with its own first traversal
@@ -43,6 +45,9 @@ pub enum Peer {
     /// The same in Embree's robust (watertight) mode: the guarantee our traversals always
     /// give, at Embree's cost for it.
     EmbreeRobust,
+    /// Embree as a new user gets it, its kernels limited to AVX2 (`max_isa=avx2`): on a CPU
+    /// with AVX-512, the instruction set our traversals use at most.
+    EmbreeAvx2,
 }
 
 impl Peer {
@@ -51,6 +56,7 @@ impl Peer {
         match self {
             Self::Embree => "embree",
             Self::EmbreeRobust => "embree-robust",
+            Self::EmbreeAvx2 => "embree-avx2",
         }
     }
 
@@ -58,6 +64,7 @@ impl Peer {
     fn options(self) -> EmbreeOptions {
         EmbreeOptions {
             robust: self == Self::EmbreeRobust,
+            avx2_at_most: self == Self::EmbreeAvx2,
             ..EmbreeOptions::default()
         }
     }
@@ -95,8 +102,8 @@ pub struct Args {
     /// Skip the full-frame render timing.
     #[arg(long)]
     no_frame: bool,
-    /// Also trace the rays on peers, comma-separated (embree, embree-robust), check that
-    /// each agrees with ours, and time ours and the peers interleaved in one run.
+    /// Also trace the rays on peers, comma-separated (embree, embree-robust, embree-avx2),
+    /// check that each agrees with ours, and time ours and the peers interleaved in one run.
     #[arg(long, value_enum, value_delimiter = ',')]
     peer: Vec<Peer>,
     /// Threads the timed traversals run on (default: every core). Loading, building and
