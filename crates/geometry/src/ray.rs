@@ -130,12 +130,8 @@ impl RayPre {
     #[inline]
     pub fn new(ray: &Ray) -> Self {
         let d = ray.dir;
-        let inv = glam::Vec4::ONE / glam::Vec4::new(d.x, d.y, d.z, 1.0);
-        let neg = [
-            d.x.is_sign_negative(),
-            d.y.is_sign_negative(),
-            d.z.is_sign_negative(),
-        ];
+        let inv = Self::reciprocal(d);
+        let neg = Self::signs(d);
         let kz = Self::major_axis(d);
         let dkz = pick([d.x, d.y, d.z], kz);
         // (kx, ky) = (kz + 1, kz + 2) mod 3, two bits per kz in a constant.
@@ -146,11 +142,27 @@ impl RayPre {
         let s = [s.x, s.y, s.z];
         Self {
             ray: *ray,
-            inv_dir: inv.truncate(),
+            inv_dir: inv,
             neg,
             k: [kx, ky, kz],
             shear: Vec3::new(pick(s, kx), pick(s, ky), pick([inv.x, inv.y, inv.z], kz)),
         }
+    }
+
+    /// [`RayPre::inv_dir`] of a ray with direction `d`, as [`RayPre::new`] computes it.
+    #[inline(always)]
+    pub fn reciprocal(d: Vec3) -> Vec3 {
+        (glam::Vec4::ONE / glam::Vec4::new(d.x, d.y, d.z, 1.0)).truncate()
+    }
+
+    /// [`RayPre::neg`] of a ray with direction `d`: the sign bit of each component.
+    #[inline(always)]
+    pub fn signs(d: Vec3) -> [bool; 3] {
+        [
+            d.x.is_sign_negative(),
+            d.y.is_sign_negative(),
+            d.z.is_sign_negative(),
+        ]
     }
 
     /// The watertight test's `kz` for direction `d`: x when `|dx| >= |dy|` and `|dx| >=

@@ -52,7 +52,10 @@
 //! first, the rest pushed sorted by entry distance, ties by slot, the later first; with
 //! AVX2, three or more hit children of a BVH8 node are sorted by a vector network on a key
 //! that orders distances differing only in their last three bits by slot, the later first;
-//! for shadow rays the hit children in slot order).
+//! for shadow rays the hit children in slot order). A shadow ray computes the watertight
+//! test's axes and shear only once it reaches a leaf: its node steps until then run with
+//! the box test's constants alone (the same box tests), and most shadow rays of some scenes
+//! reach no leaf.
 //!
 //! A ray's query either borrows a thread-local stack and finds the copy's arrays
 //! ([`CpuBvh::traverse`]) or runs in a [`CpuQuery`] ([`CpuBvh::query`]), which holds the

@@ -394,11 +394,7 @@ impl Avx2 {
                 RayPre {
                     ray: *ray,
                     inv_dir: Vec3::new(inv[0], inv[1], inv[2]),
-                    neg: [
-                        d.x.is_sign_negative(),
-                        d.y.is_sign_negative(),
-                        d.z.is_sign_negative(),
-                    ],
+                    neg: RayPre::signs(d),
                     k: [k[0] as usize, k[1] as usize, kz],
                     shear: Vec3::new(s[0], s[1], s[3]),
                 }

@@ -5,7 +5,7 @@ use super::layout::{LANES, TriPacket};
 use crate::wide::simd::{Avx2, PlaneRows8};
 #[cfg(doc)]
 use dualsplit_geometry::Triangle;
-use dualsplit_geometry::{EXIT_WIDEN, RayPre};
+use dualsplit_geometry::{EXIT_WIDEN, Ray, RayPre, Vec3};
 use wide::{CmpEq, CmpGt, CmpLe, CmpLt, f32x4};
 
 /// What [`RaySimd::triangle_edges`] finds for the four triangles of a packet.
@@ -128,6 +128,21 @@ impl RaySimd {
             sx: f32x4::splat(r.shear.x),
             sy: f32x4::splat(r.shear.y),
         }
+    }
+
+    /// The box test's constants of `ray` alone, for a shadow ray that has met no leaf yet
+    /// (the traversal's first phase): the reciprocal and signs as [`RayPre::new`] computes
+    /// them; the watertight test's fields hold axes x, y, z and no shear, not the ray's, and
+    /// no box test reads them.
+    #[inline(always)]
+    pub(super) fn boxes(ray: &Ray) -> Self {
+        Self::new(&RayPre {
+            ray: *ray,
+            inv_dir: RayPre::reciprocal(ray.dir),
+            neg: RayPre::signs(ray.dir),
+            k: [0, 1, 2],
+            shear: Vec3::ZERO,
+        })
     }
 
     /// The first stage of [`Triangle::intersect`] (shear, edge functions `u`, `v`, `w`, the
