@@ -31,11 +31,10 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
             None => return None,
         }
     }
-    // The same constants either way. For shadow rays the vector form measured worse: their
-    // node loop then kept its plane-row offsets on the stack rather than in registers (Sponza,
-    // 885 → 898 instructions per ray; `docs/cpu-traversal.md`).
+    // The same constants either way (for shadow rays the vector form measured worse while
+    // they computed them before their first node step; `docs/cpu-traversal.md`).
     let r = match isa.avx2() {
-        Some(avx2) if !ANY => avx2.ray_pre(ray),
+        Some(avx2) => avx2.ray_pre(ray),
         _ => ray.precompute(),
     };
     let rs = RaySimd::new(&r);
