@@ -9,7 +9,8 @@ use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, Triangle, TriangleHit, Vec3, 
 use std::cell::RefCell;
 use wide::f32x4;
 
-/// The traversal (see the [`super`] module docs) of `nodes` and `packets` with instructions `I`.
+/// The traversal (see the [`super`] module docs) of `nodes` and `packets` with instructions
+/// `I`: a closest-hit ray's here, a shadow ray's (`ANY`) in [`any_hit`].
 #[inline(always)]
 pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
     isa: I,
@@ -18,25 +19,10 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
     ray: &Ray,
     stack: &mut [Entry],
 ) -> Option<Hit> {
-    let mut cur = 0u32;
-    // Entries in use: `stack[..sp]`, the top last. The caller sizes `stack` to the copy's
-    // bound (`stack_len`), so no push goes past its end.
-    let mut sp = 0usize;
     if ANY {
-        // A shadow ray reaches its first leaf with the box test's constants alone: most
-        // shadow rays of some scenes reach none (88 % of Dragon Box's, 36 % of Sponza's),
-        // and then never need the watertight test's axes and shear.
-        match first_leaf(isa, nodes, packets, ray, stack) {
-            Some((leaf, depth)) => (cur, sp) = (leaf, depth),
-            None => return None,
-        }
+        return any_hit(isa, nodes, packets, ray, stack);
     }
-    // The same constants either way (for shadow rays the vector form measured worse while
-    // they computed them before their first node step; `docs/cpu-traversal.md`).
-    let r = match isa.avx2() {
-        Some(avx2) => avx2.ray_pre(ray),
-        _ => ray.precompute(),
-    };
+    let r = ray_constants(isa, ray);
     let rs = RaySimd::new(&r);
     let mut best: Option<Hit> = None;
     let mut best_t = ray.t_max;
@@ -44,6 +30,10 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
     // reloading the ray's address for it at every node.
     let t_min = ray.t_min;
     let mut limit = cull_limit(best_t);
+    let mut cur = 0u32;
+    // Entries in use: `stack[..sp]`, the top last. The caller sizes `stack` to the copy's
+    // bound (`stack_len`), so no push goes past its end.
+    let mut sp = 0usize;
     loop {
         if cur & LEAF == 0 {
             let node = &nodes[cur as usize];
@@ -56,10 +46,6 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
                 let rest = mask & (mask - 1);
                 if rest == 0 {
                     cur = child(first);
-                    continue;
-                }
-                if ANY {
-                    cur = step_any(nodes, packets, node, mask, stack, &mut sp);
                     continue;
                 }
                 let second = rest.trailing_zeros() as usize;
@@ -133,21 +119,17 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
             }
         } else {
             let slot = (cur & !LEAF) as usize;
-            if test_leaf::<ANY>(isa.avx2(), packets, slot, &rs, &r, &mut best, &mut best_t) {
-                return best;
-            }
+            test_leaf::<false>(isa.avx2(), packets, slot, &rs, &r, &mut best, &mut best_t);
             limit = cull_limit(best_t);
         }
-        // Next: the nearest stacked entry not beyond the limit. A shadow ray's limit never
-        // moves (its first hit ends it), and every entry was pushed because its entry
-        // distance was within it, so none of its entries is skipped.
+        // Next: the nearest stacked entry not beyond the limit.
         loop {
             if sp == 0 {
                 return best;
             }
             sp -= 1;
             let e = stack[sp];
-            if ANY || e.t <= limit {
+            if e.t <= limit {
                 cur = e.child;
                 break;
             }
@@ -160,7 +142,7 @@ pub(super) fn run<N: Lanes, I: Isa, const ANY: bool>(
 /// the hit children are visited in slot order, which the copy makes the order of their
 /// chances of stopping the ray (`order.rs`): the first is next, the others are pushed last
 /// slot first, so that they pop in slot order. Their entry distances are not kept: the
-/// limit they passed is the one they are popped under (see [`run`]).
+/// limit they passed is the one they are popped under (see [`any_hit`]).
 #[inline(always)]
 fn step_any<N: Lanes>(
     nodes: &[N],
@@ -182,37 +164,82 @@ fn step_any<N: Lanes>(
     node.child(mask.trailing_zeros() as usize)
 }
 
-/// The first phase of a shadow ray's traversal: its node steps (as in [`run`]) until it
-/// reaches a leaf, with the box test's constants alone ([`RaySimd::boxes`]). Returns the
-/// leaf's child word and the entries then stacked, or `None` when the ray reaches no leaf
-/// (no hit). The box tests are [`run`]'s, on the same reciprocal and interval.
+/// The ray's constants for the box and triangle tests: by vector instructions where there
+/// is AVX2 ([`Avx2::ray_pre`], the same bits as [`Ray::precompute`]).
 #[inline(always)]
-fn first_leaf<N: Lanes, I: Isa>(
+fn ray_constants<I: Isa>(isa: I, ray: &Ray) -> RayPre {
+    match isa.avx2() {
+        Some(avx2) => avx2.ray_pre(ray),
+        _ => ray.precompute(),
+    }
+}
+
+/// A shadow ray's traversal. Any hit ends it, and its limit never moves, so every stacked
+/// entry passed the limit it is popped under: entries keep no distance, and none is
+/// skipped. It reaches its first leaf with the box test's constants alone
+/// ([`RaySimd::boxes`]): most shadow rays of some scenes reach none (88 % of Dragon Box's,
+/// 36 % of Sponza's) and then never need the watertight test's axes and shear, which are
+/// computed there, for the leaves and the node steps after them.
+#[inline(always)]
+fn any_hit<N: Lanes, I: Isa>(
     isa: I,
     nodes: &[N],
     packets: &[TriPacket],
     ray: &Ray,
     stack: &mut [Entry],
-) -> Option<(u32, usize)> {
-    let rs = RaySimd::boxes(ray);
+) -> Option<Hit> {
     let (t_min, limit) = (ray.t_min, cull_limit(ray.t_max));
-    let mut cur = 0u32;
     let mut sp = 0usize;
+    let boxes = RaySimd::boxes(ray);
+    let mut leaf = descend(isa, nodes, packets, &boxes, t_min, limit, stack, 0, &mut sp)?;
+    let r = ray_constants(isa, ray);
+    let rs = RaySimd::new(&r);
+    let (mut best, mut best_t) = (None, ray.t_max);
     loop {
-        if cur & LEAF != 0 {
-            return Some((cur, sp));
-        }
-        let node = &nodes[cur as usize];
-        let (_, mask) = node.test(isa, &rs, t_min, limit);
-        if mask != 0 {
-            cur = step_any(nodes, packets, node, mask, stack, &mut sp);
-            continue;
+        let slot = (leaf & !LEAF) as usize;
+        if test_leaf::<true>(isa.avx2(), packets, slot, &rs, &r, &mut best, &mut best_t) {
+            return best;
         }
         if sp == 0 {
             return None;
         }
         sp -= 1;
-        cur = stack[sp].child;
+        let next = stack[sp].child;
+        leaf = descend(isa, nodes, packets, &rs, t_min, limit, stack, next, &mut sp)?;
+    }
+}
+
+/// A shadow ray's node steps from child word `cur` on `[t_min, limit]` until a leaf, whose
+/// child word it returns, popping `stack[..*sp]` at a node whose children the ray all
+/// misses; `None` when the stack runs out first (no hit).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn descend<N: Lanes, I: Isa>(
+    isa: I,
+    nodes: &[N],
+    packets: &[TriPacket],
+    rs: &RaySimd,
+    t_min: f32,
+    limit: f32,
+    stack: &mut [Entry],
+    mut cur: u32,
+    sp: &mut usize,
+) -> Option<u32> {
+    loop {
+        if cur & LEAF != 0 {
+            return Some(cur);
+        }
+        let node = &nodes[cur as usize];
+        let (_, mask) = node.test(isa, rs, t_min, limit);
+        if mask != 0 {
+            cur = step_any(nodes, packets, node, mask, stack, sp);
+            continue;
+        }
+        if *sp == 0 {
+            return None;
+        }
+        *sp -= 1;
+        cur = stack[*sp].child;
     }
 }
 
