@@ -160,8 +160,18 @@ pub type RTCCreateLeafFunction = unsafe extern "C" fn(
     *mut c_void,
 ) -> *mut c_void;
 
-/// `struct RTCBuildArguments` (Embree 3.13's `rtcore_builder.h`), with the split-primitive
-/// and progress callbacks always null (no spatial splits, no progress).
+/// `RTCSplitPrimitiveFunction`: a primitive's boxes left and right of a plane.
+pub type RTCSplitPrimitiveFunction = unsafe extern "C" fn(
+    *const RTCBuildPrimitive,
+    c_uint,
+    f32,
+    *mut RTCBounds,
+    *mut RTCBounds,
+    *mut c_void,
+);
+
+/// `struct RTCBuildArguments` (Embree 3.13's `rtcore_builder.h`), with the progress callback
+/// always null.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct RTCBuildArguments {
@@ -183,8 +193,8 @@ pub struct RTCBuildArguments {
     pub set_node_children: Option<RTCSetNodeChildrenFunction>,
     pub set_node_bounds: Option<RTCSetNodeBoundsFunction>,
     pub create_leaf: Option<RTCCreateLeafFunction>,
-    /// `RTCSplitPrimitiveFunction`, always null here.
-    pub split_primitive: *const c_void,
+    /// Null unless the build makes spatial splits (high quality).
+    pub split_primitive: Option<RTCSplitPrimitiveFunction>,
     /// `RTCProgressMonitorFunction`, always null here.
     pub build_progress: *const c_void,
     pub user_ptr: *mut c_void,

@@ -5,8 +5,8 @@
 use crate::EmbreeError;
 use crate::ffi::{self, RTCBounds, RTCBuildPrimitive, RTCThreadLocalAllocator};
 use crate::linked::{call_error, new_device};
-use crate::tree::{BuiltTree, Child, TreeArgs};
-use dualsplit_geometry::{Aabb, Vec3};
+use crate::tree::{BuiltTree, Child, TreeArgs, clipped_bounds};
+use dualsplit_geometry::{Aabb, Triangle, Vec3};
 use std::ffi::{c_uint, c_void};
 
 /// Most children of a node the callbacks store ([`TreeArgs::branching`] is checked).
@@ -118,6 +118,52 @@ unsafe extern "C" fn create_leaf(
     unsafe { place(alloc, leaf) }
 }
 
+/// `RTCSplitPrimitiveFunction`: the boxes of the parts of the primitive's triangle on either
+/// side of the plane `x[dim] = pos`, each within the primitive's box cut at the plane
+/// ([`clipped_bounds`]; that cut box itself where the part is empty by rounding).
+unsafe extern "C" fn split_primitive(
+    prim: *const RTCBuildPrimitive,
+    dim: c_uint,
+    pos: f32,
+    left: *mut RTCBounds,
+    right: *mut RTCBounds,
+    user: *mut c_void,
+) {
+    // SAFETY: `user` is the `&[Triangle]` that `build_tree` passes as the user pointer,
+    // live for the build; `prim` is a primitive of the build, whose id indexes it (ids
+    // are set by `build_tree` and kept by Embree through splits); `left` and `right`
+    // are Embree's boxes to write.
+    unsafe {
+        let triangles = &*user.cast::<&[Triangle]>();
+        let p = &*prim;
+        let b = Aabb {
+            min: Vec3::new(p.lower_x, p.lower_y, p.lower_z),
+            max: Vec3::new(p.upper_x, p.upper_y, p.upper_z),
+        };
+        let d = (dim as usize).min(2);
+        let pos = pos.clamp(b.min[d], b.max[d]);
+        let (mut l, mut r) = (b, b);
+        l.max[d] = pos;
+        r.min[d] = pos;
+        let t = &triangles[p.prim_id as usize];
+        *left = bounds(clipped_bounds(t, &l).unwrap_or(l));
+        *right = bounds(clipped_bounds(t, &r).unwrap_or(r));
+    }
+}
+
+/// The `RTCBounds` of a box.
+fn bounds(b: Aabb) -> RTCBounds {
+    RTCBounds {
+        lower_x: b.min.x,
+        lower_y: b.min.y,
+        lower_z: b.min.z,
+        upper_x: b.max.x,
+        upper_y: b.max.y,
+        upper_z: b.max.z,
+        ..Default::default()
+    }
+}
+
 /// The box of an `RTCBounds`.
 fn aabb(b: &RTCBounds) -> Aabb {
     Aabb {
@@ -126,7 +172,13 @@ fn aabb(b: &RTCBounds) -> Aabb {
     }
 }
 
-pub(crate) fn build_tree(boxes: &[Aabb], args: &TreeArgs) -> Result<BuiltTree, EmbreeError> {
+/// The tree over `boxes`; with `split`, the high-quality build with spatial splits of those
+/// triangles (`boxes[i]` is `split[i]`'s box).
+pub(crate) fn build_tree(
+    boxes: &[Aabb],
+    args: &TreeArgs,
+    split: Option<&[Triangle]>,
+) -> Result<BuiltTree, EmbreeError> {
     // Released when `guard` drops, after the tree is copied out.
     let guard = new_device("verbose=0")?;
     let device = guard.0;
@@ -144,6 +196,12 @@ pub(crate) fn build_tree(boxes: &[Aabb], args: &TreeArgs) -> Result<BuiltTree, E
             prim_id: i as u32,
         })
         .collect();
+    let count = prims.len();
+    // Room for the references spatial splits add.
+    if split.is_some() {
+        prims.resize(2 * count, prims[0]);
+    }
+    let mut triangles: &[Triangle] = split.unwrap_or_default();
     // SAFETY: `device` is live.
     let bvh = unsafe { ffi::rtcNewBVH(device) };
     if bvh.is_null() {
@@ -151,7 +209,10 @@ pub(crate) fn build_tree(boxes: &[Aabb], args: &TreeArgs) -> Result<BuiltTree, E
     }
     let a = ffi::RTCBuildArguments {
         byte_size: std::mem::size_of::<ffi::RTCBuildArguments>(),
-        build_quality: ffi::RTC_BUILD_QUALITY_MEDIUM,
+        build_quality: match split {
+            Some(_) => ffi::RTC_BUILD_QUALITY_HIGH,
+            None => ffi::RTC_BUILD_QUALITY_MEDIUM,
+        },
         build_flags: 0,
         max_branching_factor: args.branching,
         max_depth: 64,
@@ -162,19 +223,21 @@ pub(crate) fn build_tree(boxes: &[Aabb], args: &TreeArgs) -> Result<BuiltTree, E
         intersection_cost: args.intersection_cost,
         bvh,
         primitives: prims.as_mut_ptr(),
-        primitive_count: prims.len(),
+        primitive_count: count,
         primitive_array_capacity: prims.len(),
         create_node: Some(create_node),
         set_node_children: Some(set_children),
         set_node_bounds: Some(set_bounds),
         create_leaf: Some(create_leaf),
-        split_primitive: std::ptr::null(),
+        split_primitive: split.map(|_| split_primitive as ffi::RTCSplitPrimitiveFunction),
         build_progress: std::ptr::null(),
-        user_ptr: std::ptr::null_mut(),
+        user_ptr: (&raw mut triangles).cast(),
     };
     // SAFETY: `a` is a complete `RTCBuildArguments` whose primitive array (`prims`,
-    // 32-byte aligned elements) is live and exclusively lent for the call, and whose
-    // callbacks write only memory they allocated from Embree's allocator.
+    // 32-byte aligned elements, `count` of them in use and room for as many more) is live
+    // and exclusively lent for the call, whose callbacks write only memory they allocated
+    // from Embree's allocator or the two boxes Embree hands the split callback, and whose
+    // user pointer is `triangles`, live for the call.
     let root = unsafe { ffi::rtcBuildBVH(&a) };
     let tree = if root.is_null() {
         Err(call_error(device, "rtcBuildBVH"))
@@ -206,7 +269,14 @@ unsafe fn walk(root: *mut c_void) -> BuiltTree {
         let child = unsafe {
             if *p.cast::<u32>() == 1 {
                 let l = &*p.cast::<RawLeaf>();
-                t.leaves.push(l.prims[..l.count as usize].to_vec());
+                // Spatial splits can give a leaf two parts of one triangle: kept once.
+                let mut ids: Vec<u32> = Vec::with_capacity(l.count as usize);
+                for &id in &l.prims[..l.count as usize] {
+                    if !ids.contains(&id) {
+                        ids.push(id);
+                    }
+                }
+                t.leaves.push(ids);
                 Child::Leaf(t.leaves.len() as u32 - 1)
             } else {
                 let n = &*p.cast::<RawNode>();

@@ -1,9 +1,11 @@
 //! Embree's own BVH builder (`rtcBuildBVH`) over boxes: the tree Embree would build, handed
 //! back as plain nodes and leaves, so that another traversal can be run on Embree's topology
-//! (to tell a tree's quality apart from the cost of traversing it).
+//! (to tell a tree's quality apart from the cost of traversing it). [`build_tree`] makes the
+//! tree Embree's triangle scenes get (binned SAH); [`build_tree_split`] its high-quality
+//! tree with spatial splits (Stich et al. 2009), over triangles.
 
 use crate::EmbreeError;
-use dualsplit_geometry::Aabb;
+use dualsplit_geometry::{Aabb, Triangle, Vec3};
 
 /// A child of a [`BuiltTree`] node: an internal node or a leaf, by index.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -27,8 +29,9 @@ pub struct BuiltTree {
     pub root: Child,
 }
 
-/// The settings of `struct RTCBuildArguments` that shape the tree. The quality is always
-/// medium (binned SAH, no spatial splits), the one Embree's scenes use by default.
+/// The settings of `struct RTCBuildArguments` that shape the tree. The quality is medium
+/// (binned SAH, no spatial splits, the one Embree's scenes use by default) for
+/// [`build_tree`], high (with spatial splits) for [`build_tree_split`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TreeArgs {
     /// Most children per node (2 to 8).
@@ -69,6 +72,23 @@ impl TreeArgs {
 /// (branching outside 2..=8, `max_leaf` outside 1..=32) or `boxes` empty or over
 /// `u32::MAX` boxes ([`EmbreeError::Unsupported`]); Embree reports an error.
 pub fn build_tree(boxes: &[Aabb], args: &TreeArgs) -> Result<BuiltTree, EmbreeError> {
+    check(boxes, args)?;
+    imp::build_tree(boxes, args, None)
+}
+
+/// Builds Embree's high-quality tree over `triangles` (primitive `i` is `triangles[i]`)
+/// with `args`, on every core: binned SAH with spatial splits, which may put a triangle in
+/// several leaves (at most twice as many references as triangles), each under a box of the
+/// part of the triangle on its side of the split planes ([`clipped_bounds`]). Errors as
+/// [`build_tree`]'s.
+pub fn build_tree_split(triangles: &[Triangle], args: &TreeArgs) -> Result<BuiltTree, EmbreeError> {
+    let boxes: Vec<Aabb> = triangles.iter().map(Triangle::bounds).collect();
+    check(&boxes, args)?;
+    imp::build_tree(&boxes, args, Some(triangles))
+}
+
+/// [`build_tree`]'s checks of its arguments.
+fn check(boxes: &[Aabb], args: &TreeArgs) -> Result<(), EmbreeError> {
     if !(2..=8).contains(&args.branching) || !(1..=32).contains(&args.max_leaf) {
         return Err(EmbreeError::Unsupported(format!(
             "tree arguments {args:?}: branching must be 2 to 8 and max_leaf 1 to 32"
@@ -80,7 +100,68 @@ pub fn build_tree(boxes: &[Aabb], args: &TreeArgs) -> Result<BuiltTree, EmbreeEr
             boxes.len()
         )));
     }
-    imp::build_tree(boxes, args)
+    Ok(())
+}
+
+/// A box of the part of triangle `t` inside box `b`, or `None` when none is: the triangle
+/// clipped to each of `b`'s six planes in f64 (Sutherland–Hodgman), the polygon's bounds
+/// rounded outward to f32 and widened by one ulp more, then cut to `b`. It holds every point
+/// of the triangle inside `b` (the clipped polygon's vertices lie within f64 rounding of the
+/// exact ones), so a ray that meets that part of the triangle meets the box: a tree over
+/// such boxes culls no hit.
+pub fn clipped_bounds(t: &Triangle, b: &Aabb) -> Option<Aabb> {
+    let mut poly: Vec<[f64; 3]> = t.v.iter().map(|p| p.to_array().map(f64::from)).collect();
+    for axis in 0..3 {
+        for (keep_above, plane) in [(true, b.min[axis] as f64), (false, b.max[axis] as f64)] {
+            let inside = |p: &[f64; 3]| {
+                if keep_above {
+                    p[axis] >= plane
+                } else {
+                    p[axis] <= plane
+                }
+            };
+            let mut out = Vec::with_capacity(poly.len() + 1);
+            for (i, &p) in poly.iter().enumerate() {
+                let q = poly[(i + 1) % poly.len()];
+                if inside(&p) {
+                    out.push(p);
+                }
+                if inside(&p) != inside(&q) {
+                    let s = (plane - p[axis]) / (q[axis] - p[axis]);
+                    let mut x = [0.0; 3];
+                    for (a, x) in x.iter_mut().enumerate() {
+                        *x = p[a] + (q[a] - p[a]) * s;
+                    }
+                    x[axis] = plane;
+                    out.push(x);
+                }
+            }
+            poly = out;
+            if poly.is_empty() {
+                return None;
+            }
+        }
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in &poly {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    // The nearest f32 at or below (above) `x`, then one ulp further.
+    let down = |x: f64| {
+        let m = x as f32;
+        (if f64::from(m) > x { m.next_down() } else { m }).next_down()
+    };
+    let up = |x: f64| {
+        let m = x as f32;
+        (if f64::from(m) < x { m.next_up() } else { m }).next_up()
+    };
+    Some(Aabb::new(
+        Vec3::from(lo.map(down)).max(b.min),
+        Vec3::from(hi.map(up)).min(b.max),
+    ))
 }
 
 #[cfg(dualsplit_embree)]
@@ -93,7 +174,106 @@ mod imp {
     use crate::EmbreeError;
     use dualsplit_geometry::Aabb;
 
-    pub(super) fn build_tree(_: &[Aabb], _: &TreeArgs) -> Result<BuiltTree, EmbreeError> {
+    pub(super) fn build_tree(
+        _: &[Aabb],
+        _: &TreeArgs,
+        _: Option<&[dualsplit_geometry::Triangle]>,
+    ) -> Result<BuiltTree, EmbreeError> {
         Err(EmbreeError::Missing(crate::STATUS))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dualsplit_geometry::Pcg32;
+
+    /// Points of `t` by barycentric weights on a grid of `n` steps, in f64.
+    fn points(t: &Triangle, n: u32) -> Vec<[f64; 3]> {
+        let v = t.v.map(|p| p.to_array().map(f64::from));
+        let mut out = Vec::new();
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (a, b) = (i as f64 / n as f64, j as f64 / n as f64);
+                out.push(
+                    [0, 1, 2].map(|k| v[0][k] + a * (v[1][k] - v[0][k]) + b * (v[2][k] - v[0][k])),
+                );
+            }
+        }
+        out
+    }
+
+    fn holds(b: &Aabb, p: &[f64; 3]) -> bool {
+        (0..3).all(|a| b.min[a] as f64 <= p[a] && p[a] <= b.max[a] as f64)
+    }
+
+    #[test]
+    fn clipped_bounds_hold_the_triangle_on_each_side_of_a_plane() {
+        let mut rng = Pcg32::new(7, 3);
+        let mut split = 0;
+        for _ in 0..2000 {
+            let mut v = || {
+                Vec3::new(
+                    rng.range_f32(-8.0, 8.0),
+                    rng.range_f32(-8.0, 8.0),
+                    rng.range_f32(-8.0, 8.0),
+                )
+            };
+            let t = Triangle::new(v(), v(), v());
+            let b = t.bounds();
+            assert_eq!(clipped_bounds(&t, &b), Some(b), "a triangle's own box");
+            let d = rng.below(3) as usize;
+            let pos = rng.range_f32(b.min[d], b.max[d]);
+            let (mut l, mut r) = (b, b);
+            l.max[d] = pos;
+            r.min[d] = pos;
+            let (lc, rc) = (clipped_bounds(&t, &l), clipped_bounds(&t, &r));
+            // The grid, and where the edges cross the plane (the parts' corners there).
+            let v = t.v.map(|p| p.to_array().map(f64::from));
+            let mut pts = points(&t, 24);
+            for (p, q) in [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])] {
+                let s = (pos as f64 - p[d]) / (q[d] - p[d]);
+                if (0.0..=1.0).contains(&s) {
+                    pts.push([0, 1, 2].map(|k| {
+                        if k == d {
+                            pos as f64
+                        } else {
+                            p[k] + (q[k] - p[k]) * s
+                        }
+                    }));
+                }
+            }
+            for p in pts {
+                let (pl, pr) = (p[d] <= pos as f64, p[d] >= pos as f64);
+                if pl {
+                    let lc = lc.expect("a point on the left");
+                    assert!(
+                        holds(&lc, &p) && l.contains_box(&lc),
+                        "{t:?} {d} {pos}: {lc:?}"
+                    );
+                }
+                if pr {
+                    let rc = rc.expect("a point on the right");
+                    assert!(
+                        holds(&rc, &p) && r.contains_box(&rc),
+                        "{t:?} {d} {pos}: {rc:?}"
+                    );
+                }
+            }
+            if let (Some(lc), Some(rc)) = (lc, rc) {
+                split += (lc.half_area() < b.half_area() && rc.half_area() < b.half_area()) as u32;
+            }
+        }
+        assert!(split > 1000, "the parts' boxes are smaller: {split}");
+    }
+
+    #[test]
+    fn clipped_bounds_of_a_box_beside_the_triangle_are_none() {
+        let t = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
+        let above = Aabb::new(Vec3::new(0.0, 0.0, 1.0), Vec3::splat(2.0));
+        assert_eq!(clipped_bounds(&t, &above), None);
+        // Beyond the hypotenuse, inside the triangle's box.
+        let corner = Aabb::new(Vec3::new(0.75, 0.75, 0.0), Vec3::new(1.0, 1.0, 0.0));
+        assert_eq!(clipped_bounds(&t, &corner), None);
     }
 }

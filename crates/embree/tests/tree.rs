@@ -1,14 +1,21 @@
 //! Embree's builder wrapper (`tree::build_tree`): the tree it hands back holds every box
-//! once, in boxes that contain their subtrees, within the arguments' limits. Tests that need
-//! the library pass with a note when the crate was built without it (never under CI).
+//! once, in boxes that contain their subtrees, within the arguments' limits; with spatial
+//! splits (`tree::build_tree_split`) every part of every triangle lies in a box of a leaf
+//! that holds it. Tests that need the library pass with a note when the crate was built
+//! without it (never under CI).
 
-use dualsplit_embree::tree::{BuiltTree, Child, TreeArgs, build_tree};
+use dualsplit_embree::tree::{BuiltTree, Child, TreeArgs, build_tree, build_tree_split};
 use dualsplit_embree::{EmbreeError, available};
 use dualsplit_geometry::{Aabb, Vec3};
 use dualsplit_testkit::scenes::shipped_triangles;
 
 fn build(boxes: &[Aabb], args: &TreeArgs) -> Option<BuiltTree> {
-    match build_tree(boxes, args) {
+    skip_if_missing(build_tree(boxes, args))
+}
+
+/// The tree, or `None` (with a note) when the crate was built without Embree.
+fn skip_if_missing(built: Result<BuiltTree, EmbreeError>) -> Option<BuiltTree> {
+    match built {
         Ok(t) => Some(t),
         Err(EmbreeError::Missing(why)) => {
             assert!(!available());
@@ -113,4 +120,69 @@ fn one_box_is_a_leaf_root_and_bad_arguments_are_refused() {
     }
     let e = build_tree(&[], &TreeArgs::bvh8_triangle4()).expect_err("no boxes");
     assert!(matches!(e, EmbreeError::Unsupported(_)), "{e}");
+}
+
+/// Every leaf's box (as its parent gives it) and triangles, below `c` in box `b`, checking
+/// that each node's boxes lie within its own.
+fn leaves(t: &BuiltTree, c: Child, b: Aabb, out: &mut Vec<(Aabb, Vec<u32>)>) {
+    match c {
+        Child::Leaf(l) => out.push((b, t.leaves[l as usize].clone())),
+        Child::Node(n) => {
+            for &(cb, child) in &t.nodes[n as usize] {
+                assert!(b.contains_box(&cb), "node {n}: {cb:?} outside {b:?}");
+                leaves(t, child, cb, out);
+            }
+        }
+    }
+}
+
+#[test]
+fn split_tree_puts_every_part_of_a_triangle_in_a_leaf_box_that_holds_it() {
+    let tris = shipped_triangles("dragon_res4.ply.gz").expect("dragon_res4 is committed");
+    let args = TreeArgs::bvh8_triangle4();
+    let Some(t) = skip_if_missing(build_tree_split(&tris, &args)) else {
+        return;
+    };
+    let scene = tris.iter().fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+    let mut all = Vec::new();
+    leaves(&t, t.root, scene, &mut all);
+    let mut boxes_of = vec![Vec::new(); tris.len()];
+    for (b, ids) in &all {
+        assert!((1..=args.max_leaf as usize).contains(&ids.len()), "{ids:?}");
+        let mut once = ids.clone();
+        once.sort_unstable();
+        once.dedup();
+        assert_eq!(
+            once.len(),
+            ids.len(),
+            "a triangle twice in one leaf: {ids:?}"
+        );
+        for &p in ids {
+            boxes_of[p as usize].push(*b);
+        }
+    }
+    let refs: usize = boxes_of.iter().map(Vec::len).sum();
+    assert!(
+        refs > tris.len(),
+        "spatial splits made no reference: {refs}"
+    );
+    assert!(refs <= 2 * tris.len(), "{refs} references");
+    // Each triangle's points on a grid of barycentric weights (f64): each lies in a box
+    // of a leaf holding the triangle.
+    let n = 8;
+    for (i, tri) in tris.iter().enumerate() {
+        let v = tri.v.map(|p| p.to_array().map(f64::from));
+        for a in 0..=n {
+            for c in 0..=n - a {
+                let (wa, wc) = (a as f64 / n as f64, c as f64 / n as f64);
+                let p: [f64; 3] = std::array::from_fn(|k| {
+                    v[0][k] + wa * (v[1][k] - v[0][k]) + wc * (v[2][k] - v[0][k])
+                });
+                let held = boxes_of[i]
+                    .iter()
+                    .any(|b| (0..3).all(|k| b.min[k] as f64 <= p[k] && p[k] <= b.max[k] as f64));
+                assert!(held, "triangle {i}: {p:?} in none of {:?}", boxes_of[i]);
+            }
+        }
+    }
 }
