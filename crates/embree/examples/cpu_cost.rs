@@ -16,13 +16,15 @@
 //! S=sponza_dabrovic.ply.gz   # a shipped mesh's path, or builtin:NAME
 //! run 'cpu_cost::ours' $S 64 primary      # our whole query
 //! run 'cpu_cost::embree_query' $S 64 primary   # Embree's whole query
-//! run 'dualsplit_accel::wide::simd::Avx2::vectorize::with_avx2*' $S 64 primary   # our traversal
 //! run rtcIntersect1 $S 64 primary   # Embree's (rtcOccluded1 for the shadow set)
 //! ```
 //!
 //! "Collected" lists Ir, conditional branches and mispredicted ones; the program prints the
-//! set's ray count to divide by. (Our copy's traversal runs inside the AVX2 function that the
-//! third toggle names when the CPU has AVX2; nothing else runs there in this program.)
+//! set's ray count to divide by. Our copy's traversal proper runs inside the AVX2 function
+//! `dualsplit_accel::wide::simd::Avx2::vectorize::with_avx2` when the CPU has AVX2: its
+//! inclusive cost inside our whole query (`--callgrind-out-file=F` with the first toggle,
+//! then `callgrind_annotate --inclusive=yes F`). Collecting with that function as the
+//! toggle would count the structures' builds too, which run other kernels through it.
 //!
 //! `cpu_cost SCENE RES SET away` traces the set's rays moved to start beyond the scene's box
 //! and point away from it, so that every query ends at the root's box test: what a ray costs
