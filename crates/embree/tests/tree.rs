@@ -1,12 +1,14 @@
 //! Embree's builder wrapper (`tree::build_tree`): the tree it hands back holds every box
 //! once, in boxes that contain their subtrees, within the arguments' limits; with spatial
 //! splits (`tree::build_tree_split`) every part of every triangle lies in a box of a leaf
-//! that holds it. Tests that need the library pass with a note when the crate was built
-//! without it (never under CI).
+//! that holds it, as `tree::clipped_bounds` makes the parts' boxes. Tests that need the
+//! library pass with a note when the crate was built without it (never under CI).
 
-use dualsplit_embree::tree::{BuiltTree, Child, TreeArgs, build_tree, build_tree_split};
+use dualsplit_embree::tree::{
+    BuiltTree, Child, TreeArgs, build_tree, build_tree_split, clipped_bounds,
+};
 use dualsplit_embree::{EmbreeError, available};
-use dualsplit_geometry::{Aabb, Vec3};
+use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3};
 use dualsplit_testkit::scenes::shipped_triangles;
 
 fn build(boxes: &[Aabb], args: &TreeArgs) -> Option<BuiltTree> {
@@ -169,20 +171,100 @@ fn split_tree_puts_every_part_of_a_triangle_in_a_leaf_box_that_holds_it() {
     assert!(refs <= 2 * tris.len(), "{refs} references");
     // Each triangle's points on a grid of barycentric weights (f64): each lies in a box
     // of a leaf holding the triangle.
-    let n = 8;
     for (i, tri) in tris.iter().enumerate() {
-        let v = tri.v.map(|p| p.to_array().map(f64::from));
-        for a in 0..=n {
-            for c in 0..=n - a {
-                let (wa, wc) = (a as f64 / n as f64, c as f64 / n as f64);
-                let p: [f64; 3] = std::array::from_fn(|k| {
-                    v[0][k] + wa * (v[1][k] - v[0][k]) + wc * (v[2][k] - v[0][k])
-                });
-                let held = boxes_of[i]
-                    .iter()
-                    .any(|b| (0..3).all(|k| b.min[k] as f64 <= p[k] && p[k] <= b.max[k] as f64));
-                assert!(held, "triangle {i}: {p:?} in none of {:?}", boxes_of[i]);
-            }
+        for p in points(tri, 8) {
+            let held = boxes_of[i].iter().any(|b| holds(b, &p));
+            assert!(held, "triangle {i}: {p:?} in none of {:?}", boxes_of[i]);
         }
     }
+}
+
+/// Points of `t` by barycentric weights on a grid of `n` steps, in f64.
+fn points(t: &Triangle, n: u32) -> Vec<[f64; 3]> {
+    let v = t.v.map(|p| p.to_array().map(f64::from));
+    let mut out = Vec::new();
+    for i in 0..=n {
+        for j in 0..=n - i {
+            let (a, b) = (i as f64 / n as f64, j as f64 / n as f64);
+            out.push(
+                [0, 1, 2].map(|k| v[0][k] + a * (v[1][k] - v[0][k]) + b * (v[2][k] - v[0][k])),
+            );
+        }
+    }
+    out
+}
+
+/// Whether box `b` holds point `p` (compared in f64, so no rounding of `p`).
+fn holds(b: &Aabb, p: &[f64; 3]) -> bool {
+    (0..3).all(|a| b.min[a] as f64 <= p[a] && p[a] <= b.max[a] as f64)
+}
+
+#[test]
+fn clipped_bounds_hold_the_triangle_on_each_side_of_a_plane() {
+    let mut rng = Pcg32::new(7, 3);
+    let mut split = 0;
+    for _ in 0..2000 {
+        let mut v = || {
+            Vec3::new(
+                rng.range_f32(-8.0, 8.0),
+                rng.range_f32(-8.0, 8.0),
+                rng.range_f32(-8.0, 8.0),
+            )
+        };
+        let t = Triangle::new(v(), v(), v());
+        let b = t.bounds();
+        assert_eq!(clipped_bounds(&t, &b), Some(b), "a triangle's own box");
+        let d = rng.below(3) as usize;
+        let pos = rng.range_f32(b.min[d], b.max[d]);
+        let (mut l, mut r) = (b, b);
+        l.max[d] = pos;
+        r.min[d] = pos;
+        let (lc, rc) = (clipped_bounds(&t, &l), clipped_bounds(&t, &r));
+        // The grid, and where the edges cross the plane (the parts' corners there).
+        let v = t.v.map(|p| p.to_array().map(f64::from));
+        let mut pts = points(&t, 24);
+        for (p, q) in [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])] {
+            let s = (pos as f64 - p[d]) / (q[d] - p[d]);
+            if (0.0..=1.0).contains(&s) {
+                pts.push([0, 1, 2].map(|k| {
+                    if k == d {
+                        pos as f64
+                    } else {
+                        p[k] + (q[k] - p[k]) * s
+                    }
+                }));
+            }
+        }
+        for p in pts {
+            let (pl, pr) = (p[d] <= pos as f64, p[d] >= pos as f64);
+            if pl {
+                let lc = lc.expect("a point on the left");
+                assert!(
+                    holds(&lc, &p) && l.contains_box(&lc),
+                    "{t:?} {d} {pos}: {lc:?}"
+                );
+            }
+            if pr {
+                let rc = rc.expect("a point on the right");
+                assert!(
+                    holds(&rc, &p) && r.contains_box(&rc),
+                    "{t:?} {d} {pos}: {rc:?}"
+                );
+            }
+        }
+        if let (Some(lc), Some(rc)) = (lc, rc) {
+            split += (lc.half_area() < b.half_area() && rc.half_area() < b.half_area()) as u32;
+        }
+    }
+    assert!(split > 1000, "the parts' boxes are smaller: {split}");
+}
+
+#[test]
+fn clipped_bounds_of_a_box_beside_the_triangle_are_none() {
+    let t = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
+    let above = Aabb::new(Vec3::new(0.0, 0.0, 1.0), Vec3::splat(2.0));
+    assert_eq!(clipped_bounds(&t, &above), None);
+    // Beyond the hypotenuse, inside the triangle's box.
+    let corner = Aabb::new(Vec3::new(0.75, 0.75, 0.0), Vec3::new(1.0, 1.0, 0.0));
+    assert_eq!(clipped_bounds(&t, &corner), None);
 }
