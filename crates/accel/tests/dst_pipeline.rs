@@ -5,7 +5,7 @@
 use dualsplit_accel::dst::pipeline::{PipelineInput, ReturnCode, step};
 use dualsplit_accel::dst::{AxisPair, Corner, DstConfig, HeaderOffset};
 use dualsplit_accel::{CountingObserver, DstNodeKind};
-use dualsplit_geometry::{Aabb, Pcg32, Triangle, Vec3, widen_exit};
+use dualsplit_geometry::{Aabb, Pcg32, Triangle, widen_exit};
 use dualsplit_testkit::dst::build;
 use dualsplit_testkit::rays::random_rays;
 use proptest::prelude::*;
@@ -239,18 +239,8 @@ fn counters_agree_per_ray() {
     let mut rng = Pcg32::new(99, 1);
     let tris: Vec<Triangle> = (0..300)
         .map(|_| {
-            let a = Vec3::new(
-                rng.range_f32(-5.0, 5.0),
-                rng.range_f32(-5.0, 5.0),
-                rng.range_f32(-5.0, 5.0),
-            );
-            let e = |rng: &mut Pcg32| {
-                Vec3::new(
-                    rng.range_f32(-0.5, 0.5),
-                    rng.range_f32(-0.5, 0.5),
-                    rng.range_f32(-0.5, 0.5),
-                )
-            };
+            let a = rng.cube_point(-5.0, 5.0);
+            let e = |rng: &mut Pcg32| rng.cube_point(-0.5, 0.5);
             Triangle::new(a, a + e(&mut rng), a + e(&mut rng))
         })
         .collect();

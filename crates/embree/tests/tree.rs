@@ -204,13 +204,7 @@ fn clipped_bounds_hold_the_triangle_on_each_side_of_a_plane() {
     let mut rng = Pcg32::new(7, 3);
     let mut split = 0;
     for _ in 0..2000 {
-        let mut v = || {
-            Vec3::new(
-                rng.range_f32(-8.0, 8.0),
-                rng.range_f32(-8.0, 8.0),
-                rng.range_f32(-8.0, 8.0),
-            )
-        };
+        let mut v = || rng.cube_point(-8.0, 8.0);
         let t = Triangle::new(v(), v(), v());
         let b = t.bounds();
         assert_eq!(clipped_bounds(&t, &b), Some(b), "a triangle's own box");

@@ -43,6 +43,14 @@ impl Pcg32 {
         lo + (hi - lo) * self.next_f32()
     }
 
+    /// A point uniform in the cube `[lo, hi)³`, its coordinates drawn x, y, z.
+    #[inline]
+    pub fn cube_point(&mut self, lo: f32, hi: f32) -> crate::Vec3 {
+        let x = self.range_f32(lo, hi);
+        let y = self.range_f32(lo, hi);
+        crate::Vec3::new(x, y, self.range_f32(lo, hi))
+    }
+
     /// An integer uniform in `[0, n)` (Lemire's multiply-shift, slightly biased for huge n).
     #[inline]
     pub fn below(&mut self, n: u32) -> u32 {
@@ -84,6 +92,20 @@ mod tests {
                 0xa15c02b7, 0x7b47f409, 0xba1d3330, 0x83d2f293, 0xbfa4784b, 0xcbed606e
             ]
         );
+    }
+
+    #[test]
+    fn cube_point_draws_x_then_y_then_z() {
+        let (mut a, mut b) = (Pcg32::new(5, 2), Pcg32::new(5, 2));
+        for _ in 0..1000 {
+            let p = a.cube_point(-3.0, 2.0);
+            let want = [(); 3].map(|_| b.range_f32(-3.0, 2.0));
+            assert_eq!([p.x, p.y, p.z].map(f32::to_bits), want.map(f32::to_bits));
+            assert!(
+                [p.x, p.y, p.z].iter().all(|c| (-3.0..2.0).contains(c)),
+                "{p:?}"
+            );
+        }
     }
 
     #[test]

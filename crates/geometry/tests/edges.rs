@@ -150,13 +150,7 @@ fn rays_at_corner_vertices_always_enter_the_box() {
     let mut rng = Pcg32::new(0x1be, 3);
     let mut hits = 0;
     for _ in 0..50_000 {
-        let mut p = || {
-            Vec3::new(
-                rng.range_f32(-4.0, 4.0),
-                rng.range_f32(-4.0, 4.0),
-                rng.range_f32(-4.0, 4.0),
-            )
-        };
+        let mut p = || rng.cube_point(-4.0, 4.0);
         let (a, b, c, o) = (p().round(), p().round(), p().round(), p());
         let tri = Triangle::new(a, b, c);
         let bb = tri.bounds();

@@ -71,11 +71,7 @@ fn point_in(rng: &mut Pcg32, tri: &Triangle) -> Vec3 {
 
 fn unit(rng: &mut Pcg32) -> Vec3 {
     loop {
-        let v = Vec3::new(
-            rng.range_f32(-1.0, 1.0),
-            rng.range_f32(-1.0, 1.0),
-            rng.range_f32(-1.0, 1.0),
-        );
+        let v = rng.cube_point(-1.0, 1.0);
         let l = v.length();
         if l > 0.1 && l <= 1.0 {
             return v / l;
