@@ -11,81 +11,67 @@
 
 use crate::config::UnitConfig;
 use crate::hw::Cycle;
+use crate::hw::window::Window;
 
-/// Cycles a pool remembers around the current time. Requests are made at most
-/// [`crate::model::rv32::tp::LOOKAHEAD`] cycles after the current event time and never before it, so
-/// two live cycles are never this far apart and never share a ring entry.
-const RING: usize = 1024;
-
-/// One pool: `width` units, each accepting one operation per cycle.
-#[derive(Clone, Debug)]
-pub struct Pool {
-    width: u32,
-    latency: u64,
-    /// Per ring entry: the cycle it counts and how many units that cycle has taken. An
-    /// entry whose cycle is not the one asked about belongs to a cycle that is over.
-    ring: Vec<(Cycle, u32)>,
+/// One of a TM's pools, a row of [`Pools`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pool {
+    /// FP compare (`feq`, `flt`, `fle`, `fclass`): SimTRaX `FPCMP`.
+    FpCmp = 0,
+    /// FP min/max: SimTRaX `FPMIN`.
+    FpMinMax = 1,
+    /// Int ↔ FP conversions: SimTRaX `CONV`.
+    Conv = 2,
+    /// Branches and jumps: SimTRaX `BLT`.
+    Branch = 3,
+    /// Integer multiply: SimTRaX `INTMUL`.
+    IntMul = 4,
 }
 
-impl Pool {
-    /// A pool of `width` units whose results are ready `latency` cycles after issue.
-    pub fn new(width: u32, latency: u64) -> Self {
-        Self {
-            width: width.max(1),
-            latency,
-            ring: vec![(Cycle::MAX, 0); RING],
-        }
-    }
+const POOLS: usize = 5;
 
-    /// Takes a unit in the first cycle at or after `at` with one free; returns that cycle.
-    #[inline]
-    pub fn reserve(&mut self, at: Cycle) -> Cycle {
-        let mut c = at;
-        loop {
-            let e = &mut self.ring[(c.get() % RING as u64) as usize];
-            if e.0 != c {
-                *e = (c, 0);
-            }
-            if e.1 < self.width {
-                e.1 += 1;
-                return c;
-            }
-            c += 1;
-        }
-    }
-
-    /// The pool's result latency.
-    #[inline]
-    pub fn latency(&self) -> u64 {
-        self.latency
-    }
-}
-
-/// The pools of one TM, one per shared class of SimTRaX's unit list.
+/// The pools of one TM, one per shared class of SimTRaX's unit list: pool `p` has
+/// `width[p]` fully pipelined units, each accepting one operation per cycle, and its
+/// results are ready `latency[p]` cycles after issue. The per-cycle use counts of all five
+/// lie in one [`Window`] (requests are made at most `tp::LOOKAHEAD` cycles after the
+/// current event time and never before it).
 #[derive(Clone, Debug)]
 pub struct Pools {
-    /// FP compare (`feq`, `flt`, `fle`, `fclass`): SimTRaX `FPCMP`.
-    pub fpcmp: Pool,
-    /// FP min/max: SimTRaX `FPMIN`.
-    pub fpminmax: Pool,
-    /// Int ↔ FP conversions: SimTRaX `CONV`.
-    pub conv: Pool,
-    /// Branches and jumps: SimTRaX `BLT`.
-    pub branch: Pool,
-    /// Integer multiply: SimTRaX `INTMUL`.
-    pub intmul: Pool,
+    width: [u8; POOLS],
+    latency: [u64; POOLS],
+    used: Window,
 }
 
 impl Pools {
     /// The pools of one TM as `units` configures them.
     pub fn new(units: &UnitConfig) -> Self {
+        let pools = [
+            (units.fpcmp_units, units.fpcmp_latency),
+            (units.fpminmax_units, units.fpminmax_latency),
+            (units.conv_units, units.conv_latency),
+            (units.branch_units, units.branch_latency),
+            (units.intmul_units, units.intmul_latency),
+        ];
         Self {
-            fpcmp: Pool::new(units.fpcmp_units, units.fpcmp_latency),
-            fpminmax: Pool::new(units.fpminmax_units, units.fpminmax_latency),
-            conv: Pool::new(units.conv_units, units.conv_latency),
-            branch: Pool::new(units.branch_units, units.branch_latency),
-            intmul: Pool::new(units.intmul_units, units.intmul_latency),
+            // At most 64 units (`ranges.rs`), so a count fits a byte.
+            width: pools.map(|(w, _)| w.clamp(1, u8::MAX as u32) as u8),
+            latency: pools.map(|(_, l)| l),
+            used: Window::new(POOLS),
         }
+    }
+
+    /// Takes a unit of pool `p` in the first cycle at or after `at` with one free; returns
+    /// that cycle.
+    #[inline]
+    pub fn reserve(&mut self, p: Pool, at: Cycle) -> Cycle {
+        let i = p as usize;
+        Cycle(self.used.reserve(i, at.get(), self.width[i]))
+    }
+
+    /// Pool `p`'s result latency.
+    #[inline]
+    pub fn latency(&self, p: Pool) -> u64 {
+        self.latency[p as usize]
     }
 }
 
@@ -113,25 +99,36 @@ pub fn unit_latency(fu: FuClass, cfg: &UnitConfig) -> Option<u64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::SimConfig;
 
     #[test]
     fn a_full_cycle_sends_the_next_request_to_the_next_cycle() {
-        let mut p = Pool::new(2, 1);
-        assert_eq!(p.reserve(Cycle(10)), Cycle(10));
-        assert_eq!(p.reserve(Cycle(10)), Cycle(10));
-        assert_eq!(p.reserve(Cycle(10)), Cycle(11));
-        assert_eq!(p.reserve(Cycle(11)), Cycle(11));
-        assert_eq!(p.reserve(Cycle(10)), Cycle(12));
-        assert_eq!(p.reserve(Cycle(9)), Cycle(9));
+        let mut units = SimConfig::lin2020().units;
+        units.intmul_units = 2;
+        units.branch_units = 1;
+        let mut p = Pools::new(&units);
+        let m = Pool::IntMul;
+        assert_eq!(p.reserve(m, Cycle(10)), Cycle(10));
+        assert_eq!(p.reserve(m, Cycle(10)), Cycle(10));
+        assert_eq!(p.reserve(m, Cycle(10)), Cycle(11));
+        assert_eq!(p.reserve(m, Cycle(11)), Cycle(11));
+        assert_eq!(p.reserve(m, Cycle(10)), Cycle(12));
+        assert_eq!(p.reserve(m, Cycle(9)), Cycle(9));
+        // Another pool counts apart.
+        assert_eq!(p.reserve(Pool::Branch, Cycle(10)), Cycle(10));
+        assert_eq!(p.reserve(Pool::Branch, Cycle(10)), Cycle(11));
     }
 
     #[test]
-    fn a_cycle_far_later_reuses_a_ring_entry_from_zero() {
-        let mut p = Pool::new(1, 1);
-        assert_eq!(p.reserve(Cycle(3)), Cycle(3));
-        let later = Cycle(3 + RING as u64);
-        assert_eq!(p.reserve(later), later);
-        assert_eq!(p.reserve(later), later + 1);
+    fn a_cycle_far_later_finds_its_pool_free() {
+        let mut units = SimConfig::lin2020().units;
+        units.intmul_units = 1;
+        let mut p = Pools::new(&units);
+        let m = Pool::IntMul;
+        assert_eq!(p.reserve(m, Cycle(3)), Cycle(3));
+        let later = Cycle(3 + crate::hw::window::HISTORY);
+        assert_eq!(p.reserve(m, later), later);
+        assert_eq!(p.reserve(m, later), later + 1);
     }
 }
 

@@ -8,75 +8,41 @@
 
 use crate::config::UnitConfig;
 use crate::hw::Cycle;
+use crate::hw::window::Window;
 
-/// Cycles of fetch counts a bank remembers: twice the `rv32` model's run-ahead
-/// (`tp::LOOKAHEAD`, 256 cycles), so the fetches of threads running ahead and of threads at
-/// the event clock share one count per cycle.
-const HISTORY: u64 = 1024;
-
-/// One bank's fetches per cycle over a sliding window of [`HISTORY`] cycles
-/// (`[base, base + HISTORY)`, a ring). A cycle before the window is not counted: no thread
-/// fetches that far behind another's run-ahead.
-#[derive(Clone, Debug)]
-struct Bank {
-    base: u64,
-    counts: Box<[u8; HISTORY as usize]>,
+/// A fetch made by [`ICaches::try_fetch`]: the cycle it is made in, and whether it was
+/// counted yet.
+#[derive(Clone, Copy, Debug)]
+pub struct Fetch {
+    /// The cycle of the fetch.
+    pub at: Cycle,
+    bank: u32,
+    taken: bool,
 }
 
-impl Bank {
-    fn new() -> Self {
-        Self {
-            base: 0,
-            counts: Box::new([0; HISTORY as usize]),
-        }
-    }
-
+impl Fetch {
+    /// The instruction issues: the fetch is counted.
     #[inline]
-    fn count(&self, c: u64) -> u8 {
-        if c < self.base || c >= self.base + HISTORY {
-            0
-        } else {
-            self.counts[(c % HISTORY) as usize]
+    pub fn keep(self, ic: &mut ICaches) {
+        if !self.taken && ic.limit != 0 {
+            ic.banks.take(self.bank as usize, self.at.get());
         }
     }
 
-    /// The first cycle at or after `c` with fewer than `limit` fetches.
+    /// The instruction does not issue now: the fetch is not counted.
     #[inline]
-    fn first_free(&self, c: u64, limit: u8) -> u64 {
-        let mut s = c;
-        while self.count(s) >= limit {
-            s += 1;
+    pub fn give_back(self, ic: &mut ICaches) {
+        if self.taken {
+            ic.banks.untake(self.bank as usize, self.at.get());
         }
-        s
-    }
-
-    /// Counts a fetch in cycle `s`, sliding the window forward when `s` lies past it.
-    fn take(&mut self, s: u64) {
-        if s < self.base {
-            return;
-        }
-        if s >= self.base + HISTORY {
-            let base = s + 1 - HISTORY / 2;
-            let fresh = base.max(self.base + HISTORY);
-            // The cycles [fresh, base + HISTORY) reuse ring entries of forgotten cycles.
-            if base + HISTORY - fresh >= HISTORY {
-                self.counts.fill(0);
-            } else {
-                for x in fresh..base + HISTORY {
-                    self.counts[(x % HISTORY) as usize] = 0;
-                }
-            }
-            self.base = base;
-        }
-        self.counts[(s % HISTORY) as usize] += 1;
     }
 }
 
 /// The fetch counts of one TM's instruction caches.
 #[derive(Clone, Debug)]
 pub struct ICaches {
-    /// Banks of cache 0 first.
-    banks: Vec<Bank>,
+    /// One row per bank, the banks of cache 0 first.
+    banks: Window,
     caches: usize,
     bank_mask: u32,
     /// Fetches per bank per cycle; 0 = no limit.
@@ -93,7 +59,7 @@ impl ICaches {
             (units.icaches * units.icache_banks) as usize
         };
         Self {
-            banks: (0..n).map(|_| Bank::new()).collect(),
+            banks: Window::new(n),
             caches: units.icaches as usize,
             bank_mask: units.icache_banks - 1,
             limit,
@@ -118,7 +84,10 @@ impl ICaches {
         if self.limit == 0 {
             return c;
         }
-        Cycle(self.banks[self.bank(cache, pc)].first_free(c.get(), self.limit))
+        Cycle(
+            self.banks
+                .first_free(self.bank(cache, pc), c.get(), self.limit),
+        )
     }
 
     /// Fetches the instruction at `pc` from cache `cache` in cycle `s`, which [`Self::peek`]
@@ -127,8 +96,32 @@ impl ICaches {
     pub fn take(&mut self, cache: usize, pc: u32, s: Cycle) {
         if self.limit != 0 {
             let b = self.bank(cache, pc);
-            debug_assert!(self.banks[b].count(s.get()) < self.limit);
-            self.banks[b].take(s.get());
+            debug_assert!(self.banks.count(b, s.get()) < self.limit);
+            self.banks.take(b, s.get());
+        }
+    }
+
+    /// The fetch of a thread that may not issue the instruction yet: fetches the
+    /// instruction at `pc` from cache `cache` in the first cycle at or after `c` its bank
+    /// has a fetch left, when that cycle lies in the counts' window, and returns it. The
+    /// caller then either issues ([`Fetch::keep`]) or gives the fetch back
+    /// ([`Fetch::give_back`]) before anything else is fetched: either way the counts are
+    /// those of [`Self::peek`] followed, on issue, by [`Self::take`].
+    #[inline]
+    pub fn try_fetch(&mut self, cache: usize, pc: u32, c: Cycle) -> Fetch {
+        if self.limit == 0 {
+            return Fetch {
+                at: c,
+                bank: 0,
+                taken: false,
+            };
+        }
+        let bank = self.bank(cache, pc);
+        let (s, taken) = self.banks.reserve_in_window(bank, c.get(), self.limit);
+        Fetch {
+            at: Cycle(s),
+            bank: bank as u32,
+            taken,
         }
     }
 
@@ -139,11 +132,10 @@ impl ICaches {
         if self.limit == 0 {
             return c;
         }
-        let (b, limit) = (self.bank(cache, pc), self.limit);
-        let bank = &mut self.banks[b];
-        let s = bank.first_free(c.get(), limit);
-        bank.take(s);
-        Cycle(s)
+        Cycle(
+            self.banks
+                .reserve(self.bank(cache, pc), c.get(), self.limit),
+        )
     }
 }
 
@@ -151,6 +143,7 @@ impl ICaches {
 mod tests {
     use super::*;
     use crate::SimConfig;
+    use crate::hw::window::HISTORY;
 
     #[test]
     fn a_bank_serves_two_fetches_a_cycle() {

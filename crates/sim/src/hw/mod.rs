@@ -9,7 +9,7 @@
 //!   pools and classes), [`icache`] (instruction-cache fetch slots);
 //! * [`atomic`]: the global atomic unit;
 //! * [`memory`]: the L2 and GDDR5 DRAM behind the L1s;
-//! * [`slots`]: the reservation tables the units are made of;
+//! * [`slots`], [`window`]: the reservation tables the units are made of;
 //! * [`stalls`], [`counts`], [`energy`]: what the threads' cycles and instructions were,
 //!   and what they cost;
 //! * [`cycle`], [`addr`]: clock cycles, DRAM ticks and typed addresses.
@@ -29,6 +29,7 @@ pub mod pipe;
 pub mod slots;
 pub mod stalls;
 pub mod tm;
+pub mod window;
 
 pub use addr::WordAddr;
 pub use chip::{Chip, ChipStats, Units};

@@ -1,6 +1,6 @@
 //! One hardware thread (a TP's thread): architectural state and the functional executor.
 
-use super::decode::{CSR_FCSR, CSR_FRM, Info, Op, decode};
+use super::decode::{CSR_FCSR, CSR_FRM, Info, Instr, Op, decode};
 use super::elf::Program;
 use super::isa::PIPE_INPUT_WORDS;
 use super::memory::{LOCAL_STORE_ADDR, MemFault, Memory};
@@ -525,6 +525,20 @@ impl Hart {
         let Some(ins) = prog.fetch(pc) else {
             return Err(ExecError::Fetch { pc });
         };
+        let ins = *ins;
+        self.exec(&ins, prog, mem)
+    }
+
+    /// Executes `ins`, the instruction at the pc (fetched from `prog` by the caller), as
+    /// [`Hart::step`] does.
+    #[inline(always)]
+    pub fn exec<M: Memory>(
+        &mut self,
+        ins: &Instr,
+        prog: &Program,
+        mem: &mut M,
+    ) -> Result<Retired, ExecError> {
+        let pc = self.pc;
         let (op, imm) = (ins.op, ins.imm);
         // Register numbers are read where used; `& 31` lets the compiler drop the register
         // files' bounds checks.

@@ -32,7 +32,7 @@
 
 use crate::config::UnitConfig;
 use crate::engine::Wake;
-use crate::hw::fu::{ClassCounts, FuClass, Pool, fu_index};
+use crate::hw::fu::{ClassCounts, FuClass, Pool, Pools, fu_index};
 use crate::hw::issued::Issued;
 use crate::hw::memory::L2;
 use crate::hw::pipe::Pipe;
@@ -40,12 +40,34 @@ use crate::hw::tm::Tm;
 use crate::hw::{Cycle, Stalls, Units, WordAddr};
 use crate::model::rv32::placement::Placement;
 use crate::model::rv32::{
-    ExecError, FrameMemory, Hart, LOCAL_STORE_ADDR, Latches, Op, Program, Retired,
+    ExecError, FrameMemory, Hart, LOCAL_STORE_ADDR, Latches, Op, Program, Reg, Retired,
 };
 
 /// The farthest a TP runs instructions on its own units and pools ahead of the current
 /// event time.
 pub const LOOKAHEAD: u64 = 256;
+
+/// Scoreboard slots after the 64 registers: the latches `R`, `B`, `D`, `P`, and one that
+/// is always ready.
+const RAY_SLOT: usize = 64;
+const BOX_SLOT: usize = 65;
+const DST_SLOT: usize = 66;
+const PIPE_SLOT: usize = 67;
+const NO_SLOT: usize = 68;
+const SLOTS: usize = 69;
+/// The latch bits an instruction reads.
+const READS_ANY_LATCH: u8 =
+    Latches::READS_RAY | Latches::READS_BOX | Latches::READS_DST | Latches::READS_PIPE;
+
+/// The producers of the scoreboard's slots at the start: a latch's is fixed (`R` is
+/// written by the TP's own moves, `B` and `D` by a ray pipeline, `P` by loads).
+const LATCH_PRODUCERS: [Producer; SLOTS] = {
+    let mut p = [Producer::Unit; SLOTS];
+    p[BOX_SLOT] = Producer::Pipeline;
+    p[DST_SLOT] = Producer::Pipeline;
+    p[PIPE_SLOT] = Producer::Memory;
+    p
+};
 
 /// Why a register is not ready yet: the kind of unit that produces it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -80,15 +102,12 @@ pub struct Tp {
     /// The cycle of its next issue slot.
     t: Cycle,
     /// Scoreboard: the cycle each register's pending result arrives (`x0..x31`,
-    /// `f0..f31`), and what produces it.
-    ready: [Cycle; 64],
-    producer: [Producer; 64],
-    /// The same for the ray registers `R`, the box latch `B`, the DST latch `D` and the
-    /// pipeline input registers `P` (the latest of the loads that wrote them).
-    ray_ready: Cycle,
-    box_ready: Cycle,
-    dst_ready: Cycle,
-    pipe_ready: Cycle,
+    /// `f0..f31`), then the same for the ray registers `R`, the box latch `B`, the DST
+    /// latch `D` and the pipeline input registers `P` (the latest of the loads that wrote
+    /// them), and a slot that is always ready ([`NO_SLOT`], read for an absent operand);
+    /// and what produces each.
+    ready: [Cycle; SLOTS],
+    producer: [Producer; SLOTS],
     /// The latest result of any instruction so far.
     last: Cycle,
     waiting: Option<Waiting>,
@@ -105,12 +124,8 @@ impl Tp {
             tm: tm as u32,
             icache: icache as u32,
             t: Cycle::ZERO,
-            ready: [Cycle::ZERO; 64],
-            producer: [Producer::Unit; 64],
-            ray_ready: Cycle::ZERO,
-            box_ready: Cycle::ZERO,
-            dst_ready: Cycle::ZERO,
-            pipe_ready: Cycle::ZERO,
+            ready: [Cycle::ZERO; SLOTS],
+            producer: LATCH_PRODUCERS,
             last: Cycle::ZERO,
             waiting: None,
             rays: 0,
@@ -154,7 +169,7 @@ impl Tp {
             self.finish_pipe(r, w);
         }
         loop {
-            let Some(ins) = prog.fetch(self.hart.pc) else {
+            let Some(&ins) = prog.fetch(self.hart.pc) else {
                 // The executor names the faulting pc.
                 return Err(self
                     .hart
@@ -165,39 +180,29 @@ impl Tp {
             // The instruction is fetched when the previous one has issued (SimTRaX holds a
             // fetched instruction until it issues).
             let fetch_from = self.t;
-            // Operands.
-            let (mut at, mut why) = (self.t, Producer::Unit);
-            for r in info.src {
-                if let Some(i) = r.index()
-                    && self.ready[i] > at
-                {
-                    (at, why) = (self.ready[i], self.producer[i]);
-                }
-            }
+            // Operands: the registers, then the latches read (an absent one reads the
+            // always-ready slot).
             let l = info.latches;
-            for (reads, ready, p) in [
-                (l.has(Latches::READS_RAY), self.ray_ready, Producer::Unit),
-                (
-                    l.has(Latches::READS_BOX),
-                    self.box_ready,
-                    Producer::Pipeline,
-                ),
-                (
-                    l.has(Latches::READS_DST),
-                    self.dst_ready,
-                    Producer::Pipeline,
-                ),
-                (
-                    l.has(Latches::READS_PIPE),
-                    self.pipe_ready,
-                    Producer::Memory,
-                ),
-            ] {
-                if reads && ready > at {
-                    (at, why) = (ready, p);
-                }
+            let reg = |r: Reg| r.index().unwrap_or(NO_SLOT);
+            let mut sources = [NO_SLOT; 7];
+            sources[..3].copy_from_slice(&info.src.map(reg));
+            if l.bits() & READS_ANY_LATCH != 0 {
+                let latch = |flag: u8, slot: usize| if l.has(flag) { slot } else { NO_SLOT };
+                sources[3..].copy_from_slice(&[
+                    latch(Latches::READS_RAY, RAY_SLOT),
+                    latch(Latches::READS_BOX, BOX_SLOT),
+                    latch(Latches::READS_DST, DST_SLOT),
+                    latch(Latches::READS_PIPE, PIPE_SLOT),
+                ]);
             }
+            let at = sources.iter().fold(self.t, |at, &k| at.max(self.ready[k]));
             if at > self.t {
+                // The wait is counted under the producer of the first operand (in the
+                // order above) that arrives last.
+                let why = sources
+                    .iter()
+                    .find(|&&k| self.ready[k] == at)
+                    .map_or(Producer::Unit, |&k| self.producer[k]);
                 let d = at - self.t;
                 match why {
                     Producer::Unit => stalls.dependency += d,
@@ -208,7 +213,8 @@ impl Tp {
                 self.t = at;
             }
             let pc = self.hart.pc;
-            let fetched = tm.icache.peek(self.icache as usize, pc, fetch_from);
+            let fetch = tm.icache.try_fetch(self.icache as usize, pc, fetch_from);
+            let fetched = fetch.at;
             if fetched > self.t {
                 stalls.icache += fetched - self.t;
                 self.t = fetched;
@@ -222,10 +228,12 @@ impl Tp {
                 fu => on_shared_unit(fu),
             };
             if (shared && self.t > now) || self.t > now + LOOKAHEAD {
+                // Not issued yet: its fetch is made again when the thread next runs.
+                fetch.give_back(&mut tm.icache);
                 return Ok(Wake::At(self.t));
             }
-            tm.icache.take(self.icache as usize, pc, fetched);
-            let r = self.hart.step(prog, mem)?;
+            fetch.keep(&mut tm.icache);
+            let r = self.hart.exec(&ins, prog, mem)?;
             // The executed class (a load or store whose address is the local store's).
             let info = r.info;
             counts[fu_index(info.fu)] += 1;
@@ -240,11 +248,11 @@ impl Tp {
                 FuClass::LocalLoad | FuClass::LocalStore => {
                     (t, cfg.local_store_latency, Producer::Unit)
                 }
-                FuClass::FpCmp => pool(&mut tm.pools.fpcmp, t, stalls),
-                FuClass::FpMinMax => pool(&mut tm.pools.fpminmax, t, stalls),
-                FuClass::FpConv => pool(&mut tm.pools.conv, t, stalls),
-                FuClass::Branch => pool(&mut tm.pools.branch, t, stalls),
-                FuClass::IntMul => pool(&mut tm.pools.intmul, t, stalls),
+                FuClass::FpCmp => pool(&mut tm.pools, Pool::FpCmp, t, stalls),
+                FuClass::FpMinMax => pool(&mut tm.pools, Pool::FpMinMax, t, stalls),
+                FuClass::FpConv => pool(&mut tm.pools, Pool::Conv, t, stalls),
+                FuClass::Branch => pool(&mut tm.pools, Pool::Branch, t, stalls),
+                FuClass::IntMul => pool(&mut tm.pools, Pool::IntMul, t, stalls),
                 FuClass::IntDiv | FuClass::FpDiv | FuClass::FpSqrt | FuClass::Rcp => {
                     let i = tm.reciprocal(t);
                     stalls.fu_busy += i.busy;
@@ -260,7 +268,7 @@ impl Tp {
                     self.t = i.next_issue;
                     self.write(dst, i.ready, Producer::Memory);
                     if l.has(Latches::WRITES_PIPE) {
-                        self.pipe_ready = self.pipe_ready.max(i.ready);
+                        self.ready[PIPE_SLOT] = self.ready[PIPE_SLOT].max(i.ready);
                     }
                     continue;
                 }
@@ -318,11 +326,11 @@ impl Tp {
             self.t = slot + 1;
             self.write(dst, slot + lat, p);
             if l.has(Latches::WRITES_RAY) {
-                self.ray_ready = slot + lat;
+                self.ready[RAY_SLOT] = slot + lat;
             }
             if l.has(Latches::WRITES_PIPE) {
                 // rt.ldp from the local store.
-                self.pipe_ready = self.pipe_ready.max(slot + lat);
+                self.ready[PIPE_SLOT] = self.ready[PIPE_SLOT].max(slot + lat);
             }
         }
     }
@@ -333,10 +341,10 @@ impl Tp {
         self.t = r.next_issue;
         self.write(w.dst, r.ready, Producer::Pipeline);
         if w.latches.has(Latches::WRITES_BOX) {
-            self.box_ready = r.ready;
+            self.ready[BOX_SLOT] = r.ready;
         }
         if w.latches.has(Latches::WRITES_DST) {
-            self.dst_ready = r.ready;
+            self.ready[DST_SLOT] = r.ready;
         }
     }
 
@@ -382,10 +390,10 @@ fn one_slot(i: Issued, p: Producer) -> (Cycle, u64, Producer) {
 
 /// One operation on a pool from cycle `t`: (issue cycle, latency, producer).
 #[inline]
-fn pool(p: &mut Pool, t: Cycle, stalls: &mut Stalls) -> (Cycle, u64, Producer) {
-    let s = p.reserve(t);
+fn pool(pools: &mut Pools, p: Pool, t: Cycle, stalls: &mut Stalls) -> (Cycle, u64, Producer) {
+    let s = pools.reserve(p, t);
     stalls.fu_busy += s - t;
-    (s, p.latency(), Producer::Unit)
+    (s, pools.latency(p), Producer::Unit)
 }
 
 /// Whether an instruction of class `fu` uses a unit shared with other threads that keeps a

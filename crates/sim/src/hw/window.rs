@@ -1,0 +1,186 @@
+//! Per-cycle use counts of a group of resources over a sliding window of cycles: the
+//! instruction caches' fetch slots (`hw/icache.rs`) and the TM's functional-unit pools
+//! (`hw/fu.rs`). Each resource (a *row*) accepts up to a limit of operations per cycle.
+//!
+//! The window holds [`HISTORY`] cycles, `[base, base + HISTORY)`, in a ring. A cycle before
+//! the window counts as unused: requests are made at most `tp::LOOKAHEAD` (256) cycles after
+//! the current event time and never before it, so when a request past the window slides it
+//! forward (to end half a window after that request), no live cycle falls out of it.
+//!
+//! Host layout: one cycle's counts of every row lie side by side (`[cycle][row]`, one byte
+//! each), so a thread issuing at consecutive cycles reads consecutive bytes, and a TM's
+//! tables take `HISTORY × rows` bytes. This replaced one ring per resource, tagged per
+//! entry with its cycle (16 bytes an entry); the counts, and so every simulated result, are
+//! the same.
+
+/// Cycles a window remembers: four times the `rv32` model's run-ahead (`tp::LOOKAHEAD`), so
+/// that the requests of threads running ahead and of threads at the event clock always lie
+/// in one window.
+pub const HISTORY: u64 = 1024;
+
+/// Use counts of `rows` resources per cycle over a sliding window of [`HISTORY`] cycles.
+#[derive(Clone, Debug)]
+pub struct Window {
+    base: u64,
+    /// Bytes per cycle (`rows` rounded up to a power of two, so an index is a shift).
+    shift: u32,
+    /// `HISTORY << shift` counts, cycle-major.
+    counts: Box<[u8]>,
+}
+
+impl Window {
+    /// An empty window over `rows` resources (at least one).
+    pub fn new(rows: usize) -> Self {
+        let shift = rows.max(1).next_power_of_two().trailing_zeros();
+        Self {
+            base: 0,
+            shift,
+            counts: vec![0; (HISTORY as usize) << shift].into_boxed_slice(),
+        }
+    }
+
+    #[inline(always)]
+    fn index(&self, row: usize, c: u64) -> usize {
+        (((c % HISTORY) as usize) << self.shift) | row
+    }
+
+    /// Uses of `row` in cycle `c` (0 for a cycle outside the window).
+    #[inline]
+    pub fn count(&self, row: usize, c: u64) -> u8 {
+        if c < self.base || c >= self.base + HISTORY {
+            0
+        } else {
+            self.counts[self.index(row, c)]
+        }
+    }
+
+    /// The first cycle at or after `c` in which `row` has been used fewer than `limit`
+    /// times.
+    #[inline]
+    pub fn first_free(&self, row: usize, c: u64, limit: u8) -> u64 {
+        let mut s = c;
+        while self.count(row, s) >= limit {
+            s += 1;
+        }
+        s
+    }
+
+    /// Counts one use of `row` in cycle `s` (a cycle before the window is not counted),
+    /// sliding the window forward when `s` lies past it.
+    #[inline]
+    pub fn take(&mut self, row: usize, s: u64) {
+        if s < self.base {
+            return;
+        }
+        if s >= self.base + HISTORY {
+            self.slide(s);
+        }
+        let i = self.index(row, s);
+        self.counts[i] += 1;
+    }
+
+    /// Takes `row` in the first cycle at or after `c` with fewer than `limit` uses; returns
+    /// that cycle.
+    #[inline]
+    pub fn reserve(&mut self, row: usize, c: u64, limit: u8) -> u64 {
+        // Fast path (most requests): `c` is in the window and free.
+        if c >= self.base && c < self.base + HISTORY {
+            let i = self.index(row, c);
+            if self.counts[i] < limit {
+                self.counts[i] += 1;
+                return c;
+            }
+        }
+        let s = self.first_free(row, c, limit);
+        self.take(row, s);
+        s
+    }
+
+    /// Like [`Window::reserve`] when the cycle it finds lies in the window: takes `row` in
+    /// the first cycle at or after `c` with fewer than `limit` uses and returns
+    /// `(cycle, true)`. When that cycle lies past the window it takes nothing (the window
+    /// does not slide) and returns `(cycle, false)`; [`Window::take`] then takes it.
+    #[inline]
+    pub fn reserve_in_window(&mut self, row: usize, c: u64, limit: u8) -> (u64, bool) {
+        let s = if c >= self.base && c < self.base + HISTORY {
+            let i = self.index(row, c);
+            if self.counts[i] < limit {
+                self.counts[i] += 1;
+                return (c, true);
+            }
+            self.first_free(row, c, limit)
+        } else {
+            self.first_free(row, c, limit)
+        };
+        if s >= self.base && s < self.base + HISTORY {
+            let i = self.index(row, s);
+            self.counts[i] += 1;
+            (s, true)
+        } else {
+            (s, false)
+        }
+    }
+
+    /// Takes back the use of `row` in cycle `s` that [`Window::reserve_in_window`] took
+    /// (nothing was counted since), so the counts are as before it.
+    #[inline]
+    pub fn untake(&mut self, row: usize, s: u64) {
+        let i = self.index(row, s);
+        self.counts[i] -= 1;
+    }
+
+    /// Moves the window to end half a window after `s`, clearing the ring entries of the
+    /// cycles it forgets.
+    #[cold]
+    fn slide(&mut self, s: u64) {
+        let base = s + 1 - HISTORY / 2;
+        let fresh = base.max(self.base + HISTORY);
+        // The cycles [fresh, base + HISTORY) reuse ring entries of forgotten cycles: at most
+        // two runs of the ring.
+        let n = base + HISTORY - fresh;
+        if n >= HISTORY {
+            self.counts.fill(0);
+        } else {
+            let (from, rows) = ((fresh % HISTORY) as usize, self.shift);
+            let end = from + n as usize;
+            let len = HISTORY as usize;
+            self.counts[from << rows..end.min(len) << rows].fill(0);
+            if end > len {
+                self.counts[..(end - len) << rows].fill(0);
+            }
+        }
+        self.base = base;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_count_apart_and_fill_to_their_limit() {
+        let mut w = Window::new(3);
+        assert_eq!(w.reserve(0, 5, 2), 5);
+        assert_eq!(w.reserve(0, 5, 2), 5);
+        assert_eq!(w.reserve(0, 5, 2), 6);
+        assert_eq!(w.reserve(2, 5, 1), 5);
+        assert_eq!(w.reserve(2, 5, 1), 6);
+        assert_eq!(w.count(1, 5), 0);
+        // An earlier cycle is still free.
+        assert_eq!(w.reserve(0, 4, 2), 4);
+    }
+
+    #[test]
+    fn the_window_slides_and_forgets_old_cycles() {
+        let mut w = Window::new(1);
+        assert_eq!(w.reserve(0, 1000, 1), 1000);
+        assert_eq!(w.reserve(0, 1300, 1), 1300);
+        assert_eq!(w.reserve(0, 1000, 1), 1001);
+        let far = 1000 + 5 * HISTORY;
+        assert_eq!(w.reserve(0, far, 1), far);
+        assert_eq!(w.reserve(0, far, 1), far + 1);
+        // The ring entries of 1000 and 1001 were cleared, not reused.
+        assert_eq!(w.count(0, far - HISTORY / 2 + 10), 0);
+        assert_eq!(w.count(0, 1000), 0);
+    }
+}
