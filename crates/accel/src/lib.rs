@@ -64,6 +64,7 @@ pub mod saved;
 pub mod set;
 pub mod stats;
 pub mod tree;
+pub mod tree_set;
 pub mod validate;
 pub mod wide;
 
@@ -90,6 +91,7 @@ pub use set::{Plain, Tracer, TraversalSet};
 pub use tree::{
     AnyTree, BuildStats, Bvh2Tree, BvhTree, CwbvhTree, DstDecoding, DstQTree, DstTree, TreeKind,
 };
+pub use tree_set::TreeSet;
 
 use dualsplit_geometry::{Aabb, Hit, Ray, Triangle};
 use serde::{Deserialize, Serialize};

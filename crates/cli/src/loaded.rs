@@ -11,6 +11,7 @@ use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_accel::{
     AccelKind, AnyTree, BuildConfig, MemoryImage, Observer, Plain, Structures, TraversalSet,
+    TreeSet,
 };
 use dualsplit_geometry::{Aabb, Hit, Ray};
 use dualsplit_scene::Scene;
@@ -25,6 +26,13 @@ pub enum Loaded {
     Built {
         /// BVH2, BVH4, BVH8 and the DST.
         structures: Structures,
+        /// Wall time of the build, in milliseconds.
+        build_ms: f64,
+    },
+    /// The structures of some traversals only, built from the scene's BVH2.
+    Some {
+        /// Their trees.
+        set: TreeSet,
         /// Wall time of the build, in milliseconds.
         build_ms: f64,
     },
@@ -71,11 +79,34 @@ impl Loaded {
         }
     }
 
+    /// Like [`Loaded::get`], but without `tree` builds only the structures that the
+    /// traversals `kinds` read (every structure when `kinds` is empty).
+    pub fn get_for(
+        scene: &Scene,
+        tree: Option<&Path>,
+        kinds: &[AccelKind],
+        ctx: &Ctx,
+    ) -> anyhow::Result<Loaded> {
+        if tree.is_some() || kinds.is_empty() {
+            return Self::get(scene, tree, ctx);
+        }
+        let t = Instant::now();
+        let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
+        let sp = ctx.spinner(format!("building the trees of {}", names.join(", ")));
+        let set = TreeSet::build(&scene.triangles[..], &BuildConfig::default(), kinds)
+            .with_context(|| format!("building the structures of {}", scene.spec))?;
+        sp.finish_and_clear();
+        Ok(Loaded::Some {
+            set,
+            build_ms: t.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+
     /// What was built or loaded and how long it took, as one JSON object:
     /// `{"scene", "build_ms"}` or `{"scene", "tree", "kind", "load_ms"}`.
     pub fn timing_json(&self, scene: &Scene) -> serde_json::Value {
         match self {
-            Loaded::Built { build_ms, .. } => {
+            Loaded::Built { build_ms, .. } | Loaded::Some { build_ms, .. } => {
                 serde_json::json!({"scene": scene.name, "build_ms": build_ms})
             }
             Loaded::Saved {
@@ -94,6 +125,10 @@ impl Loaded {
         match self {
             Loaded::Built { build_ms, .. } => {
                 format!("structures built in {:.2} s", build_ms / 1e3)
+            }
+            Loaded::Some { set, build_ms } => {
+                let names: Vec<&str> = set.trees().iter().map(|t| t.kind().name()).collect();
+                format!("{} built in {:.2} s", names.join(", "), build_ms / 1e3)
             }
             Loaded::Saved {
                 tree,
@@ -143,6 +178,7 @@ impl TraversalSet for Loaded {
     fn kinds(&self) -> &[AccelKind] {
         match self {
             Loaded::Built { structures, .. } => TraversalSet::kinds(structures),
+            Loaded::Some { set, .. } => set.kinds(),
             Loaded::Saved { tree, .. } => tree.kinds(),
         }
     }
@@ -151,6 +187,7 @@ impl TraversalSet for Loaded {
     fn closest_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> Option<Hit> {
         match self {
             Loaded::Built { structures, .. } => structures.closest_hit(kind, ray, obs),
+            Loaded::Some { set, .. } => TraversalSet::closest_hit(set, kind, ray, obs),
             Loaded::Saved { tree, .. } => TraversalSet::closest_hit(tree, kind, ray, obs),
         }
     }
@@ -159,6 +196,7 @@ impl TraversalSet for Loaded {
     fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool {
         match self {
             Loaded::Built { structures, .. } => structures.any_hit(kind, ray, obs),
+            Loaded::Some { set, .. } => TraversalSet::any_hit(set, kind, ray, obs),
             Loaded::Saved { tree, .. } => TraversalSet::any_hit(tree, kind, ray, obs),
         }
     }
@@ -166,6 +204,7 @@ impl TraversalSet for Loaded {
     fn plain(&self, kind: AccelKind) -> Option<Plain<'_>> {
         match self {
             Loaded::Built { structures, .. } => TraversalSet::plain(structures, kind),
+            Loaded::Some { set, .. } => TraversalSet::plain(set, kind),
             Loaded::Saved { tree, .. } => TraversalSet::plain(tree, kind),
         }
     }
@@ -173,6 +212,7 @@ impl TraversalSet for Loaded {
     fn image(&self, kind: AccelKind) -> &MemoryImage {
         match self {
             Loaded::Built { structures, .. } => structures.image(kind),
+            Loaded::Some { set, .. } => TraversalSet::image(set, kind),
             Loaded::Saved { tree, .. } => TraversalSet::image(tree, kind),
         }
     }
@@ -180,6 +220,7 @@ impl TraversalSet for Loaded {
     fn scene_box(&self) -> Aabb {
         match self {
             Loaded::Built { structures, .. } => TraversalSet::scene_box(structures),
+            Loaded::Some { set, .. } => TraversalSet::scene_box(set),
             Loaded::Saved { tree, .. } => TraversalSet::scene_box(tree),
         }
     }
@@ -187,6 +228,7 @@ impl TraversalSet for Loaded {
     fn dstq_config(&self) -> Option<dualsplit_accel::dstq::DstQConfig> {
         match self {
             Loaded::Built { structures, .. } => TraversalSet::dstq_config(structures),
+            Loaded::Some { set, .. } => TraversalSet::dstq_config(set),
             Loaded::Saved { tree, .. } => TraversalSet::dstq_config(tree),
         }
     }

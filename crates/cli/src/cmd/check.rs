@@ -50,6 +50,8 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             let failed = print_validation(&structures.validate());
             equivalence(&scene, structures, structures, args.rays, ctx) || failed
         }
+        // `Loaded::get` builds every structure or loads one tree.
+        Loaded::Some { .. } => unreachable!("check never builds a partial set"),
         Loaded::Saved { tree, .. } => {
             println!("{}", subject.summary());
             // The reference: a BVH2 built afresh from the scene, with the tree's settings.

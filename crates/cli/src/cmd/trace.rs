@@ -82,7 +82,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             k
         }
         None => match &structures {
-            Loaded::Saved { .. } => structures.kinds()[0],
+            Loaded::Saved { .. } | Loaded::Some { .. } => structures.kinds()[0],
             Loaded::Built { .. } => AccelKind::Bvh2,
         },
     };

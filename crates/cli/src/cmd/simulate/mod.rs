@@ -97,7 +97,13 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     // The frame and the camera obey the renderer's limits (the simulator renders the same
     // image), checked before the structures are built.
     dualsplit_render::validate(&scene, &settings)?;
-    let structures = Loaded::get(&scene, args.tree.as_deref(), ctx)?;
+    // Only the structures of the configurations asked for are built.
+    let wanted: Vec<_> = if args.accel.is_empty() {
+        vec![SimAccel::Dst.kind()]
+    } else {
+        sim_accels(&args.accel).iter().map(|a| a.kind()).collect()
+    };
+    let structures = Loaded::get_for(&scene, args.tree.as_deref(), &wanted, ctx)?;
     let accels = configurations(&args.accel, &structures)?;
 
     let total = settings.width as u64 * settings.height as u64;
