@@ -531,13 +531,43 @@ impl Hart {
 
     /// Executes `ins`, the instruction at the pc (fetched from `prog` by the caller), as
     /// [`Hart::step`] does.
-    #[inline(always)]
+    #[inline]
     pub fn exec<M: Memory>(
         &mut self,
         ins: &Instr,
         prog: &Program,
         mem: &mut M,
     ) -> Result<Retired, ExecError> {
+        let (acc, taken) = self.execute(ins, prog, mem)?;
+        let mut info = ins.info;
+        info.fu = executed_class(info.fu, &acc);
+        Ok(Retired {
+            info,
+            mem: acc,
+            taken,
+        })
+    }
+
+    /// Executes `ins` as [`Hart::exec`] does, returning only its memory access (a timing
+    /// model that has the instruction's [`Info`] needs nothing else).
+    #[inline(never)]
+    pub fn exec_access<M: Memory>(
+        &mut self,
+        ins: &Instr,
+        prog: &Program,
+        mem: &mut M,
+    ) -> Result<MemAccess, ExecError> {
+        self.execute(ins, prog, mem).map(|(acc, _)| acc)
+    }
+
+    /// Executes `ins`: its memory access and whether it was a taken branch or a jump.
+    #[inline(always)]
+    fn execute<M: Memory>(
+        &mut self,
+        ins: &Instr,
+        prog: &Program,
+        mem: &mut M,
+    ) -> Result<(MemAccess, bool), ExecError> {
         let pc = self.pc;
         let (op, imm) = (ins.op, ins.imm);
         // Register numbers are read where used; `& 31` lets the compiler drop the register
@@ -872,19 +902,19 @@ impl Hart {
         }
         self.x[0] = 0;
         self.pc = next;
-        let mut info = ins.info;
-        if acc.local && matches!(info.fu, FuClass::Load | FuClass::Store) {
-            info.fu = if acc.store {
-                FuClass::LocalStore
-            } else {
-                FuClass::LocalLoad
-            };
-        }
-        Ok(Retired {
-            info,
-            mem: acc,
-            taken,
-        })
+        Ok((acc, taken))
+    }
+}
+
+/// The class an instruction of class `fu` executed on, given its access `acc`: a load or
+/// store that addressed the local store is [`FuClass::LocalLoad`] or
+/// [`FuClass::LocalStore`].
+#[inline]
+pub fn executed_class(fu: FuClass, acc: &MemAccess) -> FuClass {
+    match fu {
+        FuClass::Load if acc.local => FuClass::LocalLoad,
+        FuClass::Store if acc.local => FuClass::LocalStore,
+        f => f,
     }
 }
 

@@ -38,9 +38,10 @@ use crate::hw::memory::L2;
 use crate::hw::pipe::Pipe;
 use crate::hw::tm::Tm;
 use crate::hw::{Cycle, Stalls, Units, WordAddr};
+use crate::model::rv32::hart::executed_class;
 use crate::model::rv32::placement::Placement;
 use crate::model::rv32::{
-    ExecError, FrameMemory, Hart, LOCAL_STORE_ADDR, Latches, Op, Program, Reg, Retired,
+    ExecError, FrameMemory, Hart, Info, LOCAL_STORE_ADDR, Latches, MemAccess, Op, Program, Reg,
 };
 
 /// The farthest a TP runs instructions on its own units and pools ahead of the current
@@ -68,6 +69,19 @@ const LATCH_PRODUCERS: [Producer; SLOTS] = {
     p[PIPE_SLOT] = Producer::Memory;
     p
 };
+
+/// The scoreboard slots of the latches `l` reads, in the order `R`, `B`, `D`, `P` (the
+/// always-ready slot for one it does not read).
+#[inline]
+fn latch_slots(l: Latches) -> [usize; 4] {
+    let slot = |flag: u8, slot: usize| if l.has(flag) { slot } else { NO_SLOT };
+    [
+        slot(Latches::READS_RAY, RAY_SLOT),
+        slot(Latches::READS_BOX, BOX_SLOT),
+        slot(Latches::READS_DST, DST_SLOT),
+        slot(Latches::READS_PIPE, PIPE_SLOT),
+    ]
+}
 
 /// Why a register is not ready yet: the kind of unit that produces it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -180,29 +194,23 @@ impl Tp {
             // The instruction is fetched when the previous one has issued (SimTRaX holds a
             // fetched instruction until it issues).
             let fetch_from = self.t;
-            // Operands: the registers, then the latches read (an absent one reads the
-            // always-ready slot).
+            // Operands: the registers, then the latches read.
             let l = info.latches;
             let reg = |r: Reg| r.index().unwrap_or(NO_SLOT);
-            let mut sources = [NO_SLOT; 7];
-            sources[..3].copy_from_slice(&info.src.map(reg));
+            let mut at = self
+                .t
+                .max(self.ready[reg(info.src[0])])
+                .max(self.ready[reg(info.src[1])])
+                .max(self.ready[reg(info.src[2])]);
             if l.bits() & READS_ANY_LATCH != 0 {
-                let latch = |flag: u8, slot: usize| if l.has(flag) { slot } else { NO_SLOT };
-                sources[3..].copy_from_slice(&[
-                    latch(Latches::READS_RAY, RAY_SLOT),
-                    latch(Latches::READS_BOX, BOX_SLOT),
-                    latch(Latches::READS_DST, DST_SLOT),
-                    latch(Latches::READS_PIPE, PIPE_SLOT),
-                ]);
+                at = at.max(
+                    latch_slots(l)
+                        .iter()
+                        .fold(Cycle::ZERO, |a, &k| a.max(self.ready[k])),
+                );
             }
-            let at = sources.iter().fold(self.t, |at, &k| at.max(self.ready[k]));
             if at > self.t {
-                // The wait is counted under the producer of the first operand (in the
-                // order above) that arrives last.
-                let why = sources
-                    .iter()
-                    .find(|&&k| self.ready[k] == at)
-                    .map_or(Producer::Unit, |&k| self.producer[k]);
+                let why = self.producer_of(&info, at);
                 let d = at - self.t;
                 match why {
                     Producer::Unit => stalls.dependency += d,
@@ -233,15 +241,15 @@ impl Tp {
                 return Ok(Wake::At(self.t));
             }
             fetch.keep(&mut tm.icache);
-            let r = self.hart.exec(&ins, prog, mem)?;
+            let acc = self.hart.exec_access(&ins, prog, mem)?;
             // The executed class (a load or store whose address is the local store's).
-            let info = r.info;
-            counts[fu_index(info.fu)] += 1;
+            let fu = executed_class(info.fu, &acc);
+            counts[fu_index(fu)] += 1;
             self.rays += (ins.op == Op::RtSetOrg) as u64;
             let dst = info.dst.index();
             let t = self.t;
             // (issue cycle, result latency, producer) for units that take one slot.
-            let (slot, lat, p) = match info.fu {
+            let (slot, lat, p) = match fu {
                 FuClass::IntAlu | FuClass::FpMove => (t, cfg.int_latency, Producer::Unit),
                 FuClass::FpAdd => (t, cfg.fpadd_latency, Producer::Unit),
                 FuClass::FpMul | FuClass::FpFma => (t, cfg.fpmul_latency, Producer::Unit),
@@ -264,7 +272,7 @@ impl Tp {
                     one_slot(i, Producer::Atomic)
                 }
                 FuClass::Load => {
-                    let i = l1_load(tm, l2, placement, &r, t, now, stalls);
+                    let i = l1_load(tm, l2, placement, &acc, t, now, stalls);
                     self.t = i.next_issue;
                     self.write(dst, i.ready, Producer::Memory);
                     if l.has(Latches::WRITES_PIPE) {
@@ -274,8 +282,8 @@ impl Tp {
                 }
                 FuClass::Store => {
                     let i = tm.store(
-                        WordAddr::from_byte(placement.physical(r.mem.addr)),
-                        r.mem.words as u64,
+                        WordAddr::from_byte(placement.physical(acc.addr)),
+                        acc.words as u64,
                         t,
                         now,
                     );
@@ -290,7 +298,7 @@ impl Tp {
                         FuClass::TriPipe => (Pipe::Triangle, 1),
                         _ => (Pipe::DualSplit, 1),
                     };
-                    let i = l1_load(tm, l2, placement, &r, t, now, stalls);
+                    let i = l1_load(tm, l2, placement, &acc, t, now, stalls);
                     let w = Waiting {
                         pipe,
                         n,
@@ -335,6 +343,18 @@ impl Tp {
         }
     }
 
+    /// The producer of the first operand of `info` (the registers in order, then the
+    /// latches `R`, `B`, `D`, `P`) whose result arrives at `at`, the last of them: the
+    /// cause a wait for the operands is counted under.
+    #[cold]
+    fn producer_of(&self, info: &Info, at: Cycle) -> Producer {
+        let regs = info.src.map(|r| r.index().unwrap_or(NO_SLOT));
+        regs.iter()
+            .chain(latch_slots(info.latches).iter())
+            .find(|&&k| self.ready[k] == at)
+            .map_or(Producer::Unit, |&k| self.producer[k])
+    }
+
     /// A pipeline op issued with timing `r`: its results in the destination register and
     /// the latches it writes.
     fn finish_pipe(&mut self, r: Issued, w: Waiting) {
@@ -364,15 +384,15 @@ fn l1_load(
     tm: &mut Tm,
     l2: &mut L2,
     placement: &Placement,
-    r: &Retired,
+    acc: &MemAccess,
     t: Cycle,
     now: Cycle,
     stalls: &mut Stalls,
 ) -> Issued {
-    let words = r.mem.words as u64;
+    let words = acc.words as u64;
     let i = tm.load(
         l2,
-        WordAddr::from_byte(placement.physical(r.mem.addr)),
+        WordAddr::from_byte(placement.physical(acc.addr)),
         words,
         t,
         now,
