@@ -45,6 +45,8 @@ pub struct ICaches {
     banks: Window,
     caches: usize,
     bank_mask: u32,
+    /// log2(banks per cache): the bank count is a power of two (`ranges.rs`).
+    bank_shift: u32,
     /// Fetches per bank per cycle; 0 = no limit.
     limit: u8,
 }
@@ -62,6 +64,7 @@ impl ICaches {
             banks: Window::new(n),
             caches: units.icaches as usize,
             bank_mask: units.icache_banks - 1,
+            bank_shift: units.icache_banks.trailing_zeros(),
             limit,
         }
     }
@@ -74,7 +77,7 @@ impl ICaches {
     /// The bank of cache `cache` holding the instruction at byte address `pc`.
     #[inline]
     fn bank(&self, cache: usize, pc: u32) -> usize {
-        cache * (self.bank_mask as usize + 1) + ((pc >> 2) & self.bank_mask) as usize
+        (cache << self.bank_shift) | ((pc >> 2) & self.bank_mask) as usize
     }
 
     /// The first cycle at or after `c` at which cache `cache` could fetch the instruction at
