@@ -276,3 +276,129 @@ fn ray_counts_are_bounded() {
         assert!(err.contains("from 1 to 4194304"), "{cmd}: {err}");
     }
 }
+
+/// A study of `builtin:cornell` at 4² with one configuration and workload: (its folder,
+/// the result file name of entry 0).
+fn small_study(dir: &Path) -> (std::path::PathBuf, String) {
+    let out = dualsplit(
+        &[
+            "plan",
+            "builtin:cornell",
+            "--res",
+            "4",
+            "--tms",
+            "4",
+            "--accel",
+            "bvh2",
+            "--workload",
+            "cast",
+            "--out",
+            "study",
+        ],
+        dir,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let study = dir.join("study");
+    let plan: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(study.join("plan.json")).unwrap()).unwrap();
+    let key = plan["entries"][0]["cache_key"].as_str().unwrap().to_string();
+    std::fs::create_dir_all(study.join("cache")).unwrap();
+    (study, key)
+}
+
+#[cfg(unix)]
+#[test]
+fn study_files_are_read_only_from_bounded_regular_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let (study, key) = small_study(dir.path());
+    let entry = study.join("cache").join(&key);
+    let report = || dualsplit(&["report", "--from", "study"], dir.path());
+    // A result linked to /dev/zero once read until killed for memory; a named pipe blocked
+    // `report --from` and `run-job` forever; a 300 MB one was read whole.
+    std::os::unix::fs::symlink("/dev/zero", &entry).unwrap();
+    let out = report();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("not a regular file (a character device)"), "{err}");
+    std::fs::remove_file(&entry).unwrap();
+    let ok = Command::new("mkfifo").arg(&entry).status().unwrap().success();
+    assert!(ok);
+    let out = report();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("not a regular file (a named pipe)"), "{err}");
+    // run-job sees the pipe as an invalid result and replaces it.
+    let out = dualsplit(&["run-job", "study", "0"], dir.path());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::metadata(&entry).unwrap().is_file());
+    std::fs::remove_file(&entry).unwrap();
+    let f = std::fs::File::create(&entry).unwrap();
+    f.set_len(300 << 20).unwrap(); // sparse: no disk used
+    drop(f);
+    let out = report();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("larger than 268435456 bytes"), "{err}");
+    // The plan itself.
+    let plan = study.join("plan.json");
+    std::fs::remove_file(&plan).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", &plan).unwrap();
+    fails_with(&report(), "not a regular file (a character device)");
+    fails_with(
+        &dualsplit(&["run-job", "study", "0"], dir.path()),
+        "not a regular file (a character device)",
+    );
+    std::fs::remove_file(&plan).unwrap();
+    let ok = Command::new("mkfifo").arg(&plan).status().unwrap().success();
+    assert!(ok);
+    fails_with(&report(), "not a regular file (a named pipe)");
+    fails_with(
+        &dualsplit(&["run-job", "study", "0"], dir.path()),
+        "not a regular file (a named pipe)",
+    );
+}
+
+#[test]
+fn plans_are_bounded_before_they_are_made() {
+    let dir = tempfile::tempdir().unwrap();
+    let values: Vec<String> = (1..=64).map(|i| i.to_string()).collect();
+    let values = values.join(",");
+    let sweeps: Vec<String> = ["dst_pipes", "box_pipes", "tri_pipes"]
+        .iter()
+        .map(|k| format!("units.{k}={values}"))
+        .collect();
+    // Once about 4.2 M entries, past 3.3 GB of memory and still growing.
+    let out = dualsplit(
+        &[
+            "plan",
+            "builtin:cornell",
+            "--res",
+            "4",
+            "--vary",
+            &sweeps[0],
+            "--vary",
+            &sweeps[1],
+            "--vary",
+            &sweeps[2],
+            "--out",
+            "s",
+        ],
+        dir.path(),
+    );
+    fails_with(&out, "the plan would have 11534336 entries");
+    fails_with(&out, "at most 65536");
+    assert!(!dir.path().join("s/plan.json").exists());
+    let many: Vec<String> = (1..=1025).map(|i| i.to_string()).collect();
+    let out = dualsplit(
+        &[
+            "plan",
+            "builtin:cornell",
+            "--vary",
+            &format!("l1.hit_latency={}", many.join(",")),
+            "--out",
+            "s",
+        ],
+        dir.path(),
+    );
+    fails_with(&out, "1025 values; at most 1024 for one key");
+}

@@ -1,5 +1,44 @@
 use std::path::PathBuf;
 
+/// Why a small input file ([`read_limited`](crate::load::read_limited)) was not read.
+#[derive(Debug, thiserror::Error)]
+pub enum FileError {
+    /// The file could not be opened or read.
+    #[error("{}: {error}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error (in the message, not a `source()`, so `anyhow` prints it once).
+        error: std::io::Error,
+    },
+    /// The path names a directory, device, named pipe or socket (links followed), which is
+    /// never opened: it could block or never end.
+    #[error("{}: not a regular file ({kind}); only regular files are read", path.display())]
+    NotAFile {
+        /// The file.
+        path: PathBuf,
+        /// What it is instead.
+        kind: &'static str,
+    },
+    /// The file is larger than the limit of what is read.
+    #[error("{}: larger than {limit} bytes, the limit ({size} bytes or more)", path.display())]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Its size (from its metadata, or the bytes read before stopping).
+        size: u64,
+        /// The limit.
+        limit: u64,
+    },
+}
+
+impl FileError {
+    /// True when the file does not exist.
+    pub fn is_not_found(&self) -> bool {
+        matches!(self, FileError::Io { error, .. } if error.kind() == std::io::ErrorKind::NotFound)
+    }
+}
+
 /// Everything that can go wrong while loading or generating a scene.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {

@@ -49,7 +49,7 @@ pub mod load;
 pub mod make;
 
 pub use camera::{Camera, CameraError, Light, parse_vec3};
-pub use error::SceneError;
+pub use error::{FileError, SceneError};
 pub use limits::Limits;
 
 use dualsplit_geometry::{Aabb, Triangle};

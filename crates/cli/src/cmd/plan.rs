@@ -44,8 +44,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     crate::output::prepare_dir(&args.out, "--out")?;
     let base_config = match &args.config {
         Some(p) => {
-            let text =
-                std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            let text = crate::input::read_text(p, crate::input::MAX_CONFIG_BYTES)?;
             SimConfig::from_toml(&text).with_context(|| format!("{}", p.display()))?
         }
         None => SimConfig::lin2020(),

@@ -13,6 +13,7 @@
 
 use super::plan::{PlanEntry, Varied, code_version};
 use crate::ReportError;
+use crate::cache::MAX_ENTRY_BYTES;
 use dualsplit_render::Workload;
 use dualsplit_sim::{SimAccel, SimResult};
 use serde::{Deserialize, Serialize};
@@ -90,16 +91,19 @@ impl ResultStore {
         self.dir.join(&entry.cache_key)
     }
 
-    /// Reads and verifies `entry`'s result.
+    /// Reads and verifies `entry`'s result. Only a regular file (links followed) of at
+    /// most [`MAX_ENTRY_BYTES`] is read, with the read stopping one byte past it: a link to
+    /// `/dev/zero`, a named pipe or a larger file is [`Stored::Invalid`], never read whole
+    /// or waited on.
     pub fn read(&self, entry: &PlanEntry) -> Stored {
         let path = self.path(entry);
-        match std::fs::read(&path) {
+        match dualsplit_scene::load::read_limited(&path, MAX_ENTRY_BYTES) {
             Ok(bytes) => match verify(&bytes, entry) {
                 Ok(r) => Stored::Valid(Box::new(r)),
                 Err(why) => Stored::Invalid(why),
             },
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Stored::Missing,
-            Err(e) => Stored::Invalid(format!("{}: {e}", path.display())),
+            Err(e) if e.is_not_found() => Stored::Missing,
+            Err(e) => Stored::Invalid(e.to_string()),
         }
     }
 
