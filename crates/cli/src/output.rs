@@ -73,7 +73,7 @@ impl JsonOut {
     /// Writes `text` (a newline is added) to the destination.
     pub fn emit(&self, text: &str) -> anyhow::Result<()> {
         match self {
-            JsonOut::Stdout => println!("{text}"),
+            JsonOut::Stdout => outln!("{text}"),
             JsonOut::File(p) => {
                 std::fs::write(p, format!("{text}\n"))
                     .with_context(|| format!("writing {}", p.display()))?;

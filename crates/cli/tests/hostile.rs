@@ -402,3 +402,68 @@ fn plans_are_bounded_before_they_are_made() {
     );
     fails_with(&out, "1025 values; at most 1024 for one key");
 }
+
+#[test]
+fn ray_files_are_bounded_and_their_rays_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let trace = |rays: &str| {
+        dualsplit(
+            &["trace", "builtin:cornell", "--rays", rays, "-o", "hits.bin"],
+            dir.path(),
+        )
+    };
+    let file = |vals: &[f32]| -> Vec<u8> { vals.iter().flat_map(|v| v.to_le_bytes()).collect() };
+    let good = [0.0, 0.5, 3.0, 0.0, 0.0, -1.0, 0.0, f32::INFINITY];
+    let mut bad = good.to_vec();
+    bad.extend_from_slice(&[0.0, 0.5, 3.0, 0.0, 0.0, -1.0, 0.0, f32::NAN]);
+    std::fs::write(dir.path().join("good.bin"), file(&good)).unwrap();
+    std::fs::write(dir.path().join("nan.bin"), file(&bad)).unwrap();
+    let out = trace("good.bin");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // A NaN t_max once gave a hit in five traversals and a miss in two.
+    fails_with(&trace("nan.bin"), "ray 1: t_max is NaN");
+    bad[9] = f32::INFINITY;
+    std::fs::write(dir.path().join("inf.bin"), file(&bad)).unwrap();
+    fails_with(&trace("inf.bin"), "ray 1: origin.y is inf");
+    // Once read until killed for memory.
+    fails_with(&trace("/dev/zero"), "not a regular file (a character device)");
+    let f = std::fs::File::create(dir.path().join("big.bin")).unwrap();
+    f.set_len((1 << 30) + 32).unwrap(); // sparse
+    drop(f);
+    fails_with(&trace("big.bin"), "larger than 1073741824 bytes");
+}
+
+/// Runs `args` with standard output closed before the command writes to it.
+#[cfg(unix)]
+fn with_closed_stdout(args: &[&str], dir: &Path) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_dualsplit"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    drop(child.stdout.take());
+    child.wait_with_output().expect("it ends")
+}
+
+#[cfg(unix)]
+#[test]
+fn a_closed_standard_output_ends_quietly_and_files_are_still_written() {
+    let dir = tempfile::tempdir().unwrap();
+    // `simulate ... | head -1` and `render ... | head -1` once panicked with "failed
+    // printing to stdout: Broken pipe", render before it wrote its PNG.
+    let runs: [&[&str]; 3] = [
+        &["simulate", "builtin:cornell", "--res", "8", "--accel", "bvh2"],
+        &["render", "builtin:cornell", "--res", "8", "-o", "c.png"],
+        &["stats", "builtin:cornell"],
+    ];
+    for args in runs {
+        let out = with_closed_stdout(args, dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
+        assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{args:?}: {err}");
+    }
+    let png = std::fs::read(dir.path().join("c.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"), "{} bytes", png.len());
+}

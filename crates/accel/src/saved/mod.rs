@@ -76,6 +76,14 @@ pub enum SavedError {
         /// What is wrong with it.
         source: Box<SavedError>,
     },
+    /// The path names a directory, device, named pipe or socket, which is never opened.
+    #[error("{}: not a regular file ({kind}); only regular files are read", path.display())]
+    NotAFile {
+        /// The file.
+        path: PathBuf,
+        /// What it is instead.
+        kind: &'static str,
+    },
     /// The file does not start with [`MAGIC`].
     #[error("not a dualsplit tree file (bad magic)")]
     NotATree,
@@ -428,13 +436,48 @@ impl AnyTree {
             path: path.to_owned(),
             source,
         };
+        // Only a regular file (links followed) is opened: a named pipe would block the open
+        // until a writer appears, a device never end. Checked again on the handle.
+        let not_a_file = |meta: &std::fs::Metadata| SavedError::NotAFile {
+            path: path.to_owned(),
+            kind: file_kind(meta.file_type()),
+        };
+        let meta = std::fs::metadata(path).map_err(io)?;
+        if !meta.is_file() {
+            return Err(not_a_file(&meta));
+        }
         let f = std::fs::File::open(path).map_err(io)?;
-        let len = f.metadata().map_err(io)?.len();
+        let meta = f.metadata().map_err(io)?;
+        if !meta.is_file() {
+            return Err(not_a_file(&meta));
+        }
+        let len = meta.len();
         Self::read_from(io::BufReader::with_capacity(1 << 16, f), len, scene).map_err(|e| match e {
             SavedError::Io { source, .. } => io(source),
             e => e.at(path),
         })
     }
+}
+
+/// What a non-regular file is, for [`SavedError::NotAFile`].
+fn file_kind(t: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a named pipe";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+    }
+    if t.is_dir() { "a directory" } else { "not a file" }
 }
 
 /// The tree a checked header and its regions describe.

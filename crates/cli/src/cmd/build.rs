@@ -110,7 +110,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if let Some(j) = json {
         j.emit(&serde_json::to_string_pretty(&out)?)?;
     } else {
-        println!(
+        outln!(
             "{} {}: {} triangles, {} node + {} index bytes, built in {:.1} ms (BVH2 {:.1} ms), \
              saved {} bytes to {} in {:.1} ms",
             out.scene,

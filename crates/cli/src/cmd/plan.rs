@@ -117,7 +117,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|e| e.estimated_rays() / per_core)
         .fold(0.0f64, f64::max);
-    println!(
+    outln!(
         "wrote {}: {} jobs ({} scenes at {r}×{r}, {} thread model, {} swept combinations); \
          estimated {cpu_hours:.2} CPU-hours, the longest job about {} on one core",
         path.display(),

@@ -85,7 +85,7 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             let comments: Vec<&str> = comments.iter().map(String::as_str).collect();
             make::write_ply_gz(&args.output, &tris, &comments)
                 .with_context(|| format!("writing {}", args.output.display()))?;
-            println!(
+            outln!(
                 "wrote {}: {} triangles ({n} of {}, {} of the box), triangles sha256 {}",
                 args.output.display(),
                 tris.len(),
@@ -105,7 +105,7 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             );
             make::write_ply_gz(&args.output, &scene.triangles, &[&comment])
                 .with_context(|| format!("writing {}", args.output.display()))?;
-            println!(
+            outln!(
                 "wrote {}: {} triangles of {}, triangles sha256 {}",
                 args.output.display(),
                 scene.triangles.len(),
