@@ -467,3 +467,24 @@ fn a_closed_standard_output_ends_quietly_and_files_are_still_written() {
     let png = std::fs::read(dir.path().join("c.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"), "{} bytes", png.len());
 }
+
+#[test]
+fn far_lights_and_cameras_are_refused_for_what_they_are() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |flag: &str, value: &str| {
+        let args = ["render", "builtin:cornell", "--workload", "cast", "--res", "32"];
+        dualsplit(&[&args[..], &[flag, value, "-o", "x.png"]].concat(), dir.path())
+    };
+    // Once exit 0 with "shadow 0 rays" and a wrong image.
+    fails_with(&render("--light", "1e20,1e20,1e20"), "beyond ±1.1529215e18");
+    fails_with(&render("--light", "1e19,0,0"), "beyond ±1.1529215e18");
+    // Once "eye and target coincide".
+    fails_with(&render("--eye", "0,0,1e30"), "--eye `0,0,1e30`: a coordinate lies beyond");
+    fails_with(&render("--target", "1e30,0,0"), "--target `1e30,0,0`: a coordinate lies beyond");
+    let args = ["render", "builtin:cornell", "--light-radius=-1", "-o", "x.png"];
+    fails_with(
+        &dualsplit(&args, dir.path()),
+        "--light-radius -1: must be from 0 to 2^60",
+    );
+    assert!(!dir.path().join("x.png").exists());
+}
