@@ -51,6 +51,7 @@ use crate::image::{MemoryImage, SharedTriangles, Words};
 use crate::tree::{AnyTree, BuildStats, BvhTree, CwbvhTree, DstQTree, DstTree, TreeKind};
 use crate::wide::BvhImage;
 use dualsplit_geometry::Triangle;
+use crate::BuildConfig;
 use header::{Extra, Header};
 use sha2::{Digest, Sha256};
 use std::io::{self, Read, Write};
@@ -265,19 +266,41 @@ impl AnyTree {
             triangles: t,
             file_bytes: header::implied_bytes(n, i, t).unwrap_or(u64::MAX),
             triangle_hash: triangle_hash(img.triangle_slice()),
-            build: *self.config(),
+            // What the builder used: it clamps the bins and takes at least one triangle per
+            // leaf, so the recorded settings pass `check_build`.
+            build: BuildConfig {
+                bins: self.config().bins.clamp(2, 256),
+                max_leaf_size: self.config().max_leaf_size.max(1),
+                ..*self.config()
+            },
             extra,
         }
     }
 
     /// Writes the tree in the saved-tree format to `w`. The same tree always gives the
-    /// same bytes (no time stamps; build times are not stored).
+    /// same bytes (no time stamps; build times are not stored). A tree built with a
+    /// negative or non-finite cost is refused (`InvalidInput`): loading would refuse it.
     pub fn write_to<W: Write>(&self, w: W) -> io::Result<()> {
+        let h = self.header();
+        let checked = header::check_build(&h.build).and_then(|()| match &h.extra {
+            Extra::Dst { config, .. } => [
+                ("split", config.costs.split),
+                ("single_carve", config.costs.single_carve),
+                ("dual_carve", config.costs.dual_carve),
+                ("triangle", config.costs.triangle),
+            ]
+            .into_iter()
+            .try_for_each(|(n, c)| header::check_cost("DST cost", n, c)),
+            _ => Ok(()),
+        });
+        if let Err(e) = checked {
+            return Err(io::Error::new(io::ErrorKind::InvalidInput, e.to_string()));
+        }
         let mut out = HashingWriter {
             inner: w,
             hash: Sha256::new(),
         };
-        let mut head = self.header().encode();
+        let mut head = h.encode();
         head.resize(WORDS_OFFSET as usize, 0);
         out.write_all(&head)?;
         let img = self.image();
@@ -293,11 +316,13 @@ impl AnyTree {
         out.inner.flush()
     }
 
-    /// The saved-tree file as bytes.
+    /// The saved-tree file as bytes (empty for a tree [`AnyTree::write_to`] refuses).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut v = Vec::new();
-        // Writing to a Vec cannot fail.
-        let _ = self.write_to(&mut v);
+        // Writing to a Vec cannot fail; a refused tree writes nothing.
+        if self.write_to(&mut v).is_err() {
+            v.clear();
+        }
         v
     }
 
@@ -415,6 +440,22 @@ impl AnyTree {
             return Err(SavedError::malformed(format!(
                 "header byte {at} is not what this version writes (unused fields and padding are zero)"
             )));
+        }
+        // The DST's and DST-Q's scene box is where their traversals start (the first slab
+        // test): it must be exactly the bounds of the file's triangles, as a build makes it.
+        if let Extra::Dst { scene_box, .. } | Extra::DstQ { scene_box, .. } = &h.extra {
+            let bounds = tris
+                .iter()
+                .fold(dualsplit_geometry::Aabb::EMPTY, |b, t| b.union(t.bounds()));
+            let bits = |b: &dualsplit_geometry::Aabb| {
+                (b.min.to_array().map(f32::to_bits), b.max.to_array().map(f32::to_bits))
+            };
+            if bits(scene_box) != bits(&bounds) {
+                return Err(SavedError::malformed(format!(
+                    "scene box {:?} to {:?} is not the bounds of the file's triangles ({:?} to {:?})",
+                    scene_box.min, scene_box.max, bounds.min, bounds.max
+                )));
+            }
         }
         let tree = assemble(&h, words, tris);
         // Everything a traversal indexes with, so a forged file cannot make one panic,
