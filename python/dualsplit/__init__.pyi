@@ -9,9 +9,11 @@ import numpy.typing as npt
 
 __version__: str
 
-StructureKind = Literal["dst", "bvh2", "bvh4", "bvh8"]
-Traversal = Literal["bvh2", "bvh4", "bvh8", "dst-sw", "dst"]
-SimConfigName = Literal["bvh2", "bvh2+", "bvh4", "bvh4+", "bvh8", "bvh8+", "dst-sw", "dst", "all"]
+StructureKind = Literal["dst", "bvh2", "bvh4", "bvh8", "cwbvh", "dst-q"]
+Traversal = Literal["bvh2", "bvh4", "bvh8", "dst-sw", "dst", "cwbvh", "dst-q"]
+SimConfigName = Literal[
+    "bvh2", "bvh2+", "bvh4", "bvh4+", "bvh8", "bvh8+", "dst-sw", "dst", "cwbvh", "cwbvh+", "dst-q", "all"
+]
 ConfigValue = Union[bool, int, float, str]
 PerRay = Union[float, npt.NDArray[np.float32]]
 

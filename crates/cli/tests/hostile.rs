@@ -488,3 +488,42 @@ fn far_lights_and_cameras_are_refused_for_what_they_are() {
     );
     assert!(!dir.path().join("x.png").exists());
 }
+
+#[test]
+fn dragon_boxes_that_would_not_load_are_not_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let make = |input: &str, obj: &str| {
+        std::fs::write(dir.path().join(input), obj).unwrap();
+        dualsplit(&["scene", "dragon-box", input, "-o", "box.ply.gz"], dir.path())
+    };
+    // Once exit 0 with a box every loader then refused.
+    let out = make("wide.obj", "v 0 0 0\nv 1.1e18 0 0\nv 0 1 0\nf 1 2 3\n");
+    fails_with(&out, "wide.obj: cannot make the Dragon Box: the result would not load");
+    fails_with(&out, "exceeds");
+    // Once 11 triangles of size zero.
+    let out = make("point.obj", "v 1 2 3\nv 1 2 3\nv 1 2 3\nf 1 2 3\n");
+    fails_with(&out, "box triangle 0 has no area");
+    assert!(!dir.path().join("box.ply.gz").exists());
+    let out = make("ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = dualsplit(&["info", "box.ply.gz"], dir.path());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+#[test]
+fn outputs_that_name_an_input_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    std::fs::write(dir.path().join("s.obj"), obj).unwrap();
+    // `build S -o S` once overwrote the scene without a word.
+    let out = dualsplit(&["build", "s.obj", "--accel", "bvh2", "-o", "s.obj"], dir.path());
+    fails_with(&out, "-o s.obj: is the input s.obj; writing it would overwrite it");
+    let out = dualsplit(&["build", "s.obj", "--accel", "bvh2", "-o", "./s.obj"], dir.path());
+    fails_with(&out, "would overwrite it");
+    assert_eq!(std::fs::read_to_string(dir.path().join("s.obj")).unwrap(), obj);
+    let help = dualsplit(&["build", "--help"], dir.path());
+    let help = String::from_utf8_lossy(&help.stdout);
+    for kind in ["dst", "bvh2", "bvh4", "bvh8", "cwbvh", "dst-q"] {
+        assert!(help.contains(kind), "build --help lacks {kind}: {help}");
+    }
+}

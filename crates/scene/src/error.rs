@@ -139,6 +139,17 @@ pub enum SceneError {
         /// [`Scene::MAX_COORDINATE`](crate::Scene::MAX_COORDINATE).
         limit: f32,
     },
+    /// A scene made from another ([`crate::make`]) would be unusable: degenerate
+    /// triangles, or bounds the loaders refuse.
+    #[error("{spec}: cannot make {what}: {reason}")]
+    Make {
+        /// The input's spec.
+        spec: String,
+        /// What was being made (`the Dragon Box`).
+        what: &'static str,
+        /// Why not.
+        reason: String,
+    },
     /// A builtin name or parameter is wrong.
     #[error("builtin scene `{spec}`: {message}")]
     Builtin {

@@ -14,7 +14,7 @@
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_scene::make;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// The scene files `dualsplit scene` makes.
@@ -60,6 +60,7 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     match cmd {
         Command::DragonBox(args) => {
             crate::output::check_file(&args.output, "-o")?;
+            crate::output::check_not_an_input(&args.output, "-o", &[Path::new(&args.dragon)])?;
             let dragon = super::load(&args.dragon, ctx)?;
             let tris = if args.closed {
                 make::closed_dragon_box(&dragon.triangles)
@@ -67,6 +68,7 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                 make::dragon_box(&dragon.triangles)
             };
             let n = dragon.triangles.len();
+            make::check_dragon_box(&dragon.spec, n, &tris)?;
             let comments = [
                 format!(
                     "Dragon Box: {} ({n} tris, faces 0..{})",
@@ -97,6 +99,7 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         }
         Command::Convert(args) => {
             crate::output::check_file(&args.output, "-o")?;
+            crate::output::check_not_an_input(&args.output, "-o", &[Path::new(&args.input)])?;
             let scene = super::load(&args.input, ctx)?;
             let comment = format!(
                 "{} ({} tris) converted by dualsplit scene convert",

@@ -45,6 +45,9 @@ pub struct Args {
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     crate::output::check_file(&args.output, "-o")?;
+    let mut inputs = vec![args.rays.as_path(), std::path::Path::new(&args.scene)];
+    inputs.extend(args.tree.as_deref());
+    crate::output::check_not_an_input(&args.output, "-o", &inputs)?;
     let bytes = dualsplit_scene::load::read_limited(&args.rays, ray_file::MAX_BYTES)?;
     let rays = ray_file::parse_rays(&bytes)
         .with_context(|| format!("rays {}", args.rays.display()))?;

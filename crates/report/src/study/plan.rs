@@ -367,8 +367,18 @@ impl Plan {
                 StudyError::File(e)
             }
         })?;
+        Self::parse(&path, &bytes)
+    }
+
+    /// The plan in `bytes`, the contents of the plan file `path`, with the checks of
+    /// [`Plan::load`] but the file's type and size (the fuzz target `study_plan` runs it).
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<Self, StudyError> {
+        let bad = |reason: String| StudyError::Plan {
+            path: path.to_path_buf(),
+            reason,
+        };
         let plan: Plan =
-            serde_json::from_slice(&bytes).map_err(|e| bad(format!("not a study plan: {e}")))?;
+            serde_json::from_slice(bytes).map_err(|e| bad(format!("not a study plan: {e}")))?;
         if plan.entries.len() as u64 > MAX_PLAN_ENTRIES {
             return Err(bad(format!(
                 "{} entries; at most {MAX_PLAN_ENTRIES}",

@@ -137,8 +137,8 @@ impl ResultStore {
     }
 }
 
-/// Header line plus payload.
-fn encode(json: &[u8]) -> Vec<u8> {
+/// A result file's bytes: the header line, then `json` (a [`JobRecord`]'s JSON).
+pub fn encode(json: &[u8]) -> Vec<u8> {
     let sum = hex(&Sha256::digest(json));
     let mut out = format!(
         "{MAGIC} {RESULT_FORMAT} sha256={sum} bytes={}\n",
@@ -153,8 +153,10 @@ fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// Checks a result file's header, length, checksum and that it is `entry`'s.
-fn verify(bytes: &[u8], entry: &PlanEntry) -> Result<JobRecord, String> {
+/// Checks a result file's header, length, checksum and that it is `entry`'s (what
+/// [`ResultStore::read`] does with the bytes it read; the fuzz target `study_result` runs
+/// it).
+pub fn verify(bytes: &[u8], entry: &PlanEntry) -> Result<JobRecord, String> {
     let nl = bytes
         .iter()
         .position(|&b| b == b'\n')

@@ -341,8 +341,34 @@ fn parse_error(path: &Path, line: Option<u64>, message: impl Into<String>) -> Sc
     SceneError::Parse {
         path: path.to_path_buf(),
         line,
-        message: message.into(),
+        message: clip_message(message.into()),
     }
+}
+
+/// Longest parse error message kept, in bytes: a parser may quote the bad line, and a
+/// 200 KB line must not make a 200 KB message.
+pub const MAX_MESSAGE_BYTES: usize = 240;
+
+/// `message` cut to at most [`MAX_MESSAGE_BYTES`] (at a character boundary, control
+/// characters shown as spaces), saying how much was cut.
+fn clip_message(message: String) -> String {
+    let clean = |s: &str| -> String {
+        s.chars()
+            .map(|c| if c.is_control() { ' ' } else { c })
+            .collect()
+    };
+    if message.len() <= MAX_MESSAGE_BYTES {
+        return clean(&message);
+    }
+    let mut end = MAX_MESSAGE_BYTES;
+    while !message.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!(
+        "{}… ({} more bytes)",
+        clean(&message[..end]),
+        message.len() - end
+    )
 }
 
 /// Appends the fan triangulation of the polygon `poly` (`n >= 3` vertex indices) to
