@@ -476,8 +476,8 @@ fn far_lights_and_cameras_are_refused_for_what_they_are() {
         dualsplit(&[&args[..], &[flag, value, "-o", "x.png"]].concat(), dir.path())
     };
     // Once exit 0 with "shadow 0 rays" and a wrong image.
-    fails_with(&render("--light", "1e20,1e20,1e20"), "beyond ±1.1529215e18");
-    fails_with(&render("--light", "1e19,0,0"), "beyond ±1.1529215e18");
+    fails_with(&render("--light", "1e20,1e20,1e20"), "beyond ±4.611686e18");
+    fails_with(&render("--light", "1e19,0,0"), "beyond ±4.611686e18");
     // Once "eye and target coincide".
     fails_with(&render("--eye", "0,0,1e30"), "--eye `0,0,1e30`: a coordinate lies beyond");
     fails_with(&render("--target", "1e30,0,0"), "--target `1e30,0,0`: a coordinate lies beyond");

@@ -63,10 +63,10 @@ pub fn validate(scene: &Scene, settings: &RenderSettings) -> Result<(), RenderEr
     if !(c.eye.is_finite() && c.target.is_finite() && c.up.is_finite() && c.fov_y_deg.is_finite()) {
         return Err(cam_err("non-finite value"));
     }
-    let far = |p: glam::Vec3| p.abs().max_element() > Scene::MAX_COORDINATE;
+    let far = |p: glam::Vec3| p.abs().max_element() > dualsplit_scene::MAX_VIEW_COORDINATE;
     if far(c.eye) || far(c.target) {
         return Err(cam_err(
-            "a coordinate of the eye or target lies beyond ±2^60 (Scene::MAX_COORDINATE)",
+            "a coordinate of the eye or target lies beyond ±2^62 (MAX_VIEW_COORDINATE)",
         ));
     }
     if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
@@ -98,11 +98,11 @@ pub fn validate(scene: &Scene, settings: &RenderSettings) -> Result<(), RenderEr
             "non-finite value, negative radius or negative intensity",
         ));
     }
-    // Within ±2^60 the distance² to any point of the scene (also within ±2^60) stays
-    // finite, so every shadow ray and its 1/d² are computed.
+    // Within ±2^62 and a radius of 2^60 the distance² to any point of the scene (within
+    // ±2^60) stays finite, so every shadow ray and its 1/d² are computed.
     if far(l.position) || l.radius > Scene::MAX_COORDINATE {
         return Err(light_err(
-            "the position lies beyond ±2^60 (Scene::MAX_COORDINATE) or the radius exceeds 2^60",
+            "the position lies beyond ±2^62 (MAX_VIEW_COORDINATE) or the radius exceeds 2^60",
         ));
     }
     if !crate::FrameConstants::new(scene).light_power.is_finite() {

@@ -34,6 +34,14 @@ pub struct Light {
     pub intensity: f32,
 }
 
+/// Farthest a camera's eye or target, or a light's centre, may lie from the origin on any
+/// axis: 2^62 ≈ 4.6e18. A scene lies within ±[`Scene::MAX_COORDINATE`](crate::Scene::MAX_COORDINATE)
+/// = 2^60, and the fitted camera of the widest scene stands within ±3.3 · 2^60; within
+/// these bounds (and a light radius of at most 2^60) a view direction's and a shadow ray's
+/// squared length stay below f32's largest value (3 · (1.5 · 2^62)² ≈ 1.2e38), so no shadow
+/// ray is lost to an overflowing distance.
+pub const MAX_VIEW_COORDINATE: f32 = (1u64 << 62) as f32;
+
 /// A bad camera or light override from the command line.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CameraError {
@@ -55,18 +63,17 @@ pub enum CameraError {
         /// The range, in words.
         range: &'static str,
     },
-    /// A position lies farther than [`Scene::MAX_COORDINATE`](crate::Scene::MAX_COORDINATE)
-    /// (2^60) from the origin on some axis: the light's distance to the scene, its power
-    /// and the view direction would overflow f32.
+    /// A position lies farther than [`MAX_VIEW_COORDINATE`] (2^62) from the origin on some
+    /// axis: the light's distance to the scene and the view direction would overflow f32.
     #[error(
-        "--{what} `{value}`: a coordinate lies beyond ±{limit:e} (2^60, the limit of scene coordinates)"
+        "--{what} `{value}`: a coordinate lies beyond ±{limit:e} (2^62, the limit of camera and light positions)"
     )]
     Far {
         /// Which option (`eye`, `target`, `light`).
         what: &'static str,
         /// The text given.
         value: String,
-        /// [`Scene::MAX_COORDINATE`](crate::Scene::MAX_COORDINATE).
+        /// [`MAX_VIEW_COORDINATE`].
         limit: f32,
     },
     /// The eye and the target coincide, or the view direction is parallel to up.
@@ -111,10 +118,10 @@ fn check_range(
     }
 }
 
-/// [`parse_vec3`], refusing a point beyond ±[`Scene::MAX_COORDINATE`](crate::Scene::MAX_COORDINATE).
+/// [`parse_vec3`], refusing a point beyond ±[`MAX_VIEW_COORDINATE`].
 fn parse_point(what: &'static str, s: &str) -> Result<Vec3, CameraError> {
     let v = parse_vec3(what, s)?;
-    let limit = crate::Scene::MAX_COORDINATE;
+    let limit = MAX_VIEW_COORDINATE;
     if v.abs().max_element() > limit {
         return Err(CameraError::Far {
             what,

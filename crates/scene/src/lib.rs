@@ -48,7 +48,7 @@ pub mod limits;
 pub mod load;
 pub mod make;
 
-pub use camera::{Camera, CameraError, Light, parse_vec3};
+pub use camera::{Camera, CameraError, Light, MAX_VIEW_COORDINATE, parse_vec3};
 pub use error::{FileError, SceneError};
 pub use limits::Limits;
 
