@@ -63,7 +63,9 @@ fn path_text(obj: &Bound<'_, PyAny>) -> PyResult<String> {
     if let Ok(s) = obj.cast::<PyString>() {
         return match s.to_cow() {
             Ok(t) => Ok(t.into_owned()),
-            Err(_) => Err(not_utf8(s.repr().map(|r| r.to_string()).unwrap_or_default())),
+            Err(_) => Err(not_utf8(
+                s.repr().map(|r| r.to_string()).unwrap_or_default(),
+            )),
         };
     }
     let p: PathBuf = obj.extract().map_err(|_| {

@@ -614,8 +614,8 @@ fn forged_header_settings_and_scene_boxes_are_refused() {
             (92, f32::NAN.to_le_bytes(), "cost_traversal is NaN"),
             (96, (-1.0f32).to_le_bytes(), "cost_triangle is -1"),
         ] {
-            let e = AnyTree::from_bytes(&forge_header(&good, at, &bytes), Some(&tris))
-                .expect_err(name);
+            let e =
+                AnyTree::from_bytes(&forge_header(&good, at, &bytes), Some(&tris)).expect_err(name);
             assert!(matches!(e, SavedError::Malformed(_)), "{name}: {e}");
             assert!(e.to_string().contains(says), "{name}: {e}");
         }
@@ -628,16 +628,28 @@ fn forged_header_settings_and_scene_boxes_are_refused() {
                     Some(&tris),
                 )
                 .expect_err(name);
-                assert!(e.to_string().contains("DST cost single_carve is inf"), "{e}");
+                assert!(
+                    e.to_string().contains("DST cost single_carve is inf"),
+                    "{e}"
+                );
                 128
             }
             TreeKind::DstQ => 116,
             _ => continue,
         };
-        for (off, v) in [(0, f32::NEG_INFINITY), (12, f32::INFINITY), (4, -1e30), (16, 0.5)] {
+        for (off, v) in [
+            (0, f32::NEG_INFINITY),
+            (12, f32::INFINITY),
+            (4, -1e30),
+            (16, 0.5),
+        ] {
             let f = forge_header(&good, box_at + off, &v.to_le_bytes());
             let e = AnyTree::from_bytes(&f, Some(&tris)).expect_err(name);
-            assert!(e.to_string().contains("is not the bounds of the file's triangles"), "{name}: {e}");
+            assert!(
+                e.to_string()
+                    .contains("is not the bounds of the file's triangles"),
+                "{name}: {e}"
+            );
         }
     }
 }
@@ -652,15 +664,23 @@ fn settings_a_load_would_refuse_are_not_saved() {
     };
     // The builder clamps these, and the file records what it used.
     let bvh2 = Bvh2Tree::build(&tris[..], &odd).expect("bvh2");
-    let any: AnyTree = BvhTree::from_bvh2(&bvh2, TreeKind::Bvh2).expect("bvh").expect("encode").into();
+    let any: AnyTree = BvhTree::from_bvh2(&bvh2, TreeKind::Bvh2)
+        .expect("bvh")
+        .expect("encode")
+        .into();
     AnyTree::from_bytes(&any.to_bytes(), Some(&tris)).expect("clamped settings load");
     let nan = BuildConfig {
         cost_traversal: f32::NAN,
         ..BuildConfig::default()
     };
     let bvh2 = Bvh2Tree::build(&tris[..], &nan).expect("bvh2");
-    let any: AnyTree = BvhTree::from_bvh2(&bvh2, TreeKind::Bvh2).expect("bvh").expect("encode").into();
-    let e = any.write_to(Vec::new()).expect_err("a NaN cost is not saved");
+    let any: AnyTree = BvhTree::from_bvh2(&bvh2, TreeKind::Bvh2)
+        .expect("bvh")
+        .expect("encode")
+        .into();
+    let e = any
+        .write_to(Vec::new())
+        .expect_err("a NaN cost is not saved");
     assert_eq!(e.kind(), std::io::ErrorKind::InvalidInput);
     assert!(any.to_bytes().is_empty());
 }

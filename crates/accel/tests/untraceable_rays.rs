@@ -40,17 +40,34 @@ fn trees(tris: &[dualsplit_accel::math::Triangle]) -> Vec<AnyTree> {
     let bvh2 = Bvh2Tree::build(tris, &BuildConfig::default()).expect("bvh2");
     let mut out: Vec<AnyTree> = [TreeKind::Bvh2, TreeKind::Bvh4, TreeKind::Bvh8]
         .into_iter()
-        .map(|k| BvhTree::from_bvh2(&bvh2, k).expect("bvh").expect("encode").into())
+        .map(|k| {
+            BvhTree::from_bvh2(&bvh2, k)
+                .expect("bvh")
+                .expect("encode")
+                .into()
+        })
         .collect();
-    out.push(DstTree::from_bvh2(&bvh2, &DstConfig::hardware()).expect("dst").into());
+    out.push(
+        DstTree::from_bvh2(&bvh2, &DstConfig::hardware())
+            .expect("dst")
+            .into(),
+    );
     out.push(CwbvhTree::from_bvh2(&bvh2).expect("cwbvh").into());
-    out.push(DstQTree::from_bvh2(&bvh2, &Default::default()).expect("dstq").into());
+    out.push(
+        DstQTree::from_bvh2(&bvh2, &Default::default())
+            .expect("dstq")
+            .into(),
+    );
     out
 }
 
 /// Every answer `set` gives `ray` through traversal `kind`: plain, observed, through a
 /// tracer; closest hit and any hit.
-fn answers<S: TraversalSet>(set: &S, kind: AccelKind, ray: &Ray) -> Vec<Option<(u32, u32, u32, u32)>> {
+fn answers<S: TraversalSet>(
+    set: &S,
+    kind: AccelKind,
+    ray: &Ray,
+) -> Vec<Option<(u32, u32, u32, u32)>> {
     let mut obs = CountingObserver::default();
     let mut tracer = set.tracer(kind);
     let any = |b: bool| b.then_some((1, 1, 1, 1));
@@ -74,7 +91,11 @@ fn untraceable_rays_miss_in_every_structure_and_query_form() {
         .iter()
         .filter(|r| s.closest_hit(AccelKind::Bvh2, r, &mut NoObserver).is_some())
         .count();
-    assert!(hits > rays.len() / 2, "only {hits} of {} rays hit", rays.len());
+    assert!(
+        hits > rays.len() / 2,
+        "only {hits} of {} rays hit",
+        rays.len()
+    );
     let bad = [f32::NAN, -f32::NAN, f32::INFINITY, f32::NEG_INFINITY];
     let mut untraceable = 0;
     for (i, base) in rays.iter().enumerate() {
@@ -88,15 +109,29 @@ fn untraceable_rays_miss_in_every_structure_and_query_form() {
                 let want = answers(&s, AccelKind::Bvh2, &ray);
                 if !traceable {
                     untraceable += 1;
-                    assert!(want.iter().all(Option::is_none), "ray {i} field {f} = {v}: {want:?}");
-                    assert_eq!(ray.untraceable_field().map(|(_, x)| x.to_bits()), Some(v.to_bits()));
+                    assert!(
+                        want.iter().all(Option::is_none),
+                        "ray {i} field {f} = {v}: {want:?}"
+                    );
+                    assert_eq!(
+                        ray.untraceable_field().map(|(_, x)| x.to_bits()),
+                        Some(v.to_bits())
+                    );
                 }
                 for kind in AccelKind::ALL {
-                    assert_eq!(answers(&s, kind, &ray), want, "{kind:?}: ray {i} field {f} = {v}");
+                    assert_eq!(
+                        answers(&s, kind, &ray),
+                        want,
+                        "{kind:?}: ray {i} field {f} = {v}"
+                    );
                 }
                 for t in &singles {
                     for &kind in t.kinds() {
-                        assert_eq!(answers(t, kind, &ray), want, "saved {kind:?}: ray {i}, field {f} = {v}");
+                        assert_eq!(
+                            answers(t, kind, &ray),
+                            want,
+                            "saved {kind:?}: ray {i}, field {f} = {v}"
+                        );
                         if let AnyTree::Bvh(b) = t {
                             assert_eq!(bits(b.intersect(&ray)), want[0], "{kind:?} RayQuery");
                             assert_eq!(b.occluded(&ray), want[3].is_some(), "{kind:?} RayQuery");

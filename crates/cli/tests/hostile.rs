@@ -297,11 +297,18 @@ fn small_study(dir: &Path) -> (std::path::PathBuf, String) {
         ],
         dir,
     );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let study = dir.join("study");
     let plan: serde_json::Value =
         serde_json::from_slice(&std::fs::read(study.join("plan.json")).unwrap()).unwrap();
-    let key = plan["entries"][0]["cache_key"].as_str().unwrap().to_string();
+    let key = plan["entries"][0]["cache_key"]
+        .as_str()
+        .unwrap()
+        .to_string();
     std::fs::create_dir_all(study.join("cache")).unwrap();
     (study, key)
 }
@@ -319,9 +326,16 @@ fn study_files_are_read_only_from_bounded_regular_files() {
     let out = report();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("not a regular file (a character device)"), "{err}");
+    assert!(
+        err.contains("not a regular file (a character device)"),
+        "{err}"
+    );
     std::fs::remove_file(&entry).unwrap();
-    let ok = Command::new("mkfifo").arg(&entry).status().unwrap().success();
+    let ok = Command::new("mkfifo")
+        .arg(&entry)
+        .status()
+        .unwrap()
+        .success();
     assert!(ok);
     let out = report();
     let err = String::from_utf8_lossy(&out.stderr);
@@ -329,7 +343,11 @@ fn study_files_are_read_only_from_bounded_regular_files() {
     assert!(err.contains("not a regular file (a named pipe)"), "{err}");
     // run-job sees the pipe as an invalid result and replaces it.
     let out = dualsplit(&["run-job", "study", "0"], dir.path());
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(std::fs::metadata(&entry).unwrap().is_file());
     std::fs::remove_file(&entry).unwrap();
     let f = std::fs::File::create(&entry).unwrap();
@@ -349,7 +367,11 @@ fn study_files_are_read_only_from_bounded_regular_files() {
         "not a regular file (a character device)",
     );
     std::fs::remove_file(&plan).unwrap();
-    let ok = Command::new("mkfifo").arg(&plan).status().unwrap().success();
+    let ok = Command::new("mkfifo")
+        .arg(&plan)
+        .status()
+        .unwrap()
+        .success();
     assert!(ok);
     fails_with(&report(), "not a regular file (a named pipe)");
     fails_with(
@@ -419,14 +441,21 @@ fn ray_files_are_bounded_and_their_rays_checked() {
     std::fs::write(dir.path().join("good.bin"), file(&good)).unwrap();
     std::fs::write(dir.path().join("nan.bin"), file(&bad)).unwrap();
     let out = trace("good.bin");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // A NaN t_max once gave a hit in five traversals and a miss in two.
     fails_with(&trace("nan.bin"), "ray 1: t_max is NaN");
     bad[9] = f32::INFINITY;
     std::fs::write(dir.path().join("inf.bin"), file(&bad)).unwrap();
     fails_with(&trace("inf.bin"), "ray 1: origin.y is inf");
     // Once read until killed for memory.
-    fails_with(&trace("/dev/zero"), "not a regular file (a character device)");
+    fails_with(
+        &trace("/dev/zero"),
+        "not a regular file (a character device)",
+    );
     let f = std::fs::File::create(dir.path().join("big.bin")).unwrap();
     f.set_len((1 << 30) + 32).unwrap(); // sparse
     drop(f);
@@ -454,7 +483,14 @@ fn a_closed_standard_output_ends_quietly_and_files_are_still_written() {
     // `simulate ... | head -1` and `render ... | head -1` once panicked with "failed
     // printing to stdout: Broken pipe", render before it wrote its PNG.
     let runs: [&[&str]; 3] = [
-        &["simulate", "builtin:cornell", "--res", "8", "--accel", "bvh2"],
+        &[
+            "simulate",
+            "builtin:cornell",
+            "--res",
+            "8",
+            "--accel",
+            "bvh2",
+        ],
         &["render", "builtin:cornell", "--res", "8", "-o", "c.png"],
         &["stats", "builtin:cornell"],
     ];
@@ -462,7 +498,10 @@ fn a_closed_standard_output_ends_quietly_and_files_are_still_written() {
         let out = with_closed_stdout(args, dir.path());
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
-        assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{args:?}: {err}");
+        assert!(
+            !err.contains("panicked") && !err.contains("Broken pipe"),
+            "{args:?}: {err}"
+        );
     }
     let png = std::fs::read(dir.path().join("c.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"), "{} bytes", png.len());
@@ -472,16 +511,38 @@ fn a_closed_standard_output_ends_quietly_and_files_are_still_written() {
 fn far_lights_and_cameras_are_refused_for_what_they_are() {
     let dir = tempfile::tempdir().unwrap();
     let render = |flag: &str, value: &str| {
-        let args = ["render", "builtin:cornell", "--workload", "cast", "--res", "32"];
-        dualsplit(&[&args[..], &[flag, value, "-o", "x.png"]].concat(), dir.path())
+        let args = [
+            "render",
+            "builtin:cornell",
+            "--workload",
+            "cast",
+            "--res",
+            "32",
+        ];
+        dualsplit(
+            &[&args[..], &[flag, value, "-o", "x.png"]].concat(),
+            dir.path(),
+        )
     };
     // Once exit 0 with "shadow 0 rays" and a wrong image.
     fails_with(&render("--light", "1e20,1e20,1e20"), "beyond ±4.611686e18");
     fails_with(&render("--light", "1e19,0,0"), "beyond ±4.611686e18");
     // Once "eye and target coincide".
-    fails_with(&render("--eye", "0,0,1e30"), "--eye `0,0,1e30`: a coordinate lies beyond");
-    fails_with(&render("--target", "1e30,0,0"), "--target `1e30,0,0`: a coordinate lies beyond");
-    let args = ["render", "builtin:cornell", "--light-radius=-1", "-o", "x.png"];
+    fails_with(
+        &render("--eye", "0,0,1e30"),
+        "--eye `0,0,1e30`: a coordinate lies beyond",
+    );
+    fails_with(
+        &render("--target", "1e30,0,0"),
+        "--target `1e30,0,0`: a coordinate lies beyond",
+    );
+    let args = [
+        "render",
+        "builtin:cornell",
+        "--light-radius=-1",
+        "-o",
+        "x.png",
+    ];
     fails_with(
         &dualsplit(&args, dir.path()),
         "--light-radius -1: must be from 0 to 2^60",
@@ -494,20 +555,34 @@ fn dragon_boxes_that_would_not_load_are_not_written() {
     let dir = tempfile::tempdir().unwrap();
     let make = |input: &str, obj: &str| {
         std::fs::write(dir.path().join(input), obj).unwrap();
-        dualsplit(&["scene", "dragon-box", input, "-o", "box.ply.gz"], dir.path())
+        dualsplit(
+            &["scene", "dragon-box", input, "-o", "box.ply.gz"],
+            dir.path(),
+        )
     };
     // Once exit 0 with a box every loader then refused.
     let out = make("wide.obj", "v 0 0 0\nv 1.1e18 0 0\nv 0 1 0\nf 1 2 3\n");
-    fails_with(&out, "wide.obj: cannot make the Dragon Box: the result would not load");
+    fails_with(
+        &out,
+        "wide.obj: cannot make the Dragon Box: the result would not load",
+    );
     fails_with(&out, "exceeds");
     // Once 11 triangles of size zero.
     let out = make("point.obj", "v 1 2 3\nv 1 2 3\nv 1 2 3\nf 1 2 3\n");
     fails_with(&out, "box triangle 0 has no area");
     assert!(!dir.path().join("box.ply.gz").exists());
     let out = make("ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let out = dualsplit(&["info", "box.ply.gz"], dir.path());
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]
@@ -516,11 +591,23 @@ fn outputs_that_name_an_input_are_refused() {
     let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
     std::fs::write(dir.path().join("s.obj"), obj).unwrap();
     // `build S -o S` once overwrote the scene without a word.
-    let out = dualsplit(&["build", "s.obj", "--accel", "bvh2", "-o", "s.obj"], dir.path());
-    fails_with(&out, "-o s.obj: is the input s.obj; writing it would overwrite it");
-    let out = dualsplit(&["build", "s.obj", "--accel", "bvh2", "-o", "./s.obj"], dir.path());
+    let out = dualsplit(
+        &["build", "s.obj", "--accel", "bvh2", "-o", "s.obj"],
+        dir.path(),
+    );
+    fails_with(
+        &out,
+        "-o s.obj: is the input s.obj; writing it would overwrite it",
+    );
+    let out = dualsplit(
+        &["build", "s.obj", "--accel", "bvh2", "-o", "./s.obj"],
+        dir.path(),
+    );
     fails_with(&out, "would overwrite it");
-    assert_eq!(std::fs::read_to_string(dir.path().join("s.obj")).unwrap(), obj);
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("s.obj")).unwrap(),
+        obj
+    );
     let help = dualsplit(&["build", "--help"], dir.path());
     let help = String::from_utf8_lossy(&help.stdout);
     for kind in ["dst", "bvh2", "bvh4", "bvh8", "cwbvh", "dst-q"] {

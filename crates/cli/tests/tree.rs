@@ -252,7 +252,10 @@ fn a_damaged_tree_file_is_refused() {
         assert!(ok);
         for cmd in ["check", "simulate"] {
             let e = refused(&[cmd, SCENE, "--tree", "pipe.dst"], d);
-            assert!(e.contains("pipe.dst: not a regular file (a named pipe)"), "{e}");
+            assert!(
+                e.contains("pipe.dst: not a regular file (a named pipe)"),
+                "{e}"
+            );
         }
     }
 }

@@ -110,7 +110,13 @@ impl Ray {
             self.t_max,
         ];
         (0..8)
-            .find(|&i| if i < 6 { !v[i].is_finite() } else { v[i].is_nan() })
+            .find(|&i| {
+                if i < 6 {
+                    !v[i].is_finite()
+                } else {
+                    v[i].is_nan()
+                }
+            })
             .map(|i| (NAMES[i], v[i]))
     }
 

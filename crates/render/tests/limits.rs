@@ -114,7 +114,10 @@ fn lights_and_cameras_beyond_the_coordinate_limit_are_refused() {
     );
     let mut s = base.clone();
     s.light.radius = 1e19;
-    assert!(matches!(validate(&s, &settings), Err(RenderError::Light { .. })));
+    assert!(matches!(
+        validate(&s, &settings),
+        Err(RenderError::Light { .. })
+    ));
     let mut s = base.clone();
     s.camera.eye = Vec3::new(0.0, 0.0, 1e30);
     let r = validate(&s, &settings);

@@ -358,7 +358,8 @@ impl Light {
         if let Some(r) = radius {
             // Radius 0 is a point light; -0 is taken as 0.
             let ok = (0.0..=crate::Scene::MAX_COORDINATE).contains(&r);
-            l.radius = check_range("light-radius", r, ok, "from 0 to 2^60 (1.1529215e18)")?.max(0.0);
+            l.radius =
+                check_range("light-radius", r, ok, "from 0 to 2^60 (1.1529215e18)")?.max(0.0);
         }
         if let Some(i) = intensity {
             let ok = i > 0.0 && i.is_finite();

@@ -176,7 +176,10 @@ fn camera_overrides_apply_and_check() {
         (Some("0,0,-4.7e18"), None, "eye"),
     ] {
         let e = c.with_overrides(eye, target, None).unwrap_err();
-        assert!(matches!(e, CameraError::Far { what: w, .. } if w == what), "{e:?}");
+        assert!(
+            matches!(e, CameraError::Far { what: w, .. } if w == what),
+            "{e:?}"
+        );
         assert!(e.to_string().contains("beyond ±4.611686e18"), "{e}");
     }
     assert!(c.with_overrides(Some("0,0,4.6e18"), None, None).is_ok());
@@ -216,7 +219,10 @@ fn light_overrides_apply_and_check() {
     }
     assert!(matches!(
         l.with_overrides(None, Some(1e19), None),
-        Err(CameraError::OutOfRange { what: "light-radius", .. })
+        Err(CameraError::OutOfRange {
+            what: "light-radius",
+            ..
+        })
     ));
     // The range reads as words, not as "(-0.0000…117549, 3402823500000…)".
     let e = l.with_overrides(None, Some(-1.0), None).unwrap_err();
@@ -224,7 +230,13 @@ fn light_overrides_apply_and_check() {
         e.to_string(),
         "--light-radius -1: must be from 0 to 2^60 (1.1529215e18)"
     );
-    assert_eq!(l.with_overrides(None, Some(-0.0), None).unwrap().radius.to_bits(), 0);
+    assert_eq!(
+        l.with_overrides(None, Some(-0.0), None)
+            .unwrap()
+            .radius
+            .to_bits(),
+        0
+    );
 }
 
 #[test]

@@ -405,12 +405,23 @@ fn long_bad_lines_give_short_messages() {
     );
     for (name, bytes) in [
         ("first.ply", format!("{long}\n")),
-        ("header.ply", format!("ply\nformat ascii 1.0\n{long}\nend_header\n")),
+        (
+            "header.ply",
+            format!("ply\nformat ascii 1.0\n{long}\nend_header\n"),
+        ),
         ("body.ply", ascii_body),
-        ("bad.obj", format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 {long}\n")),
+        (
+            "bad.obj",
+            format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 {long}\n"),
+        ),
     ] {
         let e = fail(name, bytes.as_bytes()).to_string();
-        assert!(e.len() < 400, "{name}: a message of {} bytes: {}", e.len(), e.chars().take(400).collect::<String>());
+        assert!(
+            e.len() < 400,
+            "{name}: a message of {} bytes: {}",
+            e.len(),
+            e.chars().take(400).collect::<String>()
+        );
         assert!(e.contains(name), "{name}: {e}");
     }
 }

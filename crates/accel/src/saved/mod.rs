@@ -44,6 +44,7 @@ mod structure;
 
 pub use header::{CHECKSUM_BYTES, FORMAT_VERSION, HEADER_BYTES, MAGIC, WORDS_OFFSET};
 
+use crate::BuildConfig;
 use crate::cwbvh::Cwbvh;
 use crate::dst::Dst;
 use crate::dstq::DstQ;
@@ -51,7 +52,6 @@ use crate::image::{MemoryImage, SharedTriangles, Words};
 use crate::tree::{AnyTree, BuildStats, BvhTree, CwbvhTree, DstQTree, DstTree, TreeKind};
 use crate::wide::BvhImage;
 use dualsplit_geometry::Triangle;
-use crate::BuildConfig;
 use header::{Extra, Header};
 use sha2::{Digest, Sha256};
 use std::io::{self, Read, Write};
@@ -448,7 +448,10 @@ impl AnyTree {
                 .iter()
                 .fold(dualsplit_geometry::Aabb::EMPTY, |b, t| b.union(t.bounds()));
             let bits = |b: &dualsplit_geometry::Aabb| {
-                (b.min.to_array().map(f32::to_bits), b.max.to_array().map(f32::to_bits))
+                (
+                    b.min.to_array().map(f32::to_bits),
+                    b.max.to_array().map(f32::to_bits),
+                )
             };
             if bits(scene_box) != bits(&bounds) {
                 return Err(SavedError::malformed(format!(
@@ -518,7 +521,11 @@ fn file_kind(t: std::fs::FileType) -> &'static str {
             return "a block device";
         }
     }
-    if t.is_dir() { "a directory" } else { "not a file" }
+    if t.is_dir() {
+        "a directory"
+    } else {
+        "not a file"
+    }
 }
 
 /// The tree a checked header and its regions describe.

@@ -233,7 +233,11 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if json.is_none() && (show_rays || !args.no_frame) {
         outln!(
             "{:<8} {:>16} {:>16} {:>16} {:>14}",
-            "accel", "primary Mrays/s", "shadow Mrays/s", "diffuse Mrays/s", "frame s"
+            "accel",
+            "primary Mrays/s",
+            "shadow Mrays/s",
+            "diffuse Mrays/s",
+            "frame s"
         );
     }
     for &kind in &accels {
@@ -542,7 +546,10 @@ impl PeerRun<'_> {
             {
                 outln!(
                     "  {kind:<8} ours {:.1e} / {:.1e}; {name} {:.1e} / {:.1e}",
-                    e["ours"].p999, e["ours"].max, e[name].p999, e[name].max
+                    e["ours"].p999,
+                    e["ours"].max,
+                    e[name].p999,
+                    e[name].max
                 );
             }
         }
@@ -640,7 +647,10 @@ fn print_timings(
     );
     outln!(
         "{:<19} {:>18} {:>18} {:>18}",
-        "accel", "primary", "shadow", "diffuse"
+        "accel",
+        "primary",
+        "shadow",
+        "diffuse"
     );
     let mut names: Vec<&str> = Vec::new();
     for t in timings {

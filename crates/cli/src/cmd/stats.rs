@@ -161,7 +161,11 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if let Some(d) = stats.iter().find_map(|st| st.dst) {
         outln!(
             "dst nodes: {} splitting, {} single-axis carving, {} dual-axis carving, {} leaves, {} carving leaves (hardware preset, identical bounds)",
-            d.splitting, d.single_carving, d.dual_carving, d.leaves, d.carving_leaves
+            d.splitting,
+            d.single_carving,
+            d.dual_carving,
+            d.leaves,
+            d.carving_leaves
         );
     }
     outln!();
@@ -171,7 +175,14 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     );
     outln!(
         "{:<32} {:>10} {:>8} {:>8} {:>8} {:>10} {:>10} {:>9}",
-        "", "total MiB", "% BVH2", "nodes", "leaves", "tests", "triangles", "bytes"
+        "",
+        "total MiB",
+        "% BVH2",
+        "nodes",
+        "leaves",
+        "tests",
+        "triangles",
+        "bytes"
     );
     outln!(
         "{:<32} {:>10.2} {:>7.1}% {:>8.2} {:>8} {:>10.2} {:>10.2} {:>9.1}",

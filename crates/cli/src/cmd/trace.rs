@@ -49,8 +49,8 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     inputs.extend(args.tree.as_deref());
     crate::output::check_not_an_input(&args.output, "-o", &inputs)?;
     let bytes = dualsplit_scene::load::read_limited(&args.rays, ray_file::MAX_BYTES)?;
-    let rays = ray_file::parse_rays(&bytes)
-        .with_context(|| format!("rays {}", args.rays.display()))?;
+    let rays =
+        ray_file::parse_rays(&bytes).with_context(|| format!("rays {}", args.rays.display()))?;
     drop(bytes);
     let scene = super::load(&args.scene, ctx)?;
     let structures = Loaded::get(&scene, args.tree.as_deref(), ctx)?;

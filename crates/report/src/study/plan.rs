@@ -453,8 +453,15 @@ mod tests {
             vec!["tms=2,8", "units.dst_pipes=1,2,3"],
         ];
         for vary in cases {
-            let v: Vec<Vary> = vary.iter().map(|a| Vary::parse(a, &base).unwrap()).collect();
-            for workloads in [vec![Workload::Cast], vec![Workload::Path], Workload::ALL.to_vec()] {
+            let v: Vec<Vary> = vary
+                .iter()
+                .map(|a| Vary::parse(a, &base).unwrap())
+                .collect();
+            for workloads in [
+                vec![Workload::Cast],
+                vec![Workload::Path],
+                Workload::ALL.to_vec(),
+            ] {
                 let mut o = opts(v.clone());
                 o.workloads = workloads;
                 o.tms = vec![2, 4, 4, 8];

@@ -261,7 +261,8 @@ fn print_result(r: &SimResult, host: Duration) {
     if i.qbox_ops + i.qdst_ops > 0 {
         outln!(
             "  quantized      box ops {} (dequantized child boxes), dual-split ops {} (records)",
-            i.qbox_ops, i.qdst_ops
+            i.qbox_ops,
+            i.qdst_ops
         );
     }
     outln!(
