@@ -77,7 +77,9 @@ class Tree:
         npt.NDArray[np.float32], npt.NDArray[np.int64], npt.NDArray[np.float32], npt.NDArray[np.float32]
     ]:
         """Closest hits of the ``(N, 3)`` float32 rays: ``(t, prim, u, v)``; a miss is
-        ``t = inf``, ``prim = -1``, ``u = v = 0``. Runs on the Rust thread pool without the GIL."""
+        ``t = inf``, ``prim = -1``, ``u = v = 0``. A ray with a non-finite origin or direction, or
+        a NaN ``tmin`` or ``tmax``, raises ``DualsplitError`` naming the ray and the field. Runs
+        on the Rust thread pool without the GIL."""
     def occluded(
         self,
         origins: npt.NDArray[np.float32],
@@ -87,7 +89,8 @@ class Tree:
         *,
         traversal: Union[Traversal, None] = None,
     ) -> npt.NDArray[np.bool_]:
-        """True where a ray hits any triangle within ``[tmin, tmax]``."""
+        """True where a ray hits any triangle within ``[tmin, tmax]``; rays are checked as in
+        ``intersect``."""
 
 def load_scene(
     spec: Union[str, os.PathLike[str]],

@@ -421,8 +421,10 @@ impl Tree {
 
     /// Closest hits: `(t, prim, u, v)` arrays of N (float32, int64, float32, float32);
     /// a miss is `t = inf`, `prim = -1`, `u = v = 0`. Rays are `origins[i] + t *
-    /// directions[i]` with `tmin <= t <= tmax` (scalars or arrays of N). Runs on the Rust
-    /// thread pool without the GIL. `traversal` picks `dst-sw` or `dst` for a DST.
+    /// directions[i]` with `tmin <= t <= tmax` (scalars or arrays of N). A ray with a
+    /// non-finite origin or direction, or a NaN `tmin` or `tmax`, is a `DualsplitError`
+    /// naming the ray and the field (`tmax = inf` is the usual unbounded ray). Runs on the
+    /// Rust thread pool without the GIL. `traversal` picks `dst-sw` or `dst` for a DST.
     #[pyo3(signature = (origins, directions, tmin=None, tmax=None, *, traversal=None))]
     fn intersect<'py>(
         &self,
@@ -472,7 +474,8 @@ impl Tree {
     }
 
     /// Shadow rays: a bool array of N, true where the ray hits any triangle within
-    /// `[tmin, tmax]`. Runs on the Rust thread pool without the GIL.
+    /// `[tmin, tmax]`; rays are checked as in `intersect`. Runs on the Rust thread pool
+    /// without the GIL.
     #[pyo3(signature = (origins, directions, tmin=None, tmax=None, *, traversal=None))]
     fn occluded<'py>(
         &self,

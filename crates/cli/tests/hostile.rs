@@ -215,6 +215,12 @@ fn configurations_are_read_only_from_small_regular_files() {
         assert!(ok);
         fails_with(&sim("pipe.toml"), "not a regular file");
     }
+    // A TOML error was printed twice (its wrapper shows it, then the cause chain again).
+    std::fs::write(dir.path().join("bad.toml"), "tms = \"x\"\n").unwrap();
+    let out = sim("bad.toml");
+    fails_with(&out, "TOML parse error at line 1");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("TOML parse error").count(), 1, "{err}");
 }
 
 #[test]
