@@ -345,12 +345,14 @@ fn parse_error(path: &Path, line: Option<u64>, message: impl Into<String>) -> Sc
     }
 }
 
-/// Longest parse error message kept, in bytes: a parser may quote the bad line, and a
-/// 200 KB line must not make a 200 KB message.
+/// Longest parse error message kept whole, in bytes: a parser may quote the bad line, and
+/// a 200 KB line must not make a 200 KB message ([`clip_message`] keeps 240 bytes of a
+/// longer one).
 pub const MAX_MESSAGE_BYTES: usize = 240;
 
-/// `message` cut to at most [`MAX_MESSAGE_BYTES`] (at a character boundary, control
-/// characters shown as spaces), saying how much was cut.
+/// `message` cut to about [`MAX_MESSAGE_BYTES`]: its first 160 and last 80 bytes (at
+/// character boundaries) around `…(N bytes)…`, so both a quoted line's start and the
+/// explanation after it remain; control characters are shown as spaces.
 fn clip_message(message: String) -> String {
     let clean = |s: &str| -> String {
         s.chars()
@@ -360,14 +362,19 @@ fn clip_message(message: String) -> String {
     if message.len() <= MAX_MESSAGE_BYTES {
         return clean(&message);
     }
-    let mut end = MAX_MESSAGE_BYTES;
-    while !message.is_char_boundary(end) {
-        end -= 1;
+    let mut head = 160;
+    while !message.is_char_boundary(head) {
+        head -= 1;
+    }
+    let mut tail = message.len() - 80;
+    while !message.is_char_boundary(tail) {
+        tail += 1;
     }
     format!(
-        "{}… ({} more bytes)",
-        clean(&message[..end]),
-        message.len() - end
+        "{}…({} bytes)…{}",
+        clean(&message[..head]),
+        tail - head,
+        clean(&message[tail..])
     )
 }
 
