@@ -1,7 +1,7 @@
 //! Standard output that ends quietly on a closed pipe.
 //!
 //! `dualsplit simulate ... | head -1` closes the pipe after one line; `println!` would then
-//! panic ("failed printing to stdout: Broken pipe"). [`outln!`] and [`out!`] write through
+//! panic ("failed printing to stdout: Broken pipe"). `outln!` and `out!` write through
 //! [`write_out`] instead: once the reader has gone, further output is dropped, the command
 //! carries on (so the files it writes, a PNG or a JSON, are still written) and exits with
 //! its own status, printing nothing about the pipe, as tools killed by SIGPIPE do. Any other

@@ -113,8 +113,8 @@ pub fn dragon_box(dragon: &[Triangle]) -> Vec<Triangle> {
 }
 
 /// Checks a Dragon Box made by [`dragon_box`] or [`closed_dragon_box`] from the
-/// `dragon_len` triangles of `spec` before it is written ([`SceneError::Make`]
-/// otherwise): every triangle the box adds has an area (a dragon of a single point, or one
+/// `dragon_len` triangles of `spec` before it is written
+/// ([`SceneError::Make`](crate::SceneError::Make) otherwise): every triangle the box adds has an area (a dragon of a single point, or one
 /// too thin for f32, gives a box of zero size), and the whole scene is one every loader
 /// accepts ([`Scene::from_triangles`](crate::Scene::from_triangles): the box is 1.5 × the
 /// dragon's extent, so a dragon near [`Scene::MAX_EXTENT`](crate::Scene::MAX_EXTENT) makes

@@ -346,8 +346,8 @@ fn parse_error(path: &Path, line: Option<u64>, message: impl Into<String>) -> Sc
 }
 
 /// Longest parse error message kept whole, in bytes: a parser may quote the bad line, and
-/// a 200 KB line must not make a 200 KB message ([`clip_message`] keeps 240 bytes of a
-/// longer one).
+/// a 200 KB line must not make a 200 KB message (a longer one keeps its first 160 and
+/// last 80 bytes).
 pub const MAX_MESSAGE_BYTES: usize = 240;
 
 /// `message` cut to about [`MAX_MESSAGE_BYTES`]: its first 160 and last 80 bytes (at
