@@ -51,7 +51,10 @@ fuzz_target!(|data: &[u8]| {
     );
     if back[56..88] != file[56..88] {
         let h = dualsplit_accel::saved::triangle_hash(tree.image().triangle_slice());
-        assert!(back[56..88] == h, "the written triangle hash is not the triangles'");
+        assert!(
+            back[56..88] == h,
+            "the written triangle hash is not the triangles'"
+        );
     }
     let b = tree.scene_box();
     let centre = if b.is_empty() { Vec3::ZERO } else { b.center() };

@@ -9,7 +9,7 @@
 * ``load_scene(spec)``: a file (.obj, .ply, .gltf, .glb, optionally .gz) or
   ``builtin:NAME?params``; ``Scene.triangles`` is a read-only ``(N, 3, 3)`` float32 array
   holding the loader's memory.
-* ``build(scene, kind)``: ``dst``, ``bvh2``, ``bvh4`` or ``bvh8``, as ``dualsplit build``.
+* ``build(scene, kind)``: ``dst``, ``bvh2``, ``bvh4``, ``bvh8``, ``cwbvh`` or ``dst-q``, as ``dualsplit build``.
 * ``Tree.save(path)`` / ``Tree.load(path, scene)``: the saved-tree format of the command line.
 * ``Tree.intersect`` / ``Tree.occluded``: batched ray queries on the Rust thread pool, without
   the GIL.

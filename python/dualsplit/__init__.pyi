@@ -9,9 +9,11 @@ import numpy.typing as npt
 
 __version__: str
 
-StructureKind = Literal["dst", "bvh2", "bvh4", "bvh8"]
-Traversal = Literal["bvh2", "bvh4", "bvh8", "dst-sw", "dst"]
-SimConfigName = Literal["bvh2", "bvh2+", "bvh4", "bvh4+", "bvh8", "bvh8+", "dst-sw", "dst", "all"]
+StructureKind = Literal["dst", "bvh2", "bvh4", "bvh8", "cwbvh", "dst-q"]
+Traversal = Literal["bvh2", "bvh4", "bvh8", "dst-sw", "dst", "cwbvh", "dst-q"]
+SimConfigName = Literal[
+    "bvh2", "bvh2+", "bvh4", "bvh4+", "bvh8", "bvh8+", "dst-sw", "dst", "cwbvh", "cwbvh+", "dst-q", "all"
+]
 ConfigValue = Union[bool, int, float, str]
 PerRay = Union[float, npt.NDArray[np.float32]]
 
@@ -75,7 +77,9 @@ class Tree:
         npt.NDArray[np.float32], npt.NDArray[np.int64], npt.NDArray[np.float32], npt.NDArray[np.float32]
     ]:
         """Closest hits of the ``(N, 3)`` float32 rays: ``(t, prim, u, v)``; a miss is
-        ``t = inf``, ``prim = -1``, ``u = v = 0``. Runs on the Rust thread pool without the GIL."""
+        ``t = inf``, ``prim = -1``, ``u = v = 0``. A ray with a non-finite origin or direction, or
+        a NaN ``tmin`` or ``tmax``, raises ``DualsplitError`` naming the ray and the field. Runs
+        on the Rust thread pool without the GIL."""
     def occluded(
         self,
         origins: npt.NDArray[np.float32],
@@ -85,7 +89,8 @@ class Tree:
         *,
         traversal: Union[Traversal, None] = None,
     ) -> npt.NDArray[np.bool_]:
-        """True where a ray hits any triangle within ``[tmin, tmax]``."""
+        """True where a ray hits any triangle within ``[tmin, tmax]``; rays are checked as in
+        ``intersect``."""
 
 def load_scene(
     spec: Union[str, os.PathLike[str]],

@@ -51,15 +51,30 @@ fn py_err(context: &str, err: &(dyn std::error::Error + 'static)) -> PyErr {
     }
 }
 
-/// A path or a string as text.
+/// A path or a string as text. A name that is not valid UTF-8 (a `str` with surrogate
+/// escapes, an `os.PathLike` of such bytes) is a `DualsplitError`: scene specs are text,
+/// and a lossy conversion would silently name another file.
 fn path_text(obj: &Bound<'_, PyAny>) -> PyResult<String> {
+    let not_utf8 = |name: String| {
+        DualsplitError::new_err(format!(
+            "path {name} is not valid UTF-8; scene files must have UTF-8 names"
+        ))
+    };
     if let Ok(s) = obj.cast::<PyString>() {
-        return Ok(s.to_cow()?.into_owned());
+        return match s.to_cow() {
+            Ok(t) => Ok(t.into_owned()),
+            Err(_) => Err(not_utf8(
+                s.repr().map(|r| r.to_string()).unwrap_or_default(),
+            )),
+        };
     }
     let p: PathBuf = obj.extract().map_err(|_| {
         PyTypeError::new_err("expected a str or an os.PathLike naming a file or builtin:NAME")
     })?;
-    Ok(p.to_string_lossy().into_owned())
+    match p.to_str() {
+        Some(t) => Ok(t.to_owned()),
+        None => Err(not_utf8(format!("{p:?}"))),
+    }
 }
 
 /// A loaded scene: its triangles as a read-only `(N, 3, 3)` float32 array (triangle,
@@ -309,14 +324,21 @@ fn rays(
         None => PerRay::One(f32::INFINITY),
     };
     let (o, d) = (o.as_array(), d.as_array());
-    Ok((0..n)
-        .map(|i| Ray {
-            origin: Vec3::new(o[[i, 0]], o[[i, 1]], o[[i, 2]]),
-            dir: Vec3::new(d[[i, 0]], d[[i, 1]], d[[i, 2]]),
-            t_min: lo.get(i),
-            t_max: hi.get(i),
+    // Rays outside `Ray::is_traceable` are refused by index and field, as `dualsplit trace
+    // --rays` refuses them, rather than answered with the traversals' defined miss.
+    (0..n)
+        .map(|i| {
+            let ray = Ray {
+                origin: Vec3::new(o[[i, 0]], o[[i, 1]], o[[i, 2]]),
+                dir: Vec3::new(d[[i, 0]], d[[i, 1]], d[[i, 2]]),
+                t_min: lo.get(i),
+                t_max: hi.get(i),
+            };
+            dualsplit_accel::ray_file::check_ray(i as u64, &ray)
+                .map(|()| ray)
+                .map_err(|e| py_err("", &e))
         })
-        .collect())
+        .collect()
 }
 
 impl Tree {
@@ -346,7 +368,7 @@ type Hits<'py> = (
 
 #[pymethods]
 impl Tree {
-    /// `dst`, `bvh2`, `bvh4` or `bvh8`.
+    /// `dst`, `bvh2`, `bvh4`, `bvh8`, `cwbvh` or `dst-q`.
     #[getter]
     fn kind(&self) -> &'static str {
         self.tree.kind().name()
@@ -399,8 +421,10 @@ impl Tree {
 
     /// Closest hits: `(t, prim, u, v)` arrays of N (float32, int64, float32, float32);
     /// a miss is `t = inf`, `prim = -1`, `u = v = 0`. Rays are `origins[i] + t *
-    /// directions[i]` with `tmin <= t <= tmax` (scalars or arrays of N). Runs on the Rust
-    /// thread pool without the GIL. `traversal` picks `dst-sw` or `dst` for a DST.
+    /// directions[i]` with `tmin <= t <= tmax` (scalars or arrays of N). A ray with a
+    /// non-finite origin or direction, or a NaN `tmin` or `tmax`, is a `DualsplitError`
+    /// naming the ray and the field (`tmax = inf` is the usual unbounded ray). Runs on the
+    /// Rust thread pool without the GIL. `traversal` picks `dst-sw` or `dst` for a DST.
     #[pyo3(signature = (origins, directions, tmin=None, tmax=None, *, traversal=None))]
     fn intersect<'py>(
         &self,
@@ -450,7 +474,8 @@ impl Tree {
     }
 
     /// Shadow rays: a bool array of N, true where the ray hits any triangle within
-    /// `[tmin, tmax]`. Runs on the Rust thread pool without the GIL.
+    /// `[tmin, tmax]`; rays are checked as in `intersect`. Runs on the Rust thread pool
+    /// without the GIL.
     #[pyo3(signature = (origins, directions, tmin=None, tmax=None, *, traversal=None))]
     fn occluded<'py>(
         &self,
@@ -546,13 +571,23 @@ fn toml_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
     )))
 }
 
+/// Most levels of nested dicts in a `config` (the configuration's tables are one level
+/// deep); deeper nesting, a dict that contains itself included, is a `DualsplitError`.
+const MAX_CONFIG_DEPTH: usize = 4;
+
 /// `config` flattened to dotted keys: `{"l2.size_bytes": 1}` and `{"l2": {"size_bytes": 1}}`
-/// are the same.
+/// are the same. The recursion stops at [`MAX_CONFIG_DEPTH`] levels.
 fn flatten(
     prefix: &str,
+    depth: usize,
     map: &Bound<'_, PyDict>,
     out: &mut Vec<(String, toml::Value)>,
 ) -> PyResult<()> {
+    if depth > MAX_CONFIG_DEPTH {
+        return Err(DualsplitError::new_err(format!(
+            "config[{prefix:?}]: nested more than {MAX_CONFIG_DEPTH} levels deep (a dict that contains itself?)"
+        )));
+    }
     for (k, v) in map.iter() {
         let k: String = k
             .extract()
@@ -563,7 +598,7 @@ fn flatten(
             format!("{prefix}.{k}")
         };
         match v.cast::<PyDict>() {
-            Ok(d) => flatten(&key, d, out)?,
+            Ok(d) => flatten(&key, depth + 1, d, out)?,
             Err(_) => {
                 let value = toml_value(&key, &v)?;
                 out.push((key, value));
@@ -589,23 +624,13 @@ fn parse_res(res: &Bound<'_, PyAny>) -> PyResult<(u32, u32)> {
 /// Largest configuration file read, as the command line's `--config`: 1 MiB.
 const MAX_CONFIG_BYTES: u64 = 1 << 20;
 
-/// The text of a configuration file: a regular file of at most [`MAX_CONFIG_BYTES`].
+/// The text of a configuration file: a regular file of at most [`MAX_CONFIG_BYTES`]
+/// ([`dualsplit_scene::load::read_limited`], as the command line reads it).
 fn read_config(p: &std::path::Path) -> PyResult<String> {
-    let io = |e: std::io::Error| py_err(&format!("reading {}", p.display()), &e);
-    let meta = std::fs::metadata(p).map_err(io)?;
-    if !meta.is_file() {
-        return Err(DualsplitError::new_err(format!(
-            "{}: not a regular file; only regular files are read",
-            p.display()
-        )));
-    }
-    if meta.len() > MAX_CONFIG_BYTES {
-        return Err(DualsplitError::new_err(format!(
-            "{}: larger than {MAX_CONFIG_BYTES} bytes",
-            p.display()
-        )));
-    }
-    std::fs::read_to_string(p).map_err(io)
+    let bytes =
+        dualsplit_scene::load::read_limited(p, MAX_CONFIG_BYTES).map_err(|e| py_err("", &e))?;
+    String::from_utf8(bytes)
+        .map_err(|_| DualsplitError::new_err(format!("{}: not UTF-8 text", p.display())))
 }
 
 /// Simulates one frame per configuration on the TRaX-style many-core model and returns the
@@ -653,7 +678,7 @@ fn simulate<'py>(
     };
     if let Some(map) = config {
         let mut set = Vec::new();
-        flatten("", map, &mut set)?;
+        flatten("", 1, map, &mut set)?;
         cfg = vary::apply(&cfg, &set).map_err(|e| py_err("config", &e))?;
     }
     if let Some(t) = tms {

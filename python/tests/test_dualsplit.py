@@ -273,3 +273,41 @@ def test_queries_release_the_gil(scene):
         done.set()
         th.join()
     assert len(ticks) > 1
+
+
+def test_hostile_inputs_raise_dualsplit_errors(tmp_path, scene):
+    """Each once aborted the interpreter, answered differently per structure, or named
+    another file."""
+    import os
+
+    # A dict that contains itself overflowed the Rust stack.
+    d = {}
+    d["x"] = d
+    with pytest.raises(dualsplit.DualsplitError, match="nested more than 4 levels"):
+        dualsplit.simulate(scene, config=d, **SIM)
+    deep = {"a": {"b": {"c": {"d": {"e": 1}}}}}
+    with pytest.raises(dualsplit.DualsplitError, match="nested more than 4 levels"):
+        dualsplit.simulate(scene, config=deep, **SIM)
+    # Rays that are not traceable are refused by index and field, for every structure.
+    o = np.zeros((3, 3), np.float32)
+    dirs = np.tile(np.array([0.0, 0.0, 1.0], np.float32), (3, 1))
+    tmax = np.array([1.0, np.nan, 1.0], np.float32)
+    for kind in ["bvh2", "bvh4", "bvh8", "dst", "cwbvh", "dst-q"]:
+        tree = dualsplit.build(scene, kind)
+        with pytest.raises(dualsplit.DualsplitError, match="ray 1: t_max is NaN"):
+            tree.intersect(o, dirs, 0.0, tmax)
+        with pytest.raises(dualsplit.DualsplitError, match="ray 1: t_max is NaN"):
+            tree.occluded(o, dirs, 0.0, tmax)
+        bad = o.copy()
+        bad[2, 0] = np.inf
+        with pytest.raises(dualsplit.DualsplitError, match="ray 2: origin.x is inf"):
+            tree.intersect(bad, dirs)
+        with pytest.raises(dualsplit.DualsplitError, match="ray 0: dir.x is NaN"):
+            tree.occluded(o, np.full((3, 3), np.nan, np.float32))
+        with pytest.raises(dualsplit.DualsplitError, match="ray 0: t_min is NaN"):
+            tree.intersect(o, dirs, np.nan)
+    # A name that is not UTF-8 once became another name through a lossy conversion.
+    name = os.fsdecode(b"scene-\xff.obj")
+    for arg in [name, tmp_path / name]:
+        with pytest.raises(dualsplit.DualsplitError, match="not valid UTF-8"):
+            dualsplit.load_scene(arg)

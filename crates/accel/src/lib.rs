@@ -60,6 +60,7 @@ pub mod dstq;
 pub mod image;
 pub mod observer;
 pub mod query;
+pub mod ray_file;
 pub mod saved;
 pub mod set;
 pub mod stats;

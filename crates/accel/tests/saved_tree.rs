@@ -593,3 +593,94 @@ fn random_forgeries_load_or_fail_typed_and_traverse_in_bounded_time() {
         seen += 1;
     }
 }
+
+/// `file` with the little-endian `bytes` at header byte `at`, resealed.
+fn forge_header(file: &[u8], at: usize, bytes: &[u8]) -> Vec<u8> {
+    forge(file, |f| f[at..at + bytes.len()].copy_from_slice(bytes))
+}
+
+#[test]
+fn forged_header_settings_and_scene_boxes_are_refused() {
+    let tris = scene("builtin:cornell");
+    for tree in trees(&tris) {
+        let good = tree.to_bytes();
+        let name = tree.kind().name();
+        AnyTree::from_bytes(&good, Some(&tris)).expect("the good file loads");
+        // Build settings (bytes 88–107) once loaded unchecked.
+        for (at, bytes, says) in [
+            (88, 0u32.to_le_bytes(), "max_leaf_size is 0"),
+            (100, 0u32.to_le_bytes(), "bins is 0"),
+            (100, u32::MAX.to_le_bytes(), "bins is 4294967295"),
+            (92, f32::NAN.to_le_bytes(), "cost_traversal is NaN"),
+            (96, (-1.0f32).to_le_bytes(), "cost_triangle is -1"),
+        ] {
+            let e =
+                AnyTree::from_bytes(&forge_header(&good, at, &bytes), Some(&tris)).expect_err(name);
+            assert!(matches!(e, SavedError::Malformed(_)), "{name}: {e}");
+            assert!(e.to_string().contains(says), "{name}: {e}");
+        }
+        // The DST's costs, and the scene box where the DST and DST-Q traversals start: a
+        // DST-Q box of x = ±inf once passed `check` and simulated differently.
+        let box_at = match tree.kind() {
+            TreeKind::Dst => {
+                let e = AnyTree::from_bytes(
+                    &forge_header(&good, 112, &f32::INFINITY.to_le_bytes()),
+                    Some(&tris),
+                )
+                .expect_err(name);
+                assert!(
+                    e.to_string().contains("DST cost single_carve is inf"),
+                    "{e}"
+                );
+                128
+            }
+            TreeKind::DstQ => 116,
+            _ => continue,
+        };
+        for (off, v) in [
+            (0, f32::NEG_INFINITY),
+            (12, f32::INFINITY),
+            (4, -1e30),
+            (16, 0.5),
+        ] {
+            let f = forge_header(&good, box_at + off, &v.to_le_bytes());
+            let e = AnyTree::from_bytes(&f, Some(&tris)).expect_err(name);
+            assert!(
+                e.to_string()
+                    .contains("is not the bounds of the file's triangles"),
+                "{name}: {e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn settings_a_load_would_refuse_are_not_saved() {
+    let tris = scene("builtin:cornell");
+    let odd = BuildConfig {
+        bins: 0,
+        max_leaf_size: 0,
+        ..BuildConfig::default()
+    };
+    // The builder clamps these, and the file records what it used.
+    let bvh2 = Bvh2Tree::build(&tris[..], &odd).expect("bvh2");
+    let any: AnyTree = BvhTree::from_bvh2(&bvh2, TreeKind::Bvh2)
+        .expect("bvh")
+        .expect("encode")
+        .into();
+    AnyTree::from_bytes(&any.to_bytes(), Some(&tris)).expect("clamped settings load");
+    let nan = BuildConfig {
+        cost_traversal: f32::NAN,
+        ..BuildConfig::default()
+    };
+    let bvh2 = Bvh2Tree::build(&tris[..], &nan).expect("bvh2");
+    let any: AnyTree = BvhTree::from_bvh2(&bvh2, TreeKind::Bvh2)
+        .expect("bvh")
+        .expect("encode")
+        .into();
+    let e = any
+        .write_to(Vec::new())
+        .expect_err("a NaN cost is not saved");
+    assert_eq!(e.kind(), std::io::ErrorKind::InvalidInput);
+    assert!(any.to_bytes().is_empty());
+}

@@ -2,29 +2,20 @@
 //! at most a bounded number of bytes, so a path naming `/dev/zero` or a named pipe is an
 //! error instead of a hang or an out-of-memory abort.
 
-use anyhow::{Context, bail};
-use std::io::Read;
 use std::path::Path;
 
 /// Largest configuration file read: 1 MiB (the shipped ones are under 8 KiB).
 pub const MAX_CONFIG_BYTES: u64 = 1 << 20;
 
-/// The text of `path`, a regular file (links followed) of at most `max` bytes in UTF-8.
+/// The text of `path`, a regular file (links followed) of at most `max` bytes in UTF-8
+/// ([`dualsplit_scene::load::read_limited`]).
 pub fn read_text(path: &Path, max: u64) -> anyhow::Result<String> {
-    let meta = std::fs::metadata(path).with_context(|| format!("reading {}", path.display()))?;
-    if !meta.is_file() {
-        bail!(
-            "{}: not a regular file; only regular files are read",
-            path.display()
-        );
-    }
-    let file = std::fs::File::open(path).with_context(|| format!("reading {}", path.display()))?;
-    let mut text = String::new();
-    file.take(max + 1)
-        .read_to_string(&mut text)
-        .with_context(|| format!("reading {}", path.display()))?;
-    if text.len() as u64 > max {
-        bail!("{}: larger than {max} bytes", path.display());
-    }
-    Ok(text)
+    let bytes = dualsplit_scene::load::read_limited(path, max)?;
+    String::from_utf8(bytes).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: not UTF-8 text (byte {})",
+            path.display(),
+            e.utf8_error().valid_up_to()
+        )
+    })
 }

@@ -1,6 +1,8 @@
 //! The `dualsplit` command line. Each subcommand lives in `cmd/<name>.rs` with its own
 //! arguments; this file only parses and dispatches.
 
+#[macro_use]
+mod out;
 mod args;
 mod cmd;
 mod host;
@@ -109,11 +111,60 @@ fn main() -> std::process::ExitCode {
         Command::Trace(a) => cmd::trace::run(a, &ctx),
         Command::Scene(c) => cmd::scene::run(c, &ctx),
     };
+    let result = result.and_then(|code| match out::take_error() {
+        Some(e) => Err(anyhow::anyhow!("writing standard output: {e}")),
+        None => Ok(code),
+    });
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_text(&e));
             std::process::ExitCode::FAILURE
         }
+    }
+}
+
+/// `e` and its causes, `outer: inner: ...`, skipping a cause whose text already ends the
+/// message (an error that shows its source in its own text, `path: {source}`, would
+/// otherwise print it twice).
+fn error_text(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if out.ends_with(&text) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&text);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn causes_shown_in_their_wrapper_are_not_repeated() {
+        #[derive(Debug)]
+        struct At {
+            source: std::io::Error,
+        }
+        impl std::fmt::Display for At {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, "t.tree: {}", self.source)
+            }
+        }
+        impl std::error::Error for At {
+            fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+                Some(&self.source)
+            }
+        }
+        let inner = std::io::Error::other("tree file is corrupt: checksum mismatch");
+        let e = anyhow::Error::new(At { source: inner }).context("--tree t.tree");
+        assert_eq!(
+            super::error_text(&e),
+            "--tree t.tree: t.tree: tree file is corrupt: checksum mismatch"
+        );
     }
 }

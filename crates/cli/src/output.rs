@@ -37,6 +37,24 @@ pub fn check_file(path: &Path, what: &str) -> anyhow::Result<()> {
     probe_dir(&dir, &format!("{what} {}", path.display()))
 }
 
+/// Refuses an output `path` that names one of `inputs` (the same file, through any path or
+/// link): `build scene.ply -o scene.ply` would overwrite the scene.
+pub fn check_not_an_input(path: &Path, what: &str, inputs: &[&Path]) -> anyhow::Result<()> {
+    let Ok(out) = std::fs::canonicalize(path) else {
+        return Ok(()); // not there yet: it names no existing input
+    };
+    for input in inputs {
+        if std::fs::canonicalize(input).is_ok_and(|i| i == out) {
+            bail!(
+                "{what} {}: is the input {}; writing it would overwrite it",
+                path.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Creates the output folder `dir` (and its parents) and checks that it is writable.
 pub fn prepare_dir(dir: &Path, what: &str) -> anyhow::Result<()> {
     if dir.exists() && !dir.is_dir() {
@@ -73,7 +91,7 @@ impl JsonOut {
     /// Writes `text` (a newline is added) to the destination.
     pub fn emit(&self, text: &str) -> anyhow::Result<()> {
         match self {
-            JsonOut::Stdout => println!("{text}"),
+            JsonOut::Stdout => outln!("{text}"),
             JsonOut::File(p) => {
                 std::fs::write(p, format!("{text}\n"))
                     .with_context(|| format!("writing {}", p.display()))?;

@@ -215,6 +215,12 @@ fn configurations_are_read_only_from_small_regular_files() {
         assert!(ok);
         fails_with(&sim("pipe.toml"), "not a regular file");
     }
+    // A TOML error was printed twice (its wrapper shows it, then the cause chain again).
+    std::fs::write(dir.path().join("bad.toml"), "tms = \"x\"\n").unwrap();
+    let out = sim("bad.toml");
+    fails_with(&out, "TOML parse error at line 1");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("TOML parse error").count(), 1, "{err}");
 }
 
 #[test]
@@ -274,5 +280,343 @@ fn ray_counts_are_bounded() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{cmd}: {err}");
         assert!(err.contains("from 1 to 4194304"), "{cmd}: {err}");
+    }
+}
+
+/// A study of `builtin:cornell` at 4² with one configuration and workload: (its folder,
+/// the result file name of entry 0).
+fn small_study(dir: &Path) -> (std::path::PathBuf, String) {
+    let out = dualsplit(
+        &[
+            "plan",
+            "builtin:cornell",
+            "--res",
+            "4",
+            "--tms",
+            "4",
+            "--accel",
+            "bvh2",
+            "--workload",
+            "cast",
+            "--out",
+            "study",
+        ],
+        dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let study = dir.join("study");
+    let plan: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(study.join("plan.json")).unwrap()).unwrap();
+    let key = plan["entries"][0]["cache_key"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    std::fs::create_dir_all(study.join("cache")).unwrap();
+    (study, key)
+}
+
+#[cfg(unix)]
+#[test]
+fn study_files_are_read_only_from_bounded_regular_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let (study, key) = small_study(dir.path());
+    let entry = study.join("cache").join(&key);
+    let report = || dualsplit(&["report", "--from", "study"], dir.path());
+    // A result linked to /dev/zero once read until killed for memory; a named pipe blocked
+    // `report --from` and `run-job` forever; a 300 MB one was read whole.
+    std::os::unix::fs::symlink("/dev/zero", &entry).unwrap();
+    let out = report();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("not a regular file (a character device)"),
+        "{err}"
+    );
+    std::fs::remove_file(&entry).unwrap();
+    let ok = Command::new("mkfifo")
+        .arg(&entry)
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok);
+    let out = report();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("not a regular file (a named pipe)"), "{err}");
+    // run-job sees the pipe as an invalid result and replaces it.
+    let out = dualsplit(&["run-job", "study", "0"], dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(std::fs::metadata(&entry).unwrap().is_file());
+    std::fs::remove_file(&entry).unwrap();
+    let f = std::fs::File::create(&entry).unwrap();
+    f.set_len(300 << 20).unwrap(); // sparse: no disk used
+    drop(f);
+    let out = report();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("larger than 268435456 bytes"), "{err}");
+    // The plan itself.
+    let plan = study.join("plan.json");
+    std::fs::remove_file(&plan).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", &plan).unwrap();
+    fails_with(&report(), "not a regular file (a character device)");
+    fails_with(
+        &dualsplit(&["run-job", "study", "0"], dir.path()),
+        "not a regular file (a character device)",
+    );
+    std::fs::remove_file(&plan).unwrap();
+    let ok = Command::new("mkfifo")
+        .arg(&plan)
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok);
+    fails_with(&report(), "not a regular file (a named pipe)");
+    fails_with(
+        &dualsplit(&["run-job", "study", "0"], dir.path()),
+        "not a regular file (a named pipe)",
+    );
+}
+
+#[test]
+fn plans_are_bounded_before_they_are_made() {
+    let dir = tempfile::tempdir().unwrap();
+    let values: Vec<String> = (1..=64).map(|i| i.to_string()).collect();
+    let values = values.join(",");
+    let sweeps: Vec<String> = ["dst_pipes", "box_pipes", "tri_pipes"]
+        .iter()
+        .map(|k| format!("units.{k}={values}"))
+        .collect();
+    // Once about 4.2 M entries, past 3.3 GB of memory and still growing.
+    let out = dualsplit(
+        &[
+            "plan",
+            "builtin:cornell",
+            "--res",
+            "4",
+            "--vary",
+            &sweeps[0],
+            "--vary",
+            &sweeps[1],
+            "--vary",
+            &sweeps[2],
+            "--out",
+            "s",
+        ],
+        dir.path(),
+    );
+    fails_with(&out, "the plan would have 11534336 entries");
+    fails_with(&out, "at most 65536");
+    assert!(!dir.path().join("s/plan.json").exists());
+    let many: Vec<String> = (1..=1025).map(|i| i.to_string()).collect();
+    let out = dualsplit(
+        &[
+            "plan",
+            "builtin:cornell",
+            "--vary",
+            &format!("l1.hit_latency={}", many.join(",")),
+            "--out",
+            "s",
+        ],
+        dir.path(),
+    );
+    fails_with(&out, "1025 values; at most 1024 for one key");
+}
+
+#[test]
+fn ray_files_are_bounded_and_their_rays_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let trace = |rays: &str| {
+        dualsplit(
+            &["trace", "builtin:cornell", "--rays", rays, "-o", "hits.bin"],
+            dir.path(),
+        )
+    };
+    let file = |vals: &[f32]| -> Vec<u8> { vals.iter().flat_map(|v| v.to_le_bytes()).collect() };
+    let good = [0.0, 0.5, 3.0, 0.0, 0.0, -1.0, 0.0, f32::INFINITY];
+    let mut bad = good.to_vec();
+    bad.extend_from_slice(&[0.0, 0.5, 3.0, 0.0, 0.0, -1.0, 0.0, f32::NAN]);
+    std::fs::write(dir.path().join("good.bin"), file(&good)).unwrap();
+    std::fs::write(dir.path().join("nan.bin"), file(&bad)).unwrap();
+    let out = trace("good.bin");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // A NaN t_max once gave a hit in five traversals and a miss in two.
+    fails_with(&trace("nan.bin"), "ray 1: t_max is NaN");
+    bad[9] = f32::INFINITY;
+    std::fs::write(dir.path().join("inf.bin"), file(&bad)).unwrap();
+    fails_with(&trace("inf.bin"), "ray 1: origin.y is inf");
+    // Once read until killed for memory.
+    fails_with(
+        &trace("/dev/zero"),
+        "not a regular file (a character device)",
+    );
+    let f = std::fs::File::create(dir.path().join("big.bin")).unwrap();
+    f.set_len((1 << 30) + 32).unwrap(); // sparse
+    drop(f);
+    fails_with(&trace("big.bin"), "larger than 1073741824 bytes");
+}
+
+/// Runs `args` with standard output closed before the command writes to it.
+#[cfg(unix)]
+fn with_closed_stdout(args: &[&str], dir: &Path) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_dualsplit"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    drop(child.stdout.take());
+    child.wait_with_output().expect("it ends")
+}
+
+#[cfg(unix)]
+#[test]
+fn a_closed_standard_output_ends_quietly_and_files_are_still_written() {
+    let dir = tempfile::tempdir().unwrap();
+    // `simulate ... | head -1` and `render ... | head -1` once panicked with "failed
+    // printing to stdout: Broken pipe", render before it wrote its PNG.
+    let runs: [&[&str]; 3] = [
+        &[
+            "simulate",
+            "builtin:cornell",
+            "--res",
+            "8",
+            "--accel",
+            "bvh2",
+        ],
+        &["render", "builtin:cornell", "--res", "8", "-o", "c.png"],
+        &["stats", "builtin:cornell"],
+    ];
+    for args in runs {
+        let out = with_closed_stdout(args, dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
+        assert!(
+            !err.contains("panicked") && !err.contains("Broken pipe"),
+            "{args:?}: {err}"
+        );
+    }
+    let png = std::fs::read(dir.path().join("c.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"), "{} bytes", png.len());
+}
+
+#[test]
+fn far_lights_and_cameras_are_refused_for_what_they_are() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |flag: &str, value: &str| {
+        let args = [
+            "render",
+            "builtin:cornell",
+            "--workload",
+            "cast",
+            "--res",
+            "32",
+        ];
+        dualsplit(
+            &[&args[..], &[flag, value, "-o", "x.png"]].concat(),
+            dir.path(),
+        )
+    };
+    // Once exit 0 with "shadow 0 rays" and a wrong image.
+    fails_with(&render("--light", "1e20,1e20,1e20"), "beyond ±4.611686e18");
+    fails_with(&render("--light", "1e19,0,0"), "beyond ±4.611686e18");
+    // Once "eye and target coincide".
+    fails_with(
+        &render("--eye", "0,0,1e30"),
+        "--eye `0,0,1e30`: a coordinate lies beyond",
+    );
+    fails_with(
+        &render("--target", "1e30,0,0"),
+        "--target `1e30,0,0`: a coordinate lies beyond",
+    );
+    let args = [
+        "render",
+        "builtin:cornell",
+        "--light-radius=-1",
+        "-o",
+        "x.png",
+    ];
+    fails_with(
+        &dualsplit(&args, dir.path()),
+        "--light-radius -1: must be from 0 to 2^60",
+    );
+    assert!(!dir.path().join("x.png").exists());
+}
+
+#[test]
+fn dragon_boxes_that_would_not_load_are_not_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let make = |input: &str, obj: &str| {
+        std::fs::write(dir.path().join(input), obj).unwrap();
+        dualsplit(
+            &["scene", "dragon-box", input, "-o", "box.ply.gz"],
+            dir.path(),
+        )
+    };
+    // Once exit 0 with a box every loader then refused.
+    let out = make("wide.obj", "v 0 0 0\nv 1.1e18 0 0\nv 0 1 0\nf 1 2 3\n");
+    fails_with(
+        &out,
+        "wide.obj: cannot make the Dragon Box: the result would not load",
+    );
+    fails_with(&out, "exceeds");
+    // Once 11 triangles of size zero.
+    let out = make("point.obj", "v 1 2 3\nv 1 2 3\nv 1 2 3\nf 1 2 3\n");
+    fails_with(&out, "box triangle 0 has no area");
+    assert!(!dir.path().join("box.ply.gz").exists());
+    let out = make("ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = dualsplit(&["info", "box.ply.gz"], dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn outputs_that_name_an_input_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    std::fs::write(dir.path().join("s.obj"), obj).unwrap();
+    // `build S -o S` once overwrote the scene without a word.
+    let out = dualsplit(
+        &["build", "s.obj", "--accel", "bvh2", "-o", "s.obj"],
+        dir.path(),
+    );
+    fails_with(
+        &out,
+        "-o s.obj: is the input s.obj; writing it would overwrite it",
+    );
+    let out = dualsplit(
+        &["build", "s.obj", "--accel", "bvh2", "-o", "./s.obj"],
+        dir.path(),
+    );
+    fails_with(&out, "would overwrite it");
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("s.obj")).unwrap(),
+        obj
+    );
+    let help = dualsplit(&["build", "--help"], dir.path());
+    let help = String::from_utf8_lossy(&help.stdout);
+    for kind in ["dst", "bvh2", "bvh4", "bvh8", "cwbvh", "dst-q"] {
+        assert!(help.contains(kind), "build --help lacks {kind}: {help}");
     }
 }

@@ -235,6 +235,27 @@ fn a_damaged_tree_file_is_refused() {
             let e = refused(&[cmd, SCENE, "--tree", file], d);
             assert!(e.contains(file), "{cmd} {file}: {e}");
             assert!(e.contains(want), "{cmd} {file}: {e}");
+            // Once "checksum mismatch: tree file is corrupt: checksum mismatch".
+            if want != file {
+                assert_eq!(e.matches(want).count(), 1, "{cmd} {file}: {e}");
+            }
+        }
+    }
+    #[cfg(unix)]
+    {
+        // A named pipe once blocked the open forever.
+        let ok = std::process::Command::new("mkfifo")
+            .arg(d.join("pipe.dst"))
+            .status()
+            .unwrap()
+            .success();
+        assert!(ok);
+        for cmd in ["check", "simulate"] {
+            let e = refused(&[cmd, SCENE, "--tree", "pipe.dst"], d);
+            assert!(
+                e.contains("pipe.dst: not a regular file (a named pipe)"),
+                "{e}"
+            );
         }
     }
 }

@@ -76,6 +76,50 @@ impl Ray {
         }
     }
 
+    /// True when every structure traces this ray: its origin and direction are finite and
+    /// neither end of its interval is NaN (`t_max = +∞` is the usual unbounded ray).
+    ///
+    /// This is the one rule for rays outside it: every traversal of `dualsplit-accel`
+    /// (closest hit and any hit, plain, observed and through a query context) answers a
+    /// ray that is not traceable with a miss, without visiting a node. Entry points that
+    /// take rays from outside (`dualsplit trace --rays`, the Python package's
+    /// `Tree.intersect` and `Tree.occluded`) refuse such rays instead, naming the ray and
+    /// the field ([`Ray::untraceable_field`]).
+    #[inline(always)]
+    pub fn is_traceable(&self) -> bool {
+        self.origin.is_finite()
+            && self.dir.is_finite()
+            && !self.t_min.is_nan()
+            && !self.t_max.is_nan()
+    }
+
+    /// The first field that makes the ray not [traceable](Ray::is_traceable), with its
+    /// value: `("origin.y", inf)`, `("t_max", NaN)`; `None` for a traceable ray.
+    pub fn untraceable_field(&self) -> Option<(&'static str, f32)> {
+        const NAMES: [&str; 8] = [
+            "origin.x", "origin.y", "origin.z", "dir.x", "dir.y", "dir.z", "t_min", "t_max",
+        ];
+        let v = [
+            self.origin.x,
+            self.origin.y,
+            self.origin.z,
+            self.dir.x,
+            self.dir.y,
+            self.dir.z,
+            self.t_min,
+            self.t_max,
+        ];
+        (0..8)
+            .find(|&i| {
+                if i < 6 {
+                    !v[i].is_finite()
+                } else {
+                    v[i].is_nan()
+                }
+            })
+            .map(|i| (NAMES[i], v[i]))
+    }
+
     /// The point at parameter `t`.
     pub fn at(&self, t: f32) -> Vec3 {
         self.origin + self.dir * t

@@ -35,9 +35,14 @@ pub enum RenderError {
         /// What is wrong.
         reason: &'static str,
     },
-    /// The light has a non-finite position, a negative radius or a negative intensity.
-    #[error("invalid light (position {position:?}, radius {radius}, intensity {intensity})")]
+    /// The light has a non-finite position or one beyond ±2^60, a negative radius or one
+    /// above 2^60, a negative intensity, or a power (`2 · intensity · d²`) that overflows.
+    #[error(
+        "invalid light (position {position:?}, radius {radius}, intensity {intensity}): {reason}"
+    )]
     Light {
+        /// What is wrong.
+        reason: &'static str,
         /// Centre.
         position: [f32; 3],
         /// Radius.

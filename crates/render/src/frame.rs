@@ -63,6 +63,12 @@ pub fn validate(scene: &Scene, settings: &RenderSettings) -> Result<(), RenderEr
     if !(c.eye.is_finite() && c.target.is_finite() && c.up.is_finite() && c.fov_y_deg.is_finite()) {
         return Err(cam_err("non-finite value"));
     }
+    let far = |p: glam::Vec3| p.abs().max_element() > dualsplit_scene::MAX_VIEW_COORDINATE;
+    if far(c.eye) || far(c.target) {
+        return Err(cam_err(
+            "a coordinate of the eye or target lies beyond ±2^62 (MAX_VIEW_COORDINATE)",
+        ));
+    }
     if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
         return Err(cam_err(
             "the field of view must lie strictly between 0° and 180°",
@@ -76,17 +82,33 @@ pub fn validate(scene: &Scene, settings: &RenderSettings) -> Result<(), RenderEr
         return Err(cam_err("the view direction is parallel to the up vector"));
     }
     let l = &scene.light;
+    let light_err = |reason| RenderError::Light {
+        reason,
+        position: l.position.to_array(),
+        radius: l.radius,
+        intensity: l.intensity,
+    };
     if !(l.position.is_finite()
         && l.radius.is_finite()
         && l.radius >= 0.0
         && l.intensity.is_finite()
         && l.intensity >= 0.0)
     {
-        return Err(RenderError::Light {
-            position: l.position.to_array(),
-            radius: l.radius,
-            intensity: l.intensity,
-        });
+        return Err(light_err(
+            "non-finite value, negative radius or negative intensity",
+        ));
+    }
+    // Within ±2^62 and a radius of 2^60 the distance² to any point of the scene (within
+    // ±2^60) stays finite, so every shadow ray and its 1/d² are computed.
+    if far(l.position) || l.radius > Scene::MAX_COORDINATE {
+        return Err(light_err(
+            "the position lies beyond ±2^62 (MAX_VIEW_COORDINATE) or the radius exceeds 2^60",
+        ));
+    }
+    if !crate::FrameConstants::new(scene).light_power.is_finite() {
+        return Err(light_err(
+            "its power 2 · intensity · d² (d: its distance to the scene centre) overflows f32: lower the intensity",
+        ));
     }
     Ok(())
 }

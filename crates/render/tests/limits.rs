@@ -87,3 +87,42 @@ fn cameras_that_overflow_are_refused() {
     let r = validate(&scene, &RenderSettings::new(8, 8, Workload::Cast));
     assert!(matches!(r, Err(RenderError::Camera { .. })), "{r:?}");
 }
+
+#[test]
+fn lights_and_cameras_beyond_the_coordinate_limit_are_refused() {
+    use dualsplit_geometry::{Triangle, Vec3};
+    let small = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
+    let base =
+        dualsplit_scene::Scene::from_triangles("s", "s", vec![small], Default::default()).unwrap();
+    let settings = RenderSettings::new(8, 8, Workload::Cast);
+    // A light at 1e20 once dropped every shadow ray (its distance² overflowed) and exited 0;
+    // at 1e19 the power 2·intensity·d² overflowed.
+    for far in [1e20, 1e19, 4.7e18] {
+        let mut s = base.clone();
+        s.light.position = Vec3::splat(far);
+        let r = validate(&s, &settings);
+        assert!(matches!(r, Err(RenderError::Light { .. })), "{far}: {r:?}");
+    }
+    let mut s = base.clone();
+    s.light.position = Vec3::splat(4.6e18);
+    validate(&s, &settings).expect("a light within 2^62");
+    s.light.intensity = 1e30;
+    let r = validate(&s, &settings);
+    assert!(
+        matches!(&r, Err(e @ RenderError::Light { .. }) if e.to_string().contains("overflows")),
+        "{r:?}"
+    );
+    let mut s = base.clone();
+    s.light.radius = 1e19;
+    assert!(matches!(
+        validate(&s, &settings),
+        Err(RenderError::Light { .. })
+    ));
+    let mut s = base.clone();
+    s.camera.eye = Vec3::new(0.0, 0.0, 1e30);
+    let r = validate(&s, &settings);
+    assert!(
+        matches!(&r, Err(e @ RenderError::Camera { .. }) if e.to_string().contains("beyond ±2^62")),
+        "{r:?}"
+    );
+}

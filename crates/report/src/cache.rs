@@ -32,7 +32,8 @@ use std::path::{Path, PathBuf};
 pub const SCHEMA: u32 = 5;
 
 /// Largest cache entry [`Cache::get`] reads (a render's base64 PNG is the largest piece,
-/// a few MB).
+/// a few MB), and largest study result file
+/// ([`ResultStore::read`](crate::study::store::ResultStore::read)).
 pub const MAX_ENTRY_BYTES: u64 = 256 << 20;
 
 /// Crate version plus [`SCHEMA`]: part of every cache key.
@@ -113,16 +114,7 @@ impl Cache {
     /// edited, outdated or foreign entry counts as missing.
     pub fn get<T: DeserializeOwned>(&self, key: &CacheKey) -> Option<T> {
         let path = self.dir.join(key.file_name());
-        let meta = std::fs::metadata(&path).ok()?;
-        if !meta.is_file() || meta.len() > MAX_ENTRY_BYTES {
-            return None;
-        }
-        let mut bytes = Vec::new();
-        std::io::Read::read_to_end(
-            &mut std::io::Read::take(std::fs::File::open(&path).ok()?, MAX_ENTRY_BYTES),
-            &mut bytes,
-        )
-        .ok()?;
+        let bytes = dualsplit_scene::load::read_limited(&path, MAX_ENTRY_BYTES).ok()?;
         decode(key, &bytes)
     }
 

@@ -34,6 +34,14 @@ pub struct Light {
     pub intensity: f32,
 }
 
+/// Farthest a camera's eye or target, or a light's centre, may lie from the origin on any
+/// axis: 2^62 ≈ 4.6e18. A scene lies within ±[`Scene::MAX_COORDINATE`](crate::Scene::MAX_COORDINATE)
+/// = 2^60, and the fitted camera of the widest scene stands within ±3.3 · 2^60; within
+/// these bounds (and a light radius of at most 2^60) a view direction's and a shadow ray's
+/// squared length stay below f32's largest value (3 · (1.5 · 2^62)² ≈ 1.2e38), so no shadow
+/// ray is lost to an overflowing distance.
+pub const MAX_VIEW_COORDINATE: f32 = (1u64 << 62) as f32;
+
 /// A bad camera or light override from the command line.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CameraError {
@@ -46,16 +54,27 @@ pub enum CameraError {
         value: String,
     },
     /// A scalar is out of its range (or not finite).
-    #[error("--{what} {value}: must lie in ({min}, {max})")]
+    #[error("--{what} {value}: must be {range}")]
     OutOfRange {
         /// Which option (`fov`, `light-radius`, `light-intensity`).
         what: &'static str,
         /// The value given.
         value: f32,
-        /// Exclusive lower bound.
-        min: f32,
-        /// Exclusive upper bound.
-        max: f32,
+        /// The range, in words.
+        range: &'static str,
+    },
+    /// A position lies farther than [`MAX_VIEW_COORDINATE`] (2^62) from the origin on some
+    /// axis: the light's distance to the scene and the view direction would overflow f32.
+    #[error(
+        "--{what} `{value}`: a coordinate lies beyond ±{limit:e} (2^62, the limit of camera and light positions)"
+    )]
+    Far {
+        /// Which option (`eye`, `target`, `light`).
+        what: &'static str,
+        /// The text given.
+        value: String,
+        /// [`MAX_VIEW_COORDINATE`].
+        limit: f32,
     },
     /// The eye and the target coincide, or the view direction is parallel to up.
     #[error(
@@ -86,17 +105,31 @@ pub fn parse_vec3(what: &'static str, s: &str) -> Result<Vec3, CameraError> {
     }
 }
 
-fn check_range(what: &'static str, value: f32, min: f32, max: f32) -> Result<f32, CameraError> {
-    if value > min && value < max {
+fn check_range(
+    what: &'static str,
+    value: f32,
+    ok: bool,
+    range: &'static str,
+) -> Result<f32, CameraError> {
+    if ok {
         Ok(value)
     } else {
-        Err(CameraError::OutOfRange {
-            what,
-            value,
-            min,
-            max,
-        })
+        Err(CameraError::OutOfRange { what, value, range })
     }
+}
+
+/// [`parse_vec3`], refusing a point beyond ±[`MAX_VIEW_COORDINATE`].
+fn parse_point(what: &'static str, s: &str) -> Result<Vec3, CameraError> {
+    let v = parse_vec3(what, s)?;
+    let limit = MAX_VIEW_COORDINATE;
+    if v.abs().max_element() > limit {
+        return Err(CameraError::Far {
+            what,
+            value: s.to_string(),
+            limit,
+        });
+    }
+    Ok(v)
 }
 
 /// The closed Dragon Box (`dragon_box_closed`, [`crate::make::closed_dragon_box`]) is seen
@@ -247,13 +280,18 @@ impl Camera {
     ) -> Result<Self, CameraError> {
         let mut c = *self;
         if let Some(e) = eye {
-            c.eye = parse_vec3("eye", e)?;
+            c.eye = parse_point("eye", e)?;
         }
         if let Some(t) = target {
-            c.target = parse_vec3("target", t)?;
+            c.target = parse_point("target", t)?;
         }
         if let Some(f) = fov {
-            c.fov_y_deg = check_range("fov", f, 0.0, 180.0)?;
+            c.fov_y_deg = check_range(
+                "fov",
+                f,
+                f > 0.0 && f < 180.0,
+                "strictly between 0 and 180 degrees",
+            )?;
         }
         let fwd = c.target - c.eye;
         if fwd.length_squared() == 0.0 || fwd.cross(c.up).length_squared() == 0.0 {
@@ -315,14 +353,17 @@ impl Light {
     ) -> Result<Self, CameraError> {
         let mut l = *self;
         if let Some(p) = position {
-            l.position = parse_vec3("light", p)?;
+            l.position = parse_point("light", p)?;
         }
         if let Some(r) = radius {
-            // Radius 0 is allowed (a point light): check against a range open below -0.
-            l.radius = check_range("light-radius", r, -f32::MIN_POSITIVE, f32::MAX)?.max(0.0);
+            // Radius 0 is a point light; -0 is taken as 0.
+            let ok = (0.0..=crate::Scene::MAX_COORDINATE).contains(&r);
+            l.radius =
+                check_range("light-radius", r, ok, "from 0 to 2^60 (1.1529215e18)")?.max(0.0);
         }
         if let Some(i) = intensity {
-            l.intensity = check_range("light-intensity", i, 0.0, f32::MAX)?;
+            let ok = i > 0.0 && i.is_finite();
+            l.intensity = check_range("light-intensity", i, ok, "a finite number above 0")?;
         }
         Ok(l)
     }

@@ -1,5 +1,44 @@
 use std::path::PathBuf;
 
+/// Why a small input file ([`read_limited`](crate::load::read_limited)) was not read.
+#[derive(Debug, thiserror::Error)]
+pub enum FileError {
+    /// The file could not be opened or read.
+    #[error("{}: {error}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error (in the message, not a `source()`, so `anyhow` prints it once).
+        error: std::io::Error,
+    },
+    /// The path names a directory, device, named pipe or socket (links followed), which is
+    /// never opened: it could block or never end.
+    #[error("{}: not a regular file ({kind}); only regular files are read", path.display())]
+    NotAFile {
+        /// The file.
+        path: PathBuf,
+        /// What it is instead.
+        kind: &'static str,
+    },
+    /// The file is larger than the limit of what is read.
+    #[error("{}: larger than {limit} bytes, the limit ({size} bytes or more)", path.display())]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Its size (from its metadata, or the bytes read before stopping).
+        size: u64,
+        /// The limit.
+        limit: u64,
+    },
+}
+
+impl FileError {
+    /// True when the file does not exist.
+    pub fn is_not_found(&self) -> bool {
+        matches!(self, FileError::Io { error, .. } if error.kind() == std::io::ErrorKind::NotFound)
+    }
+}
+
 /// Everything that can go wrong while loading or generating a scene.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
@@ -99,6 +138,17 @@ pub enum SceneError {
         max: [f32; 3],
         /// [`Scene::MAX_COORDINATE`](crate::Scene::MAX_COORDINATE).
         limit: f32,
+    },
+    /// A scene made from another ([`crate::make`]) would be unusable: degenerate
+    /// triangles, or bounds the loaders refuse.
+    #[error("{spec}: cannot make {what}: {reason}")]
+    Make {
+        /// The input's spec.
+        spec: String,
+        /// What was being made (`the Dragon Box`).
+        what: &'static str,
+        /// Why not.
+        reason: String,
     },
     /// A builtin name or parameter is wrong.
     #[error("builtin scene `{spec}`: {message}")]

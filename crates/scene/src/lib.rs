@@ -48,8 +48,8 @@ pub mod limits;
 pub mod load;
 pub mod make;
 
-pub use camera::{Camera, CameraError, Light, parse_vec3};
-pub use error::SceneError;
+pub use camera::{Camera, CameraError, Light, MAX_VIEW_COORDINATE, parse_vec3};
+pub use error::{FileError, SceneError};
 pub use limits::Limits;
 
 use dualsplit_geometry::{Aabb, Triangle};

@@ -112,6 +112,40 @@ pub fn dragon_box(dragon: &[Triangle]) -> Vec<Triangle> {
     out
 }
 
+/// Checks a Dragon Box made by [`dragon_box`] or [`closed_dragon_box`] from the
+/// `dragon_len` triangles of `spec` before it is written
+/// ([`SceneError::Make`](crate::SceneError::Make) otherwise): every triangle the box adds has an area (a dragon of a single point, or one
+/// too thin for f32, gives a box of zero size), and the whole scene is one every loader
+/// accepts ([`Scene::from_triangles`](crate::Scene::from_triangles): the box is 1.5 × the
+/// dragon's extent, so a dragon near [`Scene::MAX_EXTENT`](crate::Scene::MAX_EXTENT) makes
+/// a box beyond it).
+pub fn check_dragon_box(
+    spec: &str,
+    dragon_len: usize,
+    triangles: &[Triangle],
+) -> Result<(), crate::SceneError> {
+    let bad = |reason: String| crate::SceneError::Make {
+        spec: spec.to_string(),
+        what: "the Dragon Box",
+        reason,
+    };
+    if let Some(i) = triangles[dragon_len.min(triangles.len())..]
+        .iter()
+        .position(Triangle::is_degenerate)
+    {
+        let dragon = triangles[..dragon_len.min(triangles.len())]
+            .iter()
+            .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+        return Err(bad(format!(
+            "box triangle {i} has no area (the input's bounds {:?} to {:?} have no extent for f32)",
+            dragon.min, dragon.max
+        )));
+    }
+    crate::Scene::from_triangles(spec, spec, triangles.to_vec(), Default::default())
+        .map(drop)
+        .map_err(|e| bad(format!("the result would not load: {e}")))
+}
+
 /// The PLY bytes of `triangles` in the shipped files' shape (binary little-endian, float
 /// x y z vertices, `uchar uint` index lists), each `comments` line as a `comment`. Vertices
 /// with the same bits are written once, in order of first use, so a loaded file gives back

@@ -168,6 +168,21 @@ fn camera_overrides_apply_and_check() {
         c.with_overrides(None, Some("x"), None),
         Err(CameraError::BadVector { what: "target", .. })
     ));
+    // An eye or target at 1e30 was refused as "eye and target coincide" (the view
+    // direction's length overflowed).
+    for (eye, target, what) in [
+        (Some("0,0,1e30"), None, "eye"),
+        (None, Some("1e30,0,0"), "target"),
+        (Some("0,0,-4.7e18"), None, "eye"),
+    ] {
+        let e = c.with_overrides(eye, target, None).unwrap_err();
+        assert!(
+            matches!(e, CameraError::Far { what: w, .. } if w == what),
+            "{e:?}"
+        );
+        assert!(e.to_string().contains("beyond ±4.611686e18"), "{e}");
+    }
+    assert!(c.with_overrides(Some("0,0,4.6e18"), None, None).is_ok());
 }
 
 #[test]
@@ -197,6 +212,31 @@ fn light_overrides_apply_and_check() {
         l.with_overrides(Some("1;2;3"), None, None),
         Err(CameraError::BadVector { what: "light", .. })
     ));
+    // A light at 1e20 dropped every shadow ray; at 1e19 its power overflowed.
+    for far in ["1e20,1e20,1e20", "1e19,0,0"] {
+        let e = l.with_overrides(Some(far), None, None).unwrap_err();
+        assert!(matches!(e, CameraError::Far { what: "light", .. }), "{e:?}");
+    }
+    assert!(matches!(
+        l.with_overrides(None, Some(1e19), None),
+        Err(CameraError::OutOfRange {
+            what: "light-radius",
+            ..
+        })
+    ));
+    // The range reads as words, not as "(-0.0000…117549, 3402823500000…)".
+    let e = l.with_overrides(None, Some(-1.0), None).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "--light-radius -1: must be from 0 to 2^60 (1.1529215e18)"
+    );
+    assert_eq!(
+        l.with_overrides(None, Some(-0.0), None)
+            .unwrap()
+            .radius
+            .to_bits(),
+        0
+    );
 }
 
 #[test]

@@ -395,3 +395,33 @@ fn gltf_errors() {
         SceneError::Empty { .. }
     ));
 }
+
+#[test]
+fn long_bad_lines_give_short_messages() {
+    // A 200 KB first line once gave a 200 KB message with a Rust Debug dump.
+    let long = "x".repeat(200_000);
+    let ascii_body = format!(
+        "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 {long}\n"
+    );
+    for (name, bytes) in [
+        ("first.ply", format!("{long}\n")),
+        (
+            "header.ply",
+            format!("ply\nformat ascii 1.0\n{long}\nend_header\n"),
+        ),
+        ("body.ply", ascii_body),
+        (
+            "bad.obj",
+            format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 {long}\n"),
+        ),
+    ] {
+        let e = fail(name, bytes.as_bytes()).to_string();
+        assert!(
+            e.len() < 400,
+            "{name}: a message of {} bytes: {}",
+            e.len(),
+            e.chars().take(400).collect::<String>()
+        );
+        assert!(e.contains(name), "{name}: {e}");
+    }
+}

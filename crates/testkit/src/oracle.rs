@@ -5,8 +5,12 @@ use dualsplit_accel::{AccelKind, CountingObserver, NoObserver, Structures};
 use dualsplit_geometry::{Hit, PrimId, Ray, Triangle};
 
 /// Closest hit over all triangles on `[t_min, t_max]`, ordered by `(t, triangle id)`: equal
-/// `t` goes to the smaller id.
+/// `t` goes to the smaller id. A ray that is not [traceable](Ray::is_traceable) misses, as
+/// in every structure.
 pub fn oracle_closest(tris: &[Triangle], ray: &Ray) -> Option<Hit> {
+    if !ray.is_traceable() {
+        return None;
+    }
     let r = ray.precompute();
     let mut best: Option<Hit> = None;
     for (i, tri) in tris.iter().enumerate() {
@@ -18,8 +22,12 @@ pub fn oracle_closest(tris: &[Triangle], ray: &Ray) -> Option<Hit> {
     best
 }
 
-/// Whether any triangle is hit on `[t_min, t_max]`.
+/// Whether any triangle is hit on `[t_min, t_max]` (never for a ray that is not
+/// [traceable](Ray::is_traceable)).
 pub fn oracle_any(tris: &[Triangle], ray: &Ray) -> bool {
+    if !ray.is_traceable() {
+        return false;
+    }
     let r = ray.precompute();
     tris.iter()
         .any(|t| t.intersect(&r, ray.t_min, ray.t_max).is_some())

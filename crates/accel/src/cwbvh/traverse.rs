@@ -44,6 +44,10 @@ pub fn traverse<O: Observer, const ANY: bool>(
     ray: &Ray,
     obs: &mut O,
 ) -> Option<Hit> {
+    // Untraceable rays miss (`Ray::is_traceable`), in every structure alike.
+    if !ray.is_traceable() {
+        return None;
+    }
     let mut stack = STACK.take();
     stack.clear();
     let hit = traverse_with::<O, ANY>(img, ray, obs, &mut stack);

@@ -85,6 +85,10 @@ impl DstQuery<'_> {
 
     #[inline(always)]
     fn traverse<const ANY: bool>(&self, ray: &Ray) -> Option<Hit> {
+        // Untraceable rays miss (`Ray::is_traceable`), in every structure alike.
+        if !ray.is_traceable() {
+            return None;
+        }
         match self.avx2 {
             Some(t) => t.vectorize(Fast::<ANY> { q: self, ray }).unpack(),
             None => self.fast::<ANY>(ray),

@@ -152,7 +152,8 @@ impl<'a> Tracer<'a> {
     /// the BVH culls), returning the root interval or `None` when it misses the scene.
     #[inline(always)]
     pub fn start(dst: &'a Dst, ray: &Ray) -> Option<(Self, f32, f32)> {
-        if dst.is_empty() {
+        // Untraceable rays miss (`Ray::is_traceable`), in every structure alike.
+        if dst.is_empty() || !ray.is_traceable() {
             return None;
         }
         let r = ray.precompute();

@@ -61,7 +61,8 @@ impl DstQ {
     }
 
     fn traverse<O: Observer, const ANY: bool>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        if self.is_empty() {
+        // Untraceable rays miss (`Ray::is_traceable`), in every structure alike.
+        if self.is_empty() || !ray.is_traceable() {
             return None;
         }
         let r = ray.precompute();

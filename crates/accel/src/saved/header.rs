@@ -120,6 +120,36 @@ impl In<'_> {
     }
 }
 
+/// Checks the build settings a header records: what a build can record (the builder
+/// clamps the bins to 2..=256 and takes at least one triangle per leaf, and
+/// [`AnyTree::write_to`](crate::AnyTree::write_to) refuses other costs).
+pub(super) fn check_build(b: &BuildConfig) -> Result<(), SavedError> {
+    if b.max_leaf_size == 0 {
+        return Err(SavedError::malformed(
+            "build setting max_leaf_size is 0; at least 1".into(),
+        ));
+    }
+    if !(2..=256).contains(&b.bins) {
+        return Err(SavedError::malformed(format!(
+            "build setting bins is {}; from 2 to 256",
+            b.bins
+        )));
+    }
+    check_cost("build setting", "cost_traversal", b.cost_traversal)?;
+    check_cost("build setting", "cost_triangle", b.cost_triangle)
+}
+
+/// A cost must be a finite number ≥ 0.
+pub(super) fn check_cost(what: &str, name: &str, c: f32) -> Result<(), SavedError> {
+    if c.is_finite() && c >= 0.0 {
+        Ok(())
+    } else {
+        Err(SavedError::malformed(format!(
+            "{what} {name} is {c}; a finite number of at least 0"
+        )))
+    }
+}
+
 impl Header {
     /// The header's `HEADER_BYTES` bytes.
     pub fn encode(&self) -> Vec<u8> {
@@ -249,6 +279,7 @@ impl Header {
             bins: i.u32(),
             parallel_threshold: i.u32(),
         };
+        check_build(&build)?;
         let extra = match kind {
             TreeKind::Dst => {
                 let costs = DstCosts {
@@ -257,6 +288,14 @@ impl Header {
                     dual_carve: i.f32(),
                     triangle: i.f32(),
                 };
+                for (name, c) in [
+                    ("split", costs.split),
+                    ("single_carve", costs.single_carve),
+                    ("dual_carve", costs.dual_carve),
+                    ("triangle", costs.triangle),
+                ] {
+                    check_cost("DST cost", name, c)?;
+                }
                 let partitioning = match i.u32() {
                     0 => Partitioning::Identical,
                     1 => Partitioning::Similar,

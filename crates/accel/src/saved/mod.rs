@@ -44,6 +44,7 @@ mod structure;
 
 pub use header::{CHECKSUM_BYTES, FORMAT_VERSION, HEADER_BYTES, MAGIC, WORDS_OFFSET};
 
+use crate::BuildConfig;
 use crate::cwbvh::Cwbvh;
 use crate::dst::Dst;
 use crate::dstq::DstQ;
@@ -75,6 +76,14 @@ pub enum SavedError {
         path: PathBuf,
         /// What is wrong with it.
         source: Box<SavedError>,
+    },
+    /// The path names a directory, device, named pipe or socket, which is never opened.
+    #[error("{}: not a regular file ({kind}); only regular files are read", path.display())]
+    NotAFile {
+        /// The file.
+        path: PathBuf,
+        /// What it is instead.
+        kind: &'static str,
     },
     /// The file does not start with [`MAGIC`].
     #[error("not a dualsplit tree file (bad magic)")]
@@ -257,19 +266,41 @@ impl AnyTree {
             triangles: t,
             file_bytes: header::implied_bytes(n, i, t).unwrap_or(u64::MAX),
             triangle_hash: triangle_hash(img.triangle_slice()),
-            build: *self.config(),
+            // What the builder used: it clamps the bins and takes at least one triangle per
+            // leaf, so the recorded settings pass `check_build`.
+            build: BuildConfig {
+                bins: self.config().bins.clamp(2, 256),
+                max_leaf_size: self.config().max_leaf_size.max(1),
+                ..*self.config()
+            },
             extra,
         }
     }
 
     /// Writes the tree in the saved-tree format to `w`. The same tree always gives the
-    /// same bytes (no time stamps; build times are not stored).
+    /// same bytes (no time stamps; build times are not stored). A tree built with a
+    /// negative or non-finite cost is refused (`InvalidInput`): loading would refuse it.
     pub fn write_to<W: Write>(&self, w: W) -> io::Result<()> {
+        let h = self.header();
+        let checked = header::check_build(&h.build).and_then(|()| match &h.extra {
+            Extra::Dst { config, .. } => [
+                ("split", config.costs.split),
+                ("single_carve", config.costs.single_carve),
+                ("dual_carve", config.costs.dual_carve),
+                ("triangle", config.costs.triangle),
+            ]
+            .into_iter()
+            .try_for_each(|(n, c)| header::check_cost("DST cost", n, c)),
+            _ => Ok(()),
+        });
+        if let Err(e) = checked {
+            return Err(io::Error::new(io::ErrorKind::InvalidInput, e.to_string()));
+        }
         let mut out = HashingWriter {
             inner: w,
             hash: Sha256::new(),
         };
-        let mut head = self.header().encode();
+        let mut head = h.encode();
         head.resize(WORDS_OFFSET as usize, 0);
         out.write_all(&head)?;
         let img = self.image();
@@ -285,11 +316,13 @@ impl AnyTree {
         out.inner.flush()
     }
 
-    /// The saved-tree file as bytes.
+    /// The saved-tree file as bytes (empty for a tree [`AnyTree::write_to`] refuses).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut v = Vec::new();
-        // Writing to a Vec cannot fail.
-        let _ = self.write_to(&mut v);
+        // Writing to a Vec cannot fail; a refused tree writes nothing.
+        if self.write_to(&mut v).is_err() {
+            v.clear();
+        }
         v
     }
 
@@ -408,6 +441,25 @@ impl AnyTree {
                 "header byte {at} is not what this version writes (unused fields and padding are zero)"
             )));
         }
+        // The DST's and DST-Q's scene box is where their traversals start (the first slab
+        // test): it must be exactly the bounds of the file's triangles, as a build makes it.
+        if let Extra::Dst { scene_box, .. } | Extra::DstQ { scene_box, .. } = &h.extra {
+            let bounds = tris
+                .iter()
+                .fold(dualsplit_geometry::Aabb::EMPTY, |b, t| b.union(t.bounds()));
+            let bits = |b: &dualsplit_geometry::Aabb| {
+                (
+                    b.min.to_array().map(f32::to_bits),
+                    b.max.to_array().map(f32::to_bits),
+                )
+            };
+            if bits(scene_box) != bits(&bounds) {
+                return Err(SavedError::malformed(format!(
+                    "scene box {:?} to {:?} is not the bounds of the file's triangles ({:?} to {:?})",
+                    scene_box.min, scene_box.max, bounds.min, bounds.max
+                )));
+            }
+        }
         let tree = assemble(&h, words, tris);
         // Everything a traversal indexes with, so a forged file cannot make one panic,
         // loop or read the wrong memory (`structure`).
@@ -428,12 +480,51 @@ impl AnyTree {
             path: path.to_owned(),
             source,
         };
+        // Only a regular file (links followed) is opened: a named pipe would block the open
+        // until a writer appears, a device never end. Checked again on the handle.
+        let not_a_file = |meta: &std::fs::Metadata| SavedError::NotAFile {
+            path: path.to_owned(),
+            kind: file_kind(meta.file_type()),
+        };
+        let meta = std::fs::metadata(path).map_err(io)?;
+        if !meta.is_file() {
+            return Err(not_a_file(&meta));
+        }
         let f = std::fs::File::open(path).map_err(io)?;
-        let len = f.metadata().map_err(io)?.len();
+        let meta = f.metadata().map_err(io)?;
+        if !meta.is_file() {
+            return Err(not_a_file(&meta));
+        }
+        let len = meta.len();
         Self::read_from(io::BufReader::with_capacity(1 << 16, f), len, scene).map_err(|e| match e {
             SavedError::Io { source, .. } => io(source),
             e => e.at(path),
         })
+    }
+}
+
+/// What a non-regular file is, for [`SavedError::NotAFile`].
+fn file_kind(t: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a named pipe";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+    }
+    if t.is_dir() {
+        "a directory"
+    } else {
+        "not a file"
     }
 }
 

@@ -225,6 +225,10 @@ fn traverse_on<const ANY: bool>(
     ray: &Ray,
     stack: &mut [Entry],
 ) -> Option<Option<Hit>> {
+    // Untraceable rays miss (`Ray::is_traceable`), in every structure alike.
+    if !ray.is_traceable() {
+        return Some(None);
+    }
     if (ray.t_min - cull_limit(ray.t_max)).is_nan() {
         return None;
     }

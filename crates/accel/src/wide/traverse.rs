@@ -45,6 +45,11 @@ pub fn traverse<L: NodeLayout, O: Observer, const ANY: bool>(
     ray: &Ray,
     obs: &mut O,
 ) -> Option<Hit> {
+    // Untraceable rays (non-finite origin or direction, NaN interval end) miss
+    // (`Ray::is_traceable`), in every structure alike.
+    if !ray.is_traceable() {
+        return None;
+    }
     let mut stack = STACK.take();
     stack.clear();
     let hit = traverse_with::<L, O, ANY>(img, ray, obs, &mut stack);

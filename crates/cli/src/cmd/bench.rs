@@ -146,7 +146,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let mut lines: Vec<String> = Vec::new();
     let mut json_line = |v: String| {
         if json == Some(JsonOut::Stdout) {
-            println!("{v}");
+            outln!("{v}");
         } else {
             lines.push(v);
         }
@@ -231,9 +231,13 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     }
     let show_rays = peers.is_empty();
     if json.is_none() && (show_rays || !args.no_frame) {
-        println!(
+        outln!(
             "{:<8} {:>16} {:>16} {:>16} {:>14}",
-            "accel", "primary Mrays/s", "shadow Mrays/s", "diffuse Mrays/s", "frame s"
+            "accel",
+            "primary Mrays/s",
+            "shadow Mrays/s",
+            "diffuse Mrays/s",
+            "frame s"
         );
     }
     for &kind in &accels {
@@ -283,7 +287,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                     .map(|r| format!("{:.2}", r.mrays_per_s))
                     .unwrap_or_else(|| "-".into())
             };
-            println!(
+            outln!(
                 "{:<8} {:>16} {:>16} {:>16} {:>14}",
                 kind.name(),
                 cell(RayKind::Primary),
@@ -525,7 +529,7 @@ impl PeerRun<'_> {
             sp.finish_and_clear();
         }
         if !self.json {
-            println!(
+            outln!(
                 "{name} {}: scene built in {:.2} s; agreement with {} (every structure \
                  above equals it bit for bit):",
                 b.scene.version(),
@@ -535,20 +539,23 @@ impl PeerRun<'_> {
             for set in sets {
                 print_agreement(set.kind.name(), &agreement[set.kind.name()]);
             }
-            println!("hit distance t against f64 (relative error, p99.9 / max):");
+            outln!("hit distance t against f64 (relative error, p99.9 / max):");
             for (kind, e) in sets
                 .iter()
                 .filter_map(|s| t_error.get_key_value(s.kind.name()))
             {
-                println!(
+                outln!(
                     "  {kind:<8} ours {:.1e} / {:.1e}; {name} {:.1e} / {:.1e}",
-                    e["ours"].p999, e["ours"].max, e[name].p999, e[name].max
+                    e["ours"].p999,
+                    e["ours"].max,
+                    e[name].p999,
+                    e[name].max
                 );
             }
         }
         if let Some((kind, a)) = agreement.iter().find(|(_, a)| !a.is_explained()) {
             if self.json {
-                println!(
+                outln!(
                     "{}",
                     serde_json::json!({"peer": name, "agreement": agreement})
                 );
@@ -603,7 +610,7 @@ fn print_agreement(kind: &str, a: &Agreement) {
             x.tie, x.grazing, x.boundary, x.unexplained
         ),
     };
-    println!(
+    outln!(
         "  {kind:<8} {:>8} rays, {:>8} same; hit/miss differs {}; triangle differs {}{}",
         a.rays,
         a.same,
@@ -634,13 +641,16 @@ fn print_timings(
             passes.push(p);
         }
     }
-    println!(
+    outln!(
         "interleaved on {threads} thread(s), passes: {}; Mrays/s over all passes (fastest pass)",
         passes.join(", ")
     );
-    println!(
+    outln!(
         "{:<19} {:>18} {:>18} {:>18}",
-        "accel", "primary", "shadow", "diffuse"
+        "accel",
+        "primary",
+        "shadow",
+        "diffuse"
     );
     let mut names: Vec<&str> = Vec::new();
     for t in timings {
@@ -656,7 +666,7 @@ fn print_timings(
                 .map(|t| format!("{:.2} ({:.2})", t.mrays_per_s, t.best_pass_mrays_per_s))
                 .unwrap_or_else(|| "-".into())
         };
-        println!(
+        outln!(
             "{name:<19} {:>18} {:>18} {:>18}",
             cell(RayKind::Primary),
             cell(RayKind::Shadow),
@@ -668,7 +678,7 @@ fn print_timings(
             (Some(r), Some(f)) => format!("{r:.2} ({f:.2}) {}", best[k.name()]),
             _ => "-".into(),
         };
-        println!(
+        outln!(
             "{:<19} {:>18} {:>18} {:>18}",
             format!("best/{peer}"),
             cell(RayKind::Primary),

@@ -1,5 +1,5 @@
-//! `dualsplit build SCENE --accel dst|bvh2|bvh4|bvh8 -o FILE [--json]`: builds exactly one
-//! structure (a DST, BVH4 or BVH8 is derived from the scene's BVH2) and saves it in the
+//! `dualsplit build SCENE --accel dst|bvh2|bvh4|bvh8|cwbvh|dst-q -o FILE [--json]`: builds
+//! exactly one structure (every kind but the BVH2 is derived from the scene's BVH2) and saves it in the
 //! saved-tree format (`docs/tree-format.md`), so later runs can load it instead of
 //! building. The structure is validated before it is written (a DST against its BVH2, as
 //! `check --tree` does): one that does not validate is an error and no file is written.
@@ -23,7 +23,8 @@ pub struct Args {
     /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
     #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
-    /// The structure to build: dst (hardware preset), bvh2, bvh4 or bvh8.
+    /// The structure to build: dst (hardware preset), bvh2, bvh4, bvh8, cwbvh (compressed
+    /// BVH8) or dst-q (quantized DST).
     #[arg(long, value_parser = parse_tree_kind)]
     accel: TreeKind,
     /// The tree file to write.
@@ -61,6 +62,7 @@ struct Built<'a> {
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let json = crate::output::JsonOut::from_arg(args.json.as_deref())?;
     crate::output::check_file(&args.output, "-o")?;
+    crate::output::check_not_an_input(&args.output, "-o", &[std::path::Path::new(&args.scene)])?;
     let sp = ctx.spinner(format!("loading {}", args.scene));
     let scene = dualsplit_scene::load_with(&args.scene, &ctx.limits)
         .with_context(|| format!("loading scene {}", args.scene))?;
@@ -110,7 +112,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if let Some(j) = json {
         j.emit(&serde_json::to_string_pretty(&out)?)?;
     } else {
-        println!(
+        outln!(
             "{} {}: {} triangles, {} node + {} index bytes, built in {:.1} ms (BVH2 {:.1} ms), \
              saved {} bytes to {} in {:.1} ms",
             out.scene,

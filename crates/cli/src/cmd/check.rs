@@ -44,7 +44,7 @@ const SHOW: usize = 5;
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let scene = super::load(&args.scene, ctx)?;
     let subject = Loaded::get(&scene, args.tree.as_deref(), ctx)?;
-    println!("{} ({} triangles)", scene.name, scene.triangles.len());
+    outln!("{} ({} triangles)", scene.name, scene.triangles.len());
     let failed = match &subject {
         Loaded::Built { structures, .. } => {
             let failed = print_validation(&structures.validate());
@@ -53,13 +53,13 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         // `Loaded::get` builds every structure or loads one tree.
         Loaded::Some { .. } => unreachable!("check never builds a partial set"),
         Loaded::Saved { tree, .. } => {
-            println!("{}", subject.summary());
+            outln!("{}", subject.summary());
             // The reference: a BVH2 built afresh from the scene, with the tree's settings.
             let sp = ctx.spinner("building the reference BVH2");
             let fresh = Bvh2Tree::build(&scene.triangles[..], tree.config())
                 .with_context(|| format!("building the reference BVH2 of {}", scene.spec))?;
             sp.finish_and_clear();
-            println!(
+            outln!(
                 "reference: bvh2 built from the scene in {:.1} ms",
                 fresh.stats().build_ms
             );
@@ -70,10 +70,10 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         }
     };
     if failed {
-        println!("check FAILED");
+        outln!("check FAILED");
         Ok(ExitCode::FAILURE)
     } else {
-        println!("check passed");
+        outln!("check passed");
         Ok(ExitCode::SUCCESS)
     }
 }
@@ -81,9 +81,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
 /// Prints the validation reports; true when one failed.
 fn print_validation(reports: &[ValidationReport]) -> bool {
     let mut failed = false;
-    println!("validation:");
+    outln!("validation:");
     for rep in reports {
-        println!(
+        outln!(
             "  {:<5} {:<4} internal {:>9} leaves {:>9} triangles {:>9}/{:<9} max depth {:>3} errors {}",
             rep.structure,
             if rep.is_ok() { "ok" } else { "FAIL" },
@@ -95,7 +95,7 @@ fn print_validation(reports: &[ValidationReport]) -> bool {
             rep.error_count
         );
         for e in &rep.errors {
-            println!("        {e}");
+            outln!("        {e}");
         }
         failed |= !rep.is_ok();
     }
@@ -113,8 +113,8 @@ fn equivalence(
 ) -> bool {
     let mut failed = false;
     let sets = super::rays::record(scene, reference, n, ctx);
-    println!("equivalence against BVH2 (per-ray averages from CountingObserver):");
-    println!(
+    outln!("equivalence against BVH2 (per-ray averages from CountingObserver):");
+    outln!(
         "  {:<8} {:<8} {:>8} {:>10} {:>8} {:>8} {:>10} {:>10} {:>10} {:>10}",
         "kind",
         "rays",
@@ -168,7 +168,7 @@ fn equivalence(
                 );
             bar.finish_and_clear();
             let n = rays.len().max(1) as f64;
-            println!(
+            outln!(
                 "  {:<8} {:<8} {:>8} {:>10} {:>8.2} {:>8.2} {:>10.2} {:>10.2} {:>10.2} {:>10.1}",
                 kind.name(),
                 format!("{what:?}").to_lowercase(),
@@ -182,7 +182,7 @@ fn equivalence(
                 counts.bytes as f64 / n
             );
             for r in bad.iter().take(SHOW) {
-                println!("        mismatch: {r:?}");
+                outln!("        mismatch: {r:?}");
             }
             failed |= !bad.is_empty();
         }

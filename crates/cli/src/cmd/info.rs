@@ -63,7 +63,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if let Some(out) = json {
         out.emit(&serde_json::to_string_pretty(&info)?)?;
     } else {
-        print!("{}", table(&info));
+        out!("{}", table(&info));
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -44,8 +44,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     crate::output::prepare_dir(&args.out, "--out")?;
     let base_config = match &args.config {
         Some(p) => {
-            let text =
-                std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            let text = crate::input::read_text(p, crate::input::MAX_CONFIG_BYTES)?;
             SimConfig::from_toml(&text).with_context(|| format!("{}", p.display()))?
         }
         None => SimConfig::lin2020(),
@@ -118,7 +117,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|e| e.estimated_rays() / per_core)
         .fold(0.0f64, f64::max);
-    println!(
+    outln!(
         "wrote {}: {} jobs ({} scenes at {r}×{r}, {} thread model, {} swept combinations); \
          estimated {cpu_hours:.2} CPU-hours, the longest job about {} on one core",
         path.display(),

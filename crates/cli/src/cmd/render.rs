@@ -75,7 +75,7 @@ pub(crate) fn say(line: &str, stdout_is_data: bool) {
     if stdout_is_data {
         eprintln!("{line}");
     } else {
-        println!("{line}");
+        outln!("{line}");
     }
 }
 
@@ -96,7 +96,7 @@ pub(crate) fn get_structures(
 pub(crate) fn print_counts(c: &RayCounts) {
     for k in RayKind::ALL {
         let n = c.get(k);
-        println!(
+        outln!(
             "  {:<8} {:>12} rays {:>12} hits {:>12} misses",
             k.name(),
             n.rays,
@@ -104,7 +104,7 @@ pub(crate) fn print_counts(c: &RayCounts) {
             n.misses()
         );
     }
-    println!(
+    outln!(
         "  {:<8} {:>12} rays {:>12} hits {:>12} misses",
         "total",
         c.rays(),
@@ -142,7 +142,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let frame = render(&scene, &structures, accel, &settings, &|| bar.inc(1))?;
     let secs = t.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    println!(
+    outln!(
         "rendered {}x{} {} at {} spp on {} in {:.3} s ({:.2} Mrays/s, {} threads)",
         settings.width,
         settings.height,
@@ -155,6 +155,6 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     );
     print_counts(&frame.counts);
     frame.image.write(&args.output)?;
-    println!("wrote {}", args.output.display());
+    outln!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
 }

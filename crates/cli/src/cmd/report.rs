@@ -175,7 +175,7 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     for w in dualsplit_report::summary::idle_warnings(&data, None) {
         eprintln!("warning: {w}");
     }
-    println!(
+    outln!(
         "wrote {} ({} files; {} pieces computed, the rest from {}) in {:.1} s",
         out.join("index.html").display(),
         written.len(),

@@ -31,7 +31,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     match outcome? {
         JobOutcome::AlreadyDone(path) => {
-            println!(
+            outln!(
                 "entry {}: a valid result is already stored ({}); nothing to do",
                 args.index,
                 path.display()
@@ -48,7 +48,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                     args.index
                 );
             }
-            println!(
+            outln!(
                 "entry {}: simulated in {wall_s:.1} s, stored {}",
                 args.index,
                 path.display()

@@ -14,7 +14,7 @@
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_scene::make;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// The scene files `dualsplit scene` makes.
@@ -60,6 +60,7 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     match cmd {
         Command::DragonBox(args) => {
             crate::output::check_file(&args.output, "-o")?;
+            crate::output::check_not_an_input(&args.output, "-o", &[Path::new(&args.dragon)])?;
             let dragon = super::load(&args.dragon, ctx)?;
             let tris = if args.closed {
                 make::closed_dragon_box(&dragon.triangles)
@@ -67,6 +68,7 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                 make::dragon_box(&dragon.triangles)
             };
             let n = dragon.triangles.len();
+            make::check_dragon_box(&dragon.spec, n, &tris)?;
             let comments = [
                 format!(
                     "Dragon Box: {} ({n} tris, faces 0..{})",
@@ -85,7 +87,7 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             let comments: Vec<&str> = comments.iter().map(String::as_str).collect();
             make::write_ply_gz(&args.output, &tris, &comments)
                 .with_context(|| format!("writing {}", args.output.display()))?;
-            println!(
+            outln!(
                 "wrote {}: {} triangles ({n} of {}, {} of the box), triangles sha256 {}",
                 args.output.display(),
                 tris.len(),
@@ -97,6 +99,7 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         }
         Command::Convert(args) => {
             crate::output::check_file(&args.output, "-o")?;
+            crate::output::check_not_an_input(&args.output, "-o", &[Path::new(&args.input)])?;
             let scene = super::load(&args.input, ctx)?;
             let comment = format!(
                 "{} ({} tris) converted by dualsplit scene convert",
@@ -105,7 +108,7 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             );
             make::write_ply_gz(&args.output, &scene.triangles, &[&comment])
                 .with_context(|| format!("writing {}", args.output.display()))?;
-            println!(
+            outln!(
                 "wrote {}: {} triangles of {}, triangles sha256 {}",
                 args.output.display(),
                 scene.triangles.len(),

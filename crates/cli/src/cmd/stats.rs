@@ -124,12 +124,12 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         out.emit(&serde_json::to_string_pretty(&v)?)?;
         return Ok(ExitCode::SUCCESS);
     }
-    println!(
+    outln!(
         "{} ({} triangles) — sizes as in Lin et al. 2020, Table 3 (MiB = 2^20 B; nodes + index lists, triangles excluded)",
         scene.name,
         scene.triangles.len()
     );
-    println!(
+    outln!(
         "{:<6} {:>10} {:>10} {:>11} {:>12} {:>10} {:>8} {:>8} {:>10}",
         "",
         "internal",
@@ -142,7 +142,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         "time ms"
     );
     for st in &stats {
-        println!(
+        outln!(
             "{:<6} {:>10} {:>10} {:>11.2} {:>12.2} {:>10.2} {:>7.1}% {:>8.2} {:>10.1}",
             st.name,
             st.internal_nodes,
@@ -155,25 +155,36 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             st.build_ms
         );
     }
-    println!(
+    outln!(
         "time: BVH2 build, BVH4/BVH8 collapse, DST conversion from the BVH2, CWBVH collapse and encoding, DST-Q quantization of the DST (wall clock, this machine)"
     );
     if let Some(d) = stats.iter().find_map(|st| st.dst) {
-        println!(
+        outln!(
             "dst nodes: {} splitting, {} single-axis carving, {} dual-axis carving, {} leaves, {} carving leaves (hardware preset, identical bounds)",
-            d.splitting, d.single_carving, d.dual_carving, d.leaves, d.carving_leaves
+            d.splitting,
+            d.single_carving,
+            d.dual_carving,
+            d.leaves,
+            d.carving_leaves
         );
     }
-    println!();
-    println!(
+    outln!();
+    outln!(
         "per-ray work, closest hit on {} primary + diffuse rays (averages):",
         rays.len()
     );
-    println!(
+    outln!(
         "{:<32} {:>10} {:>8} {:>8} {:>8} {:>10} {:>10} {:>9}",
-        "", "total MiB", "% BVH2", "nodes", "leaves", "tests", "triangles", "bytes"
+        "",
+        "total MiB",
+        "% BVH2",
+        "nodes",
+        "leaves",
+        "tests",
+        "triangles",
+        "bytes"
     );
-    println!(
+    outln!(
         "{:<32} {:>10.2} {:>7.1}% {:>8.2} {:>8} {:>10.2} {:>10.2} {:>9.1}",
         "bvh2 (boxes)",
         base as f64 / MIB,
@@ -185,7 +196,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         bvh.bytes as f64 / n
     );
     for v in &variants {
-        println!(
+        outln!(
             "{:<32} {:>10.2} {:>7.1}% {:>8.2} {:>8.2} {:>10.2} {:>10.2} {:>9.1}",
             format!("dst {} (planes)", v.name),
             v.bytes_total as f64 / MIB,

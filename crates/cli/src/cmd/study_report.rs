@@ -16,7 +16,7 @@ pub fn run(dir: &Path, out: Option<&Path>) -> anyhow::Result<ExitCode> {
         .iter()
         .filter(|f| f.extension().is_some_and(|e| e == "svg"))
         .count();
-    println!(
+    outln!(
         "wrote {} ({} of {} results, {charts} sweep charts)",
         out.join("index.html").display(),
         data.rows.len(),

@@ -3,22 +3,20 @@
 //!
 //! Both files are raw little-endian records, one per ray, in the rays' order:
 //!
-//! * rays (32 bytes): `f32` origin x, y, z, direction x, y, z, `t_min`, `t_max`;
+//! * rays (32 bytes): `f32` origin x, y, z, direction x, y, z, `t_min`, `t_max`
+//!   ([`dualsplit_accel::ray_file`]: at most 2^25 rays, each with a finite origin and
+//!   direction and no NaN `t_min` or `t_max`; a ray breaking that is an error naming it);
 //! * closest hits (16 bytes): `f32 t`, `i32 prim`, `f32 u`, `f32 v`; a miss is
 //!   `t = +inf`, `prim = -1`, `u = v = 0` (the Python package's `Tree.intersect` arrays);
 //! * with `--occluded`, one byte per ray: 1 when it hits any triangle, else 0.
 use crate::args::{parse_accel, parse_scene};
 use crate::loaded::Loaded;
 use crate::progress::Ctx;
-use anyhow::{Context, bail};
-use dualsplit_accel::{AccelKind, NoObserver, TraversalSet};
-use dualsplit_geometry::{Ray, Vec3};
+use anyhow::Context;
+use dualsplit_accel::{AccelKind, NoObserver, TraversalSet, ray_file};
 use rayon::prelude::*;
 use std::path::PathBuf;
 use std::process::ExitCode;
-
-/// Bytes of one ray record.
-const RAY_BYTES: usize = 32;
 
 /// Arguments of `dualsplit trace`.
 #[derive(clap::Args)]
@@ -44,36 +42,16 @@ pub struct Args {
     output: PathBuf,
 }
 
-/// The rays of `bytes`, 32-byte records.
-fn parse_rays(bytes: &[u8], file: &std::path::Path) -> anyhow::Result<Vec<Ray>> {
-    if !bytes.len().is_multiple_of(RAY_BYTES) {
-        bail!(
-            "{}: {} bytes is not a whole number of {RAY_BYTES}-byte ray records",
-            file.display(),
-            bytes.len()
-        );
-    }
-    Ok(bytes
-        .chunks_exact(RAY_BYTES)
-        .map(|r| {
-            let f =
-                |i: usize| f32::from_le_bytes([r[4 * i], r[4 * i + 1], r[4 * i + 2], r[4 * i + 3]]);
-            Ray {
-                origin: Vec3::new(f(0), f(1), f(2)),
-                dir: Vec3::new(f(3), f(4), f(5)),
-                t_min: f(6),
-                t_max: f(7),
-            }
-        })
-        .collect())
-}
-
 /// Runs the subcommand.
 pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     crate::output::check_file(&args.output, "-o")?;
-    let bytes = std::fs::read(&args.rays)
-        .with_context(|| format!("reading rays {}", args.rays.display()))?;
-    let rays = parse_rays(&bytes, &args.rays)?;
+    let mut inputs = vec![args.rays.as_path(), std::path::Path::new(&args.scene)];
+    inputs.extend(args.tree.as_deref());
+    crate::output::check_not_an_input(&args.output, "-o", &inputs)?;
+    let bytes = dualsplit_scene::load::read_limited(&args.rays, ray_file::MAX_BYTES)?;
+    let rays =
+        ray_file::parse_rays(&bytes).with_context(|| format!("rays {}", args.rays.display()))?;
+    drop(bytes);
     let scene = super::load(&args.scene, ctx)?;
     let structures = Loaded::get(&scene, args.tree.as_deref(), ctx)?;
     let kind = match args.accel {
@@ -118,21 +96,4 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         args.output.display()
     );
     Ok(ExitCode::SUCCESS)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn ray_records_are_read_in_order_and_partial_records_refused() {
-        let vals: Vec<f32> = (0..16).map(|i| i as f32).collect();
-        let bytes: Vec<u8> = vals.iter().flat_map(|v| v.to_le_bytes()).collect();
-        let rays = parse_rays(&bytes, std::path::Path::new("r")).unwrap();
-        assert_eq!(rays.len(), 2);
-        assert_eq!(rays[1].origin, Vec3::new(8.0, 9.0, 10.0));
-        assert_eq!((rays[1].t_min, rays[1].t_max), (14.0, 15.0));
-        let e = parse_rays(&bytes[..40], std::path::Path::new("r")).unwrap_err();
-        assert!(e.to_string().contains("not a whole number"), "{e}");
-    }
 }

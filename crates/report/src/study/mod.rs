@@ -56,6 +56,19 @@ pub enum StudyError {
         /// What is wrong.
         reason: String,
     },
+    /// The sweeps make more plan entries than [`plan::MAX_PLAN_ENTRIES`].
+    #[error(
+        "the plan would have {count} entries (scenes x configurations x workloads x TM counts x every --vary value combination); at most {limit}: sweep fewer values, or narrow --accel, --workload or the scenes"
+    )]
+    TooManyEntries {
+        /// Entries the options make.
+        count: u128,
+        /// [`plan::MAX_PLAN_ENTRIES`].
+        limit: u64,
+    },
+    /// A file of the study is not a regular file of bounded size, or cannot be read.
+    #[error(transparent)]
+    File(#[from] dualsplit_scene::FileError),
     /// An entry index beyond the plan.
     #[error("entry {index} is not in the plan ({len} entries, 0 to {last})", last = len.saturating_sub(1))]
     NoEntry {

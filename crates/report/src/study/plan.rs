@@ -17,6 +17,15 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
+/// Most entries of a plan. A plan is read whole by every job, and each entry carries its
+/// full configuration (about 3 KB of `plan.json`), so [`Plan::build`] refuses a larger one
+/// before making any entry, and [`Plan::load`] refuses a file with more.
+pub const MAX_PLAN_ENTRIES: u64 = 1 << 16;
+
+/// Largest `plan.json` [`Plan::load`] reads: room for [`MAX_PLAN_ENTRIES`] entries of
+/// 4 KiB each.
+pub const MAX_PLAN_BYTES: u64 = MAX_PLAN_ENTRIES * 4096;
+
 /// Layout version of `plan.json`.
 pub const PLAN_FORMAT: u32 = 1;
 /// Rays per pixel of the cast workload, as `dualsplit-render` traces the paper's scenes
@@ -193,6 +202,7 @@ pub fn config_hash(cfg: &SimConfig) -> String {
 
 impl Plan {
     /// Builds the plan; every swept combination is validated before any entry is made.
+    /// A plan of more than [`MAX_PLAN_ENTRIES`] entries is refused before any is made.
     pub fn build(opts: &PlanOptions) -> Result<Self, StudyError> {
         let varies_tms = opts.vary.iter().any(|v| v.key == "tms");
         let specs: Vec<String> = opts
@@ -201,6 +211,13 @@ impl Plan {
             .map(|s| format!("{} {}", s.name, s.spec))
             .collect();
         let scaling = Producer::scaling_specs(&specs);
+        let count = Self::count(opts, &scaling, varies_tms);
+        if count > u128::from(MAX_PLAN_ENTRIES) {
+            return Err(StudyError::TooManyEntries {
+                count,
+                limit: MAX_PLAN_ENTRIES,
+            });
+        }
         let mut entries = Vec::new();
         for combo in vary::cross_product(&opts.vary) {
             let mut base = opts.base_config.clone();
@@ -279,6 +296,35 @@ impl Plan {
         })
     }
 
+    /// The number of entries [`Plan::build`] makes: the same for every swept combination
+    /// (a swept `tms` leaves no scaling entries), counted without making any.
+    fn count(opts: &PlanOptions, scaling: &[bool], varies_tms: bool) -> u128 {
+        let accels = SimAccel::ALL
+            .iter()
+            .filter(|a| opts.accels.contains(a))
+            .count() as u128;
+        let workloads = Workload::ALL
+            .iter()
+            .filter(|w| opts.workloads.contains(w))
+            .count() as u128;
+        let path = u128::from(opts.workloads.contains(&Workload::Path));
+        let others = opts.tms.iter().filter(|&&t| t != opts.base_tms).count() as u128;
+        let per_combo: u128 = scaling
+            .iter()
+            .map(|&s| {
+                let scaled = if s && !varies_tms {
+                    others * accels * path
+                } else {
+                    0
+                };
+                accels * workloads + scaled
+            })
+            .sum();
+        opts.vary
+            .iter()
+            .fold(per_combo, |n, v| n.saturating_mul(v.values.len() as u128))
+    }
+
     /// `DIR/plan.json`.
     pub fn path(dir: &Path) -> PathBuf {
         dir.join("plan.json")
@@ -291,23 +337,54 @@ impl Plan {
             path: path.clone(),
             reason: e.to_string(),
         })?;
+        if json.len() as u64 > MAX_PLAN_BYTES {
+            return Err(StudyError::Plan {
+                path,
+                reason: format!(
+                    "{} bytes; a plan file holds at most {MAX_PLAN_BYTES} (shorter scene paths or fewer entries)",
+                    json.len()
+                ),
+            });
+        }
         store::write_atomic(&path, &json)?;
         Ok(path)
     }
 
-    /// Reads `DIR/plan.json` and checks it: its format, that this program's code version
-    /// made it, that entries are numbered in order and that each entry's result file name
-    /// is the key of its contents.
+    /// Reads `DIR/plan.json` and checks it: a regular file (links followed) of at most
+    /// [`MAX_PLAN_BYTES`] and [`MAX_PLAN_ENTRIES`] entries, its format, that this program's
+    /// code version made it, that entries are numbered in order and that each entry's
+    /// result file name is the key of its contents.
     pub fn load(dir: &Path) -> Result<Self, StudyError> {
         let path = Self::path(dir);
         let bad = |reason: String| StudyError::Plan {
             path: path.clone(),
             reason,
         };
-        let bytes = std::fs::read(&path)
-            .map_err(|e| bad(format!("{e} (write one with `dualsplit plan --out DIR`)")))?;
+        let bytes = dualsplit_scene::load::read_limited(&path, MAX_PLAN_BYTES).map_err(|e| {
+            if e.is_not_found() {
+                bad("no such file (write one with `dualsplit plan --out DIR`)".into())
+            } else {
+                StudyError::File(e)
+            }
+        })?;
+        Self::parse(&path, &bytes)
+    }
+
+    /// The plan in `bytes`, the contents of the plan file `path`, with the checks of
+    /// [`Plan::load`] but the file's type and size (the fuzz target `study_plan` runs it).
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<Self, StudyError> {
+        let bad = |reason: String| StudyError::Plan {
+            path: path.to_path_buf(),
+            reason,
+        };
         let plan: Plan =
-            serde_json::from_slice(&bytes).map_err(|e| bad(format!("not a study plan: {e}")))?;
+            serde_json::from_slice(bytes).map_err(|e| bad(format!("not a study plan: {e}")))?;
+        if plan.entries.len() as u64 > MAX_PLAN_ENTRIES {
+            return Err(bad(format!(
+                "{} entries; at most {MAX_PLAN_ENTRIES}",
+                plan.entries.len()
+            )));
+        }
         if plan.format != PLAN_FORMAT {
             return Err(bad(format!(
                 "plan format {} (this program reads {PLAN_FORMAT})",
@@ -364,6 +441,50 @@ mod tests {
             base_config: SimConfig::lin2020(),
             vary,
         }
+    }
+
+    #[test]
+    fn the_entry_count_is_known_before_building_and_bounded() {
+        let base = SimConfig::lin2020();
+        let cases = [
+            vec![],
+            vec!["l1.size_bytes=32768,65536"],
+            vec!["tms=2,4,8"],
+            vec!["tms=2,8", "units.dst_pipes=1,2,3"],
+        ];
+        for vary in cases {
+            let v: Vec<Vary> = vary
+                .iter()
+                .map(|a| Vary::parse(a, &base).unwrap())
+                .collect();
+            for workloads in [
+                vec![Workload::Cast],
+                vec![Workload::Path],
+                Workload::ALL.to_vec(),
+            ] {
+                let mut o = opts(v.clone());
+                o.workloads = workloads;
+                o.tms = vec![2, 4, 4, 8];
+                let plan = Plan::build(&o).unwrap();
+                let scaling = Producer::scaling_specs(&["cornell builtin:cornell".to_string()]);
+                let varies_tms = o.vary.iter().any(|v| v.key == "tms");
+                assert_eq!(
+                    Plan::count(&o, &scaling, varies_tms),
+                    plan.entries.len() as u128,
+                    "{vary:?}"
+                );
+            }
+        }
+        let values: Vec<String> = (1..=64).map(|i| i.to_string()).collect();
+        let sweeps: Vec<Vary> = ["dst_pipes", "box_pipes", "tri_pipes"]
+            .iter()
+            .map(|k| Vary::parse(&format!("units.{k}={}", values.join(",")), &base).unwrap())
+            .collect();
+        let e = Plan::build(&opts(sweeps)).unwrap_err();
+        assert!(
+            matches!(e, StudyError::TooManyEntries { count, limit } if count == 64 * 64 * 64 * 6 && limit == MAX_PLAN_ENTRIES),
+            "{e}"
+        );
     }
 
     #[test]

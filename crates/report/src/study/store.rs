@@ -13,6 +13,7 @@
 
 use super::plan::{PlanEntry, Varied, code_version};
 use crate::ReportError;
+use crate::cache::MAX_ENTRY_BYTES;
 use dualsplit_render::Workload;
 use dualsplit_sim::{SimAccel, SimResult};
 use serde::{Deserialize, Serialize};
@@ -90,16 +91,19 @@ impl ResultStore {
         self.dir.join(&entry.cache_key)
     }
 
-    /// Reads and verifies `entry`'s result.
+    /// Reads and verifies `entry`'s result. Only a regular file (links followed) of at
+    /// most [`MAX_ENTRY_BYTES`] is read, with the read stopping one byte past it: a link to
+    /// `/dev/zero`, a named pipe or a larger file is [`Stored::Invalid`], never read whole
+    /// or waited on.
     pub fn read(&self, entry: &PlanEntry) -> Stored {
         let path = self.path(entry);
-        match std::fs::read(&path) {
+        match dualsplit_scene::load::read_limited(&path, MAX_ENTRY_BYTES) {
             Ok(bytes) => match verify(&bytes, entry) {
                 Ok(r) => Stored::Valid(Box::new(r)),
                 Err(why) => Stored::Invalid(why),
             },
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Stored::Missing,
-            Err(e) => Stored::Invalid(format!("{}: {e}", path.display())),
+            Err(e) if e.is_not_found() => Stored::Missing,
+            Err(e) => Stored::Invalid(e.to_string()),
         }
     }
 
@@ -133,8 +137,8 @@ impl ResultStore {
     }
 }
 
-/// Header line plus payload.
-fn encode(json: &[u8]) -> Vec<u8> {
+/// A result file's bytes: the header line, then `json` (a [`JobRecord`]'s JSON).
+pub fn encode(json: &[u8]) -> Vec<u8> {
     let sum = hex(&Sha256::digest(json));
     let mut out = format!(
         "{MAGIC} {RESULT_FORMAT} sha256={sum} bytes={}\n",
@@ -149,8 +153,10 @@ fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// Checks a result file's header, length, checksum and that it is `entry`'s.
-fn verify(bytes: &[u8], entry: &PlanEntry) -> Result<JobRecord, String> {
+/// Checks a result file's header, length, checksum and that it is `entry`'s (what
+/// [`ResultStore::read`] does with the bytes it read; the fuzz target `study_result` runs
+/// it).
+pub fn verify(bytes: &[u8], entry: &PlanEntry) -> Result<JobRecord, String> {
     let nl = bytes
         .iter()
         .position(|&b| b == b'\n')

@@ -7,6 +7,10 @@ use super::StudyError;
 use dualsplit_sim::SimConfig;
 use serde::{Deserialize, Serialize};
 
+/// Most values of one swept key (`--vary KEY=V1,V2,...`); the plan as a whole is bounded
+/// by [`MAX_PLAN_ENTRIES`](super::plan::MAX_PLAN_ENTRIES).
+pub const MAX_VARY_VALUES: usize = 1024;
+
 /// One swept key and its values, in the order given.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Vary {
@@ -46,6 +50,12 @@ impl Vary {
                     .filter(|k| k.starts_with(&format!("{key}.")))
                     .collect::<Vec<_>>()
                     .join(", ")
+            )));
+        }
+        let count = list.split(',').count();
+        if count > MAX_VARY_VALUES {
+            return Err(err(format!(
+                "{count} values; at most {MAX_VARY_VALUES} for one key"
             )));
         }
         let mut values = Vec::new();

@@ -162,6 +162,51 @@ fn kind_of(t: std::fs::FileType) -> &'static str {
     }
 }
 
+/// Reads `path` whole if it is a regular file (symbolic links followed) of at most `max`
+/// bytes: the rule for every small input file (report cache entries, study plans and
+/// results, configurations, ray files).
+///
+/// As in the scene loader, the type is checked before opening (a named pipe is never
+/// opened: that would block until a writer appears) and again on the open handle, the size
+/// is checked on the handle's metadata, and the read stops one byte past `max`, so a file
+/// that grows or a special file that slips through costs at most `max + 1` bytes.
+pub fn read_limited(path: &Path, max: u64) -> Result<Vec<u8>, crate::FileError> {
+    use crate::FileError;
+    let io = |error| FileError::Io {
+        path: path.to_path_buf(),
+        error,
+    };
+    let not_a_file = |t| FileError::NotAFile {
+        path: path.to_path_buf(),
+        kind: kind_of(t),
+    };
+    let too_large = |size| FileError::TooLarge {
+        path: path.to_path_buf(),
+        size,
+        limit: max,
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(not_a_file(meta.file_type()));
+    }
+    let file = std::fs::File::open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    if !meta.is_file() {
+        return Err(not_a_file(meta.file_type()));
+    }
+    if meta.len() > max {
+        return Err(too_large(meta.len()));
+    }
+    let mut out = Vec::with_capacity(meta.len() as usize);
+    file.take(max.saturating_add(1))
+        .read_to_end(&mut out)
+        .map_err(io)?;
+    if out.len() as u64 > max {
+        return Err(too_large(out.len() as u64));
+    }
+    Ok(out)
+}
+
 /// Reads `path` whole if it is a regular file (symbolic links followed) no larger than what
 /// is left of `budget` (not charged here: the caller charges what it keeps).
 ///
@@ -296,8 +341,41 @@ fn parse_error(path: &Path, line: Option<u64>, message: impl Into<String>) -> Sc
     SceneError::Parse {
         path: path.to_path_buf(),
         line,
-        message: message.into(),
+        message: clip_message(message.into()),
     }
+}
+
+/// Longest parse error message kept whole, in bytes: a parser may quote the bad line, and
+/// a 200 KB line must not make a 200 KB message (a longer one keeps its first 160 and
+/// last 80 bytes).
+pub const MAX_MESSAGE_BYTES: usize = 240;
+
+/// `message` cut to about [`MAX_MESSAGE_BYTES`]: its first 160 and last 80 bytes (at
+/// character boundaries) around `…(N bytes)…`, so both a quoted line's start and the
+/// explanation after it remain; control characters are shown as spaces.
+fn clip_message(message: String) -> String {
+    let clean = |s: &str| -> String {
+        s.chars()
+            .map(|c| if c.is_control() { ' ' } else { c })
+            .collect()
+    };
+    if message.len() <= MAX_MESSAGE_BYTES {
+        return clean(&message);
+    }
+    let mut head = 160;
+    while !message.is_char_boundary(head) {
+        head -= 1;
+    }
+    let mut tail = message.len() - 80;
+    while !message.is_char_boundary(tail) {
+        tail += 1;
+    }
+    format!(
+        "{}…({} bytes)…{}",
+        clean(&message[..head]),
+        tail - head,
+        clean(&message[tail..])
+    )
 }
 
 /// Appends the fan triangulation of the polygon `poly` (`n >= 3` vertex indices) to

@@ -139,7 +139,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     if let Some(out) = json {
         out.emit(&report.to_json()?)?;
     } else {
-        println!(
+        outln!(
             "scene {} ({} triangles), {}×{} {}, {} TMs × {} TPs, {} thread model",
             scene.name,
             scene.triangles.len(),
@@ -154,11 +154,11 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             print_result(r, *host);
         }
         if results.len() > 1 {
-            println!(
+            outln!(
                 "\ncomparison (frame time, energy and DRAM lines as % of {}; stalls and idle as shares of all thread-cycles)",
                 summary.baseline.map_or("?", |a| a.label())
             );
-            print!("{}", frames::table(summary));
+            out!("{}", frames::table(summary));
         }
         let idle = summary
             .rows
@@ -166,7 +166,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             .map(|r| r.stalls.idle_at_end)
             .fold(0.0f64, f64::max);
         if idle > IDLE_WARN {
-            println!(
+            outln!(
                 "note: threads sat idle at the end of the frame for up to {:.0} % of their cycles: the frame has too few pixels for {} threads, so the chip is not busy; a larger --res compares the structures on a busy chip",
                 100.0 * idle,
                 cfg.tms * cfg.tps_per_tm
@@ -210,8 +210,8 @@ fn print_result(r: &SimResult, host: Duration) {
     let i = &r.instructions;
     let s = &r.stalls;
     let u = &r.utilisation;
-    println!("== {label}");
-    println!(
+    outln!("== {label}");
+    outln!(
         "  frame time     {} ({} cycles), {} rays, {:.0} instructions and {:.0} thread-cycles per ray",
         units::time_ms(r.frame_ms),
         r.cycles,
@@ -219,20 +219,20 @@ fn print_result(r: &SimResult, host: Duration) {
         r.instructions.total() as f64 / r.rays.max(1) as f64,
         r.cycles as f64 * r.threads as f64 / r.rays.max(1) as f64
     );
-    println!(
+    outln!(
         "  energy         {} total: DRAM {}, caches {}, compute {}",
         units::energy_j(e.total()),
         units::energy_j(e.dram_j),
         units::energy_j(e.caches_j),
         units::energy_j(e.compute_j)
     );
-    println!(
+    outln!(
         "  DRAM           {} lines read, {} activations, row-hit rate {:.1} %",
         r.dram_lines,
         r.dram_activations,
         100.0 * r.row_hit_rate
     );
-    println!(
+    outln!(
         "  caches         L1 hit {:.1} % ({} accesses), L2 hit {:.1} % ({} accesses), L2 bank conflicts {} cycles",
         100.0 * r.l1_hit_rate,
         r.caches.l1_accesses,
@@ -241,7 +241,7 @@ fn print_result(r: &SimResult, host: Duration) {
         r.memory.l2_bank_conflict_cycles
     );
     let m = &r.memory;
-    println!(
+    outln!(
         "  memory         DRAM {:.1} GB/s, read latency mean {:.1} / p95 {} cycles, {:.2} lines and {:.2} rays per pixel",
         m.dram_gbps,
         m.dram_latency_mean_cycles,
@@ -249,7 +249,7 @@ fn print_result(r: &SimResult, host: Duration) {
         m.lines_per_pixel,
         m.rays_per_pixel
     );
-    println!(
+    outln!(
         "  instructions   {} total: int {}, fpadd {}, fpmul {}, fpcmp {}, fpinv {}, local {}, loads {}, box issues {}, tri {}, dual-split {}, atomics {}",
         i.total(),
         i.mix.int,
@@ -265,12 +265,13 @@ fn print_result(r: &SimResult, host: Duration) {
         i.atomics
     );
     if i.qbox_ops + i.qdst_ops > 0 {
-        println!(
+        outln!(
             "  quantized      box ops {} (dequantized child boxes), dual-split ops {} (records)",
-            i.qbox_ops, i.qdst_ops
+            i.qbox_ops,
+            i.qdst_ops
         );
     }
-    println!(
+    outln!(
         "  utilisation    issue {:.1} %, ray-box {:.1} %, ray-triangle {:.1} %, dual-split {:.1} %",
         100.0 * u.issue,
         100.0 * u.box_pipe,
@@ -279,7 +280,7 @@ fn print_result(r: &SimResult, host: Duration) {
     );
     let tot = (r.cycles as f64 * r.threads as f64).max(1.0);
     let pct = |x: u64| 100.0 * x as f64 / tot;
-    println!(
+    outln!(
         "  stalls (% of thread-cycles)  memory {:.1}, pipeline latency {:.1}, pipeline busy {:.1}, dependency {:.1}, busy unit {:.1}, fpinv {:.1}, L1/L2 bank {:.1}, icache {:.1}, atomic {:.1}, idle at end {:.1}",
         pct(s.memory),
         pct(s.pipeline_latency),
@@ -293,7 +294,7 @@ fn print_result(r: &SimResult, host: Duration) {
         pct(s.idle)
     );
     let secs = host.as_secs_f64();
-    println!(
+    outln!(
         "  host           {:.2} s on one core, {:.1} M simulated instructions/s (MIPS)",
         secs,
         r.instructions.total() as f64 / secs.max(1e-9) / 1e6
