@@ -215,35 +215,12 @@ pub fn read_limited(path: &Path, max: u64) -> Result<Vec<u8>, crate::FileError> 
 /// caught; the read itself stops one byte past the budget, so a file that grows, or a
 /// special file that slipped through, cannot exhaust memory.
 pub(crate) fn read_regular_file(path: &Path, budget: &ByteBudget) -> Result<Vec<u8>, SceneError> {
-    let io = |error| SceneError::Io {
-        path: path.to_path_buf(),
-        error,
-    };
-    let not_a_file = |t| SceneError::NotAFile {
-        path: path.to_path_buf(),
-        kind: kind_of(t),
-    };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(not_a_file(meta.file_type()));
-    }
-    let file = std::fs::File::open(path).map_err(io)?;
-    let meta = file.metadata().map_err(io)?;
-    if !meta.is_file() {
-        return Err(not_a_file(meta.file_type()));
-    }
-    let max = budget.remaining();
-    if meta.len() > max {
-        return Err(budget.exceeded(path));
-    }
-    let mut out = Vec::with_capacity(meta.len() as usize);
-    file.take(max.saturating_add(1))
-        .read_to_end(&mut out)
-        .map_err(io)?;
-    if out.len() as u64 > max {
-        return Err(budget.exceeded(path));
-    }
-    Ok(out)
+    use crate::FileError;
+    read_limited(path, budget.remaining()).map_err(|e| match e {
+        FileError::Io { path, error } => SceneError::Io { path, error },
+        FileError::NotAFile { path, kind } => SceneError::NotAFile { path, kind },
+        FileError::TooLarge { path, .. } => budget.exceeded(&path),
+    })
 }
 
 /// Inflates `raw` when it starts with the gzip magic bytes or `path` ends in `.gz`;
