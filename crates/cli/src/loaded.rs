@@ -1,6 +1,7 @@
-//! What `check`, `bench`, `render` and `simulate` run on: every structure built from the
-//! scene, or with `--tree FILE` the one structure a saved tree file holds (written by
-//! `dualsplit build`). This is the one place `--tree` becomes structures.
+//! What `check`, `bench`, `render`, `trace` and `simulate` run on: every structure built
+//! from the scene, only the structures of the traversals asked for (`simulate`,
+//! [`Loaded::get_for`]), or with `--tree FILE` the one structure a saved tree file holds
+//! (written by `dualsplit build`). This is the one place `--tree` becomes structures.
 //!
 //! A saved tree answers the traversals of its structure only: `dst-sw` and `dst` for a DST,
 //! its own kind for a BVH2, BVH4 or BVH8 ([`dualsplit_accel::TreeKind::accel_kinds`]).
