@@ -9,9 +9,7 @@
 //!
 //! Host layout: one cycle's counts of every row lie side by side (`[cycle][row]`, one byte
 //! each), so a thread issuing at consecutive cycles reads consecutive bytes, and a TM's
-//! tables take `HISTORY × rows` bytes. This replaced one ring per resource, tagged per
-//! entry with its cycle (16 bytes an entry); the counts, and so every simulated result, are
-//! the same.
+//! tables take `HISTORY × rows` bytes (rows rounded up to a power of two).
 
 /// Cycles a window remembers: four times the `rv32` model's run-ahead (`tp::LOOKAHEAD`), so
 /// that the requests of threads running ahead and of threads at the event clock always lie
