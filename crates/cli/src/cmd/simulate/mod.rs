@@ -31,7 +31,8 @@ pub struct Args {
     #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
     /// Configurations, comma-separated: bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst,
-    /// or all (simulated two at a time). With more than one, a comparison table follows,
+    /// cwbvh, cwbvh+, dst-q, or all (the eleven; simulated two at a time). Only the
+    /// structures they read are built. With more than one, a comparison table follows,
     /// relative to BVH2 when it is listed, else to the first. Default dst; with --tree,
     /// every configuration of the saved structure (dst-sw and dst for a DST), and `all`
     /// means those.
