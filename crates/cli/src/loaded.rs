@@ -1,5 +1,5 @@
 //! What `check`, `bench`, `render`, `trace` and `simulate` run on: every structure built
-//! from the scene, only the structures of the traversals asked for (`simulate`,
+//! from the scene, only the structures of the traversals asked for (`simulate`, `render`:
 //! [`Loaded::get_for`]), or with `--tree FILE` the one structure a saved tree file holds
 //! (written by `dualsplit build`). This is the one place `--tree` becomes structures.
 //!

@@ -179,7 +179,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             settings.height
         );
     }
-    let structures = get_structures(&scene, args.tree.as_deref(), ctx, json.is_some())?;
+    let structures = get_structures(&scene, args.tree.as_deref(), &[], ctx, json.is_some())?;
     json_line(structures.timing_json(&scene).to_string());
     let host = crate::host::Host::detect();
     json_line(serde_json::json!({ "host": host }).to_string());

@@ -79,15 +79,17 @@ pub(crate) fn say(line: &str, stdout_is_data: bool) {
     }
 }
 
-/// Builds every structure, or loads `--tree`, and says how long it took (the time line
-/// goes as in [`load_scene`]).
+/// Builds the structures the traversals `kinds` read (every structure when `kinds` is
+/// empty), or loads `--tree`, and says how long it took (the time line goes as in
+/// [`load_scene`]).
 pub(crate) fn get_structures(
     scene: &Scene,
     tree: Option<&std::path::Path>,
+    kinds: &[AccelKind],
     ctx: &Ctx,
     stdout_is_data: bool,
 ) -> anyhow::Result<Loaded> {
-    let s = Loaded::get(scene, tree, ctx)?;
+    let s = Loaded::get_for(scene, tree, kinds, ctx)?;
     say(&s.summary(), stdout_is_data);
     Ok(s)
 }
@@ -125,7 +127,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         ..RenderSettings::new(args.res.0, args.res.1, args.workload)
     };
     dualsplit_render::validate(&scene, &settings)?;
-    let structures = get_structures(&scene, args.tree.as_deref(), ctx, false)?;
+    // Only the structure of the traversal rendered is built.
+    let wanted = args.accel.unwrap_or(AccelKind::Bvh2);
+    let structures = get_structures(&scene, args.tree.as_deref(), &[wanted], ctx, false)?;
     let accel = match args.accel {
         Some(k) => {
             structures.require(k.name(), k)?;
