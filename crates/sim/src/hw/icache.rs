@@ -80,36 +80,12 @@ impl ICaches {
         (cache << self.bank_shift) | ((pc >> 2) & self.bank_mask) as usize
     }
 
-    /// The first cycle at or after `c` at which cache `cache` could fetch the instruction at
-    /// `pc`, without taking it.
-    #[inline]
-    pub fn peek(&self, cache: usize, pc: u32, c: Cycle) -> Cycle {
-        if self.limit == 0 {
-            return c;
-        }
-        Cycle(
-            self.banks
-                .first_free(self.bank(cache, pc), c.get(), self.limit),
-        )
-    }
-
-    /// Fetches the instruction at `pc` from cache `cache` in cycle `s`, which [`Self::peek`]
-    /// returned (nothing was fetched from the bank since).
-    #[inline]
-    pub fn take(&mut self, cache: usize, pc: u32, s: Cycle) {
-        if self.limit != 0 {
-            let b = self.bank(cache, pc);
-            debug_assert!(self.banks.count(b, s.get()) < self.limit);
-            self.banks.take(b, s.get());
-        }
-    }
-
     /// The fetch of a thread that may not issue the instruction yet: fetches the
     /// instruction at `pc` from cache `cache` in the first cycle at or after `c` its bank
     /// has a fetch left, when that cycle lies in the counts' window, and returns it. The
     /// caller then either issues ([`Fetch::keep`]) or gives the fetch back
     /// ([`Fetch::give_back`]) before anything else is fetched: either way the counts are
-    /// those of [`Self::peek`] followed, on issue, by [`Self::take`].
+    /// those of looking for the free cycle first and counting the fetch only on issue.
     #[inline]
     pub fn try_fetch(&mut self, cache: usize, pc: u32, c: Cycle) -> Fetch {
         if self.limit == 0 {
@@ -127,18 +103,23 @@ impl ICaches {
             taken,
         }
     }
+}
 
-    /// Fetches the instruction at `pc` from cache `cache` in the first cycle at or after `c`
-    /// its bank has a fetch left, and returns that cycle.
-    #[inline]
-    pub fn fetch(&mut self, cache: usize, pc: u32, c: Cycle) -> Cycle {
-        if self.limit == 0 {
-            return c;
-        }
-        Cycle(
-            self.banks
-                .reserve(self.bank(cache, pc), c.get(), self.limit),
-        )
+#[cfg(test)]
+impl ICaches {
+    /// The cycle a fetch of `pc` by cache `cache` from cycle `c` would take, counting
+    /// nothing.
+    fn peek(&mut self, cache: usize, pc: u32, c: Cycle) -> Cycle {
+        let f = self.try_fetch(cache, pc, c);
+        f.give_back(self);
+        f.at
+    }
+
+    /// Fetches `pc` by cache `cache` from cycle `c` and issues it; returns the fetch cycle.
+    fn fetch(&mut self, cache: usize, pc: u32, c: Cycle) -> Cycle {
+        let f = self.try_fetch(cache, pc, c);
+        f.keep(self);
+        f.at
     }
 }
 

@@ -81,16 +81,10 @@ impl Window {
     /// that cycle.
     #[inline]
     pub fn reserve(&mut self, row: usize, c: u64, limit: u8) -> u64 {
-        // Fast path (most requests): `c` is in the window and free.
-        if c >= self.base && c < self.base + HISTORY {
-            let i = self.index(row, c);
-            if self.counts[i] < limit {
-                self.counts[i] += 1;
-                return c;
-            }
+        let (s, taken) = self.reserve_in_window(row, c, limit);
+        if !taken {
+            self.take(row, s);
         }
-        let s = self.first_free(row, c, limit);
-        self.take(row, s);
         s
     }
 
@@ -100,16 +94,7 @@ impl Window {
     /// does not slide) and returns `(cycle, false)`; [`Window::take`] then takes it.
     #[inline]
     pub fn reserve_in_window(&mut self, row: usize, c: u64, limit: u8) -> (u64, bool) {
-        let s = if c >= self.base && c < self.base + HISTORY {
-            let i = self.index(row, c);
-            if self.counts[i] < limit {
-                self.counts[i] += 1;
-                return (c, true);
-            }
-            self.first_free(row, c, limit)
-        } else {
-            self.first_free(row, c, limit)
-        };
+        let s = self.first_free(row, c, limit);
         if s >= self.base && s < self.base + HISTORY {
             let i = self.index(row, s);
             self.counts[i] += 1;
