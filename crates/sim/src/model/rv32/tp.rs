@@ -183,7 +183,7 @@ impl Tp {
             self.finish_pipe(r, w);
         }
         loop {
-            let Some(&ins) = prog.fetch(self.hart.pc) else {
+            let Some(ins) = prog.fetch(self.hart.pc) else {
                 // The executor names the faulting pc.
                 return Err(self
                     .hart
@@ -241,7 +241,7 @@ impl Tp {
                 return Ok(Wake::At(self.t));
             }
             fetch.keep(&mut tm.icache);
-            let acc = self.hart.exec_access(&ins, prog, mem)?;
+            let acc = self.hart.exec_access(ins, prog, mem)?;
             // The executed class (a load or store whose address is the local store's).
             let fu = executed_class(info.fu, &acc);
             counts[fu_index(fu)] += 1;
