@@ -242,7 +242,8 @@ pub struct Timing {
     pub repeats: u32,
     /// Wall-clock seconds of all its passes.
     pub seconds: f64,
-    /// Millions of rays per second over all passes: `rays · repeats / seconds / 10⁶`.
+    /// Millions of rays per second over all passes: `rays / (seconds / repeats) / 10⁶`, from
+    /// whole nanoseconds, so it never exceeds [`Timing::best_pass_mrays_per_s`].
     pub mrays_per_s: f64,
     /// Millions of rays per second of its fastest pass (the least disturbed).
     pub best_pass_mrays_per_s: f64,
@@ -269,25 +270,28 @@ pub fn measure_interleaved(
     if set.rays.is_empty() || contenders.is_empty() {
         return Vec::new();
     }
-    let pass = |c: &Contender<'_>| -> (f64, u64) {
+    let pass = |c: &Contender<'_>| -> (u128, u64) {
         let start = Instant::now();
         let hits = if threads == 1 {
             (c.trace)(&set.rays)
         } else {
             set.rays.par_chunks(CHUNK).map(|ch| (c.trace)(ch)).sum()
         };
-        (start.elapsed().as_secs_f64(), hits)
+        (start.elapsed().as_nanos(), hits)
     };
     let n = contenders.len();
-    let mut seconds = vec![0.0f64; n];
-    let mut best = vec![f64::INFINITY; n];
+    // Whole nanoseconds: their sums are exact, so the mean pass is never shorter than the
+    // best one, as it would be by rounding with summed seconds.
+    let mut nanos = vec![0u128; n];
+    let mut best = vec![u128::MAX; n];
     let mut hits = vec![0u64; n];
     let mut repeats = 0u32;
-    while repeats < cfg.min_repeats || seconds.iter().any(|&s| s < cfg.min_seconds) {
+    let min_nanos = cfg.min_seconds * 1e9;
+    while repeats < cfg.min_repeats || nanos.iter().any(|&s| (s as f64) < min_nanos) {
         for k in 0..n {
             let i = (repeats as usize + k) % n;
             let (s, h) = pass(&contenders[i]);
-            seconds[i] += s;
+            nanos[i] += s;
             best[i] = best[i].min(s);
             hits[i] = std::hint::black_box(h);
         }
@@ -297,16 +301,20 @@ pub fn measure_interleaved(
     contenders
         .iter()
         .enumerate()
-        .map(|(i, c)| Timing {
-            accel: c.name.to_string(),
-            ray_kind: set.kind,
-            rays,
-            repeats,
-            seconds: seconds[i],
-            mrays_per_s: rays as f64 * repeats as f64 / seconds[i] / 1e6,
-            best_pass_mrays_per_s: rays as f64 / best[i] / 1e6,
-            threads,
-            hits: hits[i],
+        .map(|(i, c)| {
+            // A pass shorter than the clock's tick counts as one nanosecond.
+            let per_pass = (nanos[i] as f64 / f64::from(repeats)).max(1.0);
+            Timing {
+                accel: c.name.to_string(),
+                ray_kind: set.kind,
+                rays,
+                repeats,
+                seconds: nanos[i] as f64 / 1e9,
+                mrays_per_s: rays as f64 / (per_pass / 1e9) / 1e6,
+                best_pass_mrays_per_s: rays as f64 / (best[i].max(1) as f64 / 1e9) / 1e6,
+                threads,
+                hits: hits[i],
+            }
         })
         .collect()
 }
