@@ -117,8 +117,11 @@ def simulate(
     config: Union[Mapping[str, Union[ConfigValue, Mapping[str, ConfigValue]]], None] = None,
     config_file: Union[str, os.PathLike[str], None] = None,
     tree: Union[Tree, None] = None,
+    threads: Union[int, None] = None,
 ) -> dict[str, Any]:
     """One frame per configuration on the TRaX-style model: the dict ``dualsplit simulate
     --json`` prints. ``config`` sets keys of the hardware TOML (``{"l2.size_bytes": 1 << 20}``
     or ``{"l2": {"size_bytes": 1 << 20}}``) over ``config_file`` (default lin2020), with the
-    same checks and messages as a file; ``res`` defaults to 512."""
+    same checks and messages as a file; ``res`` defaults to 512. ``threads`` host threads
+    (default: the host's cores) run the frames side by side, splitting a frame's TMs when
+    there are fewer frames; the result is the same for any number."""

@@ -636,7 +636,7 @@ fn read_config(p: &std::path::Path) -> PyResult<String> {
 /// Simulates one frame per configuration on the TRaX-style many-core model and returns the
 /// document `dualsplit simulate --json` prints, as a dict.
 #[pyfunction]
-#[pyo3(signature = (scene, *, accel=None, workload="path", res=None, tms=None, model="rv32", config=None, config_file=None, tree=None))]
+#[pyo3(signature = (scene, *, accel=None, workload="path", res=None, tms=None, model="rv32", config=None, config_file=None, tree=None, threads=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -649,7 +649,15 @@ fn simulate<'py>(
     config: Option<&Bound<'py, PyDict>>,
     config_file: Option<PathBuf>,
     tree: Option<&Bound<'py, Tree>>,
+    threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    if threads == Some(0) {
+        return Err(PyValueError::new_err(
+            "threads: `0` is not a positive whole number",
+        ));
+    }
+    let threads =
+        threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from));
     let workload = Workload::parse(workload).ok_or_else(|| {
         PyValueError::new_err(format!(
             "unknown workload `{workload}` (expected cast or path)"
@@ -704,16 +712,36 @@ fn simulate<'py>(
     let results: Vec<(SimResult, std::time::Duration)> = match tree {
         Some(t) => {
             let t = &t.get().tree;
-            py.detach(|| simulate_frames(model, &full, t, &accels, &settings, &cfg, &|_, _, _| {}))
-                .map_err(|e| py_err("", &e))?
+            py.detach(|| {
+                simulate_frames(
+                    model,
+                    &full,
+                    t,
+                    &accels,
+                    &settings,
+                    &cfg,
+                    threads,
+                    &|_, _, _| {},
+                )
+            })
+            .map_err(|e| py_err("", &e))?
         }
         None => py
             .detach(|| {
                 let s = Structures::try_build(&full.triangles, &BuildConfig::default()).map_err(
                     |e| format!("building the structures of {}: {}", full.spec, message(&e)),
                 )?;
-                simulate_frames(model, &full, &s, &accels, &settings, &cfg, &|_, _, _| {})
-                    .map_err(|e| message(&e))
+                simulate_frames(
+                    model,
+                    &full,
+                    &s,
+                    &accels,
+                    &settings,
+                    &cfg,
+                    threads,
+                    &|_, _, _| {},
+                )
+                .map_err(|e| message(&e))
             })
             .map_err(DualsplitError::new_err)?,
     };

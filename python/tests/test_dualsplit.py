@@ -188,6 +188,14 @@ def test_simulate_equals_the_cli_json(cli, scene):
     assert got["summary"]["baseline"] == "bvh2"
 
 
+def test_simulate_threads_change_no_result(cli, scene):
+    one = dualsplit.simulate(scene, accel="dst", threads=1, **SIM)
+    assert dualsplit.simulate(scene, accel="dst", threads=2, **SIM) == one
+    assert one == sim_cli(cli, "--accel", "dst", "--sim-threads", "2")
+    with pytest.raises(ValueError, match="threads"):
+        dualsplit.simulate(scene, accel="dst", threads=0, **SIM)
+
+
 def test_simulate_with_a_saved_tree_equals_the_cli(cli, tmp_path, scene):
     path = tmp_path / "scene.dst"
     dualsplit.build(scene, "dst").save(path)

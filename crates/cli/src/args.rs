@@ -230,3 +230,23 @@ pub struct Scope {
     #[arg(long)]
     pub model: Option<String>,
 }
+
+/// Host threads for simulations, shared by `simulate`, `report`, `run-job` and `plan`.
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct SimThreads {
+    /// Host threads the simulations run on in all (default: this host's cores). Frames
+    /// run side by side first; a frame's TMs are split over several threads when there are
+    /// fewer frames than threads. Results are bit-identical for any number.
+    #[arg(long = "sim-threads", value_name = "N", value_parser = parse_positive)]
+    pub sim_threads: Option<u32>,
+}
+
+impl SimThreads {
+    /// The number asked for, else the host's cores.
+    pub fn get(self) -> usize {
+        self.sim_threads.map_or_else(
+            || std::thread::available_parallelism().map_or(1, usize::from),
+            |n| n as usize,
+        )
+    }
+}

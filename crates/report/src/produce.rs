@@ -40,7 +40,7 @@ pub const MIN_TIMING_S: f64 = 0.1;
 pub const CPU_RAYS: usize = 100_000;
 /// Most frames of the path workload generated to gather [`CPU_RAYS`] rays of each kind.
 pub const CPU_MAX_FRAMES: u32 = 8;
-/// Simulations run side by side.
+/// Simulations run side by side on two cores (the basis of `plan`'s time estimates).
 pub const SIM_WORKERS: usize = 2;
 /// The second TM count of "Beyond the paper" (beside the base count, the paper's 64): twice
 /// the paper's chip, where the paper's memory-bound regime is stronger (its Table 7).
@@ -73,22 +73,26 @@ pub type SimulateFn<'a> = dyn Fn(
         SimAccel,
         &RenderSettings,
         &SimConfig,
+        usize,
         &(dyn Fn(u64, u64) + Sync),
     ) -> Result<SimResult, String>
     + Sync
     + 'a;
 
-/// The real simulator with thread model `model` ([`dualsplit_sim::simulate`]),
-/// errors as "simulator unavailable: …".
+/// The real simulator with thread model `model` ([`dualsplit_sim::simulate`]) on the
+/// host threads it is given, errors as "simulator unavailable: …".
 pub fn real_simulator(model: ThreadModel) -> Box<SimulateFn<'static>> {
-    Box::new(move |scene, structures, accel, settings, cfg, progress| {
-        dualsplit_sim::simulate(
-            &dualsplit_sim::FrameRequest::new(scene, structures, accel, settings, cfg)
-                .with_model(model),
-            progress,
-        )
-        .map_err(|e| format!("simulator unavailable: {e}"))
-    })
+    Box::new(
+        move |scene, structures, accel, settings, cfg, threads, progress| {
+            dualsplit_sim::simulate(
+                &dualsplit_sim::FrameRequest::new(scene, structures, accel, settings, cfg)
+                    .with_model(model)
+                    .with_threads(threads),
+                progress,
+            )
+            .map_err(|e| format!("simulator unavailable: {e}"))
+        },
+    )
 }
 
 /// One simulation to run.
@@ -108,6 +112,8 @@ pub struct Producer<'a> {
     progress: &'a dyn Progress,
     simulate: &'a SimulateFn<'a>,
     computed: AtomicU64,
+    /// Host threads for the simulations ([`Producer::sim_threads`]).
+    sim_threads: usize,
 }
 
 impl<'a> Producer<'a> {
@@ -124,6 +130,17 @@ impl<'a> Producer<'a> {
             progress,
             simulate,
             computed: AtomicU64::new(0),
+            sim_threads: SIM_WORKERS,
+        }
+    }
+
+    /// Runs the simulations on `threads` host threads in all ([`SIM_WORKERS`] unless
+    /// set): as many frames side by side as there are threads (or frames), the threads
+    /// shared among them ([`dualsplit_sim::share_threads`]). Results do not depend on it.
+    pub fn sim_threads(self, threads: usize) -> Self {
+        Self {
+            sim_threads: threads.max(1),
+            ..self
         }
     }
 
@@ -265,11 +282,12 @@ impl<'a> Producer<'a> {
         let pixels = u64::from(self.settings.width) * u64::from(self.settings.height);
         self.progress
             .begin("simulating", missing.len() as u64 * pixels);
+        let (workers, per_frame) = dualsplit_sim::share_threads(missing.len(), self.sim_threads);
         let queue = Mutex::new(missing);
         let done: Mutex<Vec<(SimJob, Result<SimResult, String>)>> = Mutex::new(Vec::new());
         let write_error: Mutex<Option<ReportError>> = Mutex::new(None);
         std::thread::scope(|s| {
-            for _ in 0..SIM_WORKERS {
+            for _ in 0..workers {
                 s.spawn(|| {
                     loop {
                         let job = queue.lock().map(|mut q| q.pop_front()).ok().flatten();
@@ -306,6 +324,7 @@ impl<'a> Producer<'a> {
                             job.accel,
                             &self.sim_settings(job.workload),
                             &self.sim_config(job.tms),
+                            per_frame,
                             &report,
                         );
                         self.progress

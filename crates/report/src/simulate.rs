@@ -53,9 +53,10 @@ pub fn check_frame(
     Ok(())
 }
 
-/// Simulates one frame of `settings` per configuration in `accels`, two at a time (each run
-/// is single-threaded and deterministic, so the results do not depend on the pairing),
-/// after checking the camera against the renderer's limits. Each result comes with its
+/// Simulates one frame of `settings` per configuration in `accels` on `threads` host
+/// threads in all, frames side by side and threads shared among them
+/// ([`dualsplit_sim::share_threads`]; results do not depend on either), after checking the
+/// camera against the renderer's limits. Each result comes with its
 /// host wall time (a measurement of this machine, never part of a result). `progress` is
 /// called with (configuration, pixels done, pixels total).
 #[allow(clippy::too_many_arguments)]
@@ -66,14 +67,17 @@ pub fn simulate_frames<S: TraversalSet + Sync>(
     accels: &[SimAccel],
     settings: &RenderSettings,
     cfg: &SimConfig,
+    threads: usize,
     progress: &(dyn Fn(SimAccel, u64, u64) + Sync),
 ) -> Result<Vec<(SimResult, Duration)>, SimulateError> {
+    let (workers, per_frame) = dualsplit_sim::share_threads(accels.len(), threads);
     dualsplit_render::validate(scene, settings)?;
     let sim_one = |accel: SimAccel| -> Result<(SimResult, Duration), SimulateError> {
         let t0 = Instant::now();
         let r = dualsplit_sim::simulate(
             &dualsplit_sim::FrameRequest::new(scene, structures, accel, settings, cfg)
-                .with_model(model),
+                .with_model(model)
+                .with_threads(per_frame),
             &|done, total| progress(accel, done, total),
         )
         .map_err(|source| SimulateError::Frame {
@@ -83,7 +87,7 @@ pub fn simulate_frames<S: TraversalSet + Sync>(
         Ok((r, t0.elapsed()))
     };
     let mut results = Vec::with_capacity(accels.len());
-    for pair in accels.chunks(2) {
+    for pair in accels.chunks(workers) {
         let out: Vec<Result<(SimResult, Duration), SimulateError>> = std::thread::scope(|s| {
             let handles: Vec<_> = pair
                 .iter()

@@ -38,9 +38,9 @@ fn second_run_computes_nothing() {
         random_scene("other", 30, 2),
     ];
     let calls = AtomicU64::new(0);
-    let sim = |a: &_, b: &_, c, d: &_, e: &_, f: &(dyn Fn(u64, u64) + Sync)| {
+    let sim = |a: &_, b: &_, c, d: &_, e: &_, t, f: &(dyn Fn(u64, u64) + Sync)| {
         calls.fetch_add(1, Ordering::Relaxed);
-        fake_simulate(a, b, c, d, e, f)
+        fake_simulate(a, b, c, d, e, t, f)
     };
     // Each scene: the 11 configurations cast and path at 64 TMs (22) and "Beyond the paper"
     // at 128 TMs (7 configurations, cast and path: 14). hairball-test stands in for
@@ -98,7 +98,7 @@ fn simulator_errors_are_reported_not_cached() {
     let dir = std::env::temp_dir().join(format!("dualsplit-report-nosim-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let scenes = [random_scene("one", 20, 3)];
-    let sim = |_: &_, _: &_, _, _: &_, _: &_, _: &(dyn Fn(u64, u64) + Sync)| {
+    let sim = |_: &_, _: &_, _, _: &_, _: &_, _, _: &(dyn Fn(u64, u64) + Sync)| {
         Err("simulator unavailable: not implemented".to_string())
     };
     let p = Producer::new(Cache::new(&dir), settings(4), &NoProgress, &sim);

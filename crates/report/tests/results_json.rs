@@ -40,11 +40,11 @@ fn results_json_has_plain_documented_values() {
         thread_model: dualsplit_sim::ThreadModel::Fast,
     };
     // One configuration fails, so an error value is written too.
-    let sim = |a: &_, b: &_, c, d: &_, e: &_, f: &(dyn Fn(u64, u64) + Sync)| {
+    let sim = |a: &_, b: &_, c, d: &_, e: &_, t, f: &(dyn Fn(u64, u64) + Sync)| {
         if c == dualsplit_sim::SimAccel::Bvh8 {
             Err("simulator unavailable: test".to_string())
         } else {
-            fake_simulate(a, b, c, d, e, f)
+            fake_simulate(a, b, c, d, e, t, f)
         }
     };
     let p = Producer::new(

@@ -24,7 +24,8 @@
 
 use divan::counter::ItemsCount;
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
-use dualsplit_sim::hw::{Chip, pipe::Pipe};
+use dualsplit_sim::hw::atomic::AtomicUnit;
+use dualsplit_sim::hw::{Chip, Stalls, pipe::Pipe};
 use dualsplit_sim::model::fast::op::Op;
 use dualsplit_sim::model::fast::replay::{WorkSource, run as run_chip};
 use dualsplit_sim::model::fast::thread::Thread;
@@ -45,7 +46,13 @@ impl WorkSource for Synthetic {
     /// Reuses the thread's finished program buffer, as the real workload does, sized for
     /// the whole program (3 ops per visit, 2 more every 8th), so the generator does not
     /// reallocate and copy inside the measured replay.
-    fn next(&mut self, _id: usize, t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
+    fn next(
+        &mut self,
+        _id: usize,
+        t: &mut Thread,
+        _a: &mut AtomicUnit,
+        _s: &mut Stalls,
+    ) -> Option<Vec<Op>> {
         if self.programs_left == 0 {
             return None;
         }

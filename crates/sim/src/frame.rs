@@ -27,6 +27,9 @@ pub struct FrameRequest<'a, S> {
     pub cfg: &'a SimConfig,
     /// How the threads execute their kernel.
     pub model: ThreadModel,
+    /// Host threads the frame runs on (TMs split among them; the result is the same for
+    /// any number, `engine::run`).
+    pub threads: usize,
 }
 
 impl<'a, S: TraversalSet> FrameRequest<'a, S> {
@@ -45,6 +48,15 @@ impl<'a, S: TraversalSet> FrameRequest<'a, S> {
             settings,
             cfg,
             model: ThreadModel::Rv32,
+            threads: 1,
+        }
+    }
+
+    /// The same request on `threads` host threads (at least one).
+    pub fn with_threads(self, threads: usize) -> Self {
+        Self {
+            threads: threads.max(1),
+            ..self
         }
     }
 

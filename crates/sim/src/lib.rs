@@ -57,13 +57,14 @@ mod shares;
 /// Version of the timing and energy model. Bump it whenever a change alters simulated results
 /// for the same inputs; the report's result cache includes it in every key, so stale cached
 /// frames are recomputed.
-pub const MODEL_VERSION: u32 = 10;
+pub const MODEL_VERSION: u32 = 11;
 
 pub use accel::SimAccel;
 pub use config::{
     CacheConfig, ConfigError, DramConfig, EnergyConfig, KernelsConfig, NodeFetch, SimConfig,
     UnitConfig,
 };
+pub use engine::share_threads;
 pub use error::SimError;
 pub use frame::{FrameRequest, check_model, simulate};
 pub use hw::counts::UnitStats;

@@ -138,7 +138,19 @@ fn tiny() -> SimConfig {
 /// Runs every golden configuration; scenes that cannot be found are skipped (the caller
 /// decides whether that is allowed).
 fn run_all(missing: &mut Vec<String>) -> Vec<Golden> {
-    let cfg = tiny();
+    run_each(&tiny(), 1, missing)
+        .into_iter()
+        .map(|(key, r)| Golden::of(key, &r))
+        .collect()
+}
+
+/// Runs every golden configuration on chip `cfg` and `threads` host threads: each run's
+/// key and result.
+fn run_each(
+    cfg: &SimConfig,
+    threads: usize,
+    missing: &mut Vec<String>,
+) -> Vec<(String, SimResult)> {
     let mut out = Vec::new();
     for (name, is_file) in SCENES {
         let scene = if is_file {
@@ -159,8 +171,9 @@ fn run_all(missing: &mut Vec<String>) -> Vec<Golden> {
             for model in ThreadModel::ALL {
                 for accel in SimAccel::ALL {
                     let r = simulate(
-                        &FrameRequest::new(&scene, &structures, accel, &settings, &cfg)
-                            .with_model(model),
+                        &FrameRequest::new(&scene, &structures, accel, &settings, cfg)
+                            .with_model(model)
+                            .with_threads(threads),
                         &|_, _| {},
                     )
                     .unwrap_or_else(|e| panic!("{short} {wl_name} {}: {e}", accel.name()));
@@ -169,7 +182,7 @@ fn run_all(missing: &mut Vec<String>) -> Vec<Golden> {
                         model.name(),
                         accel.name()
                     );
-                    out.push(Golden::of(key, &r));
+                    out.push((key, r));
                 }
             }
         }
@@ -259,4 +272,47 @@ fn golden_runs_are_unchanged() {
         "runs were skipped but expected.toml has no more runs than were compared"
     );
     assert!(!runs.is_empty());
+}
+
+/// The golden configurations on 1, 2, 3 and 7 host threads give the same result, field
+/// for field and pixel for pixel (compared as their JSON): every configuration, both
+/// thread models and both workloads on `builtin:cornell`, on the tiny chip widened to 8 TMs
+/// so that every thread count splits the TMs differently. The frames are smaller than the
+/// golden runs': a frame on more host threads than the host has cores meets at every
+/// simulated cycle, slowly.
+#[test]
+fn host_threads_change_no_result() {
+    let mut cfg = tiny();
+    cfg.tms = 8;
+    let scene = dualsplit_scene::load("builtin:cornell").unwrap();
+    let structures = Structures::build(&scene.triangles, &Default::default());
+    let run = |threads: usize| -> Vec<(String, String)> {
+        let mut out = Vec::new();
+        for (wl, w, h) in [(Workload::Cast, 24, 16), (Workload::Path, 16, 16)] {
+            let settings = RenderSettings::new(w, h, wl);
+            for model in ThreadModel::ALL {
+                for accel in SimAccel::ALL {
+                    let r = simulate(
+                        &FrameRequest::new(&scene, &structures, accel, &settings, &cfg)
+                            .with_model(model)
+                            .with_threads(threads),
+                        &|_, _| {},
+                    )
+                    .unwrap();
+                    let key = format!("{} {} {}", model.name(), wl.name(), accel.name());
+                    out.push((key, serde_json::to_string(&r).expect("a result serializes")));
+                }
+            }
+        }
+        out
+    };
+    let one = run(1);
+    assert!(one.iter().all(|(_, r)| r.contains("\"reads\"")));
+    for threads in [2, 3, 7] {
+        let other = run(threads);
+        assert_eq!(other.len(), one.len());
+        for ((key, a), (_, b)) in one.iter().zip(&other) {
+            assert!(a == b, "{key}: {threads} host threads differ from one");
+        }
+    }
 }

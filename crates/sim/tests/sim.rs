@@ -319,7 +319,8 @@ fn empty_frame_is_an_error() {
 mod synthetic {
     use dualsplit_geometry::Pcg32;
     use dualsplit_sim::SimConfig;
-    use dualsplit_sim::hw::{Chip, pipe::Pipe};
+    use dualsplit_sim::hw::atomic::AtomicUnit;
+    use dualsplit_sim::hw::{Chip, Stalls, pipe::Pipe};
     use dualsplit_sim::model::fast::op::Op;
     use dualsplit_sim::model::fast::replay::{WorkSource, run as run_chip};
     use dualsplit_sim::model::fast::thread::Thread;
@@ -330,7 +331,13 @@ mod synthetic {
         loads: u64,
     }
     impl WorkSource for Random {
-        fn next(&mut self, _id: usize, _t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
+        fn next(
+            &mut self,
+            _id: usize,
+            _t: &mut Thread,
+            _a: &mut AtomicUnit,
+            _s: &mut Stalls,
+        ) -> Option<Vec<Op>> {
             if self.left == 0 {
                 return None;
             }

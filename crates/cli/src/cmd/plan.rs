@@ -37,6 +37,11 @@ pub struct Args {
     /// l1.size_bytes=32768,65536 or units.dst_pipes=1,2). Repeat for a cross product.
     #[arg(long = "vary", value_name = "KEY=V1,V2,...")]
     vary: Vec<String>,
+    /// Host threads to plan the study's runs for: the printed command runs jobs side by
+    /// side on them, each `run-job` with its share (`--sim-threads`). Nothing in the plan
+    /// depends on it.
+    #[command(flatten)]
+    threads: crate::args::SimThreads,
 }
 
 /// Runs the subcommand.
@@ -127,6 +132,14 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         dualsplit_report::study::vary::cross_product(&plan.vary).len(),
         duration(longest_s),
         r = scope.res,
+    );
+    let (side, each) = dualsplit_sim::share_threads(plan.entries.len(), args.threads.get());
+    outln!(
+        "run it on {} host threads: seq 0 {} | xargs -P {side} -I{{}} dualsplit -q run-job {} {{}} \
+         --sim-threads {each}",
+        side * each,
+        plan.entries.len() - 1,
+        args.out.display(),
     );
     Ok(ExitCode::SUCCESS)
 }

@@ -60,6 +60,8 @@ pub struct Args {
     /// Output directory.
     #[arg(long)]
     out: Option<PathBuf>,
+    #[command(flatten)]
+    threads: crate::args::SimThreads,
     /// Print the plan (scenes, frames, configurations) and the time estimate, then stop
     /// without loading anything.
     #[arg(long)]
@@ -165,7 +167,8 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         ctx,
         bar: Mutex::new(None),
     };
-    let producer = Producer::new(Cache::new(out.join("cache")), settings, &bars, &*simulate);
+    let producer = Producer::new(Cache::new(out.join("cache")), settings, &bars, &*simulate)
+        .sim_threads(args.threads.get());
     let mut data = producer.run(&scenes, skipped)?;
     data.scene_files = scope.scene_files;
     let written = dualsplit_report::write_report(&data, &out)?;

@@ -15,6 +15,8 @@ pub struct Args {
     dir: PathBuf,
     /// The plan entry to run (0-based; a Slurm array's $SLURM_ARRAY_TASK_ID).
     index: usize,
+    #[command(flatten)]
+    threads: crate::args::SimThreads,
 }
 
 /// Runs the subcommand.
@@ -27,7 +29,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         }
         bar.set_position(done);
     };
-    let outcome = run_job(&args.dir, args.index, &progress);
+    let outcome = run_job(&args.dir, args.index, args.threads.get(), &progress);
     bar.finish_and_clear();
     match outcome? {
         JobOutcome::AlreadyDone(path) => {

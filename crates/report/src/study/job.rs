@@ -26,10 +26,12 @@ pub enum JobOutcome {
     },
 }
 
-/// Runs entry `index` of the study in `dir`; `progress(done, total)` gets pixel counts.
+/// Runs entry `index` of the study in `dir` on `threads` host threads (the result does
+/// not depend on them); `progress(done, total)` gets pixel counts.
 pub fn run_job(
     dir: &Path,
     index: usize,
+    threads: usize,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<JobOutcome, StudyError> {
     let plan = Plan::load(dir)?;
@@ -44,7 +46,7 @@ pub fn run_job(
         Stored::Invalid(why) => Some(why),
     };
     let t0 = Instant::now();
-    let result = simulate_entry(entry, progress)?;
+    let result = simulate_entry(entry, threads, progress)?;
     let wall_s = t0.elapsed().as_secs_f64();
     let record = JobRecord {
         code_version: code_version(),
@@ -73,9 +75,10 @@ pub fn run_job(
 }
 
 /// Loads the entry's scene (checking its content hash), builds its structures with the
-/// report's settings and simulates the frame.
+/// report's settings and simulates the frame on `threads` host threads.
 pub fn simulate_entry(
     entry: &PlanEntry,
+    threads: usize,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<dualsplit_sim::SimResult, StudyError> {
     let fail = |reason: String| StudyError::Job {
@@ -105,7 +108,8 @@ pub fn simulate_entry(
             &settings,
             &entry.config,
         )
-        .with_model(entry.thread_model),
+        .with_model(entry.thread_model)
+        .with_threads(threads),
         progress,
     )
     .map_err(|e| fail(format!("simulating: {e}")))

@@ -73,6 +73,7 @@ pub fn fake_simulate(
     accel: SimAccel,
     settings: &RenderSettings,
     cfg: &SimConfig,
+    _threads: usize,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<SimResult, String> {
     let total = u64::from(settings.width * settings.height);

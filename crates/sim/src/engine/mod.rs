@@ -1,27 +1,54 @@
-//! The event loop: one loop for both thread models.
+//! The event loop: one loop for both thread models, on one host thread or several.
 //!
-//! The timing wheel (`wheel.rs`) hands out the threads whose next step can start at the next cycle
-//! with events. Each is stepped by its thread model ([`Threads::step`]) against its TM's
-//! units while it can start in that cycle, and goes back to sleep until the cycle it can
-//! continue ([`Wake`]). The frame ends when the last result of the last thread has arrived.
-//! Requests reserve their units at their own start cycle, never before the current event
-//! time, and events are processed in time order, so reservations are made in (nearly)
-//! causal order.
+//! The timing wheel (`wheel.rs`) hands out the threads whose next step can start at the next
+//! cycle with events. Each cycle runs in two phases:
+//!
+//! 1. **Local phase.** Each thread of the cycle is stepped by its thread model
+//!    ([`Lane::step`]) against its own TM's units (L1 hits, pipelines, pools, reciprocal
+//!    unit, instruction cache) while it can start in that cycle, and goes back to sleep until
+//!    the cycle it can continue ([`Wake`]). A step that needs something outside its TM (an L1
+//!    miss to the L2, the atomic unit, the frame buffer) stops before it and asks for the
+//!    commit phase ([`Wake::Commit`]).
+//! 2. **Commit phase.** Those threads are stepped again ([`Lane::commit`]) with the chip's
+//!    shared units, in a fixed order: by TM, then in the order their TM's threads asked. As
+//!    in hardware whose crossbar grants the L2 by a fixed priority, the requests of one cycle
+//!    reach the L2 in TM order.
+//!
+//! TMs are split into contiguous groups, one per host thread ([`Lane`]). A TM's local phase
+//! touches only that TM, and its threads' order within a cycle depends only on that TM's
+//! history, so the groups run their local phases in parallel; the commit phase walks the
+//! groups in TM order, one after another. The result is therefore bit-identical for any
+//! number of host threads. The frame ends when the last result of the last thread has
+//! arrived.
 //!
 //! ```text
-//!   engine::run ──▶ wheel: next cycle's threads, in the order they were scheduled
-//!        │
-//!        ▼ Threads::step(id, &mut Chip, now) -> Wake::{At, Forward, Done}
+//!   engine::run ──▶ per group: a wheel of its threads' wake-ups; all groups agree on the
+//!        │          next cycle with events (sync::Meeting)
+//!        ▼ Lane::step(id, TM, now) -> Wake::{At, Forward, Done, Commit}   (in parallel)
+//!        ▼ Lane::commit(id, TM, L2, atomic unit, now)                     (in TM order)
 //!   model::rv32 (thread processors executing the compiled kernels)
 //!   model::fast (threads replaying recorded macro-ops)
 //!        │
 //!        ▼ requests at a cycle, answers with the cycle their result is ready
 //!   hw::Chip: TMs (L1, pipelines, reciprocal unit, pools), L2, DRAM, atomic unit
 //! ```
+//!
+//! Anchors: Arches-v2 (`src/arches-v2/simulator/simulator.cpp`) runs every cycle as two
+//! phases over unit groups with latched ports, deterministic; Accel-Sim's OpenMP version
+//! runs SMs in parallel with per-SM statistics; SimTRaX's `--simulation-threads` takes L2
+//! requests under a mutex in host-thread order, so its results can depend on the
+//! interleaving, which the fixed commit order here rules out.
 
+pub(crate) mod sync;
 pub(crate) mod wheel;
 
-use crate::hw::{Chip, Cycle};
+use crate::hw::atomic::AtomicUnit;
+use crate::hw::memory::L2;
+use crate::hw::tm::Tm;
+use crate::hw::{Chip, Cycle, Stalls};
+use std::ops::Range;
+use std::sync::{Mutex, PoisonError};
+use sync::{Meeting, Turns};
 use wheel::{NONE, Wheel};
 
 pub use wheel::HOPS;
@@ -37,70 +64,306 @@ pub enum Wake {
     Forward(Cycle, [u32; HOPS]),
     /// Never: it is done, and its last result arrives at this cycle.
     Done(Cycle),
+    /// In this cycle's commit phase ([`Lane::commit`]): its next request needs a unit
+    /// outside its TM. Only [`Lane::step`] returns it, before making that request.
+    Commit,
 }
 
-/// A thread model: the threads of a frame, as the event loop steps them.
-pub trait Threads {
+/// What the commit phase reaches besides a thread's TM: the chip's shared units and the
+/// thread model's shared state.
+pub struct Commit<'c, S> {
+    /// The L2 (and the DRAM behind it).
+    pub l2: &'c mut L2,
+    /// The global atomic unit.
+    pub atomic: &'c mut AtomicUnit,
+    /// The thread model's shared state (the frame buffer, the work source).
+    pub model: &'c mut S,
+}
+
+/// A group of threads, on the contiguous TMs [`Lane::tms`], as one host thread steps
+/// them. Thread ids are the lane's own, `0..count`.
+pub trait Lane: Send {
     /// What a step can fail with.
-    type Error;
-    /// Whether [`Threads::touch`] is worth a pass over each cycle's threads.
+    type Error: Send;
+    /// The thread model's state that only the commit phase touches.
+    type Shared: Send;
+    /// Whether [`Lane::touch`] is worth a pass over each cycle's threads.
     const TOUCH: bool = false;
-    /// The number of threads (ids `0..count`).
+    /// The number of threads.
     fn count(&self) -> usize;
+    /// The chip's TMs this lane's threads run on.
+    fn tms(&self) -> Range<usize>;
+    /// The TM of thread `id`, counted from the lane's first.
+    fn tm_of(&self, id: usize) -> usize;
     /// Reads (without effect) the host memory thread `id`'s next step will touch first, so
     /// that the host cache misses of a cycle's threads overlap; returns a value to keep the
     /// reads. Changes nothing simulated.
     #[inline]
-    fn touch(&self, _id: usize, _chip: &Chip) -> u64 {
+    fn touch(&self, _id: usize, _tm: &Tm) -> u64 {
         0
     }
-    /// Runs thread `id` while it can start at cycle `now`.
-    fn step(&mut self, id: usize, chip: &mut Chip, now: Cycle) -> Result<Wake, Self::Error>;
-    /// Called after every cycle with events (progress reports).
+    /// Runs thread `id` while it can start at cycle `now` on its TM `tm` alone; returns
+    /// [`Wake::Commit`] before a request that needs anything else.
+    fn step(
+        &mut self,
+        id: usize,
+        tm: &mut Tm,
+        stalls: &mut Stalls,
+        now: Cycle,
+    ) -> Result<Wake, Self::Error>;
+    /// Runs thread `id`, which asked for the commit phase at cycle `now`, with the chip's
+    /// shared units; never returns [`Wake::Commit`].
+    fn commit(
+        &mut self,
+        id: usize,
+        tm: &mut Tm,
+        stalls: &mut Stalls,
+        shared: Commit<'_, Self::Shared>,
+        now: Cycle,
+    ) -> Result<Wake, Self::Error>;
+    /// Called once after each cycle with events, after its commit phase (progress reports).
     #[inline]
-    fn after_cycle(&mut self) {}
+    fn after_cycle(_shared: &mut Self::Shared) {}
 }
 
-/// Runs every thread of `threads` to completion on `chip`; returns the cycle the last
-/// result arrived, and sets the chip's idle-at-end stall count.
-pub fn run<T: Threads>(chip: &mut Chip, threads: &mut T) -> Result<Cycle, T::Error> {
-    let n = threads.count();
+/// The TMs of each of at most `threads` host threads: `tms` split into contiguous groups
+/// of sizes differing by at most one, in order (at least one group).
+pub fn groups(tms: usize, threads: usize) -> Vec<Range<usize>> {
+    let n = threads.clamp(1, tms.max(1));
+    (0..n).map(|k| k * tms / n..(k + 1) * tms / n).collect()
+}
+
+/// How to share `threads` host threads among `frames` frames: (frames run side by side,
+/// host threads per frame). Side by side first (frames scale perfectly; one frame's
+/// threads meet every cycle), so each frame gets more than one thread only when there are
+/// fewer frames than threads.
+pub fn share_threads(frames: usize, threads: usize) -> (usize, usize) {
+    let threads = threads.max(1);
+    let side = frames.clamp(1, threads);
+    (side, threads / side)
+}
+
+/// The chip's shared units and the model's shared state, behind the lock that separates
+/// the phases.
+struct Common<'a, S> {
+    l2: &'a mut L2,
+    atomic: &'a mut AtomicUnit,
+    model: &'a mut S,
+}
+
+/// What one lane leaves: its threads' finish cycles, its stall counts, and its first
+/// error with the chip TM it came from.
+struct Left<E> {
+    finish: Vec<Cycle>,
+    stalls: Stalls,
+    error: Option<(usize, E)>,
+}
+
+/// Runs every thread of `lanes` to completion on `chip`, one host thread per lane (the
+/// lanes' TMs must cover the chip's in order); returns the cycle the last result arrived,
+/// and adds the threads' stall counts and the idle-at-end count to the chip's. When steps
+/// fail, the error of the lowest TM in the first cycle with errors is returned.
+pub fn run<L: Lane>(
+    chip: &mut Chip,
+    lanes: &mut [L],
+    shared: &mut L::Shared,
+) -> Result<Cycle, L::Error> {
+    let (tms, l2, atomic, chip_stalls) = chip.parts();
+    let mut rest = tms;
+    let mut parts = Vec::with_capacity(lanes.len());
+    let mut at = 0;
+    for lane in lanes.iter() {
+        let r = lane.tms();
+        assert_eq!(r.start, at, "lanes must cover the TMs in order");
+        let (mine, others) = std::mem::take(&mut rest).split_at_mut(r.len());
+        parts.push(mine);
+        rest = others;
+        at = r.end;
+    }
+    assert!(rest.is_empty(), "lanes must cover every TM");
+    let common = Mutex::new(Common {
+        l2,
+        atomic,
+        model: shared,
+    });
+    let parties = lanes.len();
+    let (meeting, turns) = (Meeting::new(parties), Turns::new(parties));
+    let left: Vec<Left<L::Error>> = if parties == 1 {
+        lanes
+            .iter_mut()
+            .zip(parts)
+            .map(|(lane, tms)| drive(lane, tms, &common, None))
+            .collect()
+    } else {
+        let (meeting, turns, common) = (&meeting, &turns, &common);
+        std::thread::scope(|s| {
+            let handles: Vec<_> = lanes
+                .iter_mut()
+                .zip(parts)
+                .enumerate()
+                .map(|(p, (lane, tms))| {
+                    s.spawn(move || drive(lane, tms, common, Some((p, meeting, turns))))
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .collect()
+        })
+    };
+    let end = left
+        .iter()
+        .flat_map(|l| l.finish.iter().copied())
+        .max()
+        .unwrap_or(Cycle::ZERO);
+    let mut error: Option<(usize, L::Error)> = None;
+    for l in left {
+        chip_stalls.add(&l.stalls);
+        chip_stalls.idle += l.finish.iter().map(|&f| end - f).sum::<u64>();
+        if let Some((tm, e)) = l.error
+            && error.as_ref().is_none_or(|(t, _)| tm < *t)
+        {
+            error = Some((tm, e));
+        }
+    }
+    match error {
+        Some((_, e)) => Err(e),
+        None => Ok(end),
+    }
+}
+
+/// Raises the meeting's poison flag if its lane panics, so the other lanes stop waiting.
+struct PoisonOnPanic<'m>(Option<&'m Meeting>);
+
+impl Drop for PoisonOnPanic<'_> {
+    fn drop(&mut self) {
+        if let Some(m) = self.0
+            && std::thread::panicking()
+        {
+            m.poison();
+        }
+    }
+}
+
+/// Keeps `e` (from chip TM `tm`) when it is the lane's first error or from a lower TM.
+fn note<E>(error: &mut Option<(usize, E)>, tm: usize, e: E) {
+    if error.as_ref().is_none_or(|(t, _)| tm < *t) {
+        *error = Some((tm, e));
+    }
+}
+
+/// Puts thread `id` back into `wheel` as `w` says.
+#[inline(always)]
+fn schedule(wheel: &mut Wheel, finish: &mut [Cycle], deferred: &mut Vec<u32>, id: u32, w: Wake) {
+    match w {
+        Wake::At(t) => wheel.push(t, id),
+        Wake::Forward(t, hops) => wheel.push_forward(t, hops, id),
+        Wake::Done(t) => finish[id as usize] = t,
+        Wake::Commit => deferred.push(id),
+    }
+}
+
+/// One lane's loop: its wheel, cycle after cycle with events, its local phase and its
+/// turn of the commit phase; `sync` is its party number and the lanes' meeting and turns
+/// when there is more than one lane.
+fn drive<L: Lane>(
+    lane: &mut L,
+    tms: &mut [Tm],
+    common: &Mutex<Common<'_, L::Shared>>,
+    sync: Option<(usize, &Meeting, &Turns)>,
+) -> Left<L::Error> {
+    let _guard = PoisonOnPanic(sync.map(|(_, m, _)| m));
+    if let Some((p, m, _)) = sync {
+        m.join(p);
+    }
+    let n = lane.count();
+    let tm0 = lane.tms().start;
+    let last_party = sync.is_none_or(|(p, m, _)| p + 1 == m.parties());
     let mut wheel = Wheel::new(n);
     for i in 0..n as u32 {
         wheel.push(Cycle::ZERO, i);
     }
     let mut finish = vec![Cycle::ZERO; n];
-    while let Some((now, first)) = wheel.next_bucket() {
-        if T::TOUCH {
-            let mut touched = 0;
+    let mut stalls = Stalls::default();
+    let mut error: Option<(usize, L::Error)> = None;
+    let mut deferred: Vec<u32> = Vec::new();
+    let mut bucket: Option<(Cycle, u32)> = None;
+    for round in 0.. {
+        if bucket.is_none() {
+            bucket = wheel.next_bucket();
+        }
+        let mine = bucket.map_or(u64::MAX, |(c, _)| c.get());
+        let (now, abort) = match sync {
+            None => (mine, error.is_some()),
+            Some((_, m, _)) => m.meet(round, mine, error.is_some()),
+        };
+        if abort || now == u64::MAX {
+            break;
+        }
+        let now = Cycle(now);
+        if mine == now.get() {
+            let (_, first) = bucket.take().expect("a bucket at this cycle");
+            if L::TOUCH {
+                let mut touched = 0;
+                let mut id = first;
+                while id != NONE {
+                    if !wheel.is_forward(id) {
+                        touched ^= lane.touch(id as usize, &tms[lane.tm_of(id as usize)]);
+                    }
+                    id = wheel.after(id);
+                }
+                std::hint::black_box(touched);
+            }
             let mut id = first;
             while id != NONE {
-                if !wheel.is_forward(id) {
-                    touched ^= threads.touch(id as usize, chip);
+                let next = wheel.after(id);
+                wheel.taken();
+                if let Some(to) = wheel.take_forward(id) {
+                    wheel.push(to, id);
+                    id = next;
+                    continue;
                 }
-                id = wheel.after(id);
-            }
-            std::hint::black_box(touched);
-        }
-        let mut id = first;
-        while id != NONE {
-            let next = wheel.after(id);
-            wheel.taken();
-            if let Some(to) = wheel.take_forward(id) {
-                wheel.push(to, id);
+                let tm = lane.tm_of(id as usize);
+                match lane.step(id as usize, &mut tms[tm], &mut stalls, now) {
+                    Ok(w) => schedule(&mut wheel, &mut finish, &mut deferred, id, w),
+                    Err(e) => note(&mut error, tm0 + tm, e),
+                }
                 id = next;
-                continue;
             }
-            match threads.step(id as usize, chip, now)? {
-                Wake::At(t) => wheel.push(t, id),
-                Wake::Forward(t, hops) => wheel.push_forward(t, hops, id),
-                Wake::Done(t) => finish[id as usize] = t,
-            }
-            id = next;
         }
-        threads.after_cycle();
+        if let Some((p, m, t)) = sync {
+            t.wait(round, p, m);
+        }
+        if !deferred.is_empty() || last_party {
+            let mut guard = common.lock().unwrap_or_else(PoisonError::into_inner);
+            let g = &mut *guard;
+            // By TM, then in the order the TM's threads asked (a stable sort).
+            deferred.sort_by_key(|&id| lane.tm_of(id as usize));
+            for &id in &deferred {
+                let tm = lane.tm_of(id as usize);
+                let shared = Commit {
+                    l2: &mut *g.l2,
+                    atomic: &mut *g.atomic,
+                    model: &mut *g.model,
+                };
+                match lane.commit(id as usize, &mut tms[tm], &mut stalls, shared, now) {
+                    Ok(Wake::Commit) => unreachable!("a commit step asked for the commit phase"),
+                    Ok(w) => schedule(&mut wheel, &mut finish, &mut Vec::new(), id, w),
+                    Err(e) => note(&mut error, tm0 + tm, e),
+                }
+            }
+            deferred.clear();
+            if last_party {
+                L::after_cycle(g.model);
+            }
+        }
+        if let Some((p, m, t)) = sync {
+            t.pass(round, p, m);
+        }
     }
-    let end = finish.iter().copied().max().unwrap_or(Cycle::ZERO);
-    chip.set_idle(finish.iter().map(|&f| end - f).sum());
-    Ok(end)
+    Left {
+        finish,
+        stalls,
+        error,
+    }
 }

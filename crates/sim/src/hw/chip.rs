@@ -4,7 +4,7 @@
 //! `tps_per_tm` thread processors each; each TM has its L1, pipelines, reciprocal unit and
 //! functional-unit pools ([`Tm`]); all TMs share the L2 and the DRAM ([`L2`]) and the global
 //! atomic unit from which threads take their pixels ([`AtomicUnit`]). A thread model drives
-//! them through [`Chip::units`]; the event loop is `engine::run`.
+//! them through [`Chip::units`], the event loop through [`Chip::parts`] (`engine::run`).
 
 use crate::config::SimConfig;
 use crate::hw::atomic::AtomicUnit;
@@ -72,15 +72,20 @@ impl Chip {
         }
     }
 
-    /// TM `tm` and the L2, read-only (host prefetch hints).
-    #[inline(always)]
-    pub fn tm(&self, tm: usize) -> (&Tm, &L2) {
-        (&self.tms[tm], &self.l2)
+    /// The number of TMs.
+    pub fn tm_count(&self) -> usize {
+        self.tms.len()
     }
 
-    /// Sets the thread-cycles spent idle at the end of the frame.
-    pub fn set_idle(&mut self, idle: u64) {
-        self.stalls.idle = idle;
+    /// The TMs, the L2, the atomic unit and the stall counters, apart (the event loop
+    /// hands the TMs to host threads and the rest to the commit phase).
+    pub fn parts(&mut self) -> (&mut [Tm], &mut L2, &mut AtomicUnit, &mut Stalls) {
+        (
+            &mut self.tms,
+            &mut self.l2,
+            &mut self.atomic,
+            &mut self.stalls,
+        )
     }
 
     /// The counters so far.

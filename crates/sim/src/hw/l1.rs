@@ -16,6 +16,41 @@ use crate::hw::issued::Issued;
 use crate::hw::memory::{Cache, CacheStats, L2, Lookup};
 use crate::hw::slots::{self, BankSlots};
 
+/// What serves an L1's misses: the [`L2`], or nothing ([`Resident`]).
+pub trait Backing {
+    /// Reads `line` for a miss of word `word` whose L1 slot was `at` ([`L2::read`]).
+    fn read(
+        &mut self,
+        line: LineAddr,
+        word: WordAddr,
+        at: Cycle,
+        now: Cycle,
+    ) -> (Cycle, Option<Cycle>);
+}
+
+impl Backing for L2 {
+    #[inline(always)]
+    fn read(
+        &mut self,
+        line: LineAddr,
+        word: WordAddr,
+        at: Cycle,
+        now: Cycle,
+    ) -> (Cycle, Option<Cycle>) {
+        L2::read(self, line, word, at, now)
+    }
+}
+
+/// No backing: for a load whose lines the L1 holds ([`L1::holds_all`]), which therefore
+/// never misses. The parallel engine's first phase loads through it, without the L2.
+pub struct Resident;
+
+impl Backing for Resident {
+    fn read(&mut self, line: LineAddr, _: WordAddr, _: Cycle, _: Cycle) -> (Cycle, Option<Cycle>) {
+        unreachable!("line {line:?} was checked to be held (L1::holds_all) and missed")
+    }
+}
+
 /// One TM's L1: tags, bank reservation tables and counters.
 pub struct L1 {
     cache: Cache,
@@ -59,9 +94,9 @@ impl L1 {
     /// bitmap test ([`BankSlots::try_run`]) and its words are counted at once; only a bank
     /// conflict takes the word-by-word path.
     #[inline(always)]
-    pub fn load(
+    pub fn load<B: Backing>(
         &mut self,
-        l2: &mut L2,
+        l2: &mut B,
         addr: WordAddr,
         words: u64,
         at: Cycle,
@@ -123,27 +158,39 @@ impl L1 {
         }
     }
 
-    /// Reads (without effect) the L1 tag and, when the L1 holds another line there, the L2
-    /// tag of `addr`'s line, and returns a value to keep the reads: the event loop calls it
-    /// for the coming loads of a wake-up cycle so the host cache misses of their lookups
-    /// overlap. Changes nothing simulated.
+    /// Whether the L1 holds every line of the `words` words from `addr` as a tag, read
+    /// without effect: then a load of them hits or merges, and never reaches the L2.
     #[inline]
-    pub fn touch(&self, l2: &L2, addr: WordAddr) -> u64 {
-        let line = LineAddr::new(addr.get() >> self.line_word_shift);
-        let l1 = self.cache.peek(line);
-        // Most loads hit the L1 and never read the L2's tags (1 MB at random).
-        if l1 == line.get() {
-            l1
-        } else {
-            l1 ^ l2.peek(line)
-        }
+    pub fn holds_all(&self, addr: WordAddr, words: u64) -> bool {
+        let shift = self.line_word_shift;
+        let (first, last) = (
+            addr.get() >> shift,
+            (addr.get() + words.max(1) - 1) >> shift,
+        );
+        (first..=last).all(|line| self.cache.holds(LineAddr::new(line)))
+    }
+
+    /// Reads (without effect) the L1 tag of `addr`'s line and returns a value to keep the
+    /// read: the event loop calls it for the coming loads of a wake-up cycle so the host
+    /// cache misses of their lookups overlap. Changes nothing simulated. (The L2's tags
+    /// are the commit phase's, which other host threads may be changing.)
+    #[inline]
+    pub fn touch(&self, addr: WordAddr) -> u64 {
+        self.cache
+            .peek(LineAddr::new(addr.get() >> self.line_word_shift))
     }
 
     /// The first word of a line segment, at its bank slot `slot`: the tag lookup, and on a
     /// miss the L2 read and the line's installation at its fill. Returns the cycle the word
     /// is in the register and the line's fill cycle.
     #[inline(always)]
-    fn first_word(&mut self, l2: &mut L2, w: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
+    fn first_word<B: Backing>(
+        &mut self,
+        l2: &mut B,
+        w: u64,
+        slot: Cycle,
+        now: Cycle,
+    ) -> (Cycle, Cycle) {
         self.accesses += 1;
         let line = w >> self.line_word_shift;
         match self.cache.lookup(LineAddr::new(line), slot) {
@@ -160,7 +207,14 @@ impl L1 {
     }
 
     #[inline(never)]
-    fn miss(&mut self, l2: &mut L2, line: u64, w: u64, slot: Cycle, now: Cycle) -> (Cycle, Cycle) {
+    fn miss<B: Backing>(
+        &mut self,
+        l2: &mut B,
+        line: u64,
+        w: u64,
+        slot: Cycle,
+        now: Cycle,
+    ) -> (Cycle, Cycle) {
         let (ready, refused) = l2.read(LineAddr::new(line), WordAddr::new(w), slot, now);
         if let Some(accepted) = refused {
             self.accepted = self.accepted.max(accepted);
@@ -184,9 +238,9 @@ impl L1 {
     /// rest are placed after it word by word. Returns the last word's cycle, the cycle the
     /// data is in the register, and the bank stall.
     #[inline(never)]
-    fn segment_conflict(
+    fn segment_conflict<B: Backing>(
         &mut self,
-        l2: &mut L2,
+        l2: &mut B,
         w: u64,
         k: u64,
         c: Cycle,

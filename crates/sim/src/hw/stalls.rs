@@ -31,3 +31,31 @@ pub struct Stalls {
     #[serde(default)]
     pub icache: u64,
 }
+
+impl Stalls {
+    /// Adds `o`'s counts to these.
+    pub fn add(&mut self, o: &Stalls) {
+        let Stalls {
+            memory,
+            pipeline_latency,
+            pipeline_busy,
+            fpinv,
+            l1_bank,
+            atomic,
+            idle,
+            dependency,
+            fu_busy,
+            icache,
+        } = *o;
+        self.memory += memory;
+        self.pipeline_latency += pipeline_latency;
+        self.pipeline_busy += pipeline_busy;
+        self.fpinv += fpinv;
+        self.l1_bank += l1_bank;
+        self.atomic += atomic;
+        self.idle += idle;
+        self.dependency += dependency;
+        self.fu_busy += fu_busy;
+        self.icache += icache;
+    }
+}

@@ -22,8 +22,8 @@ use crate::hw::counts::UnitStats;
 use crate::hw::fu::Pools;
 use crate::hw::icache::ICaches;
 use crate::hw::issued::Issued;
-use crate::hw::l1::L1;
-use crate::hw::memory::{CacheStats, L2};
+use crate::hw::l1::{Backing, L1};
+use crate::hw::memory::CacheStats;
 use crate::hw::pipe::{Pipe, Pipelines, TmPipes};
 use crate::hw::slots::{Slots, earliest};
 
@@ -57,15 +57,21 @@ impl Tm {
 
     /// A load through the TM's L1 ([`L1::load`]).
     #[inline(always)]
-    pub fn load(
+    pub fn load<B: Backing>(
         &mut self,
-        l2: &mut L2,
+        l2: &mut B,
         addr: WordAddr,
         words: u64,
         at: Cycle,
         now: Cycle,
     ) -> Issued {
         self.l1.load(l2, addr, words, at, now)
+    }
+
+    /// Whether the TM's L1 holds every line of the words ([`L1::holds_all`]).
+    #[inline]
+    pub fn holds_all(&self, addr: WordAddr, words: u64) -> bool {
+        self.l1.holds_all(addr, words)
     }
 
     /// A store through the TM's L1 ([`L1::store`]).
@@ -92,10 +98,10 @@ impl Tm {
         }
     }
 
-    /// Reads (without effect) the tags `addr`'s load will look up ([`L1::touch`]).
+    /// Reads (without effect) the L1 tag `addr`'s load will look up ([`L1::touch`]).
     #[inline]
-    pub fn touch(&self, l2: &L2, addr: WordAddr) -> u64 {
-        self.l1.touch(l2, addr)
+    pub fn touch(&self, addr: WordAddr) -> u64 {
+        self.l1.touch(addr)
     }
 
     /// Adds the TM's counters to `caches` and `units`.
@@ -110,7 +116,12 @@ impl Tm {
     /// One word load at bank slot `slot` (already reserved): the cycle the data is in the
     /// register.
     #[cfg(test)]
-    pub(crate) fn load_word(&mut self, l2: &mut L2, word: u64, slot: Cycle) -> Cycle {
+    pub(crate) fn load_word(
+        &mut self,
+        l2: &mut crate::hw::memory::L2,
+        word: u64,
+        slot: Cycle,
+    ) -> Cycle {
         self.l1.load_word(l2, word, slot)
     }
 }
@@ -118,6 +129,7 @@ impl Tm {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::hw::memory::L2;
 
     /// SimTRaX refuses an L2 request whose bank is taken in its cycle and the thread retries
     /// (`sim/L2Cache.cc:180-185`): the load's issue is held until the bank accepts it.

@@ -31,7 +31,7 @@ pub struct Args {
     #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
     /// Configurations, comma-separated: bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst,
-    /// cwbvh, cwbvh+, dst-q, or all (the eleven; simulated two at a time). Only the
+    /// cwbvh, cwbvh+, dst-q, or all (the eleven; side by side on --sim-threads). Only the
     /// structures they read are built. With more than one, a comparison table follows,
     /// relative to BVH2 when it is listed, else to the first. Default dst; with --tree,
     /// every configuration of the saved structure (dst-sw and dst for a DST), and `all`
@@ -65,6 +65,8 @@ pub struct Args {
     /// Print JSON instead of a table; `--json=FILE` writes it to FILE.
     #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true, default_missing_value = "-")]
     json: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    threads: crate::args::SimThreads,
 }
 
 fn parse_model(s: &str) -> Result<ThreadModel, String> {
@@ -124,6 +126,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         &accels,
         &settings,
         &cfg,
+        args.threads.get(),
         &|accel, done, _| {
             if let Some((_, bar)) = bars.iter().find(|(a, _)| *a == accel) {
                 bar.set_position(done);

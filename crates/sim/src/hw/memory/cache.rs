@@ -348,6 +348,21 @@ impl Cache {
         }
     }
 
+    /// Whether a way of `line`'s set holds `line` as its tag, read without effect: then
+    /// [`Cache::lookup`] finds it `Present` at every cycle (its fill may still be coming).
+    /// False says nothing: a replaced line or one on the in-flight list may still answer.
+    #[inline]
+    pub fn holds(&self, line: LineAddr) -> bool {
+        let line = line.get();
+        let s = self.set(line);
+        match &self.ways {
+            Ways::Narrow(w) => {
+                u32::fit(line).is_some_and(|l| w[s..s + self.assoc].iter().any(|way| way.line == l))
+            }
+            Ways::Wide(w) => w[s..s + self.assoc].iter().any(|way| way.line == line),
+        }
+    }
+
     /// The tag word of `line`'s first way, read without effect (see `Thread::touch`).
     #[inline]
     pub fn peek(&self, line: LineAddr) -> u64 {

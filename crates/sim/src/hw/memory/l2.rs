@@ -93,13 +93,6 @@ impl L2 {
         (ready, refused)
     }
 
-    /// The tag word of `line`'s first way, read without effect: lets the event loop bring
-    /// the host memory of a coming lookup into the host's cache ahead of time.
-    #[inline]
-    pub fn peek(&self, line: LineAddr) -> u64 {
-        self.tags.peek(line)
-    }
-
     /// Adds the L2's counters to `c`.
     pub fn add_stats(&self, c: &mut CacheStats) {
         c.l2_accesses += self.accesses;

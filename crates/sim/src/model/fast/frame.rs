@@ -7,7 +7,8 @@ use crate::accel::SimAccel;
 use crate::config::KernelsConfig;
 use crate::error::SimError;
 use crate::frame::FrameRequest;
-use crate::hw::Chip;
+use crate::hw::atomic::AtomicUnit;
+use crate::hw::{Chip, Stalls};
 use crate::model::ThreadModel;
 use crate::model::fast::costs;
 use crate::model::fast::event::Event;
@@ -85,7 +86,13 @@ impl<S: TraversalSet> WorkSource for Pixels<'_, S> {
     /// thread, the pixel taken from the global counter first): the same op sequence as the
     /// whole pixel recorded at once, but a thread's program stays small, so the replay's
     /// host memory traffic stays in cache.
-    fn next(&mut self, id: usize, thread: &mut Thread, chip: &mut Chip) -> Option<Vec<Op>> {
+    fn next(
+        &mut self,
+        id: usize,
+        thread: &mut Thread,
+        atomic: &mut AtomicUnit,
+        stalls: &mut Stalls,
+    ) -> Option<Vec<Op>> {
         if self.tracer.tally.error().is_some() {
             return None;
         }
@@ -108,8 +115,7 @@ impl<S: TraversalSet> WorkSource for Pixels<'_, S> {
         if self.next >= self.total {
             return None;
         }
-        let u = chip.units(thread.tm());
-        thread.atomic(u.atomic, u.stalls);
+        thread.atomic(atomic, stalls);
         self.tracer.tally.atomic();
         let px = self.next;
         self.next += 1;
@@ -175,7 +181,7 @@ pub(crate) fn run<S: TraversalSet>(
                 .placed_at(placement.image_base(), (params.as_bytes().len() / 4) as u16),
         },
     };
-    let cycles = replay::run(&mut chip, &mut threads, &mut work);
+    let cycles = replay::run_with(&mut chip, &mut threads, &mut work, true, frame.threads);
     if let Some(e) = work.tracer.tally.error() {
         return Err(e.into());
     }

@@ -1,16 +1,23 @@
 //! Tests of the replay on the hardware units: exact cycles of loads, pipelines and stalls.
 
 use crate::config::SimConfig;
-use crate::hw::Chip;
+use crate::hw::atomic::AtomicUnit;
 use crate::hw::pipe::Pipe;
 use crate::hw::slots::Slots;
+use crate::hw::{Chip, Stalls};
 use crate::model::fast::op::Op;
 use crate::model::fast::replay::{WorkSource, run as run_chip, run_with as run_chip_with};
 use crate::model::fast::thread::Thread;
 
 struct Programs(Vec<Vec<Op>>);
 impl WorkSource for Programs {
-    fn next(&mut self, _id: usize, t: &mut Thread, _c: &mut Chip) -> Option<Vec<Op>> {
+    fn next(
+        &mut self,
+        _id: usize,
+        t: &mut Thread,
+        _a: &mut AtomicUnit,
+        _s: &mut Stalls,
+    ) -> Option<Vec<Op>> {
         // One program per thread.
         if t.has_no_program() {
             self.0.pop()
@@ -33,21 +40,26 @@ fn use_data() -> Op {
 
 /// Random programs of every op kind on 4 TMs × 8 threads (loads that hit, merge and
 /// miss, serial and parallel pipeline ops, reciprocal and plain instruction runs,
-/// atomics between programs): with forward entries every counter and the end cycle
-/// equal those of the plain wake-ups.
+/// atomics between programs): with forward entries, and on 2–4 host threads, every
+/// counter and the end cycle equal those of the plain wake-ups on one.
 #[test]
-fn forwards_change_no_result() {
+fn forwards_and_host_threads_change_no_result() {
     struct Random(dualsplit_geometry::Pcg32, Vec<u32>);
     impl WorkSource for Random {
-        fn next(&mut self, id: usize, t: &mut Thread, c: &mut Chip) -> Option<Vec<Op>> {
+        fn next(
+            &mut self,
+            id: usize,
+            t: &mut Thread,
+            atomic: &mut AtomicUnit,
+            stalls: &mut Stalls,
+        ) -> Option<Vec<Op>> {
             if self.1[id] == 0 {
                 return None;
             }
             self.1[id] -= 1;
             let r = &mut self.0;
             if r.below(2) == 0 {
-                let u = c.units(t.tm());
-                t.atomic(u.atomic, u.stalls);
+                t.atomic(atomic, stalls);
             }
             let mut ops = Vec::new();
             for _ in 0..1 + r.below(40) {
@@ -78,19 +90,28 @@ fn forwards_change_no_result() {
     cfg.tms = 4;
     cfg.tps_per_tm = 8;
     for seed in 0..20 {
-        let run = |forwards| {
+        let run = |forwards, host_threads| {
             let mut chip = Chip::new(&cfg, 4);
             let mut th: Vec<Thread> = (0..32).map(|i| Thread::new(i / 8)).collect();
             let mut work = Random(dualsplit_geometry::Pcg32::new(seed, 3), vec![6; 32]);
-            let end = run_chip_with(&mut chip, &mut th, &mut work, forwards);
+            let end = run_chip_with(&mut chip, &mut th, &mut work, forwards, host_threads);
             (end, chip.stats())
         };
-        let plain = run(false);
+        let plain = run(false, 1);
         assert!(
             plain.1.stalls.memory > 0 && plain.1.stalls.pipeline_busy > 0,
             "{plain:?}"
         );
-        assert_eq!(run(true), plain, "seed {seed}");
+        assert_eq!(run(true, 1), plain, "seed {seed}");
+        // Split over host threads, the TMs' requests still reach the shared units in the
+        // same order.
+        for host_threads in [2, 3, 4] {
+            assert_eq!(
+                run(true, host_threads),
+                plain,
+                "seed {seed}, {host_threads}"
+            );
+        }
     }
 }
 

@@ -13,6 +13,7 @@ use crate::engine::HOPS;
 use crate::hw::Cycle;
 use crate::hw::atomic::AtomicUnit;
 use crate::hw::issued::Issued;
+use crate::hw::l1::Resident;
 use crate::hw::memory::L2;
 use crate::hw::tm::Tm;
 use crate::hw::{Stalls, WordAddr};
@@ -24,6 +25,17 @@ enum Cause {
     Memory,
     Fpinv,
     Atomic,
+}
+
+/// How far [`Thread::run`] got.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ran {
+    /// Its next op starts after the current cycle.
+    Asleep,
+    /// Its program is done.
+    Finished,
+    /// Its next op is a load that needs the L2, left to the commit phase.
+    Commit,
 }
 
 /// A thread's program and position in it. Aligned to a host cache line: the record is
@@ -111,32 +123,47 @@ impl Thread {
         self.result(r.ready, Cause::Atomic);
     }
 
-    /// Runs ops while they can start at or before `now`; returns false when the program is
-    /// finished. The thread's next event is then at [`Thread::next_issue`].
+    /// Runs ops while they can start at or before `now`: [`Ran::Asleep`] when the next
+    /// one starts later (at [`Thread::next_issue`]), [`Ran::Finished`] when the program is
+    /// done. Without `l2` (the event loop's local phase) a load whose lines the L1 does not
+    /// hold is not made: [`Ran::Commit`], to be run again with the L2.
     ///
     /// The common ops are executed inline: a plain instruction run, a load, a pipeline op.
     /// Reciprocal runs are out of line, so the function stays small and saves few registers
     /// per wake-up.
     #[inline]
-    pub fn run(&mut self, tm: &mut Tm, l2: &mut L2, stalls: &mut Stalls, now: Cycle) -> bool {
+    pub fn run(
+        &mut self,
+        tm: &mut Tm,
+        mut l2: Option<&mut L2>,
+        stalls: &mut Stalls,
+        now: Cycle,
+    ) -> Ran {
         while let Some(&op) = self.ops.get(self.pc) {
             if self.t > now {
-                return true;
+                return Ran::Asleep;
             }
             if !matches!(op, Op::Load { .. }) && self.ready > self.t {
                 let r = self.ready;
                 self.wait(r, stalls);
                 if r > now {
                     // Sleep until the operands are there.
-                    return true;
+                    return Ran::Asleep;
                 }
             }
-            self.pc += 1;
             match op {
                 Op::Issue { n, fpinv: 0 } => self.t += n as u64,
                 Op::Issue { n, fpinv } => self.issue_fpinv(n, fpinv, tm, stalls),
                 Op::Load { word, words } => {
-                    let r = tm.load(l2, WordAddr::new(word as u64), words as u64, self.t, now);
+                    let (addr, words) = (WordAddr::new(word as u64), words as u64);
+                    let r = match l2.as_deref_mut() {
+                        Some(l2) => tm.load(l2, addr, words, self.t, now),
+                        None if tm.holds_all(addr, words) => {
+                            tm.load(&mut Resident, addr, words, self.t, now)
+                        }
+                        // A miss: the L2 is the commit phase's.
+                        None => return Ran::Commit,
+                    };
                     stalls.l1_bank += r.busy;
                     self.done(r, Cause::Memory);
                 }
@@ -148,8 +175,9 @@ impl Thread {
                     self.t = r.next_issue;
                 }
             }
+            self.pc += 1;
         }
-        false
+        Ran::Finished
     }
 
     /// Reads (without effect) the host memory the thread's next op will touch first: the
@@ -157,11 +185,11 @@ impl Thread {
     /// every thread of a wake-up cycle before running them, so those host cache misses
     /// overlap instead of coming one after another. Returns a value to keep the reads.
     #[inline]
-    pub fn touch(&self, tm: &Tm, l2: &L2) -> u64 {
+    pub fn touch(&self, tm: &Tm) -> u64 {
         let op = self.ops.get(self.pc).copied();
         let read = matches!(op, Some(Op::Load { .. })) as u64;
         match self.next.or(op) {
-            Some(Op::Load { word, .. }) => read ^ tm.touch(l2, WordAddr::new(word as u64)),
+            Some(Op::Load { word, .. }) => read ^ tm.touch(WordAddr::new(word as u64)),
             _ => read,
         }
     }

@@ -3,53 +3,104 @@
 //! counter until they run out, and writes each pixel's radiance to the frame buffer
 //! (Lin et al. 2020, §4.3–4.4; the memory map of `docs/isa.md`).
 
-use crate::config::UnitConfig;
-use crate::engine::{self, Threads, Wake};
+use crate::config::{SimConfig, UnitConfig};
+use crate::engine::{self, Commit, Lane, Wake};
 use crate::error::SimError;
 use crate::frame::FrameRequest;
+use crate::hw::atomic::AtomicUnit;
 use crate::hw::counts::InstrCounts;
 use crate::hw::fu::{ClassCounts, FU_CLASSES};
-use crate::hw::{Chip, Cycle};
+use crate::hw::l1::Resident;
+use crate::hw::tm::Tm;
+use crate::hw::{Chip, Cycle, Stalls};
 use crate::model::ThreadModel;
 use crate::model::rv32::kernels::{FRAME_FLOATS_PER_PIXEL, Params, elf, placement};
 use crate::model::rv32::placement::Placement;
 use crate::model::rv32::tp::Tp;
 use crate::model::rv32::{
-    ExecError, FRAME_BUFFER_ADDR, FrameMemory, PARAMS_ADDR, PROGRAM_BASE, Program,
+    ExecError, FRAME_BUFFER_ADDR, FrameMemory, ImageView, PARAMS_ADDR, PROGRAM_BASE, Program,
 };
 use crate::result::SimResult;
 use dualsplit_accel::TraversalSet;
+use std::ops::Range;
 
-/// The thread processors of a frame, as the event loop steps them.
+/// The thread processors of a group of TMs, as one host thread of the event loop steps
+/// them.
 pub(crate) struct Compiled<'a, 'm> {
-    pub(crate) tps: Vec<Tp>,
+    pub(crate) tps: &'a mut [Tp],
+    /// The chip's TMs the TPs are on.
+    pub(crate) tms: Range<usize>,
+    pub(crate) tps_per_tm: usize,
     pub(crate) prog: &'a Program,
-    pub(crate) mem: &'a mut FrameMemory<'m>,
+    /// The frame's memory as the local phase reads it.
+    pub(crate) image: ImageView<'m>,
     pub(crate) placement: &'a Placement,
     pub(crate) cfg: &'a UnitConfig,
     pub(crate) counts: ClassCounts,
-    /// Pixels handed out at the last progress report.
-    pub(crate) handed_out: u32,
-    pub(crate) progress: &'a mut dyn FnMut(u32),
 }
 
-impl Threads for Compiled<'_, '_> {
+/// What the TPs share: the frame's memory, and the progress reports.
+pub(crate) struct FrameShared<'a, 'm> {
+    pub(crate) mem: &'a mut FrameMemory<'m>,
+    /// Pixels handed out at the last progress report.
+    pub(crate) handed_out: u32,
+    pub(crate) progress: &'a mut (dyn FnMut(u32) + Send),
+}
+
+impl<'a, 'm: 'a> Lane for Compiled<'a, 'm> {
     type Error = ExecError;
+    type Shared = FrameShared<'a, 'm>;
 
     fn count(&self) -> usize {
         self.tps.len()
     }
 
+    fn tms(&self) -> Range<usize> {
+        self.tms.clone()
+    }
+
+    #[inline]
+    fn tm_of(&self, id: usize) -> usize {
+        id / self.tps_per_tm
+    }
+
     /// Each thread is woken at the cycle its next instruction on a shared unit can issue.
     #[inline]
-    fn step(&mut self, id: usize, chip: &mut Chip, now: Cycle) -> Result<Wake, ExecError> {
-        let tp = &mut self.tps[id];
-        let units = chip.units(tp.tm());
-        tp.run(
+    fn step(
+        &mut self,
+        id: usize,
+        tm: &mut Tm,
+        stalls: &mut Stalls,
+        now: Cycle,
+    ) -> Result<Wake, ExecError> {
+        self.tps[id].run::<false, _, _>(
             self.prog,
-            self.mem,
+            &mut self.image,
             self.cfg,
-            units,
+            tm,
+            stalls,
+            None::<(&mut Resident, &mut AtomicUnit)>,
+            self.placement,
+            &mut self.counts,
+            now,
+        )
+    }
+
+    fn commit(
+        &mut self,
+        id: usize,
+        tm: &mut Tm,
+        stalls: &mut Stalls,
+        shared: Commit<'_, Self::Shared>,
+        now: Cycle,
+    ) -> Result<Wake, ExecError> {
+        self.tps[id].run::<true, _, _>(
+            self.prog,
+            shared.model.mem,
+            self.cfg,
+            tm,
+            stalls,
+            Some((shared.l2, shared.atomic)),
             self.placement,
             &mut self.counts,
             now,
@@ -57,12 +108,60 @@ impl Threads for Compiled<'_, '_> {
     }
 
     /// Reports the pixels handed out so far (global register 0) every 1024.
-    fn after_cycle(&mut self) {
-        if self.mem.globals[0] >= self.handed_out + 1024 {
-            self.handed_out = self.mem.globals[0];
-            (self.progress)(self.handed_out);
+    fn after_cycle(shared: &mut Self::Shared) {
+        if shared.mem.globals[0] >= shared.handed_out + 1024 {
+            shared.handed_out = shared.mem.globals[0];
+            (shared.progress)(shared.handed_out);
         }
     }
+}
+
+/// Runs `tps` (`cfg.tps_per_tm` per TM, in TM order) to their `ebreak` on `chip` and
+/// `host_threads` host threads; returns the end cycle and the instructions executed per
+/// class.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn run_tps(
+    chip: &mut Chip,
+    tps: &mut [Tp],
+    prog: &Program,
+    mem: &mut FrameMemory<'_>,
+    placement: &Placement,
+    cfg: &SimConfig,
+    host_threads: usize,
+    progress: &mut (dyn FnMut(u32) + Send),
+) -> Result<(Cycle, ClassCounts), ExecError> {
+    let per_tm = cfg.tps_per_tm as usize;
+    let image = mem.view();
+    let mut rest: &mut [Tp] = tps;
+    let mut lanes = Vec::new();
+    for tms in engine::groups(cfg.tms as usize, host_threads) {
+        let n = (tms.len() * per_tm).min(rest.len());
+        let (mine, others) = std::mem::take(&mut rest).split_at_mut(n);
+        rest = others;
+        lanes.push(Compiled {
+            tps: mine,
+            tms,
+            tps_per_tm: per_tm,
+            prog,
+            image,
+            placement,
+            cfg: &cfg.units,
+            counts: [0; FU_CLASSES],
+        });
+    }
+    let mut shared = FrameShared {
+        mem,
+        handed_out: 0,
+        progress,
+    };
+    let cycles = engine::run(chip, &mut lanes, &mut shared)?;
+    let mut counts: ClassCounts = [0; FU_CLASSES];
+    for lane in &lanes {
+        for (c, l) in counts.iter_mut().zip(lane.counts) {
+            *c += l;
+        }
+    }
+    Ok((cycles, counts))
 }
 
 /// Runs one frame of `accel`'s compiled kernel for `settings` on the chip of `cfg`.
@@ -106,29 +205,29 @@ pub(crate) fn run<S: TraversalSet>(
     let placement = placement(&params, &prog, image, cfg.l1.line_bytes);
     let mut chip = Chip::new(cfg, accel.pipes(&cfg.units));
     let total = frame.pixels();
-    let mut threads = Compiled {
-        tps: (0..cfg.tms * cfg.tps_per_tm)
-            .map(|i| {
-                Tp::new(
-                    &prog,
-                    (i / cfg.tps_per_tm) as usize,
-                    ((i % cfg.tps_per_tm) % cfg.units.icaches) as usize,
-                    cfg.units.local_store_bytes,
-                )
-            })
-            .collect(),
-        prog: &prog,
-        mem: &mut mem,
-        placement: &placement,
-        cfg: &cfg.units,
-        counts: [0; FU_CLASSES],
-        handed_out: 0,
-        progress: &mut |done| progress((done as u64).min(total), total),
-    };
-    let cycles = engine::run(&mut chip, &mut threads)?;
+    let mut tps: Vec<Tp> = (0..cfg.tms * cfg.tps_per_tm)
+        .map(|i| {
+            Tp::new(
+                &prog,
+                (i / cfg.tps_per_tm) as usize,
+                ((i % cfg.tps_per_tm) % cfg.units.icaches) as usize,
+                cfg.units.local_store_bytes,
+            )
+        })
+        .collect();
+    let mut report = |done: u32| progress((done as u64).min(total), total);
+    let (cycles, counts) = run_tps(
+        &mut chip,
+        &mut tps,
+        &prog,
+        &mut mem,
+        &placement,
+        cfg,
+        frame.threads,
+        &mut report,
+    )?;
     progress(total, total);
-    let rays = threads.tps.iter().map(Tp::rays).sum();
-    let counts = threads.counts;
+    let rays = tps.iter().map(Tp::rays).sum();
     let stats = chip.stats();
     let instructions = InstrCounts::from_classes(&counts, &stats.units);
     Ok(SimResult::assemble(

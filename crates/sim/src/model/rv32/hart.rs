@@ -99,6 +99,15 @@ pub enum ExecError {
         /// Access size in bytes.
         bytes: u32,
     },
+    /// An access a read-only view of memory does not hold ([`MemFault::Elsewhere`]): the
+    /// event loop runs the instruction again in its commit phase; never a frame's error.
+    #[error("pc {pc:#010x}: access to {addr:#010x} outside the read-only view")]
+    Elsewhere {
+        /// The pc.
+        pc: u32,
+        /// The address.
+        addr: u32,
+    },
     /// A load or store to an address no region maps.
     #[error("pc {pc:#010x}: access to unmapped address {addr:#010x}")]
     Unmapped {
@@ -335,6 +344,7 @@ impl Hart {
             MemFault::Unmapped => ExecError::Unmapped { pc, addr },
             MemFault::ReadOnly => ExecError::ReadOnly { pc, addr },
             MemFault::NoGlobal => ExecError::NoGlobal { pc, index },
+            MemFault::Elsewhere => ExecError::Elsewhere { pc, addr },
         }
     }
 

@@ -40,6 +40,10 @@ pub enum MemFault {
     ReadOnly,
     /// `rt.atominc` on a global register that does not exist.
     NoGlobal,
+    /// A read-only view ([`ImageView`]) was asked for what only the whole memory has (the
+    /// frame buffer, a store, the global registers): the engine's local phase leaves such
+    /// an access to its commit phase.
+    Elsewhere,
 }
 
 /// Global memory and the global register file, shared by all threads.
@@ -64,14 +68,77 @@ pub trait Memory {
     fn atominc(&mut self, index: u32) -> Result<u32, MemFault>;
 }
 
-/// The memory of one frame: a structure's image, a parameter block, a frame buffer and
-/// [`GLOBAL_REGISTERS`] global registers (all zero at the start).
-#[derive(Debug)]
-pub struct FrameMemory<'a> {
+/// The read-only part of a frame's memory, the structure's image and the parameter block:
+/// what a thread may read in the event loop's local phase, while other host threads run
+/// theirs. Anything else is [`MemFault::Elsewhere`].
+#[derive(Clone, Copy, Debug)]
+pub struct ImageView<'a> {
     words: &'a [u8],
     tri_base: u32,
     tris: &'a [u8],
     params: &'a [u8],
+}
+
+impl ImageView<'_> {
+    /// The region and offset of `addr` below the frame buffer.
+    #[inline(always)]
+    fn slice(&self, addr: u32) -> Option<(&[u8], usize)> {
+        if addr < PARAMS_ADDR {
+            let a = addr as usize;
+            if a < self.words.len() {
+                Some((self.words, a))
+            } else {
+                Some((self.tris, addr.checked_sub(self.tri_base)? as usize))
+            }
+        } else {
+            Some((self.params, (addr - PARAMS_ADDR) as usize))
+        }
+    }
+}
+
+impl Memory for ImageView<'_> {
+    #[inline(always)]
+    fn load<const N: usize>(&mut self, addr: u32) -> Result<[u8; N], MemFault> {
+        if addr >= FRAME_BUFFER_ADDR {
+            return Err(MemFault::Elsewhere);
+        }
+        let (s, o) = self.slice(addr).ok_or(MemFault::Unmapped)?;
+        get(s, o).ok_or(MemFault::Unmapped)
+    }
+
+    fn store<const N: usize>(&mut self, _: u32, _: [u8; N]) -> Result<(), MemFault> {
+        Err(MemFault::Elsewhere)
+    }
+
+    #[inline]
+    fn load_words(&mut self, addr: u32, out: &mut [u32]) -> Result<(), MemFault> {
+        if addr >= FRAME_BUFFER_ADDR {
+            return Err(MemFault::Elsewhere);
+        }
+        let (s, o) = self.slice(addr).ok_or(MemFault::Unmapped)?;
+        words(s, o, out)
+    }
+
+    fn atominc(&mut self, _: u32) -> Result<u32, MemFault> {
+        Err(MemFault::Elsewhere)
+    }
+}
+
+/// Reads `out.len()` little-endian words from `s` at offset `o`.
+#[inline(always)]
+fn words(s: &[u8], o: usize, out: &mut [u32]) -> Result<(), MemFault> {
+    let b = s.get(o..o + 4 * out.len()).ok_or(MemFault::Unmapped)?;
+    for (w, c) in out.iter_mut().zip(b.chunks_exact(4)) {
+        *w = u32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+    }
+    Ok(())
+}
+
+/// The memory of one frame: a structure's image, a parameter block, a frame buffer and
+/// [`GLOBAL_REGISTERS`] global registers (all zero at the start).
+#[derive(Debug)]
+pub struct FrameMemory<'a> {
+    image: ImageView<'a>,
     /// The frame buffer's bytes (3 little-endian f32 per pixel for the kernels of
     /// `kernels/`).
     pub frame: Vec<u8>,
@@ -96,10 +163,12 @@ impl<'a> FrameMemory<'a> {
         assert!(params.len() <= (FRAME_BUFFER_ADDR - PARAMS_ADDR) as usize);
         assert!(frame_bytes <= (super::PROGRAM_BASE - FRAME_BUFFER_ADDR) as usize);
         FrameMemory {
-            words,
-            tri_base,
-            tris,
-            params,
+            image: ImageView {
+                words,
+                tri_base,
+                tris,
+                params,
+            },
             frame: vec![0; frame_bytes],
             globals: [0; GLOBAL_REGISTERS],
         }
@@ -113,17 +182,15 @@ impl<'a> FrameMemory<'a> {
             .collect()
     }
 
+    /// The read-only part: the image and the parameter block.
+    pub fn view(&self) -> ImageView<'a> {
+        self.image
+    }
+
     #[inline(always)]
     fn slice(&self, addr: u32) -> Option<(&[u8], usize)> {
-        if addr < PARAMS_ADDR {
-            let a = addr as usize;
-            if a < self.words.len() {
-                Some((self.words, a))
-            } else {
-                Some((self.tris, addr.checked_sub(self.tri_base)? as usize))
-            }
-        } else if addr < FRAME_BUFFER_ADDR {
-            Some((self.params, (addr - PARAMS_ADDR) as usize))
+        if addr < FRAME_BUFFER_ADDR {
+            self.image.slice(addr)
         } else {
             Some((&self.frame, (addr - FRAME_BUFFER_ADDR) as usize))
         }
@@ -168,11 +235,7 @@ impl Memory for FrameMemory<'_> {
             return Err(MemFault::Unmapped);
         }
         let (s, o) = self.slice(addr).ok_or(MemFault::Unmapped)?;
-        let b = s.get(o..o + 4 * out.len()).ok_or(MemFault::Unmapped)?;
-        for (w, c) in out.iter_mut().zip(b.chunks_exact(4)) {
-            *w = u32::from_le_bytes([c[0], c[1], c[2], c[3]]);
-        }
-        Ok(())
+        words(s, o, out)
     }
 
     #[inline]

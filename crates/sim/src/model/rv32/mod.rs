@@ -84,7 +84,7 @@ pub use decode::{DecodeError, Info, Instr, Latches, Op, Reg, decode};
 pub use elf::{ElfError, PROGRAM_BASE, PROGRAM_END, Program};
 pub use hart::{CANONICAL_NAN, DstLatch, ExecError, Hart, MemAccess, Retired};
 pub use memory::{
-    FRAME_BUFFER_ADDR, FrameMemory, GLOBAL_REGISTERS, LOCAL_STORE_ADDR, MemFault, Memory,
-    PARAMS_ADDR,
+    FRAME_BUFFER_ADDR, FrameMemory, GLOBAL_REGISTERS, ImageView, LOCAL_STORE_ADDR, MemFault,
+    Memory, PARAMS_ADDR,
 };
 pub use run::{RunError, RunStats, run_counting, run_frame, run_to_halt};

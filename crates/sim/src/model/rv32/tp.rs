@@ -32,16 +32,17 @@
 
 use crate::config::UnitConfig;
 use crate::engine::Wake;
+use crate::hw::atomic::AtomicUnit;
 use crate::hw::fu::{ClassCounts, FuClass, Pool, Pools, fu_index};
 use crate::hw::issued::Issued;
-use crate::hw::memory::L2;
+use crate::hw::l1::{Backing, Resident};
 use crate::hw::pipe::Pipe;
 use crate::hw::tm::Tm;
-use crate::hw::{Cycle, Stalls, Units, WordAddr};
+use crate::hw::{Cycle, Stalls, WordAddr};
 use crate::model::rv32::hart::executed_class;
 use crate::model::rv32::placement::Placement;
 use crate::model::rv32::{
-    ExecError, FrameMemory, Hart, Info, LOCAL_STORE_ADDR, Latches, MemAccess, Op, Program, Reg,
+    ExecError, Hart, Info, LOCAL_STORE_ADDR, Latches, MemAccess, Memory, Op, Program, Reg,
 };
 
 /// The farthest a TP runs instructions on its own units and pools ahead of the current
@@ -107,6 +108,27 @@ struct Waiting {
     latches: Latches,
 }
 
+/// How an executed instruction's L1 access ends.
+#[derive(Clone, Copy, Debug)]
+enum Access {
+    /// A load: its result goes to `dst` (scoreboard index), and to `P` when `writes_pipe`.
+    Load {
+        dst: Option<usize>,
+        writes_pipe: bool,
+    },
+    /// A ray-tracing instruction with a memory operand: it issues once its words are in.
+    Pipe(Waiting),
+}
+
+/// An executed instruction whose L1 access misses, left to the commit phase: its access,
+/// how it ends, and the cycle it issued.
+#[derive(Clone, Copy, Debug)]
+struct Pending {
+    acc: MemAccess,
+    access: Access,
+    t: Cycle,
+}
+
 /// One thread processor.
 pub struct Tp {
     hart: Hart,
@@ -125,6 +147,8 @@ pub struct Tp {
     /// The latest result of any instruction so far.
     last: Cycle,
     waiting: Option<Waiting>,
+    /// Its L1 access that misses, executed in the local phase, timed in the commit phase.
+    pending: Option<Pending>,
     /// Rays traced: each sets the ray registers' origin once (`rt.setorg`).
     rays: u64,
 }
@@ -142,6 +166,7 @@ impl Tp {
             producer: LATCH_PRODUCERS,
             last: Cycle::ZERO,
             waiting: None,
+            pending: None,
             rays: 0,
         }
     }
@@ -159,30 +184,45 @@ impl Tp {
 
     /// Executes instructions while they can issue by `now` (those on the TP's own units
     /// and pools by `now + LOOKAHEAD`).
+    ///
+    /// `COMMIT` false is the event loop's local phase: `mem` is read-only, `l2` is never
+    /// reached and there is no atomic unit. Before an instruction that needs more (an L1
+    /// miss, a global store, `rt.atominc`, a read of the frame buffer) it returns
+    /// [`Wake::Commit`]; a load found to miss after it executed is kept as the pending
+    /// access. `COMMIT` true is the commit phase: the TP finishes its pending access, or
+    /// runs the instruction it stopped before, with the whole chip, and goes back to sleep
+    /// until its next issue slot.
     #[allow(clippy::too_many_arguments)]
-    pub fn run(
+    pub fn run<const COMMIT: bool, M: Memory, B: Backing>(
         &mut self,
         prog: &Program,
-        mem: &mut FrameMemory<'_>,
+        mem: &mut M,
         cfg: &UnitConfig,
-        u: Units<'_>,
+        tm: &mut Tm,
+        stalls: &mut Stalls,
+        mut shared: Option<(&mut B, &mut AtomicUnit)>,
         placement: &Placement,
         counts: &mut ClassCounts,
         now: Cycle,
     ) -> Result<Wake, ExecError> {
-        let Units {
-            tm,
-            l2,
-            atomic,
-            stalls,
-        } = u;
+        if COMMIT && let Some(p) = self.pending.take() {
+            let (l2, _) = shared.as_mut().expect("the commit phase has the L2");
+            let i = l1_load(tm, *l2, placement, &p.acc, p.t, now, stalls);
+            let w = self.finish_access(tm, i, p.access, now, stalls);
+            return Ok(w.unwrap_or(Wake::At(self.t)));
+        }
         if let Some(w) = self.waiting.take() {
             // Its words have arrived (the thread slept until then): the pipeline op issues.
             let r = tm.pipe(w.pipe, w.n, w.n > 1, self.t);
             stalls.pipeline_busy += r.busy;
             self.finish_pipe(r, w);
         }
+        let mut executed = false;
         loop {
+            if COMMIT && executed {
+                // The commit phase runs one instruction; the rest run in local phases.
+                return Ok(Wake::At(self.t));
+            }
             let Some(ins) = prog.fetch(self.hart.pc) else {
                 // The executor names the faulting pc.
                 return Err(self
@@ -227,21 +267,36 @@ impl Tp {
                 stalls.icache += fetched - self.t;
                 self.t = fetched;
             }
-            let shared = match info.fu {
+            let (shared_unit, global_store) = match info.fu {
                 // A load or store is the L1's unless it addresses the local store.
                 FuClass::Load | FuClass::Store => {
                     let addr = self.hart.x[ins.rs1 as usize].wrapping_add(ins.imm as u32);
-                    addr < LOCAL_STORE_ADDR
+                    let global = addr < LOCAL_STORE_ADDR;
+                    (global, global && info.fu == FuClass::Store)
                 }
-                fu => on_shared_unit(fu),
+                fu => (on_shared_unit(fu), false),
             };
-            if (shared && self.t > now) || self.t > now + LOOKAHEAD {
+            if (shared_unit && self.t > now) || self.t > now + LOOKAHEAD {
                 // Not issued yet: its fetch is made again when the thread next runs.
                 fetch.give_back(&mut tm.icache);
                 return Ok(Wake::At(self.t));
             }
+            if !COMMIT && (global_store || info.fu == FuClass::Atomic) {
+                // The frame buffer and the global registers are the commit phase's.
+                fetch.give_back(&mut tm.icache);
+                return Ok(Wake::Commit);
+            }
+            let acc = match self.hart.exec_access(ins, prog, mem) {
+                Ok(acc) => acc,
+                Err(ExecError::Elsewhere { .. }) if !COMMIT => {
+                    // A read of the frame buffer: nothing was executed.
+                    fetch.give_back(&mut tm.icache);
+                    return Ok(Wake::Commit);
+                }
+                Err(e) => return Err(e),
+            };
             fetch.keep(&mut tm.icache);
-            let acc = self.hart.exec_access(ins, prog, mem)?;
+            executed = true;
             // The executed class (a load or store whose address is the local store's).
             let fu = executed_class(info.fu, &acc);
             counts[fu_index(fu)] += 1;
@@ -267,18 +322,12 @@ impl Tp {
                     one_slot(i, Producer::Unit)
                 }
                 FuClass::Atomic => {
+                    let (_, atomic) = shared
+                        .as_mut()
+                        .expect("the commit phase has the atomic unit");
                     let i = atomic.increment(t);
                     stalls.atomic += i.busy;
                     one_slot(i, Producer::Atomic)
-                }
-                FuClass::Load => {
-                    let i = l1_load(tm, l2, placement, &acc, t, now, stalls);
-                    self.t = i.next_issue;
-                    self.write(dst, i.ready, Producer::Memory);
-                    if l.has(Latches::WRITES_PIPE) {
-                        self.ready[PIPE_SLOT] = self.ready[PIPE_SLOT].max(i.ready);
-                    }
-                    continue;
                 }
                 FuClass::Store => {
                     let i = tm.store(
@@ -292,38 +341,54 @@ impl Tp {
                     self.last = self.last.max(i.ready);
                     continue;
                 }
-                FuClass::BoxPipe(_) | FuClass::TriPipe | FuClass::DstPipe => {
-                    let (pipe, n) = match info.fu {
-                        FuClass::BoxPipe(n) => (Pipe::Box, n),
-                        FuClass::TriPipe => (Pipe::Triangle, 1),
-                        _ => (Pipe::DualSplit, 1),
+                FuClass::Load | FuClass::BoxPipe(_) | FuClass::TriPipe | FuClass::DstPipe => {
+                    let access = match info.fu {
+                        FuClass::BoxPipe(n) => Access::Pipe(Waiting {
+                            pipe: Pipe::Box,
+                            n,
+                            dst,
+                            latches: l,
+                        }),
+                        FuClass::TriPipe | FuClass::DstPipe => Access::Pipe(Waiting {
+                            pipe: if info.fu == FuClass::TriPipe {
+                                Pipe::Triangle
+                            } else {
+                                Pipe::DualSplit
+                            },
+                            n: 1,
+                            dst,
+                            latches: l,
+                        }),
+                        _ => Access::Load {
+                            dst,
+                            writes_pipe: l.has(Latches::WRITES_PIPE),
+                        },
                     };
-                    let i = l1_load(tm, l2, placement, &acc, t, now, stalls);
-                    let w = Waiting {
-                        pipe,
-                        n,
-                        dst,
-                        latches: l,
-                    };
-                    if l.has(Latches::READS_PIPE) {
+                    if let Access::Pipe(w) = access
+                        && l.has(Latches::READS_PIPE)
+                    {
                         // A register form: its words are in P (waited for above).
-                        let p = tm.pipe(pipe, n, n > 1, t);
+                        let p = tm.pipe(w.pipe, w.n, w.n > 1, t);
                         stalls.pipeline_busy += p.busy;
                         self.finish_pipe(p, w);
                         continue;
                     }
-                    // The words are in the unit's operand latches at `i.ready`; the
-                    // instruction holds the issue stage until then.
-                    let arrive = i.ready.max(i.next_issue);
-                    stalls.memory += arrive - i.next_issue;
-                    self.t = arrive;
-                    if arrive > now {
-                        self.waiting = Some(w);
-                        return Ok(Wake::At(arrive));
+                    let i = match shared.as_mut() {
+                        Some((l2, _)) => l1_load(tm, *l2, placement, &acc, t, now, stalls),
+                        None => {
+                            let words = acc.words as u64;
+                            let addr = WordAddr::from_byte(placement.physical(acc.addr));
+                            if !tm.holds_all(addr, words) {
+                                // A miss: the L2 is the commit phase's.
+                                self.pending = Some(Pending { acc, access, t });
+                                return Ok(Wake::Commit);
+                            }
+                            l1_load(tm, &mut Resident, placement, &acc, t, now, stalls)
+                        }
+                    };
+                    if let Some(w) = self.finish_access(tm, i, access, now, stalls) {
+                        return Ok(w);
                     }
-                    let p = tm.pipe(pipe, n, n > 1, arrive);
-                    stalls.pipeline_busy += p.busy;
-                    self.finish_pipe(p, w);
                     continue;
                 }
                 FuClass::Halt => {
@@ -341,6 +406,44 @@ impl Tp {
                 self.ready[PIPE_SLOT] = self.ready[PIPE_SLOT].max(slot + lat);
             }
         }
+    }
+
+    /// The timing `i` of an executed instruction's L1 access: a load's result in its
+    /// register, or a ray-tracing instruction's pipeline op once its words have arrived.
+    /// Returns the wake-up when the instruction holds the issue stage past `now` for its
+    /// words, `None` when the thread goes on at its next issue slot.
+    fn finish_access(
+        &mut self,
+        tm: &mut Tm,
+        i: Issued,
+        access: Access,
+        now: Cycle,
+        stalls: &mut Stalls,
+    ) -> Option<Wake> {
+        match access {
+            Access::Load { dst, writes_pipe } => {
+                self.t = i.next_issue;
+                self.write(dst, i.ready, Producer::Memory);
+                if writes_pipe {
+                    self.ready[PIPE_SLOT] = self.ready[PIPE_SLOT].max(i.ready);
+                }
+            }
+            Access::Pipe(w) => {
+                // The words are in the unit's operand latches at `i.ready`; the instruction
+                // holds the issue stage until then.
+                let arrive = i.ready.max(i.next_issue);
+                stalls.memory += arrive - i.next_issue;
+                self.t = arrive;
+                if arrive > now {
+                    self.waiting = Some(w);
+                    return Some(Wake::At(arrive));
+                }
+                let p = tm.pipe(w.pipe, w.n, w.n > 1, arrive);
+                stalls.pipeline_busy += p.busy;
+                self.finish_pipe(p, w);
+            }
+        }
+        None
     }
 
     /// The producer of the first operand of `info` (the registers in order, then the
@@ -380,9 +483,9 @@ impl Tp {
 
 /// The L1 load of an executed instruction's memory words from cycle `t`.
 #[inline]
-fn l1_load(
+fn l1_load<B: Backing>(
     tm: &mut Tm,
-    l2: &mut L2,
+    l2: &mut B,
     placement: &Placement,
     acc: &MemAccess,
     t: Cycle,
@@ -438,10 +541,10 @@ fn on_shared_unit(fu: FuClass) -> bool {
 mod tests {
     use super::*;
     use crate::config::SimConfig;
-    use crate::engine;
     use crate::hw::Chip;
+    use crate::model::rv32::FrameMemory;
     use crate::model::rv32::PROGRAM_BASE;
-    use crate::model::rv32::frame::Compiled;
+    use crate::model::rv32::frame::run_tps;
     use crate::model::rv32::tests::asm::*;
     use dualsplit_accel::MemoryImage;
 
@@ -456,17 +559,18 @@ mod tests {
         let mut chip = Chip::new(cfg, 1);
         let placement =
             crate::model::rv32::placement::Placement::new(0, 4 * w.len() as u64, 64, 64);
-        let mut threads = Compiled {
-            tps: (0..threads).map(|_| Tp::new(&prog, 0, 0, 4096)).collect(),
-            prog: &prog,
-            mem: &mut mem,
-            placement: &placement,
-            cfg: &cfg.units,
-            counts: [0; crate::hw::fu::FU_CLASSES],
-            handed_out: 0,
-            progress: &mut |_| {},
-        };
-        let end = engine::run(&mut chip, &mut threads).unwrap();
+        let mut tps: Vec<Tp> = (0..threads).map(|_| Tp::new(&prog, 0, 0, 4096)).collect();
+        let (end, _) = run_tps(
+            &mut chip,
+            &mut tps,
+            &prog,
+            &mut mem,
+            &placement,
+            cfg,
+            1,
+            &mut |_| {},
+        )
+        .unwrap();
         (end.get(), chip.stats().stalls)
     }
 
