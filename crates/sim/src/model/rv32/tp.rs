@@ -282,6 +282,7 @@ impl Tp {
                 }
                 FuClass::Store => {
                     let i = tm.store(
+                        l2,
                         WordAddr::from_byte(placement.physical(acc.addr)),
                         acc.words as u64,
                         t,
