@@ -208,6 +208,13 @@ pub struct UnitConfig {
     pub fpadd_latency: u64,
     /// Compiled kernels: latency of a TP's own FP multiplier.
     pub fpmul_latency: u64,
+    /// Compiled kernels: integer ALUs (add and bitwise) per TM shared by its TPs; 0 = each
+    /// TP has its own (paper §2.3). SimTRaX's `bigcache.config:16` has INTADD 16.
+    pub int_units: u32,
+    /// Compiled kernels: FP adders per TM shared by its TPs; 0 = each TP has its own.
+    pub fpadd_units: u32,
+    /// Compiled kernels: FP multipliers per TM shared by its TPs; 0 = each TP has its own.
+    pub fpmul_units: u32,
     /// Compiled kernels: FP compare units per TM (shared pool).
     pub fpcmp_units: u32,
     /// Their latency.
@@ -454,6 +461,9 @@ impl SimConfig {
                 int_latency: 1,
                 fpadd_latency: 2,
                 fpmul_latency: 2,
+                int_units: 0,
+                fpadd_units: 0,
+                fpmul_units: 0,
                 fpcmp_units: 16,
                 fpcmp_latency: 1,
                 fpminmax_units: 16,
@@ -619,6 +629,9 @@ impl SimConfig {
             ("units.int_latency", Int(u.int_latency)),
             ("units.fpadd_latency", Int(u.fpadd_latency)),
             ("units.fpmul_latency", Int(u.fpmul_latency)),
+            ("units.int_units", int(u.int_units)),
+            ("units.fpadd_units", int(u.fpadd_units)),
+            ("units.fpmul_units", int(u.fpmul_units)),
             ("units.fpcmp_units", int(u.fpcmp_units)),
             ("units.fpcmp_latency", Int(u.fpcmp_latency)),
             ("units.fpminmax_units", int(u.fpminmax_units)),

@@ -276,8 +276,10 @@ struct Channel {
     /// Ticks of the activations that may still share a t_FAW window with a later one,
     /// ascending.
     faw: Vec<u64>,
-    /// Lines in the write queue not yet drained, oldest first.
-    writes: Vec<u64>,
+    /// The write queue, oldest first: each write's line and the tick of its column command,
+    /// `u64::MAX` until it is drained (a drained write stays queued, and later writes of
+    /// its line merge into it, until its column command issues).
+    writes: Vec<(u64, u64)>,
     /// No column read before this tick: the end of the last drained write's data + t_WTR.
     wtr: u64,
 }
@@ -631,7 +633,8 @@ impl Dram {
     /// A 64-byte write of `line` (a store the L2 passed on, SimTRaX `sim/L2Cache.cc:374-383`)
     /// arriving at core cycle `arrive`, `now ≤ arrive` the engine's event time. It joins
     /// its channel's write queue, merging with a queued write of the same line (USIMM
-    /// `memory_controller.cc:839-841`); the store does not wait for it. The queue is
+    /// `memory_controller.cc:839-841`), drained or not, until that write's column command
+    /// issues; the store does not wait for it. The queue is
     /// drained as USIMM's scheduler does (`scheduler.cc:87-107`): when it holds more than
     /// `write_high` writes, down to `write_low`; when no read is queued, entirely. A drained
     /// write is reserved like a read at the tick of the write that started the drain
@@ -645,30 +648,42 @@ impl Dram {
         }
         let line = line.get();
         let (chi, _, _) = self.locate(line);
+        let a = arrive.to_ticks(c.ticks_per_cycle);
         let ch = &mut self.channels[chi];
-        if ch.writes.contains(&line) {
+        // Writes whose column command has issued by `a` have left the queue.
+        ch.writes.retain(|&(_, col)| col > a.get());
+        if ch.writes.iter().any(|&(l, _)| l == line) {
             self.stats.writes_merged += 1;
             return;
         }
-        ch.writes.push(line);
-        let a = arrive.to_ticks(c.ticks_per_cycle);
+        ch.writes.push((line, u64::MAX));
         ch.bus.retire_before(self.burst.div(a.get()));
-        let keep = if ch.writes.len() > c.write_high as usize {
+        let queued = ch.writes.len();
+        let keep = if queued > c.write_high as usize {
             c.write_low.min(c.write_high) as usize
         } else if ch.bus.pending() == 0 {
             0
         } else {
             return;
         };
-        let n = ch.writes.len() - keep;
-        let drained: Vec<u64> = ch.writes.drain(..n).collect();
-        for l in drained {
-            self.write_now(l, a, now);
+        // Drain the oldest writes not yet drained until `keep` would be left.
+        let mut n = queued.saturating_sub(keep);
+        for i in 0..queued {
+            if n == 0 {
+                break;
+            }
+            let (l, col) = self.channels[chi].writes[i];
+            if col == u64::MAX {
+                let col = self.write_now(l, a, now);
+                self.channels[chi].writes[i].1 = col.get();
+                n -= 1;
+            }
         }
     }
 
-    /// Reserves one drained write of `line` from tick `a` (see [`Dram::write`]).
-    fn write_now(&mut self, line: u64, a: Tick, now: Cycle) {
+    /// Reserves one drained write of `line` from tick `a` (see [`Dram::write`]); returns
+    /// the tick of its column command.
+    fn write_now(&mut self, line: u64, a: Tick, now: Cycle) -> Tick {
         let (chi, b, row) = self.locate(line);
         self.make_room(chi, b, now);
         let c = &self.cfg;
@@ -700,6 +715,7 @@ impl Dram {
             .max(Tick((end + c.t_wr).saturating_sub(c.t_rtp)));
         ch.wtr = ch.wtr.max(end + c.t_wtr);
         self.stats.writes += 1;
+        Tick(slot * c.t_burst) - c.t_cwd
     }
 
     /// Counts a read arriving at core cycle `arrive` whose data is complete at tick `done`.
@@ -933,6 +949,12 @@ mod tests {
         // no read column before 87. Read at cycle 3 (tick 6): column 87, data 115 → slot
         // 29, done 120 ticks = cycle 60.
         assert_eq!(d.rd(bank1 + 9, 3), (60, DramAccess::RowHit));
+        // A write of a drained line merges until that write's column command (tick 41)
+        // has issued; after it, it queues anew (a read is queued: no drain).
+        d.write(LineAddr::new(bank1), Cycle(4), Cycle(4));
+        assert_eq!(d.stats().writes_merged, 2);
+        d.write(LineAddr::new(bank1), Cycle(30), Cycle(30));
+        assert_eq!((d.stats().writes_merged, d.stats().writes), (2, 3));
         // With no read queued, a write drains at once.
         let mut d = Dram::new(&cfg);
         d.write(LineAddr::new(0), Cycle(100), Cycle(100));
