@@ -275,7 +275,7 @@ static float render_pixel(const struct Params *P, uint32_t x, uint32_t y)
             if (cosl > 0.0f) {
                 float contrib = throughput * ALBEDO / PI_F * P->light_power * cosl / d2;
                 struct Ray shadow = {p, to_l, 0.0f, 1.0f - 1e-4f};
-                if (!any_hit(&shadow))
+                if (!P->shadows || !any_hit(&shadow))
                     radiance += contrib;
             }
             if (!WORKLOAD_PATH || depth >= P->bounces)

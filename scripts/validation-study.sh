@@ -66,6 +66,8 @@ study() {
   study fu-shared-65nm "$RES" "$BOX" --workload cast,path --config configs/fu-shared-65nm.toml
   study fu-shared-bigcache "$RES" "$BOX" --workload cast,path \
     --config configs/fu-shared-bigcache.toml
+  # Shadow rays at every hit, or none (the paper does not say).
+  study shadows "$RES" "$BOX" --workload path --vary kernels.shadows=true,false
   study kernel-parity "$RES" "$BOX" --workload cast,path --vary kernels.parity=true,false
   study instruction-form "$RES" "$BOX" --workload cast,path --vary kernels.node_fetch=loads,operand
   # The scene: SimTRaX's Dragon Box against the reconstruction, open and closed.

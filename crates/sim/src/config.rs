@@ -298,6 +298,11 @@ pub struct KernelsConfig {
     pub parity: bool,
     /// How the ray-tracing instructions get their node words.
     pub node_fetch: NodeFetch,
+    /// `true`: the frame's shadow rays are traced as its render settings ask (one at every
+    /// hit by default); `false`: no shadow rays, the light sample counted as visible
+    /// (`RenderSettings::shadows`). A key of the chip's configuration so that a study can
+    /// vary it; the paper does not say whether its path tracer casts shadow rays.
+    pub shadows: bool,
 }
 
 impl Default for KernelsConfig {
@@ -305,6 +310,7 @@ impl Default for KernelsConfig {
         Self {
             parity: true,
             node_fetch: NodeFetch::Loads,
+            shadows: true,
         }
     }
 }
@@ -334,28 +340,34 @@ impl NodeFetch {
 }
 
 impl KernelsConfig {
-    /// The variant's index among [`KernelsConfig::ALL`].
+    /// The variant's index among [`KernelsConfig::ALL`] (`shadows` is read at run time
+    /// from the parameter block, not a variant of the compiled kernels).
     pub fn index(self) -> usize {
         self.parity as usize | ((self.node_fetch == NodeFetch::Loads) as usize) << 1
     }
 
-    /// Every variant, in the order of [`KernelsConfig::index`].
+    /// Every variant of the compiled kernels, in the order of [`KernelsConfig::index`]
+    /// (with shadow rays).
     pub const ALL: [KernelsConfig; 4] = [
         KernelsConfig {
             parity: false,
             node_fetch: NodeFetch::Operand,
+            shadows: true,
         },
         KernelsConfig {
             parity: true,
             node_fetch: NodeFetch::Operand,
+            shadows: true,
         },
         KernelsConfig {
             parity: false,
             node_fetch: NodeFetch::Loads,
+            shadows: true,
         },
         KernelsConfig {
             parity: true,
             node_fetch: NodeFetch::Loads,
+            shadows: true,
         },
     ];
 
@@ -500,6 +512,7 @@ impl SimConfig {
             kernels: KernelsConfig {
                 parity: true,
                 node_fetch: NodeFetch::Loads,
+                shadows: true,
             },
         }
     }
@@ -667,6 +680,7 @@ impl SimConfig {
                 "kernels.node_fetch",
                 Value::Choice(self.kernels.node_fetch.name()),
             ),
+            ("kernels.shadows", Flag(self.kernels.shadows)),
         ]
     }
 

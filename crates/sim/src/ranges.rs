@@ -210,6 +210,7 @@ pub const RANGES: &[KeyRange] = &[
     real("energy.qdst_pipe_nj", 0.0, MAX_NJ, "nJ"),
     flag("kernels.parity"),
     choice("kernels.node_fetch", &["operand", "loads"]),
+    flag("kernels.shadows"),
 ];
 
 impl KeyRange {
