@@ -133,7 +133,7 @@ pub fn open_box(bounds: &Aabb) -> [Triangle; BOX_TRIANGLES] {
     faces.map(|[a, b, d]| Triangle::new(c[a], c[b], c[d]))
 }
 
-/// Triangles [`closed_dragon_box`] adds to the open box: the floor, top and side walls
+/// Triangles [`closed_reconstructed_dragon_box`] adds to the open box: the floor, top and side walls
 /// carried on past the open side, and a front wall behind the camera.
 pub const CLOSING_TRIANGLES: usize = 10;
 
