@@ -20,7 +20,7 @@
 #include <stdint.h>
 
 /* Everything a frame needs, written by the host before the run. Mirrored field for field by
- * `dualsplit_sim::kernels::Params` (#[repr(C)], 156 bytes). Word offsets count 32-bit words
+ * `dualsplit_sim::kernels::Params` (#[repr(C)], 160 bytes). Word offsets count 32-bit words
  * from image address 0. */
 struct Params {
     uint32_t width;            /* image width in pixels */
@@ -48,9 +48,10 @@ struct Params {
     float scene_min[3];        /* the DST's scene box (rays are clipped to it first) */
     float scene_max[3];
     uint32_t frame_buffer;     /* byte address of the frame buffer */
+    uint32_t shadows;          /* 1: a shadow ray at every hit; 0: none, the light counted visible */
 };
 
-_Static_assert(sizeof(struct Params) == 156, "struct Params is 156 bytes");
+_Static_assert(sizeof(struct Params) == 160, "struct Params is 160 bytes");
 
 /* ---- BVH images (crates/accel/src/image.rs) --------------------------------------------- */
 

@@ -216,23 +216,10 @@ static int any_hit(const struct Ray *ray)
 #define PI_F 3.14159265358979323846264338327950288f
 #define TAU_F 6.28318530717958647692528676655900577f
 
-static uint32_t pcg_hash(uint32_t x)
-{
-    uint32_t state = x * 747796405u + 2891336453u;
-    uint32_t word = ((state >> ((state >> 28) + 4u)) ^ state) * 277803737u;
-    return (word >> 22) ^ word;
-}
-
-/* hash_u32s(&[x, y, sample, bounce, seed, dim]) as a float in [0, 1). */
-static float rand01(uint32_t x, uint32_t y, uint32_t sample, uint32_t bounce, uint32_t seed,
-                    uint32_t dim)
-{
-    uint32_t words[6] = {x, y, sample, bounce, seed, dim};
-    uint32_t h = 0x9E3779B9u;
-    for (int i = 0; i < 6; i++)
-        h = pcg_hash(h ^ pcg_hash(words[i]));
-    return (float)(h >> 8) * (1.0f / 16777216.0f);
-}
+/* The renderer's random number of dimension dim at `bounce` of the current sample
+ * (crates/render/src/job.rs `rand`): rt.rand's unit computes it from the key rt.srand set
+ * for the sample (docs/isa.md). */
+#define RAND(bounce, dim) rt_rand(dim, (uint32_t)(bounce), P->seed)
 
 /* One pixel: every sample's path, the radiance averaged over the samples. */
 static float render_pixel(const struct Params *P, uint32_t x, uint32_t y)
@@ -244,9 +231,10 @@ static float render_pixel(const struct Params *P, uint32_t x, uint32_t y)
     uint32_t sample;
     for (sample = 0; sample < P->spp; sample++) {
         float jx = 0.5f, jy = 0.5f;
+        rt_srand(x, y, sample);
         if (P->spp > 1) {
-            jx = rand01(x, y, sample, 0, P->seed, 0);
-            jy = rand01(x, y, sample, 0, P->seed, 1);
+            jx = RAND(0, 0);
+            jy = RAND(0, 1);
         }
         float sx = (2.0f * ((float)x + jx) / w - 1.0f) * (w / h);
         float sy = 1.0f - 2.0f * ((float)y + jy) / h;
@@ -274,8 +262,8 @@ static float render_pixel(const struct Params *P, uint32_t x, uint32_t y)
             if (!WORKLOAD_PATH)
                 radiance += throughput * AMBIENT * ALBEDO;
             /* Next-event estimation toward a point sampled uniformly on the light sphere. */
-            float u1 = rand01(x, y, sample, 2 * depth + 1, P->seed, 0);
-            float u2 = rand01(x, y, sample, 2 * depth + 1, P->seed, 1);
+            float u1 = RAND(2 * depth + 1, 0);
+            float u2 = RAND(2 * depth + 1, 1);
             float z = 1.0f - 2.0f * u1;
             float r = f_sqrt(f_max(1.0f - z * z, 0.0f));
             float sphi, cphi;
@@ -287,14 +275,14 @@ static float render_pixel(const struct Params *P, uint32_t x, uint32_t y)
             if (cosl > 0.0f) {
                 float contrib = throughput * ALBEDO / PI_F * P->light_power * cosl / d2;
                 struct Ray shadow = {p, to_l, 0.0f, 1.0f - 1e-4f};
-                if (!any_hit(&shadow))
+                if (!P->shadows || !any_hit(&shadow))
                     radiance += contrib;
             }
             if (!WORKLOAD_PATH || depth >= P->bounces)
                 break;
             /* Cosine-weighted diffuse bounce; the pdf cancels cos/pi, leaving the albedo. */
-            u1 = rand01(x, y, sample, 2 * depth + 2, P->seed, 0);
-            u2 = rand01(x, y, sample, 2 * depth + 2, P->seed, 1);
+            u1 = RAND(2 * depth + 2, 0);
+            u2 = RAND(2 * depth + 2, 1);
             r = f_sqrt(u1);
             f_sincos(TAU_F * u2, &sphi, &cphi);
             /* glam's any_orthonormal_pair (Duff et al. 2017) */

@@ -51,6 +51,23 @@ static inline uint32_t rt_atominc(uint32_t g)
     return r;
 }
 
+/* K = (x, y, sample): the random key of the pixel sample that rt_rand reads */
+static inline void rt_srand(uint32_t x, uint32_t y, uint32_t sample)
+{
+    __asm__ volatile(".insn r4 0x0B, 6, 0, x0, %0, %1, %2" : : "r"(x), "r"(y), "r"(sample));
+}
+
+/* The renderer's random number hash(K.x, K.y, K.sample, bounce, seed, dim) in [0, 1), on the
+ * FP adder as TRaX's RAND (dim a constant 0-127, in funct7: a macro). */
+#define rt_rand(dim, bounce, seed)                                                   \
+    ({                                                                               \
+        float r_;                                                                    \
+        __asm__ volatile(".insn r 0x0B, 7, %3, %0, %1, %2"                           \
+                         : "=f"(r_)                                                  \
+                         : "r"(bounce), "r"(seed), "i"(dim));                        \
+        r_;                                                                          \
+    })
+
 /* ---- custom-1: ray-box, ray-triangle, dual-split --------------------------------------- */
 
 /* Slab test of the box at `box` (min xyz, max xyz) on [t_lo, t_hi]: the entry distance when

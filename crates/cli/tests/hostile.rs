@@ -562,7 +562,14 @@ fn dragon_boxes_that_would_not_load_are_not_written() {
     let make = |input: &str, obj: &str| {
         std::fs::write(dir.path().join(input), obj).unwrap();
         dualsplit(
-            &["scene", "dragon-box", input, "-o", "box.ply.gz"],
+            &[
+                "scene",
+                "dragon-box",
+                "--reconstruction",
+                input,
+                "-o",
+                "box.ply.gz",
+            ],
             dir.path(),
         )
     };
@@ -589,6 +596,14 @@ fn dragon_boxes_that_would_not_load_are_not_written() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // SimTRaX's box stands at fixed coordinates: a mesh outside it is refused.
+    std::fs::remove_file(dir.path().join("box.ply.gz")).unwrap();
+    let out = dualsplit(
+        &["scene", "dragon-box", "ok.obj", "-o", "box.ply.gz"],
+        dir.path(),
+    );
+    fails_with(&out, "not inside SimTRaX's box");
+    assert!(!dir.path().join("box.ply.gz").exists());
 }
 
 #[test]

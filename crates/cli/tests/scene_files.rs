@@ -1,5 +1,7 @@
-//! `dualsplit scene dragon-box`: rebuilt from the shipped dragon, the Dragon Box has the
-//! shipped file's triangles bit for bit; bad input is an error, not a panic.
+//! `dualsplit scene dragon-box`: SimTRaX's Dragon Box built from the committed dragon has
+//! SimTRaX's box, camera and light; rebuilt from the shipped dragon, the reconstruction has
+//! the shipped (reconstructed) `dragon_box.ply.gz`'s triangles bit for bit; bad input is an
+//! error, not a panic.
 mod common;
 
 use common::{dualsplit, stderr};
@@ -38,7 +40,7 @@ fn bits(tris: &[Triangle]) -> Vec<[u32; 9]> {
 }
 
 #[test]
-fn dragon_box_rebuilt_from_the_shipped_dragon_is_the_shipped_dragon_box() {
+fn the_reconstruction_rebuilt_from_the_shipped_dragon_is_the_shipped_dragon_box() {
     // Skips (with the reason) when a mesh is missing; fails under CI.
     let (Some(dragon), Some(_)) = (
         shipped_path("dragon.ply.gz"),
@@ -48,8 +50,10 @@ fn dragon_box_rebuilt_from_the_shipped_dragon_is_the_shipped_dragon_box() {
     };
     let dragon = dragon.to_str().unwrap().to_string();
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("dragon_box.ply.gz");
-    let o = make_dragon_box(&dragon, &out, &[], dir.path());
+    // The shared folder's `dragon_box.ply.gz` is the reconstruction (made before SimTRaX's
+    // scene was used).
+    let out = dir.path().join("dragon_box_recon.ply.gz");
+    let o = make_dragon_box(&dragon, &out, &["--reconstruction"], dir.path());
     let rebuilt = dualsplit_scene::load(out.to_str().unwrap()).unwrap();
     let want = shipped_triangles("dragon_box.ply.gz").unwrap();
     let sha = dualsplit_scene::make::triangles_sha256(&want);
@@ -74,11 +78,16 @@ fn the_closed_dragon_box_adds_ten_triangles_to_the_open_one() {
     let dragon = dragon.to_str().unwrap().to_string();
     let dir = tempfile::tempdir().unwrap();
     let (open, closed) = (
-        dir.path().join("dragon_box.ply.gz"),
-        dir.path().join("dragon_box_closed.ply.gz"),
+        dir.path().join("dragon_box_recon.ply.gz"),
+        dir.path().join("dragon_box_recon_closed.ply.gz"),
     );
-    make_dragon_box(&dragon, &open, &[], dir.path());
-    make_dragon_box(&dragon, &closed, &["--closed"], dir.path());
+    make_dragon_box(&dragon, &open, &["--reconstruction"], dir.path());
+    make_dragon_box(
+        &dragon,
+        &closed,
+        &["--reconstruction", "--closed"],
+        dir.path(),
+    );
     let open = dualsplit_scene::load(open.to_str().unwrap()).unwrap();
     let closed = dualsplit_scene::load(closed.to_str().unwrap()).unwrap();
     assert_eq!(closed.triangles.len(), open.triangles.len() + 10);
@@ -140,6 +149,7 @@ fn a_dragon_box_file_loads_back_with_its_box_last() {
             "-q",
             "scene",
             "dragon-box",
+            "--reconstruction",
             "builtin:cornell",
             "-o",
             "box.ply.gz",
@@ -159,4 +169,46 @@ fn a_dragon_box_file_loads_back_with_its_box_last() {
             &dualsplit_scene::load("builtin:cornell").unwrap().bounds
         ))
     );
+}
+
+#[test]
+fn simtrax_s_dragon_box_from_the_committed_dragon_has_its_box_camera_and_light() {
+    let Some(dragon) = shipped_path("dragon_res4.ply.gz") else {
+        return;
+    };
+    let dragon = dragon.to_str().unwrap().to_string();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("dragon_box.ply.gz");
+    make_dragon_box(&dragon, &out, &[], dir.path());
+    let scene = dualsplit_scene::load(out.to_str().unwrap()).unwrap();
+    let mesh = dualsplit_scene::load(&dragon).unwrap().triangles;
+    assert_eq!(scene.triangles.len(), mesh.len() + 12);
+    assert_eq!(bits(&scene.triangles[..mesh.len()]), bits(&mesh));
+    assert_eq!(
+        bits(&scene.triangles[mesh.len()..]),
+        bits(&dualsplit_scene::make::simtrax_box())
+    );
+    // The box encloses the dragon: the scene's bounds are the box's.
+    assert_eq!(scene.bounds, dualsplit_scene::make::simtrax_box_bounds());
+    // dragon.view: eye, looking down -z, 2·atan(1/1.015) vertically; dragon.light.
+    let c = scene.camera;
+    assert_eq!(c.eye.to_array(), [-0.008, 0.11, 0.108903]);
+    assert_eq!((c.target.x, c.target.y), (c.eye.x, c.eye.y));
+    assert!((c.target.z - c.eye.z + 1.0).abs() < 1e-6, "{c:?}");
+    let fov = 2.0 * (1.0f64 / 1.015).atan().to_degrees();
+    assert!(
+        (f64::from(c.fov_y_deg) - fov).abs() < 1e-4,
+        "{}",
+        c.fov_y_deg
+    );
+    assert!((fov - 89.147).abs() < 1e-3, "{fov}");
+    assert_eq!(scene.light.position.to_array(), [0.0, 0.2, 0.0]);
+    assert_eq!(scene.light.radius, 0.0);
+    // `--closed` needs `--reconstruction` (SimTRaX's box is closed already).
+    let o = dualsplit(
+        &["scene", "dragon-box", &dragon, "--closed", "-o", "x.ply.gz"],
+        dir.path(),
+    );
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--reconstruction"), "{}", stderr(&o));
 }

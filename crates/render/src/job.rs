@@ -75,10 +75,20 @@ pub struct RenderSettings {
     pub workload: Workload,
     /// Diffuse bounces after the primary hit (path workload).
     pub bounces: u32,
+    /// A shadow ray toward the light sample at every hit (the default; the paper does not
+    /// say whether its path tracer casts them). `false`: the light sample's contribution is
+    /// added without a visibility test and no shadow ray is traced.
+    #[serde(default = "shadow_rays_by_default")]
+    pub shadows: bool,
+}
+
+fn shadow_rays_by_default() -> bool {
+    true
 }
 
 impl RenderSettings {
-    /// Defaults: 1 spp, seed 0, 5 bounces (the paper's path tracer, §4.4).
+    /// Defaults: 1 spp, seed 0, 5 bounces (the paper's path tracer, §4.4), a shadow ray at
+    /// every hit.
     pub fn new(width: u32, height: u32, workload: Workload) -> Self {
         Self {
             width,
@@ -87,6 +97,7 @@ impl RenderSettings {
             seed: 0,
             workload,
             bounces: 5,
+            shadows: true,
         }
     }
 
@@ -429,7 +440,12 @@ impl<'a> PixelJob<'a> {
         } else {
             0.0
         };
-        if cos > 0.0 {
+        if cos > 0.0 && !self.settings.shadows {
+            // No shadow rays: the light sample counts as visible.
+            self.radiance +=
+                self.throughput * ALBEDO / std::f32::consts::PI * self.light_power * cos / d2;
+            self.continue_path(depth, p, n);
+        } else if cos > 0.0 {
             let contrib =
                 self.throughput * ALBEDO / std::f32::consts::PI * self.light_power * cos / d2;
             self.next = Some(RayQuery {

@@ -249,3 +249,33 @@ fn bad_settings_and_cameras_are_typed_errors() {
     assert!(matches!(run(&s, &ok), Err(RenderError::Light { .. })));
     assert!(run(&scene, &ok).is_ok());
 }
+
+#[test]
+fn without_shadow_rays_no_shadow_ray_is_traced_and_light_is_never_occluded() {
+    let scene = room(true, 8);
+    let structures = Structures::build(&scene.triangles, &BuildConfig::default());
+    for workload in Workload::ALL {
+        let on = RenderSettings::new(24, 24, workload);
+        assert!(on.shadows, "shadow rays by default");
+        let off = RenderSettings {
+            shadows: false,
+            ..on
+        };
+        let a = render_records(&scene, &structures, AccelKind::Bvh2, &on).unwrap();
+        let b = render_records(&scene, &structures, AccelKind::Bvh2, &off).unwrap();
+        let shadows = |r: &[dualsplit_render::PixelRecord]| {
+            r.iter()
+                .flat_map(|p| &p.rays)
+                .filter(|t| t.query.kind == RayKind::Shadow)
+                .count()
+        };
+        assert!(shadows(&a) > 0, "{}", workload.name());
+        assert_eq!(shadows(&b), 0, "{}", workload.name());
+        // The same paths (the random numbers do not depend on the shadow rays), every light
+        // sample counted: no pixel is darker, and an occluded sample makes some brighter.
+        for (p, q) in a.iter().zip(&b) {
+            assert!(q.radiance >= p.radiance, "({}, {})", p.x, p.y);
+        }
+        assert!(a.iter().zip(&b).any(|(p, q)| q.radiance > p.radiance));
+    }
+}

@@ -83,21 +83,38 @@ impl PaperScene {
 pub struct PaperMatch {
     /// The paper's scene.
     pub scene: PaperScene,
-    /// True for the paper's scene or our reconstruction of it (Crytek Sponza, the
-    /// reconstructed Dragon Box), false for a stand-in.
+    /// True for the paper's scene or our reconstruction of it (Crytek Sponza, the Dragon
+    /// Box), false for a stand-in.
     pub same_mesh: bool,
+    /// True for the Dragon Box this project reconstructed before SimTRaX's was used (a
+    /// `dragon_box_recon…` file, or a `dragon_box` whose bounds are not SimTRaX's box);
+    /// false for SimTRaX's Dragon Box and every other scene.
+    #[serde(default)]
+    pub reconstructed: bool,
 }
 
 impl PaperMatch {
     /// Finds the paper scene a scene name or spec corresponds to: `dragon_box` is the
-    /// paper's Dragon Box and `crytek` (the file `crytek_sponza.gltf`) its Crytek Sponza;
+    /// paper's Dragon Box (`dragon_box_recon…` and `dragon_box_closed` the reconstruction:
+    /// [`PaperMatch::with_bounds`] tells a reconstruction saved as `dragon_box` by its
+    /// bounds) and `crytek` (the file `crytek_sponza.gltf`) its Crytek Sponza;
     /// `dragon_sponza`, `atrium`/`sponza` (↔ Crytek Sponza), `forest`
     /// (↔ Vegetation) and `hairball` are stand-ins.
     pub fn for_scene(name: &str, spec: &str) -> Option<Self> {
         let s = format!("{name} {spec}").to_ascii_lowercase();
-        let m = |scene, same_mesh| Some(PaperMatch { scene, same_mesh });
+        let m = |scene, same_mesh| {
+            Some(PaperMatch {
+                scene,
+                same_mesh,
+                reconstructed: false,
+            })
+        };
         if s.contains("dragon_box") || s.contains("dragon-box") {
-            m(PaperScene::DragonBox, true)
+            Some(PaperMatch {
+                scene: PaperScene::DragonBox,
+                same_mesh: true,
+                reconstructed: s.contains("dragon_box_recon") || s.contains("dragon_box_closed"),
+            })
         } else if s.contains("dragon_sponza") || s.contains("dragon-sponza") {
             m(PaperScene::DragonSponza, false)
         } else if s.contains("crytek") {
@@ -113,11 +130,24 @@ impl PaperMatch {
         }
     }
 
-    /// "Dragon Box, reconstructed", "Crytek Sponza, the paper's mesh" or "stand-in for
-    /// Hairball".
+    /// This match for a loaded scene with bounds `bounds`: a Dragon Box whose bounds are
+    /// not SimTRaX's box is a reconstruction.
+    pub fn with_bounds(mut self, bounds: &dualsplit_geometry::Aabb) -> Self {
+        if self.scene == PaperScene::DragonBox
+            && *bounds != dualsplit_scene::make::simtrax_box_bounds()
+        {
+            self.reconstructed = true;
+        }
+        self
+    }
+
+    /// "Dragon Box, SimTRaX's scene", "Dragon Box, reconstructed", "Crytek Sponza, the
+    /// paper's mesh" or "stand-in for Hairball".
     pub fn describe(&self) -> String {
-        if self.same_mesh && self.scene == PaperScene::DragonBox {
+        if self.same_mesh && self.scene == PaperScene::DragonBox && self.reconstructed {
             "Dragon Box, reconstructed".to_string()
+        } else if self.same_mesh && self.scene == PaperScene::DragonBox {
+            "Dragon Box, SimTRaX's scene".to_string()
         } else if self.same_mesh {
             format!("{}, the paper's mesh", self.scene.label())
         } else {
@@ -407,9 +437,22 @@ mod tests {
             m,
             Some(PaperMatch {
                 scene: PaperScene::DragonBox,
-                same_mesh: true
+                same_mesh: true,
+                reconstructed: false,
             })
         );
+        let m = m.unwrap();
+        assert_eq!(m.describe(), "Dragon Box, SimTRaX's scene");
+        // A `dragon_box` in other bounds is a reconstruction made before SimTRaX's scene.
+        let simtrax = dualsplit_scene::make::simtrax_box_bounds();
+        assert!(!m.with_bounds(&simtrax).reconstructed);
+        let other = dualsplit_geometry::Aabb::new(simtrax.min, simtrax.max * 2.0);
+        assert_eq!(
+            m.with_bounds(&other).describe(),
+            "Dragon Box, reconstructed"
+        );
+        let r = PaperMatch::for_scene("dragon_box_recon", "s/dragon_box_recon.ply.gz").unwrap();
+        assert!(r.reconstructed && r.same_mesh);
         let m = PaperMatch::for_scene("forest", "builtin:forest?trees=10").unwrap();
         assert_eq!(m.scene, PaperScene::Vegetation);
         assert!(!m.same_mesh);

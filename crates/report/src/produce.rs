@@ -372,7 +372,8 @@ impl<'a> Producer<'a> {
                 spec: scene.spec.clone(),
                 triangles: scene.triangles.len() as u64,
                 content_hash: scene.content_hash(),
-                paper: PaperMatch::for_scene(&scene.name, &scene.spec),
+                paper: PaperMatch::for_scene(&scene.name, &scene.spec)
+                    .map(|m| m.with_bounds(&scene.bounds)),
                 cpu,
                 sim,
                 render_png_base64: render,

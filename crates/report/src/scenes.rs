@@ -135,13 +135,14 @@ pub struct PaperFile {
 }
 
 impl PaperFile {
-    /// "Dragon Box (dragon_box.ply.gz, our reconstruction of the paper's scene)",
+    /// "Dragon Box (dragon_box.ply.gz, the paper's scene as SimTRaX ships it, or …)",
     /// "Crytek Sponza (crytek_sponza.gltf, the paper's mesh)" or "… (…, a stand-in)".
     pub fn describe(&self) -> String {
         let kind = if !self.same_mesh {
             "a stand-in"
         } else if self.scene == PaperScene::DragonBox {
-            "our reconstruction of the paper's scene"
+            "the paper's scene as SimTRaX ships it, or our earlier reconstruction: the scene \
+             table says which"
         } else {
             "the paper's mesh"
         };
@@ -287,7 +288,7 @@ mod tests {
         let text = files.describe();
         assert!(
             text.contains(
-                "found: Dragon Box (dragon_box.ply.gz, our reconstruction of the paper's scene). Not found: Dragon Sponza"
+                "found: Dragon Box (dragon_box.ply.gz, the paper's scene as SimTRaX ships it, or our earlier reconstruction: the scene table says which). Not found: Dragon Sponza"
             ),
             "{text}"
         );

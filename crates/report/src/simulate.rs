@@ -136,6 +136,87 @@ pub struct SimulateJson<'a> {
     pub results: Vec<&'a SimResult>,
     /// Their comparison.
     pub summary: Summary,
+    /// The paper's published values for this scene and workload (Table 4 for ray casting,
+    /// Table 5 for path tracing), when the scene is the paper's own (SimTRaX's Dragon Box,
+    /// Crytek Sponza): one per paper configuration simulated, beside ours in `summary`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub paper: Option<PaperBeside>,
+}
+
+/// The paper's absolute values for one scene and workload, beside a `simulate` run's.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PaperBeside {
+    /// `Table 4` (ray casting) or `Table 5` (path tracing).
+    pub table: &'static str,
+    /// The paper's scene.
+    pub scene: &'static str,
+    /// What the paper states about the frame those values are of.
+    pub frame: &'static str,
+    /// One row per simulated configuration of the paper's eight, in the order simulated.
+    pub rows: Vec<PaperRow>,
+}
+
+/// One configuration's published values, in the paper's units.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PaperRow {
+    /// The configuration.
+    pub accel: SimAccel,
+    /// Frame time (ms).
+    pub frame_ms: f64,
+    /// Energy per frame (J).
+    pub energy_j: f64,
+    /// DRAM lines read, in millions.
+    pub dram_mlines: f64,
+    /// Our frame time / the paper's.
+    pub ours_frame_vs_paper: Option<f64>,
+    /// Our energy / the paper's.
+    pub ours_energy_vs_paper: Option<f64>,
+    /// Our DRAM lines / the paper's.
+    pub ours_dram_lines_vs_paper: Option<f64>,
+}
+
+/// The paper's values beside `results` when `paper` is the paper's own scene (not a
+/// stand-in, not the reconstructed Dragon Box); `None` otherwise.
+pub fn paper_beside(
+    paper: Option<crate::paper::PaperMatch>,
+    workload: Workload,
+    results: &[&SimResult],
+) -> Option<PaperBeside> {
+    use crate::paper::{Metric, table45};
+    let m = paper.filter(|m| m.same_mesh && !m.reconstructed)?;
+    let (table, frame) = match workload {
+        Workload::Path => (
+            "Table 5",
+            "path tracing, five diffuse bounces, 64 TMs; the paper states no resolution",
+        ),
+        _ => (
+            "Table 4",
+            "ray casting with a shadow ray, 1024×1024, one sample per pixel, 64 TMs",
+        ),
+    };
+    let rows: Vec<PaperRow> = results
+        .iter()
+        .filter_map(|r| r.accel.filter(|a| a.in_paper()).map(|a| (a, r)))
+        .map(|(a, r)| {
+            let v = |metric| table45(workload, metric, a, m.scene);
+            let (ms, j, ml) = (v(Metric::FrameMs), v(Metric::EnergyJ), v(Metric::DramLines));
+            PaperRow {
+                accel: a,
+                frame_ms: ms,
+                energy_j: j,
+                dram_mlines: ml,
+                ours_frame_vs_paper: ratio(r.frame_ms, ms),
+                ours_energy_vs_paper: ratio(r.energy.total(), j),
+                ours_dram_lines_vs_paper: ratio(r.dram_lines as f64 / 1e6, ml),
+            }
+        })
+        .collect();
+    (!rows.is_empty()).then(|| PaperBeside {
+        table,
+        scene: m.scene.label(),
+        frame,
+        rows,
+    })
 }
 
 impl<'a> SimulateJson<'a> {
@@ -148,6 +229,9 @@ impl<'a> SimulateJson<'a> {
         results: Vec<&'a SimResult>,
     ) -> Self {
         let summary = summarize(&results);
+        let paper = crate::paper::PaperMatch::for_scene(&scene.name, &scene.spec)
+            .map(|m| m.with_bounds(&scene.bounds));
+        let paper = paper_beside(paper, settings.workload, &results);
         Self {
             scene: &scene.name,
             spec: &scene.spec,
@@ -161,6 +245,7 @@ impl<'a> SimulateJson<'a> {
             config: cfg,
             results,
             summary,
+            paper,
         }
     }
 
@@ -363,5 +448,33 @@ mod tests {
         let s = summarize(&[&d, &result(SimAccel::Bvh8, 6.0, 900)]);
         assert_eq!(s.baseline, Some(SimAccel::Dst));
         assert_eq!(s.rows[1].frame_vs_baseline, Some(2.0));
+    }
+
+    #[test]
+    fn the_paper_s_absolute_values_stand_beside_simtrax_s_dragon_box_only() {
+        use crate::paper::{PaperMatch, PaperScene};
+        let b = result(SimAccel::Bvh2, 2.91 * 1.5, 1_060_000);
+        let simtrax = PaperMatch::for_scene("dragon_box", "dragon_box.ply.gz");
+        let p = paper_beside(simtrax, Workload::Cast, &[&b]).unwrap();
+        assert_eq!(p.table, "Table 4");
+        assert!(p.frame.contains("1024×1024"), "{}", p.frame);
+        let row = p.rows[0];
+        // Table 4, Dragon Box, BVH2: 2.91 ms, 0.54 J, 2.12 M lines.
+        assert_eq!(
+            (row.frame_ms, row.energy_j, row.dram_mlines),
+            (2.91, 0.54, 2.12)
+        );
+        assert!((row.ours_frame_vs_paper.unwrap() - 1.5).abs() < 1e-12);
+        assert!((row.ours_dram_lines_vs_paper.unwrap() - 0.5).abs() < 1e-12);
+        let p = paper_beside(simtrax, Workload::Path, &[&b]).unwrap();
+        assert_eq!(p.table, "Table 5");
+        assert!(p.frame.contains("states no resolution"), "{}", p.frame);
+        // No paper values for a reconstruction or a stand-in.
+        let recon = PaperMatch::for_scene("dragon_box_recon", "dragon_box_recon.ply.gz");
+        assert_eq!(paper_beside(recon, Workload::Cast, &[&b]), None);
+        let stand_in = PaperMatch::for_scene("hairball", "builtin:hairball");
+        assert_eq!(stand_in.map(|m| m.scene), Some(PaperScene::Hairball));
+        assert_eq!(paper_beside(stand_in, Workload::Cast, &[&b]), None);
+        assert_eq!(paper_beside(None, Workload::Cast, &[&b]), None);
     }
 }

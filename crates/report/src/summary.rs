@@ -552,6 +552,7 @@ mod tests {
         let stand_in = Some(crate::paper::PaperMatch {
             scene: PaperScene::Hairball,
             same_mesh: false,
+            reconstructed: false,
         });
         let note = regime_note(stand_in, &r).unwrap();
         assert!(

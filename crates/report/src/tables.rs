@@ -254,14 +254,15 @@ pub fn metric_unit(m: Metric, values: &[f64]) -> (String, f64) {
     }
 }
 
-/// DRAM energy (J) of a simulated frame by cause: `[reads, row activations, background]`,
-/// from its read and activation counts and frame time with the per-event energies and
+/// DRAM energy (J) of a simulated frame by cause: `[reads and writes, row activations,
+/// background]`, from its burst and activation counts and frame time with the per-event
+/// energies and
 /// background power of the hardware configuration the report simulates (`lin2020`); the
 /// three add up to the frame's DRAM energy.
 pub fn dram_split(r: &SimResult) -> [f64; 3] {
     let d = SimConfig::lin2020().dram;
     [
-        r.dram.reads as f64 * d.e_read_nj * 1e-9,
+        (r.dram.reads + r.dram.writes) as f64 * d.e_read_nj * 1e-9,
         r.dram.activations as f64 * d.e_activate_nj * 1e-9,
         d.background_w * r.frame_ms * 1e-3,
     ]
@@ -315,6 +316,7 @@ pub fn table45(data: &ReportData, workload: Workload) -> Section {
             header.push("% of BVH2".into());
         }
         header.push("idle at end".into());
+        header.push("thread-cycles per ray".into());
         let first_paper = header.len();
         if let Some(m) = &s.paper {
             for (h, _) in &paper_units {
@@ -346,6 +348,10 @@ pub fn table45(data: &ReportData, workload: Workload) -> Section {
             // Threads out of work before the frame ends (a frame too small for the chip).
             row.push(s.sim(a, workload, tms).map_or_else(Cell::none, |r| {
                 Cell::pct(dualsplit_sim::StallShares::of(r).idle_at_end)
+            }));
+            // Cycles × threads per ray: the work a ray costs the chip, memory waits included.
+            row.push(s.sim(a, workload, tms).map_or_else(Cell::none, |r| {
+                Cell::num(r.cycles as f64 * f64::from(r.threads) / r.rays.max(1) as f64)
             }));
             if let Some(pm) = &s.paper {
                 for (m, (_, scale)) in Metric::ALL.iter().copied().zip(&paper_units) {
@@ -423,7 +429,7 @@ pub fn table6(data: &ReportData) -> Section {
             .collect();
         let mut header: Vec<String> = vec!["configuration".to_string()];
         for (h, (unit, _)) in [
-            "DRAM reads",
+            "DRAM reads and writes",
             "DRAM activations",
             "DRAM background",
             "DRAM",

@@ -132,17 +132,56 @@ fn parse_point(what: &'static str, s: &str) -> Result<Vec3, CameraError> {
     Ok(v)
 }
 
-/// The closed Dragon Box (`dragon_box_closed`, [`crate::make::closed_dragon_box`]) is seen
-/// and lit exactly as the open one: its presets are the open box's, placed in the open box's
-/// bounds, which are the closed box's cut back to a cube (the open box is a cube; the
-/// closed one only extends it along +z).
+/// Which preset a stem gets in bounds `b`. The closed reconstruction
+/// (`dragon_box_recon_closed`, or its older name `dragon_box_closed`;
+/// [`crate::make::closed_reconstructed_dragon_box`]) is seen and lit exactly as the open
+/// one: its presets are the open box's, placed in the open box's bounds, which are the
+/// closed box's cut back to a cube (the open box is a cube; the closed one only extends it
+/// along +z). A `dragon_box` is SimTRaX's scene when its bounds are SimTRaX's box
+/// ([`crate::make::simtrax_box_bounds`]: the box encloses the dragon, so they are exactly
+/// the box's), and otherwise a reconstruction made before SimTRaX's scene was used (such a
+/// file may still be named `dragon_box.ply.gz`).
 fn open_box_view<'a>(stem: &'a str, b: &Aabb) -> (&'a str, Aabb) {
-    if stem == "dragon_box_closed" {
-        let mut open = *b;
-        open.max.z = open.min.z + b.extent().y;
-        ("dragon_box", open)
-    } else {
-        (stem, *b)
+    match stem {
+        "dragon_box_closed" | "dragon_box_recon_closed" => {
+            let mut open = *b;
+            open.max.z = open.min.z + b.extent().y;
+            ("dragon_box_recon", open)
+        }
+        "dragon_box" if *b != crate::make::simtrax_box_bounds() => ("dragon_box_recon", *b),
+        "dragon_box" => (SIMTRAX_DRAGON_BOX, *b),
+        _ => (stem, *b),
+    }
+}
+
+/// The internal preset name of SimTRaX's Dragon Box (a `dragon_box` in SimTRaX's box).
+const SIMTRAX_DRAGON_BOX: &str = "dragon_box (SimTRaX)";
+
+/// SimTRaX's `samples/scenes/dragon/dragon.view` (commit `f2537ff`), read as
+/// `sim/ReadViewfile.cc:21-26` reads it: eye, view direction, up, aperture, image plane
+/// left, right, bottom, top, and its distance.
+pub const SIMTRAX_DRAGON_VIEW: [f32; 15] = [
+    -0.008, 0.11, 0.108903, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.0, -1.0, 1.0, -1.0, 1.0, 1.015,
+];
+
+/// SimTRaX's `samples/scenes/dragon/dragon.light` (commit `f2537ff`): a point light,
+/// read by `sim/ReadLightfile.cc:13-14` as a position.
+pub const SIMTRAX_DRAGON_LIGHT: [f32; 3] = [0.0, 0.2, 0.0];
+
+/// The camera of [`SIMTRAX_DRAGON_VIEW`]: the eye, looking along the view direction, up as
+/// given, the vertical field of view of the image plane's top and bottom at its distance,
+/// 2·atan(1/1.015) = 89.15° (a pinhole: the aperture is 0).
+fn simtrax_dragon_camera() -> Camera {
+    let v = SIMTRAX_DRAGON_VIEW;
+    let eye = Vec3::new(v[0], v[1], v[2]);
+    let dir = Vec3::new(v[3], v[4], v[5]);
+    let (bottom, top, dist) = (f64::from(v[12]), f64::from(v[13]), f64::from(v[14]));
+    let half = (top.atan2(dist) - bottom.atan2(dist)) / 2.0;
+    Camera {
+        eye,
+        target: eye + dir,
+        up: Vec3::new(v[6], v[7], v[8]),
+        fov_y_deg: (2.0 * half).to_degrees() as f32,
     }
 }
 
@@ -204,8 +243,8 @@ fn preset_view(stem: &str) -> Option<View> {
             zoom: 0.72,
             fov: 40.0,
         },
-        // The dragon inside its box, seen through the open +z side.
-        "dragon_box" => View {
+        // The reconstruction: the dragon inside its box, seen through the open +z side.
+        "dragon_box_recon" => View {
             target: [0.5, 0.28, 0.45],
             eye: None,
             dir: Vec3::new(0.12, 0.15, 1.0),
@@ -262,12 +301,19 @@ impl Camera {
     /// stem.
     pub fn preset_for(stem: &str, bounds: &Aabb) -> Self {
         let (stem, bounds) = open_box_view(stem, bounds);
+        if stem == SIMTRAX_DRAGON_BOX {
+            return simtrax_dragon_camera();
+        }
         preset_view(stem).map_or_else(|| Self::fit(&bounds), |v| v.camera(&bounds))
     }
 
     /// True when `stem` has a preset view.
     pub fn has_preset(stem: &str) -> bool {
         preset_view(stem).is_some()
+            || matches!(
+                stem,
+                "dragon_box" | "dragon_box_closed" | "dragon_box_recon_closed"
+            )
     }
 
     /// This camera with command-line overrides: `eye` and `target` as `x,y,z`, `fov` the
@@ -326,9 +372,15 @@ impl Light {
         let at = |f: [f32; 3]| b.min + b.extent() * Vec3::from_array(f);
         let r = (b.extent().length() * 0.5).max(1e-3);
         match stem {
-            // Under the top of the box, toward the open side: the dragon casts a shadow on
-            // the floor and the back wall.
-            "dragon_box" => Self {
+            // SimTRaX's point light over the dragon.
+            SIMTRAX_DRAGON_BOX => Self {
+                position: Vec3::from_array(SIMTRAX_DRAGON_LIGHT),
+                radius: 0.0,
+                intensity: 1.0,
+            },
+            // The reconstruction: under the top of the box, toward the open side; the
+            // dragon casts a shadow on the floor and the back wall.
+            "dragon_box_recon" => Self {
                 position: at([0.3, 0.85, 0.75]),
                 radius: r * 0.02,
                 intensity: 1.0,

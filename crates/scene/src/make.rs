@@ -1,33 +1,104 @@
 //! Scene files made from public meshes: the paper's Dragon Box (Lin et al. 2020, Table 3)
-//! rebuilt from the Stanford dragon, the compact PLY writer of the shipped scene files, and
-//! the triangles' SHA-256 that `scripts/get-scenes.sh` checks converted files by.
+//! as SimTRaX ships it, a reconstruction of it made before that scene was found, the
+//! compact PLY writer of the shipped scene files, and the triangles' SHA-256 that
+//! `scripts/get-scenes.sh` checks converted files by.
 //!
-//! The paper does not describe its box. The one shipped as `dragon_box.ply.gz` is the
-//! dragon's triangles, unchanged and first, followed by 10 triangles: an axis-aligned cube
-//! open on +z whose side is 1.5 × the dragon's largest extent, centred on the dragon in x
-//! and z, with its floor at the dragon's lowest y (the dragon stands on it). The corners are
-//! computed in f64 from the f32 bounds and rounded to f32 once, which reproduces the shipped
-//! file bit for bit. Every box triangle faces into the box.
+//! **The Dragon Box** ([`dragon_box`]) is SimTRaX's sample scene `samples/scenes/dragon/`
+//! (github.com/dkoptacs/simtrax, commit `f2537ff`, "Adding dragon sample scene"):
+//! `dragon.objl` lists `dragon.obj` (the Stanford dragon in its original coordinates) and
+//! then `dragon_box.obj`, a closed axis-aligned box of 12 triangles ([`SIMTRAX_BOX`],
+//! [`simtrax_box`]). So the scene is the dragon's triangles, unchanged and first, then the
+//! box's 12 in the file's vertex and face order: 871,414 + 12 = 871,426 triangles for the
+//! full dragon, the paper's "870K". Its camera and light are `dragon.view` and
+//! `dragon.light` (`Camera::preset_for`, `Light::preset_for`).
+//!
+//! **The reconstruction** ([`reconstructed_dragon_box`]) is the dragon followed by 10
+//! triangles: an axis-aligned cube open on +z whose side is 1.5 × the dragon's largest
+//! extent, centred on the dragon in x and z, with its floor at the dragon's lowest y. The
+//! corners are computed in f64 from the f32 bounds and rounded to f32 once. Every box
+//! triangle faces into the box. [`closed_reconstructed_dragon_box`] closes it behind its
+//! camera.
 //!
 //! ```
 //! use dualsplit_geometry::{Triangle, Vec3};
 //! let dragon = vec![Triangle::new(Vec3::ZERO, Vec3::X, Vec3::new(0.0, 2.0, 0.0))];
-//! let scene = dualsplit_scene::make::dragon_box(&dragon);
+//! let scene = dualsplit_scene::make::reconstructed_dragon_box(&dragon);
 //! assert_eq!(scene.len(), 11);
 //! assert_eq!(&scene[..1], &dragon[..]);
+//! let simtrax = dualsplit_scene::make::dragon_box(&dragon);
+//! assert_eq!(simtrax.len(), 13);
 //! ```
 use dualsplit_geometry::{Aabb, Triangle, Vec3};
 use std::collections::HashMap;
 use std::io::Write;
 use std::path::Path;
 
-/// Triangles the box adds: five faces of two triangles (floor, top, back, left, right).
+/// SimTRaX's Dragon Box walls, from the comments of `samples/scenes/dragon/dragon_box.obj`
+/// (commit `f2537ff`, lines 2-7): left, right, bottom, top, front, back.
+pub const SIMTRAX_BOX: [f32; 6] = [-0.128813, 0.117055, 0.0382846, 0.2116174, 0.11, -0.119];
+
+/// Triangles of SimTRaX's closed box.
+pub const SIMTRAX_BOX_TRIANGLES: usize = 12;
+
+/// The 12 triangles of `dragon_box.obj` (SimTRaX commit `f2537ff`), in its order: vertices
+/// 1-4 the top corners (left front, left back, right back, right front), 5-8 the bottom
+/// ones in the same order (lines 10-19), faces top, back, bottom, front, left, right as
+/// written (lines 24-45; `f a b c` uses vertices a, b, c, counted from 1).
+pub fn simtrax_box() -> [Triangle; SIMTRAX_BOX_TRIANGLES] {
+    let [l, r, b, t, f, k] = SIMTRAX_BOX;
+    let v = [
+        Vec3::new(l, t, f),
+        Vec3::new(l, t, k),
+        Vec3::new(r, t, k),
+        Vec3::new(r, t, f),
+        Vec3::new(l, b, f),
+        Vec3::new(l, b, k),
+        Vec3::new(r, b, k),
+        Vec3::new(r, b, f),
+    ];
+    let faces: [[usize; 3]; SIMTRAX_BOX_TRIANGLES] = [
+        [1, 2, 3], // top
+        [3, 4, 1],
+        [2, 3, 7], // back
+        [7, 6, 2],
+        [5, 6, 7], // bottom
+        [7, 8, 5],
+        [1, 4, 8], // front
+        [8, 5, 1],
+        [1, 2, 6], // left
+        [6, 5, 1],
+        [3, 4, 8], // right
+        [8, 7, 3],
+    ];
+    faces.map(|[a, b, c]| Triangle::new(v[a - 1], v[b - 1], v[c - 1]))
+}
+
+/// The bounds of [`simtrax_box`].
+pub fn simtrax_box_bounds() -> Aabb {
+    let [l, r, b, t, f, k] = SIMTRAX_BOX;
+    Aabb::new(Vec3::new(l, b, k), Vec3::new(r, t, f))
+}
+
+/// The paper's Dragon Box as SimTRaX ships it: `dragon`'s triangles, then [`simtrax_box`]
+/// (see the module documentation). The box stands at fixed coordinates: the dragon must be
+/// the Stanford dragon in its original coordinates (or one of its decimations) to lie
+/// inside it, which [`check_dragon_box`] checks.
+pub fn dragon_box(dragon: &[Triangle]) -> Vec<Triangle> {
+    let mut out = Vec::with_capacity(dragon.len() + SIMTRAX_BOX_TRIANGLES);
+    out.extend_from_slice(dragon);
+    out.extend(simtrax_box());
+    out
+}
+
+/// Triangles the reconstruction's box adds: five faces of two triangles (floor, top, back,
+/// left, right).
 pub const BOX_TRIANGLES: usize = 10;
 
 /// The box's side over the dragon's largest extent.
 pub const SIDE_OVER_EXTENT: f64 = 1.5;
 
-/// The 10 triangles of the open box around `bounds` (see the module documentation).
+/// The 10 triangles of the reconstruction's open box around `bounds` (see the module
+/// documentation).
 pub fn open_box(bounds: &Aabb) -> [Triangle; BOX_TRIANGLES] {
     let (lo, hi) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
     let centre = (lo + hi) / 2.0;
@@ -62,7 +133,7 @@ pub fn open_box(bounds: &Aabb) -> [Triangle; BOX_TRIANGLES] {
     faces.map(|[a, b, d]| Triangle::new(c[a], c[b], c[d]))
 }
 
-/// Triangles [`closed_dragon_box`] adds to the open box: the floor, top and side walls
+/// Triangles [`closed_reconstructed_dragon_box`] adds to the open box: the floor, top and side walls
 /// carried on past the open side, and a front wall behind the camera.
 pub const CLOSING_TRIANGLES: usize = 10;
 
@@ -70,18 +141,18 @@ pub const CLOSING_TRIANGLES: usize = 10;
 /// of the box's side.
 pub const CLOSING_WALL_BEHIND_EYE: f64 = 0.1;
 
-/// The Dragon Box closed behind the camera: [`dragon_box`], then [`CLOSING_TRIANGLES`]
-/// that carry the floor, top and side walls on along +z from the open side to a front wall
-/// standing [`CLOSING_WALL_BEHIND_EYE`] × the side behind the preset camera of
-/// `dragon_box`. Saved as `dragon_box_closed`, it is seen and lit as the open box is (its
-/// camera and light presets are the open box's), so rays that leave through the open side
-/// stay in the scene.
-pub fn closed_dragon_box(dragon: &[Triangle]) -> Vec<Triangle> {
-    let mut out = dragon_box(dragon);
+/// The reconstruction closed behind its camera: [`reconstructed_dragon_box`], then
+/// [`CLOSING_TRIANGLES`] that carry the floor, top and side walls on along +z from the open
+/// side to a front wall standing [`CLOSING_WALL_BEHIND_EYE`] × the side behind the preset
+/// camera of `dragon_box_recon`. Saved as `dragon_box_recon_closed` (or the older name
+/// `dragon_box_closed`), it is seen and lit as the open box is (its camera and light
+/// presets are the open box's), so rays that leave through the open side stay in the scene.
+pub fn closed_reconstructed_dragon_box(dragon: &[Triangle]) -> Vec<Triangle> {
+    let mut out = reconstructed_dragon_box(dragon);
     let open = out[dragon.len()..]
         .iter()
         .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
-    let eye = crate::Camera::preset_for("dragon_box", &open).eye;
+    let eye = crate::Camera::preset_for("dragon_box_recon", &open).eye;
     let (lo, hi) = (open.min, open.max);
     let side = f64::from(hi.y - lo.y);
     let zw = (f64::from(eye.z) + CLOSING_WALL_BEHIND_EYE * side) as f32;
@@ -103,8 +174,9 @@ pub fn closed_dragon_box(dragon: &[Triangle]) -> Vec<Triangle> {
     out
 }
 
-/// The Dragon Box of `dragon`: its triangles, then [`open_box`] of their bounds.
-pub fn dragon_box(dragon: &[Triangle]) -> Vec<Triangle> {
+/// The reconstructed Dragon Box of `dragon`: its triangles, then [`open_box`] of their
+/// bounds.
+pub fn reconstructed_dragon_box(dragon: &[Triangle]) -> Vec<Triangle> {
     let bounds = dragon.iter().fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
     let mut out = Vec::with_capacity(dragon.len() + BOX_TRIANGLES);
     out.extend_from_slice(dragon);
@@ -112,8 +184,9 @@ pub fn dragon_box(dragon: &[Triangle]) -> Vec<Triangle> {
     out
 }
 
-/// Checks a Dragon Box made by [`dragon_box`] or [`closed_dragon_box`] from the
-/// `dragon_len` triangles of `spec` before it is written
+/// Checks a Dragon Box made by [`dragon_box`], [`reconstructed_dragon_box`] or
+/// [`closed_reconstructed_dragon_box`] from the `dragon_len` triangles of `spec` before it
+/// is written
 /// ([`SceneError::Make`](crate::SceneError::Make) otherwise): every triangle the box adds has an area (a dragon of a single point, or one
 /// too thin for f32, gives a box of zero size), and the whole scene is one every loader
 /// accepts ([`Scene::from_triangles`](crate::Scene::from_triangles): the box is 1.5 × the
@@ -144,6 +217,27 @@ pub fn check_dragon_box(
     crate::Scene::from_triangles(spec, spec, triangles.to_vec(), Default::default())
         .map(drop)
         .map_err(|e| bad(format!("the result would not load: {e}")))
+}
+
+/// Checks that `dragon` (the triangles of `spec`) lies inside [`simtrax_box`], as the
+/// Stanford dragon in its original coordinates does; [`SceneError::Make`](crate::SceneError::Make)
+/// otherwise (a mesh in other coordinates would stand outside SimTRaX's fixed box).
+pub fn check_inside_simtrax_box(spec: &str, dragon: &[Triangle]) -> Result<(), crate::SceneError> {
+    let b = dragon.iter().fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+    let walls = simtrax_box_bounds();
+    if dragon.is_empty() || !walls.contains_box(&b) {
+        return Err(crate::SceneError::Make {
+            spec: spec.to_string(),
+            what: "SimTRaX's Dragon Box",
+            reason: format!(
+                "the input's bounds {:?} to {:?} are not inside SimTRaX's box {:?} to {:?}: \
+                 give the Stanford dragon in its original coordinates, or use \
+                 --reconstruction for a box fitted to any mesh",
+                b.min, b.max, walls.min, walls.max
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// The PLY bytes of `triangles` in the shipped files' shape (binary little-endian, float
@@ -239,7 +333,7 @@ mod tests {
     #[test]
     fn the_box_is_a_cube_on_the_floor_open_on_plus_z_facing_inwards() {
         let dragon = lopsided();
-        let all = dragon_box(&dragon);
+        let all = reconstructed_dragon_box(&dragon);
         assert_eq!(all.len(), dragon.len() + BOX_TRIANGLES);
         assert_eq!(&all[..2], &dragon[..]);
         let b = all[2..]
@@ -256,6 +350,47 @@ mod tests {
             // No triangle lies in the +z plane: the box is open there.
             assert!(t.v.iter().any(|v| v.z < b.max.z), "{t:?} closes +z");
         }
+    }
+
+    #[test]
+    fn simtrax_box_is_closed_and_has_the_file_s_walls() {
+        let tris = simtrax_box();
+        let b = tris.iter().fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+        assert_eq!(b, simtrax_box_bounds());
+        assert_eq!(b.min, Vec3::new(-0.128813, 0.0382846, -0.119));
+        assert_eq!(b.max, Vec3::new(0.117055, 0.2116174, 0.11));
+        // Two triangles in each of the six wall planes: the box is closed.
+        let on = |axis: usize, v: f32| {
+            tris.iter()
+                .filter(|t| t.v.iter().all(|p| p.to_array()[axis] == v))
+                .count()
+        };
+        for axis in 0..3 {
+            assert_eq!(on(axis, b.min.to_array()[axis]), 2, "axis {axis} min");
+            assert_eq!(on(axis, b.max.to_array()[axis]), 2, "axis {axis} max");
+        }
+        // Face 1 of the file is `f 1 2 3`: top left front, top left back, top right back.
+        assert_eq!(tris[0].v[0], Vec3::new(-0.128813, 0.2116174, 0.11));
+        assert_eq!(tris[0].v[2], Vec3::new(0.117055, 0.2116174, -0.119));
+        let scene = dragon_box(&lopsided());
+        assert_eq!(scene.len(), 2 + SIMTRAX_BOX_TRIANGLES);
+        assert_eq!(&scene[2..], &tris[..]);
+    }
+
+    #[test]
+    fn a_mesh_outside_simtrax_s_box_is_refused() {
+        let err = check_inside_simtrax_box("lopsided", &lopsided()).unwrap_err();
+        assert!(
+            err.to_string().contains("not inside SimTRaX's box"),
+            "{err}"
+        );
+        assert!(check_inside_simtrax_box("none", &[]).is_err());
+        let inside = [Triangle::new(
+            Vec3::new(0.0, 0.1, 0.0),
+            Vec3::new(0.01, 0.1, 0.0),
+            Vec3::new(0.0, 0.11, 0.0),
+        )];
+        assert!(check_inside_simtrax_box("inside", &inside).is_ok());
     }
 
     #[test]
@@ -278,7 +413,7 @@ mod tests {
 
     #[test]
     fn ply_bytes_weld_identical_vertices_and_keep_the_header_shape() {
-        let tris = dragon_box(&lopsided());
+        let tris = reconstructed_dragon_box(&lopsided());
         let bytes = ply_bytes(&tris, &["made by a test"]);
         let text = String::from_utf8_lossy(&bytes[..200]);
         assert!(text.starts_with("ply\nformat binary_little_endian 1.0\ncomment made by a test\n"));
@@ -301,23 +436,23 @@ mod closed_box_tests {
             Triangle::new(Vec3::ZERO, Vec3::X, Vec3::new(0.0, 2.0, 0.5)),
             Triangle::new(Vec3::new(0.3, 0.1, -0.4), Vec3::X, Vec3::new(0.7, 1.0, 0.2)),
         ];
-        let open = dragon_box(&dragon);
-        let closed = closed_dragon_box(&dragon);
+        let open = reconstructed_dragon_box(&dragon);
+        let closed = closed_reconstructed_dragon_box(&dragon);
         assert_eq!(closed.len(), open.len() + CLOSING_TRIANGLES);
         assert_eq!(&closed[..open.len()], &open[..]);
         let bounds = |t: &[Triangle]| t.iter().fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
         let (ob, cb) = (bounds(&open), bounds(&closed));
         let (oc, cc) = (
-            Camera::preset_for("dragon_box", &ob),
-            Camera::preset_for("dragon_box_closed", &cb),
+            Camera::preset_for("dragon_box_recon", &ob),
+            Camera::preset_for("dragon_box_recon_closed", &cb),
         );
         assert_eq!(
             (oc.eye, oc.target, oc.fov_y_deg),
             (cc.eye, cc.target, cc.fov_y_deg)
         );
         let (ol, cl) = (
-            Light::preset_for("dragon_box", &ob),
-            Light::preset_for("dragon_box_closed", &cb),
+            Light::preset_for("dragon_box_recon", &ob),
+            Light::preset_for("dragon_box_recon_closed", &cb),
         );
         assert_eq!((ol.position, ol.radius), (cl.position, cl.radius));
         // The eye is inside the closed box, in front of the open side, behind the front wall.

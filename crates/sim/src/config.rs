@@ -136,13 +136,35 @@ pub struct DramConfig {
     /// Four-activate window: at most four activations in any `t_faw` ticks of one channel
     /// (its one rank); 0 = no limit.
     pub t_faw: u64,
-    /// Refresh cycle time: every `t_refi` ticks, all banks of a channel are refreshed for
-    /// `t_rfc` ticks, in which no command issues; the refresh closes every open row.
+    /// Refresh cycle time of one refresh command.
     pub t_rfc: u64,
-    /// Refresh interval; 0 = no refresh.
+    /// Refresh interval; 0 = no refresh. USIMM issues `refresh_burst` refreshes together
+    /// every `refresh_burst · t_refi` ticks: each channel is blocked for t_RP +
+    /// `refresh_burst` · t_RFC ticks ending at that deadline, every row is closed, and no
+    /// activation (column read) issues less than t_RAS (t_RTP) before the window.
     pub t_refi: u64,
+    /// Refreshes per forced-refresh window (USIMM: 8).
+    pub refresh_burst: u32,
     /// Read-queue entries per channel; a full queue stalls the request (back-pressure).
     pub read_queue: u32,
+    /// USIMM's rule that a row is not precharged while a queued read still needs it: a
+    /// read of a row that arrives before the precharge that closes it is served from it.
+    pub keep_open: bool,
+    /// Write-queue entries per channel (stores go through the L2 to it); 0 = stores are
+    /// not sent to DRAM. A drain is reserved as soon as the queue passes `write_high`, so
+    /// with `write_high` below it the queue never fills.
+    pub write_queue: u32,
+    /// Write drain starts when the write queue holds more than this many writes.
+    pub write_high: u32,
+    /// Write drain stops when the write queue holds this many writes or fewer (or
+    /// `write_high`, if that is fewer).
+    pub write_low: u32,
+    /// Column-write to data delay.
+    pub t_cwd: u64,
+    /// Write recovery: end of the write data to the bank's precharge.
+    pub t_wr: u64,
+    /// Write-to-read turnaround: end of the write data to the channel's next column read.
+    pub t_wtr: u64,
     /// Energy of one 64-byte read burst, nJ.
     pub e_read_nj: f64,
     /// Energy of one row activation (and its precharge), nJ.
@@ -186,6 +208,13 @@ pub struct UnitConfig {
     pub fpadd_latency: u64,
     /// Compiled kernels: latency of a TP's own FP multiplier.
     pub fpmul_latency: u64,
+    /// Compiled kernels: integer ALUs (add and bitwise) per TM shared by its TPs; 0 = each
+    /// TP has its own (paper §2.3). SimTRaX's `bigcache.config:16` has INTADD 16.
+    pub int_units: u32,
+    /// Compiled kernels: FP adders per TM shared by its TPs; 0 = each TP has its own.
+    pub fpadd_units: u32,
+    /// Compiled kernels: FP multipliers per TM shared by its TPs; 0 = each TP has its own.
+    pub fpmul_units: u32,
     /// Compiled kernels: FP compare units per TM (shared pool).
     pub fpcmp_units: u32,
     /// Their latency.
@@ -269,6 +298,11 @@ pub struct KernelsConfig {
     pub parity: bool,
     /// How the ray-tracing instructions get their node words.
     pub node_fetch: NodeFetch,
+    /// `true`: the frame's shadow rays are traced as its render settings ask (one at every
+    /// hit by default); `false`: no shadow rays, the light sample counted as visible
+    /// (`RenderSettings::shadows`). A key of the chip's configuration so that a study can
+    /// vary it; the paper does not say whether its path tracer casts shadow rays.
+    pub shadows: bool,
 }
 
 impl Default for KernelsConfig {
@@ -276,6 +310,7 @@ impl Default for KernelsConfig {
         Self {
             parity: true,
             node_fetch: NodeFetch::Loads,
+            shadows: true,
         }
     }
 }
@@ -305,28 +340,34 @@ impl NodeFetch {
 }
 
 impl KernelsConfig {
-    /// The variant's index among [`KernelsConfig::ALL`].
+    /// The variant's index among [`KernelsConfig::ALL`] (`shadows` is read at run time
+    /// from the parameter block, not a variant of the compiled kernels).
     pub fn index(self) -> usize {
         self.parity as usize | ((self.node_fetch == NodeFetch::Loads) as usize) << 1
     }
 
-    /// Every variant, in the order of [`KernelsConfig::index`].
+    /// Every variant of the compiled kernels, in the order of [`KernelsConfig::index`]
+    /// (with shadow rays).
     pub const ALL: [KernelsConfig; 4] = [
         KernelsConfig {
             parity: false,
             node_fetch: NodeFetch::Operand,
+            shadows: true,
         },
         KernelsConfig {
             parity: true,
             node_fetch: NodeFetch::Operand,
+            shadows: true,
         },
         KernelsConfig {
             parity: false,
             node_fetch: NodeFetch::Loads,
+            shadows: true,
         },
         KernelsConfig {
             parity: true,
             node_fetch: NodeFetch::Loads,
+            shadows: true,
         },
     ];
 
@@ -390,7 +431,7 @@ impl SimConfig {
             dram: DramConfig {
                 channels: 16,
                 banks_per_channel: 16,
-                row_bytes: 2048,
+                row_bytes: 8192,
                 ticks_per_cycle: 2,
                 t_cas: 28,
                 t_rcd: 28,
@@ -404,7 +445,15 @@ impl SimConfig {
                 t_faw: 80,
                 t_rfc: 220,
                 t_refi: 15600,
+                refresh_burst: 8,
                 read_queue: 80,
+                keep_open: true,
+                write_queue: 80,
+                write_high: 40,
+                write_low: 20,
+                t_cwd: 13,
+                t_wr: 30,
+                t_wtr: 15,
                 e_read_nj: 9.8,
                 e_activate_nj: 61.3,
                 background_w: 26.7,
@@ -424,6 +473,9 @@ impl SimConfig {
                 int_latency: 1,
                 fpadd_latency: 2,
                 fpmul_latency: 2,
+                int_units: 0,
+                fpadd_units: 0,
+                fpmul_units: 0,
                 fpcmp_units: 16,
                 fpcmp_latency: 1,
                 fpminmax_units: 16,
@@ -460,6 +512,7 @@ impl SimConfig {
             kernels: KernelsConfig {
                 parity: true,
                 node_fetch: NodeFetch::Loads,
+                shadows: true,
             },
         }
     }
@@ -502,13 +555,15 @@ impl SimConfig {
             }
         }
         let d = &self.dram;
-        if d.t_refi != 0 && d.t_refi <= d.t_rfc {
+        let burst = u64::from(d.refresh_burst);
+        if d.t_refi != 0 && d.t_refi * burst <= d.t_rp + d.t_rfc * burst + d.t_ras {
             return Err(ConfigError::Invalid {
                 field: "dram.t_refi",
                 value: d.t_refi.to_string(),
                 reason: format!(
-                    "the refresh interval must exceed t_rfc ({} ticks), or be 0 for no refresh",
-                    d.t_rfc
+                    "{burst} refresh intervals must exceed the refresh window t_rp + {burst} × \
+                     t_rfc plus t_ras ({} ticks), or t_refi be 0 for no refresh",
+                    d.t_rp + d.t_rfc * burst + d.t_ras
                 ),
             });
         }
@@ -561,7 +616,15 @@ impl SimConfig {
             ("dram.t_faw", Int(d.t_faw)),
             ("dram.t_rfc", Int(d.t_rfc)),
             ("dram.t_refi", Int(d.t_refi)),
+            ("dram.refresh_burst", int(d.refresh_burst)),
             ("dram.read_queue", int(d.read_queue)),
+            ("dram.keep_open", Flag(d.keep_open)),
+            ("dram.write_queue", int(d.write_queue)),
+            ("dram.write_high", int(d.write_high)),
+            ("dram.write_low", int(d.write_low)),
+            ("dram.t_cwd", Int(d.t_cwd)),
+            ("dram.t_wr", Int(d.t_wr)),
+            ("dram.t_wtr", Int(d.t_wtr)),
             ("dram.e_read_nj", Real(d.e_read_nj)),
             ("dram.e_activate_nj", Real(d.e_activate_nj)),
             ("dram.background_w", Real(d.background_w)),
@@ -579,6 +642,9 @@ impl SimConfig {
             ("units.int_latency", Int(u.int_latency)),
             ("units.fpadd_latency", Int(u.fpadd_latency)),
             ("units.fpmul_latency", Int(u.fpmul_latency)),
+            ("units.int_units", int(u.int_units)),
+            ("units.fpadd_units", int(u.fpadd_units)),
+            ("units.fpmul_units", int(u.fpmul_units)),
             ("units.fpcmp_units", int(u.fpcmp_units)),
             ("units.fpcmp_latency", Int(u.fpcmp_latency)),
             ("units.fpminmax_units", int(u.fpminmax_units)),
@@ -614,6 +680,7 @@ impl SimConfig {
                 "kernels.node_fetch",
                 Value::Choice(self.kernels.node_fetch.name()),
             ),
+            ("kernels.shadows", Flag(self.kernels.shadows)),
         ]
     }
 

@@ -74,7 +74,12 @@ impl<'a, S: TraversalSet> FrameRequest<'a, S> {
 /// Whether `model` runs `cfg`'s kernel variant (`[kernels]`): the `fast` model replays costs
 /// measured on the default kernels only ([`SimError::FastKernelVariant`] otherwise).
 pub fn check_model(cfg: &SimConfig, model: ThreadModel) -> Result<(), SimError> {
-    if model == ThreadModel::Fast && cfg.kernels != KernelsConfig::default() {
+    // Shadow rays or none is not a kernel variant: the fast model follows the renderer.
+    let variant = KernelsConfig {
+        shadows: true,
+        ..cfg.kernels
+    };
+    if model == ThreadModel::Fast && variant != KernelsConfig::default() {
         return Err(SimError::FastKernelVariant {
             variant: format!(
                 "parity = {}, node_fetch = \"{}\"",
@@ -142,6 +147,20 @@ pub fn simulate<S: TraversalSet>(
     footprint::check(cfg, accel, model, frame.pixels())?;
     check_model(cfg, model)?;
     check_quantized_dst(structures, accel)?;
+    // `kernels.shadows = false` turns the frame's shadow rays off.
+    let shadowless = RenderSettings {
+        shadows: false,
+        ..*settings
+    };
+    let shadowless = FrameRequest {
+        settings: &shadowless,
+        ..*frame
+    };
+    let frame = if settings.shadows && !cfg.kernels.shadows {
+        &shadowless
+    } else {
+        frame
+    };
     match model {
         ThreadModel::Rv32 => rv32::frame::run(frame, progress),
         ThreadModel::Fast => fast::frame::run(frame, progress),

@@ -146,7 +146,15 @@ pub const RANGES: &[KeyRange] = &[
     int("dram.t_faw", 0, MAX_LATENCY, "ticks"),
     int("dram.t_rfc", 0, MAX_LATENCY, "ticks"),
     int("dram.t_refi", 0, 1 << 24, "ticks"),
+    int("dram.refresh_burst", 1, 64, "refreshes"),
     int("dram.read_queue", 1, 1 << 16, "entries"),
+    flag("dram.keep_open"),
+    int("dram.write_queue", 0, 1 << 16, "entries"),
+    int("dram.write_high", 0, 1 << 16, "entries"),
+    int("dram.write_low", 0, 1 << 16, "entries"),
+    int("dram.t_cwd", 0, MAX_LATENCY, "ticks"),
+    int("dram.t_wr", 0, MAX_LATENCY, "ticks"),
+    int("dram.t_wtr", 0, MAX_LATENCY, "ticks"),
     real("dram.e_read_nj", 0.0, MAX_NJ, "nJ"),
     real("dram.e_activate_nj", 0.0, MAX_NJ, "nJ"),
     real("dram.background_w", 0.0, 1e6, "W"),
@@ -164,6 +172,9 @@ pub const RANGES: &[KeyRange] = &[
     int("units.int_latency", 1, MAX_LATENCY, "cycles"),
     int("units.fpadd_latency", 1, MAX_LATENCY, "cycles"),
     int("units.fpmul_latency", 1, MAX_LATENCY, "cycles"),
+    int("units.int_units", 0, MAX_UNITS, "units"),
+    int("units.fpadd_units", 0, MAX_UNITS, "units"),
+    int("units.fpmul_units", 0, MAX_UNITS, "units"),
     int("units.fpcmp_units", 1, MAX_UNITS, "units"),
     int("units.fpcmp_latency", 1, MAX_LATENCY, "cycles"),
     int("units.fpminmax_units", 1, MAX_UNITS, "units"),
@@ -199,6 +210,7 @@ pub const RANGES: &[KeyRange] = &[
     real("energy.qdst_pipe_nj", 0.0, MAX_NJ, "nJ"),
     flag("kernels.parity"),
     choice("kernels.node_fetch", &["operand", "loads"]),
+    flag("kernels.shadows"),
 ];
 
 impl KeyRange {

@@ -49,6 +49,45 @@ fn compiled_kernels_give_the_renderers_pixels() {
 }
 
 #[test]
+fn without_shadow_rays_both_models_give_the_shadowless_renderers_pixels() {
+    // kernels.shadows = false: no shadow ray in the kernels (Params.shadows = 0) or the fast
+    // model; both equal the CPU renderer with RenderSettings::shadows = false, and trace
+    // fewer rays than with shadow rays.
+    let scene = dualsplit_scene::load("builtin:cornell").unwrap();
+    let s = Structures::build(&scene.triangles, &Default::default());
+    let mut cfg = tiny();
+    let settings = RenderSettings::new(12, 12, Workload::Path);
+    let with = simulate(
+        &FrameRequest::new(&scene, &s, SimAccel::Dst, &settings, &cfg),
+        &|_, _| {},
+    )
+    .unwrap();
+    cfg.kernels.shadows = false;
+    let off = RenderSettings {
+        shadows: false,
+        ..settings
+    };
+    let want = dualsplit_render::render(&scene, &s, dualsplit_accel::AccelKind::Dst, &off, &|| {})
+        .unwrap();
+    for m in [ThreadModel::Rv32, ThreadModel::Fast] {
+        let r = simulate(
+            &FrameRequest::new(&scene, &s, SimAccel::Dst, &settings, &cfg).with_model(m),
+            &|_, _| {},
+        )
+        .unwrap();
+        assert!(r.rays < with.rays, "{m:?}: {} vs {}", r.rays, with.rays);
+        for (i, a) in r.radiance.iter().enumerate() {
+            let (x, y) = (i as u32 % 12, i as u32 / 12);
+            assert_eq!(
+                a.to_bits(),
+                want.image.get(x, y).to_bits(),
+                "{m:?} pixel {i}"
+            );
+        }
+    }
+}
+
+#[test]
 fn a_frame_beyond_the_memory_map_is_a_typed_error() {
     let scene = dualsplit_scene::load("builtin:cornell").unwrap();
     let s = Structures::build(&scene.triangles, &Default::default());

@@ -104,9 +104,19 @@ fn both_ends_of_every_range_are_accepted_and_one_past_them_refused() {
     SimConfig::from_toml("[l1]\nassociativity = 64\n[l2]\nassociativity = 64").unwrap();
     SimConfig::from_toml("[dram]\nt_rfc = 65536\nt_refi = 16777216").unwrap();
     SimConfig::from_toml("[dram]\nt_rfc = 0\nt_refi = 0").unwrap();
-    SimConfig::from_toml("[dram]\nt_rfc = 0\nt_refi = 1").unwrap();
-    // A refresh interval no longer than t_RFC would leave no tick to activate in.
+    SimConfig::from_toml("[dram]\nt_rfc = 0\nt_rp = 0\nt_ras = 0\nt_refi = 1").unwrap();
+    // Refresh windows (t_RP + burst × t_RFC) and t_RAS before each must leave a tick to
+    // activate in: 8 × 31 = 248 > 28 + 8 × 27 + 3 = 247; 8 × 30 = 240 is not.
+    SimConfig::from_toml("[dram]\nt_rfc = 27\nt_ras = 3\nt_refi = 31").unwrap();
+    refused(
+        "[dram]\nt_rfc = 27\nt_ras = 3\nt_refi = 30",
+        "`dram.t_refi`",
+    );
     refused("[dram]\nt_rfc = 220\nt_refi = 220", "`dram.t_refi`");
+    refused(
+        "[dram]\nrefresh_burst = 1\nt_rfc = 220\nt_refi = 300",
+        "`dram.t_refi`",
+    );
 }
 
 /// A 50-triangle soup in front of the camera.

@@ -1,10 +1,14 @@
 //! `dualsplit scene`: scene files made from public meshes.
 //!
-//! `dualsplit scene dragon-box DRAGON -o dragon_box.ply.gz` builds the reconstructed Dragon Box
-//! from the Stanford dragon exactly as the shipped `dragon_box.ply.gz` was made
-//! ([`dualsplit_scene::make`]): the dragon's triangles in file order, then an open box
-//! of 10 triangles. DRAGON is any scene file (the Stanford `dragon_vrip.ply`, or the
-//! shipped `dragon.ply.gz`); the output is a gzipped binary little-endian PLY.
+//! `dualsplit scene dragon-box DRAGON -o dragon_box.ply.gz` builds the paper's Dragon Box as
+//! SimTRaX ships it ([`dualsplit_scene::make::dragon_box`]): the dragon's triangles in file
+//! order, then SimTRaX's closed box of 12 triangles; DRAGON is the Stanford dragon in its
+//! original coordinates (the Stanford `dragon_vrip.ply`, the shipped `dragon.ply.gz` or one
+//! of its decimations). Named `dragon_box.ply.gz`, it gets SimTRaX's camera and light.
+//! `--reconstruction` builds the box this project reconstructed before SimTRaX's scene was
+//! used (an open box fitted to any mesh; name it `dragon_box_recon.ply.gz`), `--closed`
+//! closes that one behind its camera (`dragon_box_recon_closed.ply.gz`). The output is a
+//! gzipped binary little-endian PLY.
 //!
 //! `dualsplit scene convert IN -o OUT.ply.gz` writes any scene file's triangles in the
 //! same format (`scripts/get-scenes.sh` converts the downloaded originals with it).
@@ -20,8 +24,9 @@ use std::process::ExitCode;
 /// The scene files `dualsplit scene` makes.
 #[derive(clap::Subcommand)]
 pub enum Command {
-    /// The reconstructed Dragon Box from the Stanford dragon: the dragon, then an axis-aligned
-    /// cube (side 1.5 × the dragon's largest extent) open on +z, the dragon on its floor.
+    /// The paper's Dragon Box as SimTRaX ships it (samples/scenes/dragon, commit f2537ff):
+    /// the Stanford dragon in its original coordinates, then SimTRaX's closed 12-triangle
+    /// box. `--reconstruction`: this project's earlier reconstruction instead.
     DragonBox(DragonBoxArgs),
     /// Any scene file (.obj, .ply, .gltf, .glb, optionally .gz) as a gzipped binary PLY of
     /// its triangles, in the loader's triangle order (vertices with equal bits written once).
@@ -48,10 +53,16 @@ pub struct DragonBoxArgs {
     /// The Dragon Box file to write (gzipped binary PLY).
     #[arg(short, long)]
     output: PathBuf,
-    /// Close the box behind the camera (10 more triangles: the walls carried on past the
-    /// open side to a front wall behind the preset camera). Name the file
-    /// `dragon_box_closed.ply.gz`: that stem gets the open box's camera and light.
+    /// Make the reconstruction instead of SimTRaX's scene: the dragon, then an axis-aligned
+    /// cube (side 1.5 × the mesh's largest extent) open on +z, the mesh on its floor. Name
+    /// the file `dragon_box_recon.ply.gz` for its camera and light.
     #[arg(long)]
+    reconstruction: bool,
+    /// With `--reconstruction`: close the box behind the camera (10 more triangles: the
+    /// walls carried on past the open side to a front wall behind the preset camera). Name
+    /// the file `dragon_box_recon_closed.ply.gz`: that stem gets the open box's camera and
+    /// light.
+    #[arg(long, requires = "reconstruction")]
     closed: bool,
 }
 
@@ -63,8 +74,11 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             crate::output::check_not_an_input(&args.output, "-o", &[Path::new(&args.dragon)])?;
             let dragon = super::load(&args.dragon, ctx)?;
             let tris = if args.closed {
-                make::closed_dragon_box(&dragon.triangles)
+                make::closed_reconstructed_dragon_box(&dragon.triangles)
+            } else if args.reconstruction {
+                make::reconstructed_dragon_box(&dragon.triangles)
             } else {
+                make::check_inside_simtrax_box(&dragon.spec, &dragon.triangles)?;
                 make::dragon_box(&dragon.triangles)
             };
             let n = dragon.triangles.len();
@@ -76,10 +90,14 @@ pub fn run(cmd: Command, ctx: &Ctx) -> anyhow::Result<ExitCode> {
                     n.saturating_sub(1)
                 ),
                 if args.closed {
-                    "plus an open-front (+z) box of 10 triangles, then 10 closing it behind the \
-                     camera, appended as the last faces"
+                    "plus a reconstructed open-front (+z) box of 10 triangles, then 10 closing \
+                     it behind the camera, appended as the last faces"
+                } else if args.reconstruction {
+                    "plus a reconstructed open-front (+z) box of 10 triangles appended as the \
+                     last faces"
                 } else {
-                    "plus an open-front (+z) box of 10 triangles appended as the last faces"
+                    "plus SimTRaX's closed box of 12 triangles (samples/scenes/dragon/\
+                     dragon_box.obj, commit f2537ff) appended as the last faces"
                 }
                 .to_string(),
                 "made by dualsplit scene dragon-box".to_string(),

@@ -61,7 +61,10 @@ pub fn split(
         + counts.qdst_ops as f64 * e.qdst_pipe_nj)
         * nj;
     let d = &cfg.dram;
-    let dram_j = (dram.reads as f64 * d.e_read_nj + dram.activations as f64 * d.e_activate_nj) * nj
+    // A write burst costs a read's energy: USIMM prices it with IDD4W as a read with IDD4R
+    // (`sim/memory_controller.cc:2236`), and `1Gb_x16_amd2GHz.vi` has IDD4W = IDD4R.
+    let bursts = (dram.reads + dram.writes) as f64;
+    let dram_j = (bursts * d.e_read_nj + dram.activations as f64 * d.e_activate_nj) * nj
         + d.background_w * frame_ms * 1e-3;
     EnergySplit {
         dram_j,

@@ -26,13 +26,19 @@ pub enum Pool {
     Branch = 3,
     /// Integer multiply: SimTRaX `INTMUL`.
     IntMul = 4,
+    /// Integer add and bitwise, when shared (`units.int_units` > 0): SimTRaX `INTADD`.
+    IntAlu = 5,
+    /// FP add, when shared (`units.fpadd_units` > 0): SimTRaX `FPADD`.
+    FpAdd = 6,
+    /// FP multiply, when shared (`units.fpmul_units` > 0): SimTRaX `FPMUL`.
+    FpMul = 7,
 }
 
-const POOLS: usize = 5;
+const POOLS: usize = 8;
 
 /// The pools of one TM, one per shared class of SimTRaX's unit list: pool `p` has
 /// `width[p]` fully pipelined units, each accepting one operation per cycle, and its
-/// results are ready `latency[p]` cycles after issue. The per-cycle use counts of all five
+/// results are ready `latency[p]` cycles after issue. The per-cycle use counts of all
 /// lie in one [`Window`] (requests are made at most `tp::LOOKAHEAD` cycles after the
 /// current event time and never before it).
 #[derive(Clone, Debug)]
@@ -51,6 +57,9 @@ impl Pools {
             (units.conv_units, units.conv_latency),
             (units.branch_units, units.branch_latency),
             (units.intmul_units, units.intmul_latency),
+            (units.int_units, units.int_latency),
+            (units.fpadd_units, units.fpadd_latency),
+            (units.fpmul_units, units.fpmul_latency),
         ];
         Self {
             // At most 64 units (`ranges.rs`), so a count fits a byte.

@@ -3,7 +3,7 @@
 //! one access per bank per cycle); a hit returns its word `l1.hit_latency` cycles after its
 //! bank slot, a miss goes to the shared [`L2`] and the line is installed when its fill
 //! arrives; a miss to a line in flight waits for that fill (no second L2 access). Stores
-//! are write-around. When the L2 refuses a miss (its bank taken, `l2.refuse_conflicts`),
+//! are write-around and go through the L2 to DRAM's write queue. When the L2 refuses a miss (its bank taken, `l2.refuse_conflicts`),
 //! the load is retried until the L2 accepts it, as SimTRaX's issue unit retries a refused
 //! instruction (`sim/L1Cache.cc:318-322`, `sim/IssueUnit.cc:769-787`): modelled as the
 //! thread issuing nothing before the cycle after the L2 bank's first free cycle (the cycle
@@ -26,6 +26,8 @@ pub trait Backing {
         at: Cycle,
         now: Cycle,
     ) -> (Cycle, Option<Cycle>);
+    /// Writes word `word` of `line`, whose L1 slot was `at` ([`L2::write`]).
+    fn write(&mut self, line: LineAddr, word: WordAddr, at: Cycle, now: Cycle) -> Option<Cycle>;
 }
 
 impl Backing for L2 {
@@ -39,6 +41,11 @@ impl Backing for L2 {
     ) -> (Cycle, Option<Cycle>) {
         L2::read(self, line, word, at, now)
     }
+
+    #[inline]
+    fn write(&mut self, line: LineAddr, word: WordAddr, at: Cycle, now: Cycle) -> Option<Cycle> {
+        L2::write(self, line, word, at, now)
+    }
 }
 
 /// No backing: for a load whose lines the L1 holds ([`L1::holds_all`]), which therefore
@@ -48,6 +55,10 @@ pub struct Resident;
 impl Backing for Resident {
     fn read(&mut self, line: LineAddr, _: WordAddr, _: Cycle, _: Cycle) -> (Cycle, Option<Cycle>) {
         unreachable!("line {line:?} was checked to be held (L1::holds_all) and missed")
+    }
+
+    fn write(&mut self, line: LineAddr, _: WordAddr, _: Cycle, _: Cycle) -> Option<Cycle> {
+        unreachable!("a store to line {line:?} outside the commit phase")
     }
 }
 
@@ -136,24 +147,44 @@ impl L1 {
     }
 
     /// A store of `words` words from `addr` issued from cycle `at`: write-around (the L1
-    /// neither allocates nor updates a line; the data goes on to memory), each word taking
-    /// its L1 bank slot like a load's. The thread does not wait for it: `ready` is the last
-    /// word's bank slot. The memory beyond the L1 is not modelled for stores (as SimTRaX,
-    /// which counts no write traffic).
-    pub fn store(&mut self, addr: WordAddr, words: u64, at: Cycle, now: Cycle) -> Issued {
+    /// neither allocates nor updates a line), each word taking its L1 bank slot like a
+    /// load's and then going through the L2 to DRAM's write queue ([`L2::write`]; SimTRaX
+    /// `sim/L1Cache.cc:457-491`, `sim/L2Cache.cc:322-395`). The thread does not wait for
+    /// the data: `ready` is the last word's bank slot; a store the L2 refused (its bank
+    /// taken) holds the thread's issue until the bank accepts it, as a load's miss does.
+    pub fn store<B: Backing>(
+        &mut self,
+        l2: &mut B,
+        addr: WordAddr,
+        words: u64,
+        at: Cycle,
+        now: Cycle,
+    ) -> Issued {
         let shift = self.line_word_shift;
         let (mut c, mut w, end, mut busy) = (at, addr.get(), addr.get() + words, 0);
+        let mut hold = Cycle::ZERO;
         while w < end {
             let seg_end = (((w >> shift) + 1) << shift).min(end);
             let k = seg_end - w;
             let run = (self.banks).reserve_run(w & self.bank_mask, c.get(), k, now.get(), 0);
             busy += run.stall;
+            let line = LineAddr::new(w >> shift);
+            for word in w..seg_end {
+                if let Some(slot) = l2.write(line, WordAddr::new(word), Cycle(run.last), now) {
+                    hold = hold.max(slot);
+                }
+            }
             c = Cycle(run.last + 1);
             w = seg_end;
         }
+        let ready = Cycle(c.get().saturating_sub(1)).max(at);
+        if hold > Cycle::ZERO {
+            busy += (hold + 1).get().saturating_sub(c.get());
+            c = c.max(hold + 1);
+        }
         Issued {
             next_issue: c,
-            ready: Cycle(c.get().saturating_sub(1)).max(at),
+            ready,
             busy,
         }
     }

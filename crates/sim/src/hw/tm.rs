@@ -74,10 +74,17 @@ impl Tm {
         self.l1.holds_all(addr, words)
     }
 
-    /// A store through the TM's L1 ([`L1::store`]).
+    /// A store through the TM's L1 and the L2 ([`L1::store`]).
     #[inline]
-    pub fn store(&mut self, addr: WordAddr, words: u64, at: Cycle, now: Cycle) -> Issued {
-        self.l1.store(addr, words, at, now)
+    pub fn store<B: Backing>(
+        &mut self,
+        l2: &mut B,
+        addr: WordAddr,
+        words: u64,
+        at: Cycle,
+        now: Cycle,
+    ) -> Issued {
+        self.l1.store(l2, addr, words, at, now)
     }
 
     /// `n` ops on the TM's pipelines ([`Pipelines::issue`]).
@@ -166,8 +173,13 @@ mod tests {
         assert_eq!((r.next_issue, r.ready), (c(103), c(103)));
         // A store to bank 0 in cycle 200 and a load of word 16 (bank 0) in the same cycle:
         // the load waits one cycle for the bank; a store allocates no line.
-        let s = tm.store(WordAddr::new(32), 1, c(200), c(200));
+        let s = tm.store(&mut l2, WordAddr::new(32), 1, c(200), c(200));
         assert_eq!((s.next_issue, s.ready, s.busy), (c(201), c(200), 0));
+        // It went through the L2 (no read queued: the DRAM drained it at once).
+        let mut stats = Default::default();
+        l2.add_stats(&mut stats);
+        assert_eq!(stats.l2_stores, 1);
+        assert_eq!(l2.dram_stats().writes, 1);
         let r = tm.load(&mut l2, WordAddr::new(16), 1, c(200), c(200));
         assert_eq!((r.next_issue, r.busy), (c(202), 1));
         // Dual-split op: result after 8 cycles; the pipe is taken in its cycle.

@@ -81,6 +81,15 @@ pub struct DramStats {
     pub row_closed: u64,
     /// Reads that had to close another row.
     pub row_conflicts: u64,
+    /// 64-byte writes issued (drained from the write queue; stores go through the L2).
+    #[serde(default)]
+    pub writes: u64,
+    /// Row activations for writes (included in `activations`).
+    #[serde(default)]
+    pub write_activations: u64,
+    /// Writes merged with a queued write of the same line.
+    #[serde(default)]
+    pub writes_merged: u64,
     /// Core cycles reads spent waiting for a read-queue entry (summed over reads).
     pub queue_wait_cycles: u64,
     /// Sum over reads of (completion − arrival) in core cycles.
@@ -267,31 +276,61 @@ struct Channel {
     /// Ticks of the activations that may still share a t_FAW window with a later one,
     /// ascending.
     faw: Vec<u64>,
+    /// The write queue, oldest first: each write's line and the tick of its column command,
+    /// `u64::MAX` until it is drained (a drained write stays queued, and later writes of
+    /// its line merge into it, until its column command issues).
+    writes: Vec<(u64, u64)>,
+    /// No column read before this tick: the end of the last drained write's data + t_WTR.
+    wtr: u64,
 }
 
-/// The refresh schedule: window k ≥ 1 is `[k·refi, k·refi + rfc)`; `refi = 0`: none.
+/// The refresh schedule as USIMM issues it (`memory_controller.cc:215-218`, `:2097-2121`,
+/// `:1943-1956`): every `period` = `refresh_burst` · t_REFI ticks a channel's one rank is
+/// refreshed `refresh_burst` times together, forced at the deadline k · `period` (k ≥ 1):
+/// from k · `period` − `window` (`window` = t_RP + `refresh_burst` · t_RFC) to the deadline
+/// no command issues, and every row is closed. Before a window, an activation issues only
+/// if t_RAS fits before the window's start (`:913`, `:1537`) and a column read only if
+/// t_RTP does (`:933`). `period = 0`: no refresh.
 #[derive(Clone, Copy, Debug)]
 struct Refresh {
-    refi: u64,
-    rfc: u64,
+    period: u64,
+    window: u64,
+    t_ras: u64,
 }
 
 impl Refresh {
-    /// How many refreshes have started by tick `t`.
-    #[inline]
-    fn count(self, t: Tick) -> u64 {
-        t.get().checked_div(self.refi).unwrap_or(0)
+    fn new(c: &DramConfig) -> Self {
+        let burst = u64::from(c.refresh_burst);
+        Self {
+            period: c.t_refi * burst,
+            window: c.t_rp + c.t_rfc * burst,
+            t_ras: c.t_ras,
+        }
     }
 
-    /// The first tick at or after `t` outside every refresh window.
+    /// How many refresh windows have started by tick `t`.
+    #[inline]
+    fn count(self, t: Tick) -> u64 {
+        (t.get() + self.window)
+            .checked_div(self.period)
+            .unwrap_or(0)
+    }
+
+    /// The first tick at or after `t` at which an activation may issue: outside every
+    /// window, and at least t_RAS before the next one starts.
     #[inline]
     fn free(self, t: Tick) -> Tick {
-        if self.refi == 0 {
+        if self.period == 0 {
             return t;
         }
-        let (k, off) = (t.get() / self.refi, t.get() % self.refi);
-        if k >= 1 && off < self.rfc {
-            Tick(k * self.refi + self.rfc)
+        let k = self.count(t);
+        if k >= 1 && t.get() < k * self.period {
+            // Inside window k: after its deadline the next window is a period away.
+            return Tick(k * self.period);
+        }
+        let next = (k + 1) * self.period - self.window;
+        if t.get() + self.t_ras > next {
+            Tick((k + 1) * self.period)
         } else {
             t
         }
@@ -320,6 +359,63 @@ fn faw_allows(acts: &[u64], s: u64, faw: u64) -> bool {
     (at.saturating_sub(4)..=at)
         .filter(|&i| i + 4 < len)
         .all(|i| get(i + 4) - get(i) >= faw)
+}
+
+/// Opens `row` in bank `b` (record `bank`, whose open row is `open`, [`NO_ROW`] if none)
+/// of channel `ch` for a request at tick `a`: a conflict precharges the open row (≥ t_RAS
+/// after its activate, ≥ t_RTP after its last column command), the activation follows
+/// after t_RP and ≥ t_RC after the bank's previous one, at the first tick free of other
+/// activations' t_RRD spans, of refresh windows and of a fifth activation in a t_FAW
+/// window. Returns the activation's tick and how the bank was found.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn activate(
+    c: &DramConfig,
+    refresh: Refresh,
+    ch: &mut Channel,
+    epochs: &mut Epochs,
+    b: usize,
+    bank: &mut Bank,
+    row: u64,
+    a: Tick,
+    open: u64,
+) -> (Tick, DramAccess) {
+    let gap = c.t_rp + c.t_rtp;
+    let mut act = a;
+    let kind = if open != NO_ROW {
+        let pre = a.max(bank.act + c.t_ras).max(bank.last_col + c.t_rtp);
+        act = pre + c.t_rp;
+        DramAccess::Conflict
+    } else {
+        DramAccess::Closed
+    };
+    if open != NO_ROW || bank.act > Tick(0) {
+        act = act.max(bank.act + c.t_rc);
+    }
+    let rrd = c.t_rrd.max(1);
+    let mut s = act.get();
+    loop {
+        s = ch.acts.peek_span(s, rrd);
+        let f = refresh.free(Tick(s)).get();
+        if f != s {
+            s = f;
+        } else if faw_allows(&ch.faw, s, c.t_faw) {
+            break;
+        } else {
+            s += 1;
+        }
+    }
+    let placed = ch.acts.reserve_span(s, rrd);
+    debug_assert_eq!(placed, s);
+    if c.t_faw > 0 {
+        let i = ch.faw.partition_point(|&t| t <= s);
+        ch.faw.insert(i, s);
+    }
+    let act = Tick(s);
+    epochs.push(b, bank, row, act, gap);
+    bank.act = act;
+    bank.open_row = row;
+    (act, kind)
 }
 
 /// The DRAM system.
@@ -390,10 +486,7 @@ impl Dram {
             bank_bits: cfg.banks_per_channel.trailing_zeros(),
             burst: Divisor::new(cfg.t_burst),
             tpc: Divisor::new(cfg.ticks_per_cycle),
-            refresh: Refresh {
-                refi: cfg.t_refi,
-                rfc: cfg.t_rfc,
-            },
+            refresh: Refresh::new(cfg),
             stats: DramStats::default(),
             latency_histogram: vec![0; LATENCY_BUCKETS],
         }
@@ -431,21 +524,11 @@ impl Dram {
     pub fn read_at(&mut self, line: LineAddr, arrive: Cycle, now: Cycle) -> (Cycle, DramAccess) {
         let line = line.get();
         debug_assert!(now <= arrive);
+        let (chi, b, row) = self.locate(line);
+        self.make_room(chi, b, now);
         let c = &self.cfg;
         let tpc = c.ticks_per_cycle;
-        let (chi, b, row) = self.locate(line);
-        // Room for one more epoch in the bank's ring (this read opens at most one).
-        if self.banks[b].len == 1 << self.epochs.shift {
-            self.epochs.grow(&mut self.banks);
-        }
         let ch = &mut self.channels[chi];
-        let floor = now.to_ticks(tpc).get();
-        ch.bus.forget_before(self.burst.div(floor));
-        ch.acts.forget_before(floor);
-        let old = ch.faw.partition_point(|&t| t + c.t_faw < floor);
-        if old > 0 {
-            ch.faw.drain(..old);
-        }
         // The read's tick; the schedule below is in ticks.
         let mut a = arrive.to_ticks(tpc);
         // Reads complete by `a` leave the queue: slot `s` completes at (s + 1) · t_burst ≤ a,
@@ -464,6 +547,8 @@ impl Dram {
         let refresh = self.refresh;
         let epochs = &mut self.epochs;
         epochs.expire(b, bank, a, gap);
+        // No column read before the last drained write's data has ended + t_WTR.
+        let wtr = Tick(ch.wtr);
         // Row-hit-first: an earlier epoch of this row still ahead of the read serves it
         // (the last epoch is the open row's).
         if bank.open_row != row && bank.rows & 1 << (row & 63) != 0 {
@@ -476,14 +561,18 @@ impl Dram {
                     continue;
                 }
                 let close = epochs.slab[epochs.at(b, bank, i + 1)].act - gap;
-                let col = a.max(e.act + c.t_rcd);
-                if col > close {
+                // USIMM holds the precharge that ends the epoch while a queued read needs
+                // its row (`scheduler.cc:217-231`): a read arriving before that precharge
+                // (the next epoch's activate − t_RP) is served from the row.
+                let held = c.keep_open && a < close + c.t_rtp;
+                let col = a.max(e.act + c.t_rcd).max(wtr);
+                if col > close && !held {
                     continue;
                 }
                 // The column command waits for its data-bus slot (t_CAS before it).
                 let slot = ch.bus.peek(self.burst.div_ceil((col + c.t_cas).get()));
                 let col = Tick(slot * c.t_burst) - c.t_cas;
-                if col <= close && refresh.count(col) == refresh.count(e.act) {
+                if (col <= close || held) && refresh.count(col + c.t_rtp) == refresh.count(e.act) {
                     hit = Some(slot);
                     break;
                 }
@@ -498,55 +587,20 @@ impl Dram {
             }
         }
         // A refresh since the bank's last activation closed its row.
-        let open = if refresh.count(a.max(bank.col_ready)) == refresh.count(bank.act) {
+        let open = if refresh.count(a.max(bank.col_ready) + c.t_rtp) == refresh.count(bank.act) {
             bank.open_row
         } else {
             NO_ROW
         };
-        let (col, kind) = match open {
-            r if r == row => (a.max(bank.col_ready), DramAccess::RowHit),
-            open => {
-                let mut act = a;
-                let kind = if open != NO_ROW {
-                    let pre = a.max(bank.act + c.t_ras).max(bank.last_col + c.t_rtp);
-                    act = pre + c.t_rp;
-                    DramAccess::Conflict
-                } else {
-                    DramAccess::Closed
-                };
-                if open != NO_ROW || bank.act > Tick(0) {
-                    act = act.max(bank.act + c.t_rc);
-                }
-                // The first start free of other activations' t_RRD spans, of refresh
-                // windows and of a fifth activation in a t_FAW window.
-                let rrd = c.t_rrd.max(1);
-                let mut s = act.get();
-                loop {
-                    s = ch.acts.peek_span(s, rrd);
-                    let f = refresh.free(Tick(s)).get();
-                    if f != s {
-                        s = f;
-                    } else if faw_allows(&ch.faw, s, c.t_faw) {
-                        break;
-                    } else {
-                        s += 1;
-                    }
-                }
-                let placed = ch.acts.reserve_span(s, rrd);
-                debug_assert_eq!(placed, s);
-                if c.t_faw > 0 {
-                    let i = ch.faw.partition_point(|&t| t <= s);
-                    ch.faw.insert(i, s);
-                }
-                act = Tick(s);
-                epochs.push(b, bank, row, act, gap);
-                bank.act = act;
-                bank.open_row = row;
-                ((act + c.t_rcd).max(bank.col_ready), kind)
-            }
+        let (col, kind) = if open == row {
+            (a.max(bank.col_ready), DramAccess::RowHit)
+        } else {
+            let (act, kind) = activate(c, refresh, ch, epochs, b, bank, row, a, open);
+            ((act + c.t_rcd).max(bank.col_ready), kind)
         };
+        let col = col.max(wtr);
         bank.col_ready = col + c.t_ccd;
-        bank.last_col = col;
+        bank.last_col = bank.last_col.max(col);
         // The data bus takes the first free burst slot once the data is ready; a read whose
         // row is open can use a slot before a conflicting read reserved earlier, which is
         // the effect of FR-FCFS on the bus.
@@ -556,6 +610,112 @@ impl Dram {
             * c.t_burst;
         let done = Tick(data + c.t_burst);
         self.finish(arrive, done, kind)
+    }
+
+    /// Grows the epoch rings when bank `b`'s is full (a request opens at most one epoch)
+    /// and lets channel `chi`'s tables forget what ended before core cycle `now`.
+    #[inline]
+    fn make_room(&mut self, chi: usize, b: usize, now: Cycle) {
+        if self.banks[b].len == 1 << self.epochs.shift {
+            self.epochs.grow(&mut self.banks);
+        }
+        let c = &self.cfg;
+        let ch = &mut self.channels[chi];
+        let floor = now.to_ticks(c.ticks_per_cycle).get();
+        ch.bus.forget_before(self.burst.div(floor));
+        ch.acts.forget_before(floor);
+        let old = ch.faw.partition_point(|&t| t + c.t_faw < floor);
+        if old > 0 {
+            ch.faw.drain(..old);
+        }
+    }
+
+    /// A 64-byte write of `line` (a store the L2 passed on, SimTRaX `sim/L2Cache.cc:374-383`)
+    /// arriving at core cycle `arrive`, `now ≤ arrive` the engine's event time. It joins
+    /// its channel's write queue, merging with a queued write of the same line (USIMM
+    /// `memory_controller.cc:839-841`), drained or not, until that write's column command
+    /// issues; the store does not wait for it. The queue is
+    /// drained as USIMM's scheduler does (`scheduler.cc:87-107`): when it holds more than
+    /// `write_high` writes, down to `write_low`; when no read is queued, entirely. A drained
+    /// write is reserved like a read at the tick of the write that started the drain
+    /// (activating its row when another is open), with t_CWD to its data, t_WR from the
+    /// data's end to the bank's next precharge and t_WTR to the channel's next column read.
+    /// `dram.write_queue = 0`: stores are not sent to DRAM.
+    pub fn write(&mut self, line: LineAddr, arrive: Cycle, now: Cycle) {
+        let c = &self.cfg;
+        if c.write_queue == 0 {
+            return;
+        }
+        let line = line.get();
+        let (chi, _, _) = self.locate(line);
+        let a = arrive.to_ticks(c.ticks_per_cycle);
+        let ch = &mut self.channels[chi];
+        // Writes whose column command has issued by `a` have left the queue.
+        ch.writes.retain(|&(_, col)| col > a.get());
+        if ch.writes.iter().any(|&(l, _)| l == line) {
+            self.stats.writes_merged += 1;
+            return;
+        }
+        ch.writes.push((line, u64::MAX));
+        ch.bus.retire_before(self.burst.div(a.get()));
+        let queued = ch.writes.len();
+        let keep = if queued > c.write_high as usize {
+            c.write_low.min(c.write_high) as usize
+        } else if ch.bus.pending() == 0 {
+            0
+        } else {
+            return;
+        };
+        // Drain the oldest writes not yet drained until `keep` would be left.
+        let mut n = queued.saturating_sub(keep);
+        for i in 0..queued {
+            if n == 0 {
+                break;
+            }
+            let (l, col) = self.channels[chi].writes[i];
+            if col == u64::MAX {
+                let col = self.write_now(l, a, now);
+                self.channels[chi].writes[i].1 = col.get();
+                n -= 1;
+            }
+        }
+    }
+
+    /// Reserves one drained write of `line` from tick `a` (see [`Dram::write`]); returns
+    /// the tick of its column command.
+    fn write_now(&mut self, line: u64, a: Tick, now: Cycle) -> Tick {
+        let (chi, b, row) = self.locate(line);
+        self.make_room(chi, b, now);
+        let c = &self.cfg;
+        let ch = &mut self.channels[chi];
+        let bank = &mut self.banks[b];
+        let gap = c.t_rp + c.t_rtp;
+        let refresh = self.refresh;
+        let epochs = &mut self.epochs;
+        epochs.expire(b, bank, a, gap);
+        let open = if refresh.count(a.max(bank.col_ready) + c.t_rtp) == refresh.count(bank.act) {
+            bank.open_row
+        } else {
+            NO_ROW
+        };
+        let col = if open == row {
+            a.max(bank.col_ready)
+        } else {
+            let (act, _) = activate(c, refresh, ch, epochs, b, bank, row, a, open);
+            self.stats.write_activations += 1;
+            (act + c.t_rcd).max(bank.col_ready)
+        };
+        bank.col_ready = col + c.t_ccd;
+        let slot = ch.bus.reserve(self.burst.div_ceil((col + c.t_cwd).get()));
+        let end = slot * c.t_burst + c.t_burst;
+        // The bank's next precharge waits t_WR after the data (it waits t_RTP after the
+        // last column command).
+        bank.last_col = bank
+            .last_col
+            .max(Tick((end + c.t_wr).saturating_sub(c.t_rtp)));
+        ch.wtr = ch.wtr.max(end + c.t_wtr);
+        self.stats.writes += 1;
+        Tick(slot * c.t_burst) - c.t_cwd
     }
 
     /// Counts a read arriving at core cycle `arrive` whose data is complete at tick `done`.
@@ -582,7 +742,7 @@ impl Dram {
         let reads = s.row_hits + s.row_closed + s.row_conflicts;
         DramStats {
             reads,
-            activations: s.row_closed + s.row_conflicts,
+            activations: s.row_closed + s.row_conflicts + s.write_activations,
             latency_p95_cycles: percentile(&self.latency_histogram, reads, 95),
             ..s
         }
@@ -636,15 +796,16 @@ mod tests {
         }
     }
 
-    /// lin2020's timings with 8 KB rows and no t_FAW or refresh: the organisation the
-    /// hand-computed latencies below are written for (128 lines per row, 16 channels, 16
-    /// banks).
+    /// lin2020's timings with 8 KB rows and no t_FAW, refresh or keep-open rule: the
+    /// organisation the hand-computed latencies below are written for (128 lines per row,
+    /// 16 channels, 16 banks).
     fn plain() -> DramConfig {
         DramConfig {
             row_bytes: 8192,
             t_faw: 0,
             t_rfc: 0,
             t_refi: 0,
+            keep_open: false,
             ..SimConfig::lin2020().dram
         }
     }
@@ -678,19 +839,147 @@ mod tests {
         let cfg = DramConfig {
             t_rfc: 220,
             t_refi: 15600,
+            refresh_burst: 8,
             ..plain()
         };
         let mut d = Dram::new(&cfg);
-        // Row 0 opened at cycle 0; a read of it at cycle 7800 (tick 15600) falls in the
-        // first refresh window [15600, 15820): the refresh closed the row, so it is a
-        // closed-bank read activated at tick 15820: column 15848, data 15876, done 15880 =
-        // cycle 7940.
+        // USIMM: eight refreshes every 8 · 15,600 = 124,800 ticks, forced in the window
+        // [124,800 − t_RP 28 − 8 · 220, 124,800) = [123,012, 124,800). Row 0 opened at
+        // cycle 0; a read of it at cycle 61,600 (tick 123,200) falls in the window: the
+        // refresh closed the row, so it is a closed-bank read activated at tick 124,800:
+        // column 124,828, data 124,856, done 124,860 = cycle 62,430.
         assert_eq!(d.rd(0, 0), (30, DramAccess::Closed));
-        assert_eq!(d.rd(1, 7800), (7940, DramAccess::Closed));
+        assert_eq!(d.rd(1, 61_600), (62_430, DramAccess::Closed));
         // Before the window the row was still open.
         let mut d = Dram::new(&cfg);
         d.rd(0, 0);
-        assert_eq!(d.rd(1, 7000), (7016, DramAccess::RowHit));
+        assert_eq!(d.rd(1, 61_000), (61_016, DramAccess::RowHit));
+        // An activation must leave t_RAS (70 ticks) before the window: a closed bank read
+        // at tick 122,950 (cycle 61,475) would activate at 122,950 + 70 > 123,012, so it
+        // waits for the window's end: activate 124,800, done cycle 62,430.
+        let mut d = Dram::new(&cfg);
+        assert_eq!(d.rd(0, 61_475), (62_430, DramAccess::Closed));
+        // One at tick 122,900 (cycle 61,450) has t_RAS before the window: 122,900 + 70 =
+        // 122,970 ≤ 123,012; column 122,928, data 122,956, done 122,960 = cycle 61,480.
+        let mut d = Dram::new(&cfg);
+        assert_eq!(d.rd(0, 61_450), (61_480, DramAccess::Closed));
+        // A column read needs t_RTP (15) before the window: the row opened at tick 0 is
+        // read at tick 123,000 (cycle 61,500), 123,000 + 15 > 123,012: the row is closed
+        // by then, so the read activates after the window.
+        let mut d = Dram::new(&cfg);
+        d.rd(0, 0);
+        assert_eq!(d.rd(1, 61_500), (62_430, DramAccess::Closed));
+        // One refresh per window (refresh_burst = 1): [15,600 − 28 − 220, 15,600).
+        let one = DramConfig {
+            refresh_burst: 1,
+            ..cfg
+        };
+        let mut d = Dram::new(&one);
+        d.rd(0, 0);
+        assert_eq!(d.rd(1, 7_700), (7_830, DramAccess::Closed));
+    }
+
+    #[test]
+    fn a_row_is_held_open_for_a_read_arriving_before_its_precharge() {
+        let cfg = DramConfig {
+            keep_open: true,
+            ..plain()
+        };
+        let row1 = 128 * 16 * 16;
+        for (keep_open, want) in [
+            (false, (128, DramAccess::Conflict)),
+            (true, (46, DramAccess::RowHit)),
+        ] {
+            let mut d = Dram::new(&DramConfig {
+                keep_open,
+                ..cfg.clone()
+            });
+            // A: row 0, closed, act 0. B: row 1, a conflict: precharge at t_RAS 70, act 98.
+            assert_eq!(d.rd(0, 0), (30, DramAccess::Closed));
+            assert_eq!(d.rd(row1, 0), (80, DramAccess::Conflict));
+            // E: row 0 at tick 60, after row 0's last column slot that fits before the
+            // precharge (98 − t_RP 28 − t_RTP 15 = 55) but before the precharge (70).
+            // USIMM holds the precharge while E is queued: E is a row hit, column 60,
+            // data at 88 (slot 22), done 92 ticks = cycle 46. Without the rule E is a
+            // conflict after B (cycle 128, `row_hit_overtakes_an_older_conflict`).
+            assert_eq!(d.rd(3, 30), want, "keep_open {keep_open}");
+            // A read arriving at the precharge (tick 70) or later is not held: a conflict
+            // after B (without the rule, E reopened row 0 after B, so it is a row hit).
+            let (_, kind) = d.rd(4, 35);
+            let want = if keep_open {
+                DramAccess::Conflict
+            } else {
+                DramAccess::RowHit
+            };
+            assert_eq!(kind, want, "keep_open {keep_open}");
+        }
+    }
+
+    #[test]
+    fn writes_wait_in_the_queue_until_the_high_watermark_or_no_reads() {
+        let cfg = DramConfig {
+            write_queue: 80,
+            write_high: 4,
+            write_low: 2,
+            ..plain()
+        };
+        let mut d = Dram::new(&cfg);
+        // A read in flight on channel 0 (done at cycle 30): writes to channel 0 queue.
+        assert_eq!(d.rd(0, 0), (30, DramAccess::Closed));
+        let bank1 = 128 * 16;
+        for i in 0..4 {
+            d.write(LineAddr::new(bank1 + i), Cycle(1), Cycle(1));
+        }
+        assert_eq!(
+            d.stats().writes,
+            0,
+            "four writes, not above the high watermark"
+        );
+        // A second write to a queued line merges.
+        d.write(LineAddr::new(bank1), Cycle(1), Cycle(1));
+        assert_eq!(d.stats().writes_merged, 1);
+        // The fifth distinct line passes the high watermark: drained down to two.
+        d.write(LineAddr::new(bank1 + 4), Cycle(2), Cycle(2));
+        let s = d.stats();
+        assert_eq!((s.writes, s.write_activations, s.activations), (3, 1, 2));
+        // A read of the written bank's row after the drain: a row hit, but not before the
+        // last write's data + t_WTR. Writes: bank 1 activates at 13 (t_RRD after bank 0's),
+        // columns at 41, 45, 49; data slots from (41 + t_CWD 13) / 4 → 14, 15, 16 — slot 14
+        // is the read's (data 56-60), so 15, 16, 17: the last ends at tick 72; t_WTR 15:
+        // no read column before 87. Read at cycle 3 (tick 6): column 87, data 115 → slot
+        // 29, done 120 ticks = cycle 60.
+        assert_eq!(d.rd(bank1 + 9, 3), (60, DramAccess::RowHit));
+        // A write of a drained line merges until that write's column command (tick 41)
+        // has issued; after it, it queues anew (a read is queued: no drain).
+        d.write(LineAddr::new(bank1), Cycle(4), Cycle(4));
+        assert_eq!(d.stats().writes_merged, 2);
+        d.write(LineAddr::new(bank1), Cycle(30), Cycle(30));
+        assert_eq!((d.stats().writes_merged, d.stats().writes), (2, 3));
+        // With no read queued, a write drains at once.
+        let mut d = Dram::new(&cfg);
+        d.write(LineAddr::new(0), Cycle(100), Cycle(100));
+        assert_eq!(d.stats().writes, 1);
+        // write_queue = 0: stores are not sent to DRAM.
+        let mut d = Dram::new(&DramConfig {
+            write_queue: 0,
+            ..cfg
+        });
+        d.write(LineAddr::new(0), Cycle(100), Cycle(100));
+        assert_eq!(d.stats(), DramStats::default());
+    }
+
+    #[test]
+    fn a_write_holds_the_next_precharge_for_t_wr() {
+        let mut d = Dram::new(&plain());
+        // With no reads queued the write drains at once: bank 0 activates at tick 0,
+        // column 28, data slot ceil((28 + 13) / 4) = 11, ends at 48. The conflicting read
+        // at tick 0: precharge ≥ act + t_RAS 70 and ≥ 48 + t_WR 30 = 78 (> 70), act 106
+        // (≥ t_RC 98), column 134, data 162 → slot 41, done 168 ticks = cycle 84. Without
+        // the write it would be cycle 80 (`conflict_waits_for_t_ras`).
+        d.write(LineAddr::new(0), Cycle(0), Cycle(0));
+        assert_eq!(d.rd(128 * 16 * 16, 0), (84, DramAccess::Conflict));
+        let s = d.stats();
+        assert_eq!((s.reads, s.writes, s.activations), (1, 1, 2));
     }
 
     /// The same DRAM model (Lin et al. 2020 §5's GDDR5 memory) written for clarity, not
@@ -794,21 +1083,20 @@ mod tests {
                 {
                     bank.epochs.pop_front();
                 }
-                let refresh = Refresh {
-                    refi: c.t_refi,
-                    rfc: c.t_rfc,
-                };
+                let refresh = Refresh::new(c);
                 let n = |t: u64| refresh.count(Tick(t));
                 let mut result = None;
                 if bank.open_row != Some(row) {
                     for e in bank.epochs.iter().filter(|e| e.row == row) {
+                        // Held open for a read arriving before the closing precharge.
+                        let held = c.keep_open && e.close != u64::MAX && a < e.close + c.t_rtp;
                         let col = a.max(e.act + c.t_rcd);
-                        if col > e.close {
+                        if col > e.close && !held {
                             continue;
                         }
                         let slot = ch.bus.find((col + c.t_cas).div_ceil(c.t_burst), 1);
                         let col = slot * c.t_burst - c.t_cas;
-                        if col <= e.close && n(col) == n(e.act) {
+                        if (col <= e.close || held) && n(col + c.t_rtp) == n(e.act) {
                             ch.bus.reserve_span(slot, 1);
                             result = Some((slot * c.t_burst + c.t_burst, DramAccess::RowHit));
                             break;
@@ -818,7 +1106,7 @@ mod tests {
                 let (done, kind) = match result {
                     Some(r) => r,
                     None => {
-                        let open = if n(a.max(bank.col_ready)) == n(bank.act) {
+                        let open = if n(a.max(bank.col_ready) + c.t_rtp) == n(bank.act) {
                             bank.open_row
                         } else {
                             None
@@ -912,6 +1200,11 @@ mod tests {
             }
             if seed % 7 == 2 {
                 (cfg.t_refi, cfg.t_faw) = (0, 0);
+            }
+            // The keep-open rule on and off; one refresh per window or USIMM's eight.
+            cfg.keep_open = seed % 3 != 0;
+            if seed % 2 == 0 {
+                cfg.refresh_burst = 1;
             }
             let mut d = Dram::new(&cfg);
             let mut r = reference::RefDram::new(&cfg);

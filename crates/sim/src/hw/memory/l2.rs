@@ -32,6 +32,7 @@ pub struct L2 {
     hits: u64,
     merged: u64,
     bank_wait: u64,
+    stores: u64,
 }
 
 impl L2 {
@@ -49,6 +50,7 @@ impl L2 {
             hits: 0,
             merged: 0,
             bank_wait: 0,
+            stores: 0,
         }
     }
 
@@ -93,12 +95,39 @@ impl L2 {
         (ready, refused)
     }
 
+    /// A store of word `word` (in `line`) whose L1 slot was `at`, passed on to DRAM's write
+    /// queue as SimTRaX does (`sim/L2Cache.cc:322-395`: write-around, the L2's tags are
+    /// not touched, the store takes its bank for the cycle and is refused on a conflict
+    /// like a load). Returns the cycle the bank accepted it when it was refused (the
+    /// thread issues nothing before it). The L2's energy is not charged for stores
+    /// (SimTRaX `sim/main.cc:1185` counts `accesses − stores`).
+    pub fn write(
+        &mut self,
+        line: LineAddr,
+        word: WordAddr,
+        at: Cycle,
+        now: Cycle,
+    ) -> Option<Cycle> {
+        let bank_addr = if self.line_interleaved {
+            line.get()
+        } else {
+            word.get()
+        };
+        let b = (bank_addr & self.bank_mask) as usize;
+        let slot = Cycle(self.banks[b].reserve(at.get()));
+        self.bank_wait += slot - at;
+        self.stores += 1;
+        self.dram.write(line, slot, now);
+        (self.refuse_conflicts && slot > at).then_some(slot)
+    }
+
     /// Adds the L2's counters to `c`.
     pub fn add_stats(&self, c: &mut CacheStats) {
         c.l2_accesses += self.accesses;
         c.l2_hits += self.hits;
         c.l2_merged += self.merged;
         c.l2_bank_wait += self.bank_wait;
+        c.l2_stores += self.stores;
     }
 
     /// The DRAM's counters.

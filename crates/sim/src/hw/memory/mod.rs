@@ -35,4 +35,7 @@ pub struct CacheStats {
     pub l2_merged: u64,
     /// Cycles L2 requests waited for a busy L2 bank.
     pub l2_bank_wait: u64,
+    /// Store words passed through the L2 to DRAM's write queue (not in `l2_accesses`).
+    #[serde(default)]
+    pub l2_stores: u64,
 }

@@ -150,7 +150,9 @@ fn cold_load_is_a_closed_row_read_and_reload_hits_l2() {
 
 #[test]
 fn row_conflict_load() {
-    let cfg = SimConfig::lin2020();
+    // 2 KB rows (configs/dram-2kb-rows.toml), the organisation this test was written for.
+    let mut cfg = SimConfig::lin2020();
+    cfg.dram.row_bytes = 2048;
     let mut chip = Chip::new(&cfg, 1);
     chip.load_word(0, 0, 0);
     // Same channel and bank, next row: 32 lines × 16 channels × 16 banks × 16 words.
@@ -182,8 +184,10 @@ fn l2_banks_interleave_by_word_or_by_line() {
 #[test]
 fn a_conflicting_miss_replaces_a_line_only_when_its_fill_arrives() {
     // SimTRaX installs lines at their arrival (L1Cache/L2Cache UpdateCache) and finds
-    // lines in flight on its pending lists.
-    let cfg = SimConfig::lin2020();
+    // lines in flight on its pending lists. 2 KB rows (configs/dram-2kb-rows.toml), the
+    // organisation the bank numbers below are written for.
+    let mut cfg = SimConfig::lin2020();
+    cfg.dram.row_bytes = 2048;
     let mut chip = Chip::new(&cfg, 1);
     // Line 0 cold: 136 (L1 1 + L2 5 + closed row 30).
     assert_eq!(chip.load_word(0, 0, 100), 136);

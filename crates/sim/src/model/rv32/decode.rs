@@ -233,6 +233,11 @@ pub enum Op {
     RtRcp,
     /// `rt.atominc`: `x[rd] = G[x[rs1]]++`.
     RtAtomInc,
+    /// `rt.srand`: the random key `K = (x[rs1], x[rs2], x[rs3])` (pixel x, y, sample).
+    RtSRand,
+    /// `rt.rand` (`imm` = dim): `f[rd]` = the renderer's random number of
+    /// `[K, x[rs1], x[rs2], dim]` (bounce, seed) in `[0, 1)`.
+    RtRand,
     /// `rt.box`: `f[rd]` = entry distance or NaN; the exit distance to `B.exit`.
     RtBox,
     /// `rt.boxn` (`imm` = N = 2, 4, 8): `x[rd]` = hit mask, entries to `B`.
@@ -358,6 +363,10 @@ fn shape(op: Op, imm: i32) -> (K, K, K, K, FuClass, u8) {
         RtSetK => (N, X, N, N, U::IntAlu, Latches::WRITES_RAY),
         RtRcp => (F, F, N, N, U::Rcp, 0),
         RtAtomInc => (X, X, N, N, U::Atomic, 0),
+        // The key is a TP register written in program order, read by `rt.rand` issued later.
+        RtSRand => (N, X, X, X, U::IntAlu, 0),
+        // TRaX's RAND runs on the FP adder (SimTRaX `sim/FPAddSub.cc:25`, `:91`).
+        RtRand => (F, X, X, N, U::FpAdd, 0),
         RtBox => (F, X, F, F, U::BoxPipe(1), r | Latches::WRITES_BOX),
         RtBoxN => (X, X, F, F, U::BoxPipe(imm as u8), r | Latches::WRITES_BOX),
         RtBoxGet => (F, N, N, N, U::IntAlu, Latches::READS_BOX),

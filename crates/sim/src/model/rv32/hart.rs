@@ -184,6 +184,8 @@ pub struct Hart {
     pub pipe_in: [u32; PIPE_INPUT_WORDS],
     /// The DST latch `D`.
     pub dst_latch: DstLatch,
+    /// The random key `K` of `rt.srand` (pixel x, y, sample).
+    pub rand_key: [u32; 3],
     /// The TP's private local store, at [`LOCAL_STORE_ADDR`].
     pub local: Box<[u8]>,
     /// Set by `ebreak`.
@@ -200,6 +202,15 @@ pub fn initial_ray() -> RayPre {
         k: [0, 1, 2],
         shear: Vec3::ZERO,
     }
+}
+
+/// `rt.rand`'s unit: the renderer's random number (`dualsplit_render`'s per-sample
+/// generator: `hash_u32s(&[x, y, sample, bounce, seed, dim]) >> 8` as a float in `[0, 1)`),
+/// as f32 bits, for the key `K = (x, y, sample)`.
+#[inline]
+pub fn rt_rand(key: [u32; 3], bounce: u32, seed: u32, dim: u32) -> u32 {
+    let h = dualsplit_geometry::hash_u32s(&[key[0], key[1], key[2], bounce, seed, dim]);
+    ((h >> 8) as f32 * (1.0 / 16_777_216.0)).to_bits()
 }
 
 #[inline(always)]
@@ -311,6 +322,7 @@ impl Hart {
             box_exit: 0.0,
             pipe_in: [0; PIPE_INPUT_WORDS],
             dst_latch: DstLatch::default(),
+            rand_key: [0; 3],
             local: vec![0; local_store_bytes as usize].into_boxed_slice(),
             halted: false,
         }
@@ -805,6 +817,8 @@ impl Hart {
                 self.ray.k = k.map(|v| v as usize);
             }
             RtRcp => wf!(canon(1.0 / fa!())),
+            RtSRand => self.rand_key = [a!(), b!(), self.x[rs3!()]],
+            RtRand => wf!(rt_rand(self.rand_key, a!(), b!(), imm as u32)),
             RtAtomInc => {
                 let old = mem.atominc(a!()).map_err(|f| self.fault(f, 0, a!()))?;
                 wx!(old);

@@ -7,7 +7,7 @@
 
 use super::decode::Op;
 
-/// Opcode of the custom-0 space (`rt.set*`, `rt.rcp`, `rt.atominc`).
+/// Opcode of the custom-0 space (`rt.set*`, `rt.rcp`, `rt.atominc`, `rt.srand`, `rt.rand`).
 pub const OPCODE_CUSTOM0: u32 = 0x0B;
 /// Opcode of the custom-1 space (`rt.box`, `rt.boxn`, `rt.boxget`, `rt.tri`, `rt.dst`,
 /// `rt.dstget`, `rt.qboxn`).
@@ -115,7 +115,7 @@ const LDP: [bool; 4] = [false, true, false, false];
 
 /// Every ray-tracing instruction (Lin et al. 2020, §2.3, §3; `docs/isa.md`), and the
 /// quantized structures' (`rt.qboxn`, `rt.qboxnp`, `rt.dstqp`; beyond the paper).
-pub const RT_INSTRUCTIONS: [RtEncoding; 21] = [
+pub const RT_INSTRUCTIONS: [RtEncoding; 23] = [
     row(
         "rt.setorg",
         Op::RtSetOrg,
@@ -161,6 +161,24 @@ pub const RT_INSTRUCTIONS: [RtEncoding; 21] = [
         R,
         UNARY,
         Imm::None,
+    ),
+    row(
+        "rt.srand",
+        Op::RtSRand,
+        OPCODE_CUSTOM0,
+        6,
+        R4,
+        SET3,
+        Imm::None,
+    ),
+    row(
+        "rt.rand",
+        Op::RtRand,
+        OPCODE_CUSTOM0,
+        7,
+        Format::R { funct7_max: 127 },
+        [true, true, true, false],
+        Imm::Field,
     ),
     row("rt.box", Op::RtBox, OPCODE_CUSTOM1, 0, R4, MEM, Imm::None),
     row(

@@ -79,9 +79,11 @@ pub struct Params {
     pub scene_max: [f32; 3],
     /// Byte address of the frame buffer.
     pub frame_buffer: u32,
+    /// 1: a shadow ray at every hit; 0: none, the light sample counted as visible.
+    pub shadows: u32,
 }
 
-const _: () = assert!(size_of::<Params>() == 156);
+const _: () = assert!(size_of::<Params>() == 160);
 
 impl Params {
     /// The block for rendering `scene` with `settings` on configuration `accel` (whose
@@ -125,6 +127,7 @@ impl Params {
             scene_min: scene_box.min.to_array(),
             scene_max: scene_box.max.to_array(),
             frame_buffer: FRAME_BUFFER_ADDR,
+            shadows: u32::from(settings.shadows),
         }
     }
 

@@ -21,7 +21,7 @@
 //!
 //! ```no_run
 //! use dualsplit_sim::model::rv32::{Program, run_frame};
-//! # fn params_bytes() -> Vec<u8> { vec![0; 156] }
+//! # fn params_bytes() -> Vec<u8> { vec![0; 160] }
 //! # let image = dualsplit_accel::MemoryImage::default();
 //! let prog = Program::from_elf(&std::fs::read("kernels/build/dst-cast.elf").unwrap()).unwrap();
 //! let params = params_bytes(); // kernels::Params::new(..).as_bytes() (kernels/dualsplit.h)

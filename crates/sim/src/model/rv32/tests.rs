@@ -84,6 +84,42 @@ fn run_with(words: &[u32], init: impl FnOnce(&mut Hart)) -> Hart {
     hart
 }
 
+#[test]
+fn rt_rand_is_the_renderers_random_number_of_the_key_bounce_seed_and_dim() {
+    for (x, y, sample, bounce, seed, dim) in [
+        (0, 0, 0, 0, 0, 0),
+        (17, 300, 3, 9, 12345, 1),
+        (1023, 1023, 63, 11, u32::MAX, 127),
+    ] {
+        // rt.srand x1, x2, x3; f4 = rt.rand(dim) x5, x6.
+        let h = run_with(
+            &[r4(0x0B, 6, 0, 0, 1, 2, 3), r(0x0B, 7, dim, 4, 5, 6)],
+            |h| {
+                (h.x[1], h.x[2], h.x[3]) = (x, y, sample);
+                (h.x[5], h.x[6]) = (bounce, seed);
+            },
+        );
+        assert_eq!(h.rand_key, [x, y, sample]);
+        // crates/render/src/job.rs `rand`: the top 24 bits of the hash over 2^24.
+        let hash = dualsplit_geometry::hash_u32s(&[x, y, sample, bounce, seed, dim]);
+        let want = (hash >> 8) as f32 * (1.0 / 16_777_216.0);
+        assert_eq!(
+            h.f[4],
+            want.to_bits(),
+            "{x} {y} {sample} {bounce} {seed} {dim}"
+        );
+        assert!((0.0..1.0).contains(&f32::from_bits(h.f[4])));
+    }
+    // Another key gives another number; the key starts at 0.
+    let a = run_with(&[r(0x0B, 7, 0, 4, 5, 6)], |_| {}).f[4];
+    let b = run_with(&[r4(0x0B, 6, 0, 0, 1, 0, 0), r(0x0B, 7, 0, 4, 5, 6)], |h| {
+        h.x[1] = 1
+    })
+    .f[4];
+    assert_ne!(a, b);
+    assert_eq!(a, hart::rt_rand([0; 3], 0, 0, 0));
+}
+
 /// One R-type integer op on `a`, `b` (x1 = a, x2 = b, result in x3).
 fn int_op(f3: u32, f7: u32, a: u32, b: u32) -> u32 {
     run_with(&[r(0x33, f3, f7, 3, 1, 2)], |h| {
@@ -553,7 +589,7 @@ fn decode_errors_and_rounding_modes() {
     assert!(decode(r4(0x2B, 1, 3, 1, 2, 3, 4)).is_err()); // boxn N = 16
     assert!(decode(r(0x2B, 2, 9, 1, 0, 0)).is_err()); // boxget k = 9
     assert!(decode(r(0x2B, 5, 4, 1, 0, 0)).is_err()); // dstget field 4
-    assert!(decode(r(0x0B, 6, 0, 1, 0, 0)).is_err());
+    assert!(decode(r4(0x0B, 6, 1, 0, 1, 2, 3)).is_err()); // rt.srand funct2 = 1
     // CSRs read 0; writing frm = RNE is fine, another mode is an error.
     let prog = Program::from_words(BASE, &[i(0x73, 2, 5, 0, 2), i(0x73, 5, 0, 1, 2), EBREAK]);
     let image = MemoryImage::default();

@@ -305,6 +305,16 @@ impl Tp {
             let t = self.t;
             // (issue cycle, result latency, producer) for units that take one slot.
             let (slot, lat, p) = match fu {
+                // A TP's own units (paper §2.3), or TM pools as SimTRaX's configs share them.
+                FuClass::IntAlu | FuClass::FpMove if cfg.int_units > 0 => {
+                    pool(&mut tm.pools, Pool::IntAlu, t, stalls)
+                }
+                FuClass::FpAdd if cfg.fpadd_units > 0 => {
+                    pool(&mut tm.pools, Pool::FpAdd, t, stalls)
+                }
+                FuClass::FpMul | FuClass::FpFma if cfg.fpmul_units > 0 => {
+                    pool(&mut tm.pools, Pool::FpMul, t, stalls)
+                }
                 FuClass::IntAlu | FuClass::FpMove => (t, cfg.int_latency, Producer::Unit),
                 FuClass::FpAdd => (t, cfg.fpadd_latency, Producer::Unit),
                 FuClass::FpMul | FuClass::FpFma => (t, cfg.fpmul_latency, Producer::Unit),
@@ -330,7 +340,9 @@ impl Tp {
                     one_slot(i, Producer::Atomic)
                 }
                 FuClass::Store => {
+                    let (l2, _) = shared.as_mut().expect("the commit phase has the L2");
                     let i = tm.store(
+                        *l2,
                         WordAddr::from_byte(placement.physical(acc.addr)),
                         acc.words as u64,
                         t,
@@ -611,6 +623,27 @@ mod tests {
         let (end, s) = run(&cfg, &[mul], 2);
         assert_eq!(s.fu_busy, 1);
         assert_eq!(end, 2);
+    }
+
+    #[test]
+    fn shared_fp_adders_and_alus_delay_the_second_thread_own_ones_do_not() {
+        // Two threads add floats at cycle 0 (fadd.s f3, f1, f2), then add integers.
+        let fadd = r(0x53, 0, 0, 3, 1, 2);
+        let mut cfg = SimConfig::lin2020();
+        let (own, s) = run(&cfg, &[fadd], 2);
+        assert_eq!(s.fu_busy, 0, "each TP's own adder (paper §2.3)");
+        // One FP adder per TM (SimTRaX's configs share them): the second waits a cycle.
+        cfg.units.fpadd_units = 1;
+        let (end, s) = run(&cfg, &[fadd], 2);
+        assert_eq!((end, s.fu_busy), (own + 1, 1));
+        // The FP multiplier and the integer ALU likewise.
+        cfg.units.fpmul_units = 1;
+        let (_, s) = run(&cfg, &[r(0x53, 0, 8, 3, 1, 2)], 2);
+        assert_eq!(s.fu_busy, 1);
+        cfg.units.int_units = 1;
+        let (_, s) = run(&cfg, &[addi(2, 1, 1)], 2);
+        // The addi and the ebreak (an ALU op too) each wait once.
+        assert!(s.fu_busy >= 1, "{s:?}");
     }
 
     #[test]
