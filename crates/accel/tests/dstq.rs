@@ -59,8 +59,8 @@ fn build_all(s: &Structures, what: &str) -> Vec<DstQ> {
     configs()
         .into_iter()
         .map(|cfg| {
-            let q = DstQ::from_dst(&s.dst, &cfg).expect("dst-q converts");
-            let rep = q.validate(&s.dst);
+            let q = DstQ::from_dst(s.dst(), &cfg).expect("dst-q converts");
+            let rep = q.validate(s.dst());
             assert!(rep.is_ok(), "{what} {cfg:?}: {rep:?}");
             assert!(q.validate_structure().is_ok(), "{what} {cfg:?}");
             q
@@ -330,7 +330,7 @@ fn shipped_case(name: &str, n: usize) {
     let s = Structures::build(&scene.triangles, &BuildConfig::default());
     let qs = build_all(&s, name);
     let sets = record_rays(&scene, &s, 48, n);
-    let b = s.dst.scene_box();
+    let b = s.dst().scene_box();
     let random = random_rays(&mut Pcg32::new(5, 5), &scene.triangles, &b, n);
     for q in &qs {
         let what = format!("{name} {:?}", q.config());
@@ -365,7 +365,7 @@ fn observer_reports_word_accurate_fetches() {
     }
     let tris = random_scene(4, 40, 0, 1.0);
     let s = Structures::build(&tris, &BuildConfig::default());
-    let b = s.dst.scene_box();
+    let b = s.dst().scene_box();
     let rays = random_rays(&mut Pcg32::new(1, 2), &tris, &b, 200);
     for q in build_all(&s, "observer") {
         let node_end = q.image().node_bytes();
@@ -382,7 +382,7 @@ fn observer_reports_word_accurate_fetches() {
             }
             // Exact DST work is a lower bound of the quantized work.
             let (mut e, mut o) = (CountingObserver::default(), CountingObserver::default());
-            s.dst.closest_hit(ray, &mut e);
+            s.dst().closest_hit(ray, &mut e);
             q.closest_hit(ray, &mut o);
             assert!(o.nodes >= e.nodes && o.triangle_tests >= e.triangle_tests);
         }
@@ -419,7 +419,7 @@ fn first_record(q: &DstQ, kind: DstNodeKind) -> Option<u32> {
 fn validate_catches_a_shrunk_plane() {
     let s = dragon_or_random();
     for cfg in configs() {
-        let q = DstQ::from_dst(&s.dst, &cfg).unwrap();
+        let q = DstQ::from_dst(s.dst(), &cfg).unwrap();
         let bit = first_record(&q, DstNodeKind::Split).expect("a split in the root block");
         let k = cfg.bits as usize;
         let mut img = q.image().clone();
@@ -430,7 +430,7 @@ fn validate_catches_a_shrunk_plane() {
         assert_ne!(read_bits(&img.words, p0, k as u32), 0);
         write_bits(&mut img.words, p0, k as u32, 0);
         let bad = DstQ::from_image(img, q.scene_box(), cfg).expect("still well formed");
-        let rep = bad.validate(&s.dst);
+        let rep = bad.validate(s.dst());
         assert!(!rep.is_ok(), "{cfg:?}");
         assert!(
             rep.errors.iter().any(|e| e.contains("not conservative")),
@@ -440,7 +440,7 @@ fn validate_catches_a_shrunk_plane() {
         let mut img = q.image().clone();
         write_bits(&mut img.words, p0 + k, k as u32, q_max(k as u32));
         let bad = DstQ::from_image(img, q.scene_box(), cfg).unwrap();
-        assert!(!bad.validate(&s.dst).is_ok(), "{cfg:?}");
+        assert!(!bad.validate(s.dst()).is_ok(), "{cfg:?}");
     }
 }
 
@@ -448,7 +448,7 @@ fn validate_catches_a_shrunk_plane() {
 fn validate_catches_bad_offsets() {
     let s = dragon_or_random();
     let cfg = DstQConfig::default();
-    let q = DstQ::from_dst(&s.dst, &cfg).unwrap();
+    let q = DstQ::from_dst(s.dst(), &cfg).unwrap();
     let bit = first_record(&q, DstNodeKind::Split).unwrap() as usize;
     let fmt = cfg.record_format();
     let h = QHeader::read(read_bits(&q.image().words, bit, 32), &fmt);
@@ -491,7 +491,7 @@ proptest! {
         let tris = random_scene(seed, 30, 0, 1.0);
         let s = Structures::build(&tris, &BuildConfig::default());
         let cfg = DstQConfig::default();
-        let q = DstQ::from_dst(&s.dst, &cfg).unwrap();
+        let q = DstQ::from_dst(s.dst(), &cfg).unwrap();
         let mut img = q.image().clone();
         let n = img.nodes.len().max(1) as u32;
         for (at, v) in edits {
@@ -501,8 +501,8 @@ proptest! {
             }
         }
         if let Ok(t) = DstQ::from_image(img, q.scene_box(), cfg) {
-            let _ = t.validate(&s.dst);
-            let b = s.dst.scene_box();
+            let _ = t.validate(s.dst());
+            let b = s.dst().scene_box();
             for ray in random_rays(&mut Pcg32::new(seed, 3), &tris, &b, 8) {
                 t.closest_hit(&ray, &mut CountingObserver::default());
             }
@@ -567,12 +567,12 @@ fn measure(name: &str, configs: &[DstQConfig]) {
     };
     let s = Structures::build(&scene.triangles, &BuildConfig::default());
     let sets = record_rays(&scene, &s, 128, 16384);
-    let b = s.dst.scene_box();
+    let b = s.dst().scene_box();
     let random = random_rays(&mut Pcg32::new(5, 5), &scene.triangles, &b, 16384);
     let sets = [("primary", &sets.primary), ("random", &random)];
-    let dst: &Dst = &s.dst;
+    let dst: &Dst = s.dst();
     let dst_bytes = dst.stats().total_bytes as f64;
-    let bvh2_bytes = s.bvh2_image.bytes_total() as f64;
+    let bvh2_bytes = s.bvh2_image().bytes_total() as f64;
     let exact: Vec<Work> = sets
         .iter()
         .map(|(_, r)| {
@@ -662,8 +662,8 @@ fn worked_example_words() {
         ..BuildConfig::default()
     };
     let s = Structures::try_build_with(&tris, &bcfg, &DstConfig::hardware()).unwrap();
-    let q = DstQ::from_dst(&s.dst, &DstQConfig::default()).unwrap();
-    assert!(q.validate(&s.dst).is_ok());
+    let q = DstQ::from_dst(s.dst(), &DstQConfig::default()).unwrap();
+    assert!(q.validate(s.dst()).is_ok());
     let img = q.image();
     assert_eq!(img.nodes.len(), 16, "one 64-byte line");
     assert_eq!(
