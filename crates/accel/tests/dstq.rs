@@ -5,7 +5,7 @@
 //! `docs/dstq-encoding.md` (`measure_table`, ignored: run it with
 //! `cargo test --release -p dualsplit-accel --test dstq measure_table -- --ignored --nocapture`).
 
-use dualsplit_accel::dst::{Dst, DstConfig, HeaderOffset, Partitioning};
+use dualsplit_accel::dst::{DstConfig, HeaderOffset, Partitioning};
 use dualsplit_accel::dstq::frame::{choose_exponent, decode, q_max, quantize_down, quantize_up};
 use dualsplit_accel::dstq::layout::ROOT_BIT;
 use dualsplit_accel::dstq::record::{read_bits, write_bits};
@@ -19,7 +19,6 @@ use dualsplit_testkit::oracle::{key, oracle_closest};
 use dualsplit_testkit::rays::{random_rays, record_rays};
 use dualsplit_testkit::scenes::{random_scene, shipped};
 use proptest::prelude::*;
-use std::collections::HashSet;
 
 /// Every supported config: k ∈ {4, 6, 8, 10, 12, 16} × 64 and 128-byte clusters.
 fn configs() -> Vec<DstQConfig> {
@@ -507,138 +506,6 @@ proptest! {
                 t.closest_hit(&ray, &mut CountingObserver::default());
             }
         }
-    }
-}
-
-// ---------------------------------------------------------------- measurement
-
-/// Per-ray work of one structure on one ray set.
-#[derive(Default, Clone, Copy)]
-struct Work {
-    nodes: f64,
-    tris: f64,
-    bytes: f64,
-    lines: f64,
-}
-
-/// Counts bytes and the distinct 64-byte lines a ray touches.
-#[derive(Default)]
-struct Lines {
-    c: CountingObserver,
-    lines: HashSet<u64>,
-}
-impl Observer for Lines {
-    fn fetch(&mut self, addr: ByteAddr, bytes: u32) {
-        self.c.fetch(addr, bytes);
-        for l in addr.0 / 64..=(addr.0 + bytes as u64 - 1) / 64 {
-            self.lines.insert(l);
-        }
-    }
-    fn step(&mut self, s: dualsplit_accel::NodeStep) {
-        self.c.step(s);
-    }
-    fn triangle_test(&mut self, p: dualsplit_geometry::PrimId, h: bool) {
-        self.c.triangle_test(p, h);
-    }
-}
-
-fn work(rays: &[Ray], mut f: impl FnMut(&Ray, &mut Lines)) -> Work {
-    let mut w = Work::default();
-    for r in rays {
-        let mut o = Lines::default();
-        f(r, &mut o);
-        w.nodes += o.c.nodes as f64;
-        w.tris += o.c.triangle_tests as f64;
-        w.bytes += o.c.bytes as f64;
-        w.lines += o.lines.len() as f64;
-    }
-    let n = rays.len().max(1) as f64;
-    Work {
-        nodes: w.nodes / n,
-        tris: w.tris / n,
-        bytes: w.bytes / n,
-        lines: w.lines / n,
-    }
-}
-
-fn measure(name: &str, configs: &[DstQConfig]) {
-    let Some(scene) = shipped(name) else {
-        return;
-    };
-    let s = Structures::build(&scene.triangles, &BuildConfig::default());
-    let sets = record_rays(&scene, &s, 128, 16384);
-    let b = s.dst().scene_box();
-    let random = random_rays(&mut Pcg32::new(5, 5), &scene.triangles, &b, 16384);
-    let sets = [("primary", &sets.primary), ("random", &random)];
-    let dst: &Dst = s.dst();
-    let dst_bytes = dst.stats().total_bytes as f64;
-    let bvh2_bytes = s.bvh2_image().bytes_total() as f64;
-    let exact: Vec<Work> = sets
-        .iter()
-        .map(|(_, r)| {
-            work(r, |ray, o| {
-                dst.closest_hit(ray, o);
-            })
-        })
-        .collect();
-    println!(
-        "\n{name}: exact DST {:.3} MiB ({:.1} % of BVH2 {:.3} MiB)",
-        dst_bytes / 1048576.0,
-        100.0 * dst_bytes / bvh2_bytes,
-        bvh2_bytes / 1048576.0
-    );
-    for ((set, rays), e) in sets.iter().zip(&exact) {
-        println!(
-            "  exact DST, {set} ({} rays): {:.2} nodes, {:.2} triangles, {:.0} B, {:.2} lines per ray",
-            rays.len(),
-            e.nodes,
-            e.tris,
-            e.bytes,
-            e.lines
-        );
-    }
-    println!(
-        "| k | line | MiB | % DST | % BVH2 | B/node | fill | clusters | prim B/ray | prim lines | prim +nodes | prim +tris | rand B/ray | rand lines | rand +nodes | rand +tris |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for cfg in configs {
-        let q = DstQ::from_dst(dst, cfg).unwrap();
-        assert!(q.validate(dst).is_ok());
-        let st = q.stats();
-        let tot = q.bytes_total() as f64;
-        let mut row = format!(
-            "| {} | {} | {:.3} | {:.1} | {:.1} | {:.2} | {:.0} % | {} |",
-            cfg.bits,
-            cfg.cluster_bytes,
-            tot / 1048576.0,
-            100.0 * tot / dst_bytes,
-            100.0 * tot / bvh2_bytes,
-            st.bytes_per_node(),
-            100.0 * st.fill(),
-            st.clusters
-        );
-        for ((_, rays), e) in sets.iter().zip(&exact) {
-            let w = work(rays, |ray, o| {
-                q.closest_hit(ray, o);
-            });
-            row += &format!(
-                " {:.0} | {:.2} | {:+.1} % | {:+.1} % |",
-                w.bytes,
-                w.lines,
-                100.0 * (w.nodes / e.nodes - 1.0),
-                100.0 * (w.tris / e.tris - 1.0)
-            );
-        }
-        println!("{row}");
-    }
-}
-
-#[test]
-#[ignore = "prints the measurement table of docs/dstq-encoding.md (release build, about 5 s)"]
-fn measure_table() {
-    let cfgs = configs();
-    for name in ["dragon_res4.ply.gz", "bunny.ply.gz"] {
-        measure(name, &cfgs);
     }
 }
 
