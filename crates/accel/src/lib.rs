@@ -70,6 +70,9 @@ pub mod tree;
 pub mod tree_set;
 pub mod validate;
 pub mod wide;
+// The toy structure of docs/extending.md, for its test (feature `toy`).
+#[cfg(feature = "toy")]
+pub mod toy;
 
 /// The geometry types of the public API, re-exported so that callers need not depend on
 /// `dualsplit-geometry` or match its glam version.

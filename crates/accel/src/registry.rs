@@ -79,6 +79,14 @@ structures! {
             DstQ = "dst-q",
         ];
     }
+    /// The toy structure of `docs/extending.md` (feature `toy`, for its test).
+    Toy(crate::toy::ToyTree) if feature = "toy" {
+        /// Every triangle in one leaf (`tests/toy.rs`).
+        Toy = "toy", code 99, traversals [
+            /// The toy's one traversal: the leaf's triangles, one after another.
+            Toy = "toy",
+        ];
+    }
 }
 
 /// The settings the structures are derived from a BVH2 with: what `dualsplit build` and

@@ -179,7 +179,22 @@ pub(crate) fn own_frame<R>(f: impl FnOnce() -> R) -> R {
 /// saved-file code), then each traversal of that kind ([`AccelKind`] variant and
 /// command-line name). The order is the report order.
 macro_rules! structures {
-    ($(
+    // An entry without a condition: always compiled.
+    (@norm [$($done:tt)*] $(#[$tm:meta])* $tv:ident($tty:ty) { $($body:tt)* } $($rest:tt)*) => {
+        $crate::structure::structures!(@norm [$($done)* [all()] $(#[$tm])* $tv($tty) { $($body)* }] $($rest)*);
+    };
+    // An entry compiled under `cfg($cfg)` (`Toy(...) if feature = "toy" { ... }`).
+    (@norm [$($done:tt)*] $(#[$tm:meta])* $tv:ident($tty:ty) if $cfg:meta { $($body:tt)* } $($rest:tt)*) => {
+        $crate::structure::structures!(@norm [$($done)* [$cfg] $(#[$tm])* $tv($tty) { $($body)* }] $($rest)*);
+    };
+    (@norm [$($done:tt)*]) => {
+        $crate::structure::structures!(@gen $($done)*);
+    };
+    (@first $ty:ident; $first:ident $($rest:ident)*) => {
+        $ty::$first
+    };
+    (@gen $(
+        [$cfg:meta]
         $(#[$tm:meta])*
         $tv:ident($tty:ty) {
             $(
@@ -195,13 +210,25 @@ macro_rules! structures {
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
         #[serde(rename_all = "kebab-case")]
         pub enum AccelKind {
-            $($($( $(#[$am])* $av, )+)+)+
+            $($($( #[cfg($cfg)] $(#[$am])* $av, )+)+)+
         }
 
         impl AccelKind {
             /// All kinds, in report order.
-            pub const ALL: [AccelKind; [$($($($aname),+),+),+].len()] =
-                [$($($(AccelKind::$av),+),+),+];
+            pub const ALL: [AccelKind; Self::COUNT] = {
+                let mut all = [$crate::structure::structures!(@first AccelKind; $($($($av)+)+)+); Self::COUNT];
+                let mut i = 0;
+                $($($( #[cfg($cfg)] { all[i] = AccelKind::$av; i += 1; } )+)+)+
+                assert!(i == Self::COUNT);
+                all
+            };
+
+            /// How many kinds there are.
+            const COUNT: usize = {
+                let mut n = 0;
+                $($($( #[cfg($cfg)] { n += 1; let _ = $aname; } )+)+)+
+                n
+            };
 
             /// The reference traversal: the first registered (the BVH2's), the one ray
             /// sets are recorded on and every other traversal is checked against.
@@ -210,7 +237,7 @@ macro_rules! structures {
             /// The command-line name.
             pub fn name(self) -> &'static str {
                 match self {
-                    $($($( AccelKind::$av => $aname, )+)+)+
+                    $($($( #[cfg($cfg)] AccelKind::$av => $aname, )+)+)+
                 }
             }
 
@@ -227,7 +254,7 @@ macro_rules! structures {
             /// The structure this traversal reads.
             pub fn tree_kind(self) -> TreeKind {
                 match self {
-                    $($($( AccelKind::$av => TreeKind::$kv, )+)+)+
+                    $($($( #[cfg($cfg)] AccelKind::$av => TreeKind::$kv, )+)+)+
                 }
             }
         }
@@ -236,12 +263,25 @@ macro_rules! structures {
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
         #[serde(rename_all = "kebab-case")]
         pub enum TreeKind {
-            $($( $(#[$km])* $kv, )+)+
+            $($( #[cfg($cfg)] $(#[$km])* $kv, )+)+
         }
 
         impl TreeKind {
             /// All kinds, in report order.
-            pub const ALL: [TreeKind; [$($($kname),+),+].len()] = [$($(TreeKind::$kv),+),+];
+            pub const ALL: [TreeKind; Self::COUNT] = {
+                let mut all = [$crate::structure::structures!(@first TreeKind; $($($kv)+)+); Self::COUNT];
+                let mut i = 0;
+                $($( #[cfg($cfg)] { all[i] = TreeKind::$kv; i += 1; } )+)+
+                assert!(i == Self::COUNT);
+                all
+            };
+
+            /// How many kinds there are.
+            const COUNT: usize = {
+                let mut n = 0;
+                $($( #[cfg($cfg)] { n += 1; let _ = $kname; } )+)+
+                n
+            };
 
             /// The reference structure: the first registered, the BVH2 every other one
             /// is derived from.
@@ -250,7 +290,7 @@ macro_rules! structures {
             /// The command-line name.
             pub fn name(self) -> &'static str {
                 match self {
-                    $($( TreeKind::$kv => $kname, )+)+
+                    $($( #[cfg($cfg)] TreeKind::$kv => $kname, )+)+
                 }
             }
 
@@ -268,7 +308,7 @@ macro_rules! structures {
             /// [`AccelKind::DST_SOFTWARE`] first).
             pub fn accel_kinds(self) -> &'static [AccelKind] {
                 match self {
-                    $($( TreeKind::$kv => &[$(AccelKind::$av),+], )+)+
+                    $($( #[cfg($cfg)] TreeKind::$kv => &[$(AccelKind::$av),+], )+)+
                 }
             }
 
@@ -281,21 +321,21 @@ macro_rules! structures {
             /// (`crate::dst::DstTree`): its module is the structure's folder.
             pub fn rust_type(self) -> &'static str {
                 match self {
-                    $($( TreeKind::$kv => stringify!($tty), )+)+
+                    $($( #[cfg($cfg)] TreeKind::$kv => stringify!($tty), )+)+
                 }
             }
 
             /// The code of this kind in a saved file's header (`docs/tree-format.md`).
             pub(crate) fn code(self) -> u32 {
                 match self {
-                    $($( TreeKind::$kv => $code, )+)+
+                    $($( #[cfg($cfg)] TreeKind::$kv => $code, )+)+
                 }
             }
 
             /// The kind a saved file's header code names.
             pub(crate) fn from_code(code: u32) -> Option<Self> {
                 match code {
-                    $($( $code => Some(TreeKind::$kv), )+)+
+                    $($( #[cfg($cfg)] $code => Some(TreeKind::$kv), )+)+
                     _ => None,
                 }
             }
@@ -310,10 +350,11 @@ macro_rules! structures {
         /// One structure of any kind: what a saved tree file holds.
         #[derive(Clone, Debug)]
         pub enum AnyTree {
-            $( $(#[$tm])* $tv($tty), )+
+            $( #[cfg($cfg)] $(#[$tm])* $tv($tty), )+
         }
 
         $(
+            #[cfg($cfg)]
             impl From<$tty> for AnyTree {
                 fn from(t: $tty) -> Self {
                     AnyTree::$tv(t)
@@ -331,7 +372,7 @@ macro_rules! structures {
                 built: &[AnyTree],
             ) -> Result<AnyTree, AccelError> {
                 match kind {
-                    $( $(TreeKind::$kv)|+ => {
+                    $( #[cfg($cfg)] $(TreeKind::$kv)|+ => {
                         <$tty as Structure>::derive(bvh2, kind, presets, built).map(AnyTree::$tv)
                     } )+
                 }
@@ -340,28 +381,28 @@ macro_rules! structures {
             /// Which structure.
             pub fn kind(&self) -> TreeKind {
                 match self {
-                    $( AnyTree::$tv(t) => Structure::kind(t), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => Structure::kind(t), )+
                 }
             }
 
             /// The byte-exact memory image.
             pub fn image(&self) -> &MemoryImage {
                 match self {
-                    $( AnyTree::$tv(t) => Structure::image(t), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => Structure::image(t), )+
                 }
             }
 
             /// The BVH2 build settings.
             pub fn config(&self) -> &BuildConfig {
                 match self {
-                    $( AnyTree::$tv(t) => Structure::config(t), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => Structure::config(t), )+
                 }
             }
 
             /// Size and build time.
             pub fn stats(&self) -> &BuildStats {
                 match self {
-                    $( AnyTree::$tv(t) => Structure::stats(t), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => Structure::stats(t), )+
                 }
             }
 
@@ -377,28 +418,28 @@ macro_rules! structures {
             /// [`AnyTree::validate`] with the other structures derived with this one.
             pub fn validate_among(&self, bvh2: &Bvh2, built: &[AnyTree]) -> ValidationReport {
                 match self {
-                    $( AnyTree::$tv(t) => Structure::validate(t, bvh2, built), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => Structure::validate(t, bvh2, built), )+
                 }
             }
 
             /// The box around every triangle ([`Structure::scene_box`]).
             pub fn scene_box(&self) -> Aabb {
                 match self {
-                    $( AnyTree::$tv(t) => Structure::scene_box(t), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => Structure::scene_box(t), )+
                 }
             }
 
             /// Whether the tree fits its hardware unit ([`Structure::fits_unit`]).
             pub fn fits_unit(&self) -> Result<(), UnitMismatch> {
                 match self {
-                    $( AnyTree::$tv(t) => Structure::fits_unit(t), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => Structure::fits_unit(t), )+
                 }
             }
 
             /// Size and build statistics, percentages relative to `bvh2_total` bytes.
             pub fn structure_stats(&self, bvh2_total: u64) -> StructureStats {
                 match self {
-                    $( AnyTree::$tv(t) => Structure::structure_stats(t, bvh2_total), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => Structure::structure_stats(t, bvh2_total), )+
                 }
             }
 
@@ -415,7 +456,7 @@ macro_rules! structures {
                     return None;
                 }
                 Some(match self {
-                    $( AnyTree::$tv(t) => Structure::closest_hit(t, kind, ray, obs), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => Structure::closest_hit(t, kind, ray, obs), )+
                 })
             }
 
@@ -427,21 +468,21 @@ macro_rules! structures {
                     return None;
                 }
                 Some(match self {
-                    $( AnyTree::$tv(t) => Structure::any_hit(t, kind, ray, obs), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => Structure::any_hit(t, kind, ray, obs), )+
                 })
             }
 
             /// The tree inside, if it is a `T`.
             pub fn get<T: Structure + 'static>(&self) -> Option<&T> {
                 match self {
-                    $( AnyTree::$tv(t) => (t as &dyn std::any::Any).downcast_ref::<T>(), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => (t as &dyn std::any::Any).downcast_ref::<T>(), )+
                 }
             }
 
             /// The query context of traversal `kind` of this tree, if it has one.
             pub fn plain_query(&self, kind: AccelKind) -> Option<Plain<'_>> {
                 match self {
-                    $( AnyTree::$tv(t) => Structure::query(t, kind).map(Plain::$tv), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => Structure::query(t, kind).map(Plain::$tv), )+
                 }
             }
         }
@@ -450,20 +491,20 @@ macro_rules! structures {
         /// [`crate::TraversalSet::plain`]), which a [`crate::Tracer`] traces through.
         pub enum Plain<'a> {
             $( #[doc = concat!("A context of a `", stringify!($tty), "`.")]
-$tv(<$tty as Structure>::Query<'a>), )+
+#[cfg($cfg)] $tv(<$tty as Structure>::Query<'a>), )+
         }
 
         impl PlainQuery for Plain<'_> {
             #[inline]
             fn closest_hit(&mut self, ray: &Ray) -> Option<Hit> {
                 match self {
-                    $( Plain::$tv(q) => q.closest_hit(ray), )+
+                    $( #[cfg($cfg)] Plain::$tv(q) => q.closest_hit(ray), )+
                 }
             }
             #[inline]
             fn any_hit(&mut self, ray: &Ray) -> bool {
                 match self {
-                    $( Plain::$tv(q) => q.any_hit(ray), )+
+                    $( #[cfg($cfg)] Plain::$tv(q) => q.any_hit(ray), )+
                 }
             }
         }
@@ -474,13 +515,13 @@ $tv(<$tty as Structure>::Query<'a>), )+
             #[inline]
             fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
                 match self {
-                    $( AnyTree::$tv(t) => t.intersect_observed(ray, obs), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => t.intersect_observed(ray, obs), )+
                 }
             }
             #[inline]
             fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
                 match self {
-                    $( AnyTree::$tv(t) => t.occluded_observed(ray, obs), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => t.occluded_observed(ray, obs), )+
                 }
             }
             fn triangles(&self) -> &[dualsplit_geometry::Triangle] {
@@ -488,12 +529,12 @@ $tv(<$tty as Structure>::Query<'a>), )+
             }
             fn intersect_batch(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
                 match self {
-                    $( AnyTree::$tv(t) => t.intersect_batch(rays), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => t.intersect_batch(rays), )+
                 }
             }
             fn occluded_batch(&self, rays: &[Ray]) -> Vec<bool> {
                 match self {
-                    $( AnyTree::$tv(t) => t.occluded_batch(rays), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => t.occluded_batch(rays), )+
                 }
             }
         }
@@ -501,56 +542,56 @@ $tv(<$tty as Structure>::Query<'a>), )+
         /// The saved-header fields of any structure ([`Structure::Fields`]).
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub(crate) enum AnyFields {
-            $( $tv(<$tty as Structure>::Fields), )+
+            $( #[cfg($cfg)] $tv(<$tty as Structure>::Fields), )+
         }
 
         impl AnyFields {
             /// The fields of `tree`.
             pub(crate) fn of(tree: &AnyTree) -> Self {
                 match tree {
-                    $( AnyTree::$tv(t) => AnyFields::$tv(Structure::saved_fields(t)), )+
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => AnyFields::$tv(Structure::saved_fields(t)), )+
                 }
             }
 
             /// Reads the fields of a tree of kind `kind`.
             pub(crate) fn read(kind: TreeKind, input: &mut FieldReader) -> Result<Self, SavedError> {
                 Ok(match kind {
-                    $( $(TreeKind::$kv)|+ => AnyFields::$tv(SavedFields::read(kind, input)?), )+
+                    $( #[cfg($cfg)] $(TreeKind::$kv)|+ => AnyFields::$tv(SavedFields::read(kind, input)?), )+
                 })
             }
 
             /// Writes the fields.
             pub(crate) fn write(&self, out: &mut FieldWriter) {
                 match self {
-                    $( AnyFields::$tv(f) => f.write(out), )+
+                    $( #[cfg($cfg)] AnyFields::$tv(f) => f.write(out), )+
                 }
             }
 
             /// [`SavedFields::check`].
             pub(crate) fn check(&self) -> Result<(), SavedError> {
                 match self {
-                    $( AnyFields::$tv(f) => f.check(), )+
+                    $( #[cfg($cfg)] AnyFields::$tv(f) => f.check(), )+
                 }
             }
 
             /// [`SavedFields::scene_box`].
             pub(crate) fn scene_box(&self) -> Option<Aabb> {
                 match self {
-                    $( AnyFields::$tv(f) => f.scene_box(), )+
+                    $( #[cfg($cfg)] AnyFields::$tv(f) => f.scene_box(), )+
                 }
             }
 
             /// The tree of kind `kind` these fields describe (unchecked).
             pub(crate) fn assemble(self, kind: TreeKind, image: MemoryImage, build: BuildConfig) -> AnyTree {
                 match self {
-                    $( AnyFields::$tv(f) => AnyTree::$tv(Structure::from_saved(kind, image, build, f)), )+
+                    $( #[cfg($cfg)] AnyFields::$tv(f) => AnyTree::$tv(Structure::from_saved(kind, image, build, f)), )+
                 }
             }
 
             /// Checks `tree` against these fields ([`Structure::check_saved`]).
             pub(crate) fn check_tree(&self, tree: &AnyTree) -> Result<(), Violation> {
                 match (self, tree) {
-                    $( (AnyFields::$tv(f), AnyTree::$tv(t)) => t.check_saved(f), )+
+                    $( #[cfg($cfg)] (AnyFields::$tv(f), AnyTree::$tv(t)) => t.check_saved(f), )+
                     #[allow(unreachable_patterns)]
                     _ => Err(Violation {
                         word: 0,
@@ -559,6 +600,9 @@ $tv(<$tty as Structure>::Query<'a>), )+
                 }
             }
         }
+    };
+    ($($input:tt)+) => {
+        $crate::structure::structures!(@norm [] $($input)+);
     };
 }
 

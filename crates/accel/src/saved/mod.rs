@@ -388,7 +388,8 @@ impl AnyTree {
         // The file's triangles (checksummed with everything else) against the scene's, bit
         // for bit: cheaper than hashing the scene, and exact. The hashes only name them.
         if let Some(scene) = scene
-            && bytemuck::cast_slice::<Triangle, u8>(&tris) != bytemuck::cast_slice(scene)
+            && bytemuck::cast_slice::<Triangle, u8>(&tris)
+                != bytemuck::cast_slice::<Triangle, u8>(scene)
         {
             return Err(SavedError::WrongScene {
                 expected: hex(&triangle_hash(scene)),
