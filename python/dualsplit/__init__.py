@@ -9,7 +9,8 @@
 * ``load_scene(spec)``: a file (.obj, .ply, .gltf, .glb, optionally .gz) or
   ``builtin:NAME?params``; ``Scene.triangles`` is a read-only ``(N, 3, 3)`` float32 array
   holding the loader's memory.
-* ``build(scene, kind)``: ``dst``, ``bvh2``, ``bvh4``, ``bvh8``, ``cwbvh`` or ``dst-q``, as ``dualsplit build``.
+* ``build(scene, kind)``: one of ``STRUCTURES``, as ``dualsplit build``; ``TRAVERSALS`` and
+  ``CONFIGURATIONS`` name the traversals and simulated configurations (the Rust registries).
 * ``Tree.save(path)`` / ``Tree.load(path, scene)``: the saved-tree format of the command line.
 * ``Tree.intersect`` / ``Tree.occluded``: batched ray queries on the Rust thread pool, without
   the GIL.
@@ -20,6 +21,9 @@ values as ``TypeError`` / ``ValueError``.
 """
 
 from ._dualsplit import (
+    CONFIGURATIONS,
+    STRUCTURES,
+    TRAVERSALS,
     DualsplitError,
     Scene,
     Tree,
@@ -31,6 +35,9 @@ from ._dualsplit import (
 )
 
 __all__ = [
+    "CONFIGURATIONS",
+    "STRUCTURES",
+    "TRAVERSALS",
     "DualsplitError",
     "Scene",
     "Tree",

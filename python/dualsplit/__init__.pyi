@@ -9,6 +9,11 @@ import numpy.typing as npt
 
 __version__: str
 
+# The registries' names (the Rust side checks these literals against them).
+STRUCTURES: list[StructureKind]
+TRAVERSALS: list[Traversal]
+CONFIGURATIONS: list[str]
+
 StructureKind = Literal["dst", "bvh2", "bvh4", "bvh8", "cwbvh", "dst-q"]
 Traversal = Literal["bvh2", "bvh4", "bvh8", "dst-sw", "dst", "cwbvh", "dst-q"]
 SimConfigName = Literal[
@@ -100,7 +105,7 @@ def load_scene(
 ) -> Scene:
     """Loads a file (.obj, .ply, .gltf, .glb, optionally .gz) or ``builtin:NAME?params``."""
 
-def build(scene: Union[Scene, str, os.PathLike[str]], kind: StructureKind = "dst") -> Tree:
+def build(scene: Union[Scene, str, os.PathLike[str]], kind: StructureKind | None = None) -> Tree:
     """Builds one structure as ``dualsplit build`` does (default build settings)."""
 
 def builtins() -> list[str]:

@@ -229,18 +229,20 @@ struct Tree {
 
 fn parse_tree_kind(s: &str) -> PyResult<TreeKind> {
     TreeKind::parse(s).ok_or_else(|| {
-        let names: Vec<&str> = TreeKind::ALL.iter().map(|k| k.name()).collect();
-        PyValueError::new_err(format!("unknown structure `{s}` ({})", names.join(", ")))
+        PyValueError::new_err(format!("unknown structure `{s}` ({})", TreeKind::names()))
     })
 }
 
 /// Builds one structure of `scene` (a scene or a spec) exactly as `dualsplit build` does:
-/// kind `dst` (hardware preset), `bvh2`, `bvh4`, `bvh8`, `cwbvh` or `dst-q`, each derived
+/// `kind` is one of `STRUCTURES` (default: the dual-split tree, hardware preset), derived
 /// from the scene's BVH2 (default build settings).
 #[pyfunction]
-#[pyo3(signature = (scene, kind="dst"))]
-fn build(py: Python<'_>, scene: &Bound<'_, PyAny>, kind: &str) -> PyResult<Tree> {
-    let kind = parse_tree_kind(kind)?;
+#[pyo3(signature = (scene, kind=None))]
+fn build(py: Python<'_>, scene: &Bound<'_, PyAny>, kind: Option<&str>) -> PyResult<Tree> {
+    let kind = match kind {
+        Some(k) => parse_tree_kind(k)?,
+        None => TreeKind::DEFAULT,
+    };
     let scene = scene_arg(py, scene)?;
     let tris = scene.get().triangle_vec(py)?;
     let spec = scene.get().meta.spec.clone();
@@ -368,7 +370,7 @@ type Hits<'py> = (
 
 #[pymethods]
 impl Tree {
-    /// `dst`, `bvh2`, `bvh4`, `bvh8`, `cwbvh` or `dst-q`.
+    /// The structure's name, one of `STRUCTURES`.
     #[getter]
     fn kind(&self) -> &'static str {
         self.tree.kind().name()
@@ -518,7 +520,7 @@ fn sim_accels(accel: Option<&Bound<'_, PyAny>>, tree: Option<&AnyTree>) -> PyRes
     let supports = |a: SimAccel| tree.is_none_or(|t| t.supports(a.kind()));
     if names.is_empty() {
         return Ok(match tree {
-            None => vec![SimAccel::Dst],
+            None => vec![SimAccel::DEFAULT],
             Some(_) => SimAccel::ALL.into_iter().filter(|a| supports(*a)).collect(),
         });
     }
@@ -528,10 +530,9 @@ fn sim_accels(accel: Option<&Bound<'_, PyAny>>, tree: Option<&AnyTree>) -> PyRes
             SimAccel::ALL.into_iter().filter(|a| supports(*a)).collect()
         } else {
             let a = SimAccel::parse(name).ok_or_else(|| {
-                let all: Vec<_> = SimAccel::ALL.iter().map(|k| k.name()).collect();
                 PyValueError::new_err(format!(
                     "unknown configuration `{name}` (expected one of {} or all)",
-                    all.join(", ")
+                    SimAccel::names()
                 ))
             })?;
             if let Some(t) = tree.filter(|t| !t.supports(a.kind())) {
@@ -767,5 +768,10 @@ fn _dualsplit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(builtins, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    // The registries' names: structures (`build`), traversals (`Tree.traversals`) and
+    // simulated configurations (`simulate`).
+    m.add("STRUCTURES", TreeKind::ALL.map(TreeKind::name).to_vec())?;
+    m.add("TRAVERSALS", AccelKind::ALL.map(AccelKind::name).to_vec())?;
+    m.add("CONFIGURATIONS", SimAccel::ALL.map(SimAccel::name).to_vec())?;
     Ok(())
 }

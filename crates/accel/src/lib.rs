@@ -61,13 +61,18 @@ pub mod image;
 pub mod observer;
 pub mod query;
 pub mod ray_file;
+mod registry;
 pub mod saved;
 pub mod set;
 pub mod stats;
+pub mod structure;
 pub mod tree;
 pub mod tree_set;
 pub mod validate;
 pub mod wide;
+// The toy structure of docs/extending.md, for its test (feature `toy`).
+#[cfg(feature = "toy")]
+pub mod toy;
 
 /// The geometry types of the public API, re-exported so that callers need not depend on
 /// `dualsplit-geometry` or match its glam version.
@@ -84,110 +89,28 @@ pub use stats::StructureStats;
 pub use validate::ValidationReport;
 pub use wide::{BvhImage, BvhQuery, CollapseConfig, WideBvh};
 
-pub use dst::{Dst, DstConfig};
-pub use query::{DstPipeline, RayQuery};
+pub use query::RayQuery;
 /// The rayon crate builds and batch queries run on (for [`rayon::ThreadPool`]).
 pub use rayon;
-pub use set::{Plain, Tracer, TraversalSet};
-pub use tree::{
-    AnyTree, BuildStats, Bvh2Tree, BvhTree, CwbvhTree, DstDecoding, DstQTree, DstTree, TreeKind,
-};
+pub use registry::*;
+pub use set::{Tracer, TraversalSet};
+pub use structure::{Structure, UnitMismatch};
+pub use tree::BuildStats;
 pub use tree_set::TreeSet;
 
-use dualsplit_geometry::{Aabb, Hit, Ray, Triangle};
-use serde::{Deserialize, Serialize};
+use dualsplit_geometry::{Hit, Ray, Triangle};
 use std::time::Instant;
-
-/// The traversal variants a workload can run on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum AccelKind {
-    /// Binary BVH, 52-byte nodes.
-    Bvh2,
-    /// 4-wide BVH (Dammertz collapse), 100-byte nodes.
-    Bvh4,
-    /// 8-wide BVH (Ylitie collapse), 200-byte nodes.
-    Bvh8,
-    /// Dual-split tree, software decoder (the paper's DST*): the fast CPU traversal
-    /// ([`AccelKind::DST_SOFTWARE`], [`DstDecoding::Software`]; command line `dst-sw`).
-    #[doc(alias = "DstSoftware")]
-    DstSw,
-    /// Dual-split tree traversed by the hardware pipeline's step function: the model of the
-    /// paper's hardware, slower on a CPU ([`AccelKind::DST_PIPELINE`],
-    /// [`DstDecoding::Pipeline`]; command line `dst`).
-    #[doc(alias = "DstPipeline")]
-    Dst,
-    /// Compressed 8-wide BVH (Ylitie et al. 2017): the BVH8's nodes in 80 bytes, child
-    /// boxes quantized to 8 bits per plane, conservatively ([`cwbvh`]; command line `cwbvh`).
-    Cwbvh,
-    /// Quantized dual-split tree: the DST's planes as k-bit offsets in a local frame, several
-    /// levels collapsed into one fetch (the paper's §5 future work; [`dstq`]; command line
-    /// `dst-q`).
-    DstQ,
-}
-
-impl AccelKind {
-    /// The DST's software decoder (the paper's DST\*), the fast CPU traversal: an
-    /// unambiguous name for [`AccelKind::DstSw`].
-    pub const DST_SOFTWARE: AccelKind = AccelKind::DstSw;
-    /// The DST traversed by the hardware pipeline model: an unambiguous name for
-    /// [`AccelKind::Dst`].
-    pub const DST_PIPELINE: AccelKind = AccelKind::Dst;
-
-    /// All kinds, in report order.
-    pub const ALL: [AccelKind; 7] = [
-        AccelKind::Bvh2,
-        AccelKind::Bvh4,
-        AccelKind::Bvh8,
-        AccelKind::DstSw,
-        AccelKind::Dst,
-        AccelKind::Cwbvh,
-        AccelKind::DstQ,
-    ];
-
-    /// The command-line name.
-    pub fn name(self) -> &'static str {
-        match self {
-            AccelKind::Bvh2 => "bvh2",
-            AccelKind::Bvh4 => "bvh4",
-            AccelKind::Bvh8 => "bvh8",
-            AccelKind::DstSw => "dst-sw",
-            AccelKind::Dst => "dst",
-            AccelKind::Cwbvh => "cwbvh",
-            AccelKind::DstQ => "dst-q",
-        }
-    }
-
-    /// Parses a command-line name.
-    pub fn parse(s: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|k| k.name() == s)
-    }
-}
-
-/// Errors while building the structures of a scene.
-#[derive(Debug, thiserror::Error)]
-pub enum AccelError {
-    /// A memory image could not be encoded (an offset field overflowed).
-    #[error(transparent)]
-    Image(#[from] ImageError),
-    /// The dual-split tree could not be converted or encoded.
-    #[error(transparent)]
-    Dst(#[from] dst::DstError),
-    /// The quantized dual-split tree could not be encoded.
-    #[error(transparent)]
-    DstQ(#[from] dstq::DstQError),
-}
 
 /// Wall time since `t0` in milliseconds (build times: host measurements, never results).
 pub(crate) fn ms_since(t0: Instant) -> f64 {
     t0.elapsed().as_secs_f64() * 1e3
 }
 
-/// Every structure built from one scene's BVH2: the logical BVH2 and the encoded BVH2, BVH4
-/// (Dammertz collapse) and BVH8 (Ylitie collapse), all with identical leaves, the
-/// dual-split tree converted from the same BVH2 with identical bounds (hardware preset),
-/// and their quantized forms: the compressed BVH8 ([`cwbvh::Cwbvh`]) and the quantized DST
-/// ([`dstq::DstQ`], default [`dstq::DstQConfig`]).
+/// Every structure of the registry built from one scene's BVH2, in [`TreeKind::ALL`] order:
+/// the BVH2 itself, each structure derived from it with the same leaves and bounds, with
+/// [`Presets`] (the DST's hardware preset, the default BVH8 collapse and quantized DST
+/// unless built with others). Each folder adds its typed accessor ([`Structures::dst`],
+/// [`Structures::bvh8`], ...); [`Structures::tree`] gives any of them.
 ///
 /// ```
 /// use dualsplit_accel::{AccelKind, BuildConfig, NoObserver, Structures};
@@ -204,22 +127,8 @@ pub struct Structures {
     pub triangles: SharedTriangles,
     /// The source BVH2 (logical).
     pub bvh2: Bvh2,
-    /// The encoded BVH2 (52-byte nodes); its `time` is the BVH2 build time.
-    pub bvh2_image: BvhImage,
-    /// The encoded BVH4 (100-byte nodes); its `time` is the collapse time.
-    pub bvh4: BvhImage,
-    /// The encoded BVH8 (200-byte nodes); its `time` is the collapse time.
-    pub bvh8: BvhImage,
-    /// The dual-split tree (identical bounds, [`dst::DstConfig::hardware`]).
-    pub dst: dst::Dst,
-    /// Wall time of the BVH2 → DST conversion, in milliseconds (a host measurement).
-    pub dst_convert_ms: f64,
-    /// The compressed BVH8, encoded from the same collapse as `bvh8`.
-    pub cwbvh: cwbvh::Cwbvh,
-    /// The quantized DST, encoded from `dst`.
-    pub dstq: dstq::DstQ,
-    /// Wall time of the DST → quantized DST encoding, in milliseconds (a host measurement).
-    pub dstq_convert_ms: f64,
+    /// One tree per [`TreeKind`], in [`TreeKind::ALL`] order.
+    trees: Vec<AnyTree>,
 }
 
 impl Structures {
@@ -237,48 +146,26 @@ impl Structures {
 
     /// Builds every structure for `triangles`, or reports which image could not be encoded.
     pub fn try_build(triangles: &[Triangle], cfg: &BuildConfig) -> Result<Self, AccelError> {
-        Self::try_build_with(triangles, cfg, &dst::DstConfig::hardware())
+        Self::try_build_presets(triangles, cfg, &Presets::default())
     }
 
-    /// Like [`Structures::try_build`] with an explicit DST configuration.
-    pub fn try_build_with(
+    /// Like [`Structures::try_build`] with explicit presets.
+    pub fn try_build_presets(
         triangles: &[Triangle],
         cfg: &BuildConfig,
-        dst_cfg: &dst::DstConfig,
+        presets: &Presets,
     ) -> Result<Self, AccelError> {
         let shared = SharedTriangles::from(triangles);
-        let t0 = Instant::now();
-        let boxes: Vec<Aabb> = triangles.iter().map(|t| t.bounds()).collect();
-        let bvh2 = Bvh2::build(&boxes, cfg);
-        let build_time = t0.elapsed();
-        let wide2 = WideBvh::from_bvh2(&bvh2);
-        let bvh2_image = BvhImage::encode(&wide2, &bvh2, shared.clone(), cfg, build_time)?;
-        let t0 = Instant::now();
-        let wide4 = WideBvh::collapse_bvh4(&bvh2);
-        let t4 = t0.elapsed();
-        let bvh4 = BvhImage::encode(&wide4, &bvh2, shared.clone(), cfg, t4)?;
-        let t0 = Instant::now();
-        let wide8 = WideBvh::collapse_bvh8(&bvh2, &CollapseConfig::default());
-        let t8 = t0.elapsed();
-        let bvh8 = BvhImage::encode(&wide8, &bvh2, shared.clone(), cfg, t8)?;
-        let cwbvh = cwbvh::Cwbvh::from_wide(&wide8, &bvh2, shared.clone(), t8)?;
-        let t0 = Instant::now();
-        let dst = dst::Dst::from_bvh2(&bvh2, shared.clone(), dst_cfg)?;
-        let dst_convert_ms = ms_since(t0);
-        let t0 = Instant::now();
-        let dstq = dstq::DstQ::from_dst(&dst, &dstq::DstQConfig::default())?;
-        let dstq_convert_ms = ms_since(t0);
+        let bvh2 = Bvh2Tree::build(shared.clone(), cfg)?;
+        let mut trees: Vec<AnyTree> = Vec::with_capacity(TreeKind::ALL.len());
+        for kind in TreeKind::ALL {
+            let tree = AnyTree::derive_with(&bvh2, kind, presets, &trees)?;
+            trees.push(tree);
+        }
         let s = Self {
             triangles: shared,
-            bvh2,
-            bvh2_image,
-            bvh4,
-            bvh8,
-            dst,
-            dst_convert_ms,
-            cwbvh,
-            dstq,
-            dstq_convert_ms,
+            bvh2: bvh2.into_logical(),
+            trees,
         };
         // Debug builds check every image (bounds containment is undefined for NaN input,
         // which scene loading drops anyway).
@@ -290,93 +177,64 @@ impl Structures {
         Ok(s)
     }
 
-    /// The encoded BVH that `kind` traverses (BVH2, BVH4, BVH8), or `None` for the others.
-    pub fn encoded(&self, kind: AccelKind) -> Option<&BvhImage> {
-        match kind {
-            AccelKind::Bvh2 => Some(&self.bvh2_image),
-            AccelKind::Bvh4 => Some(&self.bvh4),
-            AccelKind::Bvh8 => Some(&self.bvh8),
-            AccelKind::DstSw | AccelKind::Dst | AccelKind::Cwbvh | AccelKind::DstQ => None,
+    /// The tree of `kind`.
+    #[inline]
+    pub fn tree(&self, kind: TreeKind) -> &AnyTree {
+        &self.trees[kind as usize]
+    }
+
+    /// Every tree, in [`TreeKind::ALL`] order.
+    pub fn trees(&self) -> &[AnyTree] {
+        &self.trees
+    }
+
+    /// The tree of `kind` as its own type `T` (the folders' typed accessors).
+    ///
+    /// # Panics
+    /// When `T` is not the type the registry gives `kind` (a bug in the caller).
+    pub(crate) fn structure<T: Structure + 'static>(&self, kind: TreeKind) -> &T {
+        match self.tree(kind).get::<T>() {
+            Some(t) => t,
+            None => panic!("the {kind} tree is not a {}", std::any::type_name::<T>()),
         }
     }
 
-    /// The memory image `kind` reads (what the simulator replays fetches against). Both DST
-    /// kinds read the same DST image.
+    /// The memory image `kind` reads (what the simulator replays fetches against). The
+    /// traversals of one structure read the same image.
     pub fn image(&self, kind: AccelKind) -> &MemoryImage {
-        match kind {
-            AccelKind::DstSw | AccelKind::Dst => self.dst.image(),
-            AccelKind::Cwbvh => self.cwbvh.image(),
-            AccelKind::DstQ => self.dstq.image(),
-            AccelKind::Bvh2 | AccelKind::Bvh4 | AccelKind::Bvh8 => match self.encoded(kind) {
-                Some(b) => &b.image,
-                None => unreachable!("every BVH kind is encoded"),
-            },
-        }
+        self.tree(kind.tree_kind()).image()
     }
 
-    /// Closest hit of `ray` on structure `kind`: the BVH traversals, the DST software
-    /// decoder (DST*) or the traversal loop driven by the hardware pipeline's step function.
+    /// Closest hit of `ray` on traversal `kind`.
     #[inline]
     pub fn closest_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        match kind {
-            AccelKind::Bvh2 => self.bvh2_image.closest_hit(ray, obs),
-            AccelKind::Bvh4 => self.bvh4.closest_hit(ray, obs),
-            AccelKind::Bvh8 => self.bvh8.closest_hit(ray, obs),
-            AccelKind::DstSw => own_frame(|| self.dst.closest_hit(ray, obs)),
-            AccelKind::Dst => own_frame(|| self.dst.closest_hit_pipeline(ray, obs)),
-            AccelKind::Cwbvh => own_frame(|| self.cwbvh.closest_hit(ray, obs)),
-            AccelKind::DstQ => own_frame(|| self.dstq.closest_hit(ray, obs)),
-        }
+        self.tree(kind.tree_kind())
+            .closest_hit(kind, ray, obs)
+            .flatten()
     }
 
     /// True when `ray` hits any triangle within `[t_min, t_max]`.
     #[inline]
     pub fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool {
-        match kind {
-            AccelKind::Bvh2 => self.bvh2_image.any_hit(ray, obs),
-            AccelKind::Bvh4 => self.bvh4.any_hit(ray, obs),
-            AccelKind::Bvh8 => self.bvh8.any_hit(ray, obs),
-            AccelKind::DstSw => own_frame(|| self.dst.any_hit(ray, obs)),
-            AccelKind::Dst => own_frame(|| self.dst.any_hit_pipeline(ray, obs)),
-            AccelKind::Cwbvh => own_frame(|| self.cwbvh.any_hit(ray, obs)),
-            AccelKind::DstQ => own_frame(|| self.dstq.any_hit(ray, obs)),
-        }
+        self.tree(kind.tree_kind())
+            .any_hit(kind, ray, obs)
+            .unwrap_or(false)
     }
 
-    /// Validates the three BVH images (BVH2, BVH4, BVH8), the DST (which must rebuild
-    /// every BVH2 box exactly from its planes), the compressed BVH8 (every quantized box
-    /// must contain its exact box) and the quantized DST.
+    /// Validates every structure ([`Structure::validate`]), each against the BVH2 and the
+    /// structures derived with it.
     pub fn validate(&self) -> Vec<ValidationReport> {
-        vec![
-            self.bvh2_image.validate(),
-            self.bvh4.validate(),
-            self.bvh8.validate(),
-            ValidationReport::of_dst(&self.dst, &self.bvh2),
-            self.cwbvh.validate(),
-            self.dstq.validate(&self.dst),
-        ]
+        self.trees
+            .iter()
+            .map(|t| t.validate_among(&self.bvh2, &self.trees))
+            .collect()
     }
 
-    /// Size and build statistics of BVH2, BVH4, BVH8, the DST (the paper's Table 3) and the
-    /// quantized structures, percentages relative to the BVH2 image.
+    /// Size and build statistics of every structure (the paper's Table 3 and the
+    /// quantized structures), percentages relative to the reference BVH2's image.
     pub fn stats(&self) -> Vec<StructureStats> {
-        let base = self.bvh2_image.bytes_total();
-        vec![
-            StructureStats::of("bvh2", &self.bvh2_image, base),
-            StructureStats::of("bvh4", &self.bvh4, base),
-            StructureStats::of("bvh8", &self.bvh8, base),
-            StructureStats::of_dst(&self.dst.stats(), self.dst_convert_ms, base),
-            StructureStats::of_cwbvh(&self.cwbvh, base),
-            StructureStats::of_dstq(&self.dstq, self.dstq_convert_ms, base),
-        ]
+        let base = self.tree(TreeKind::REFERENCE).image();
+        let base = base.node_bytes() + base.index_bytes();
+        self.trees.iter().map(|t| t.structure_stats(base)).collect()
     }
-}
-
-/// Calls `f` in a function of its own. The query dispatchers ([`Structures::closest_hit`],
-/// [`Structures::any_hit`]) take the DST and compressed traversals through it: inlined, their
-/// loops gave the dispatcher a frame of some 1.5 KB whose entry and exit every ray paid,
-/// the BVH queries' short path to the CPU-side copy included.
-#[inline(never)]
-fn own_frame<R>(f: impl FnOnce() -> R) -> R {
-    f()
 }

@@ -5,9 +5,7 @@
 //! from them. Batch forms run on the current rayon pool, so
 //! `pool.install(|| tree.intersect_batch(&rays))` picks the threads.
 
-use crate::dst::Dst;
 use crate::observer::{NoObserver, Observer};
-use crate::wide::BvhImage;
 use dualsplit_geometry::{Hit, Ray, Triangle, Vec3};
 use rayon::prelude::*;
 
@@ -76,12 +74,17 @@ pub trait RayQuery: Sync {
 /// each rayon job's rays through one context of the structure's `query()`.
 macro_rules! query_by_traversal {
     (@batch query) => {
-        fn intersect_batch(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
+        fn intersect_batch(
+            &self,
+            rays: &[dualsplit_geometry::Ray],
+        ) -> Vec<Option<dualsplit_geometry::Hit>> {
+            use rayon::prelude::*;
             rays.par_iter()
                 .map_init(|| self.query(), |q, r| q.closest_hit(r))
                 .collect()
         }
-        fn occluded_batch(&self, rays: &[Ray]) -> Vec<bool> {
+        fn occluded_batch(&self, rays: &[dualsplit_geometry::Ray]) -> Vec<bool> {
+            use rayon::prelude::*;
             rays.par_iter()
                 .map_init(|| self.query(), |q, r| q.any_hit(r))
                 .collect()
@@ -89,58 +92,30 @@ macro_rules! query_by_traversal {
     };
     ($(#[$doc:meta])* $ty:ty, |$s:ident| $tris:expr $(, $batch:ident)?) => {
         $(#[$doc])*
-        impl RayQuery for $ty {
+        impl $crate::query::RayQuery for $ty {
             #[inline]
-            fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
+            fn intersect_observed<O: $crate::observer::Observer>(
+                &self,
+                ray: &dualsplit_geometry::Ray,
+                obs: &mut O,
+            ) -> Option<dualsplit_geometry::Hit> {
                 self.closest_hit(ray, obs)
             }
             #[inline]
-            fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
+            fn occluded_observed<O: $crate::observer::Observer>(
+                &self,
+                ray: &dualsplit_geometry::Ray,
+                obs: &mut O,
+            ) -> bool {
                 self.any_hit(ray, obs)
             }
-            fn triangles(&self) -> &[Triangle] {
+            fn triangles(&self) -> &[dualsplit_geometry::Triangle] {
                 let $s = self;
                 $tris
             }
-            $(query_by_traversal!(@batch $batch);)?
+            $($crate::query::query_by_traversal!(@batch $batch);)?
         }
     };
 }
 
-query_by_traversal!(
-    /// The batch forms trace each rayon job's rays through one [`BvhImage::query`] context.
-    BvhImage,
-    |s| s.image.triangle_slice(),
-    query
-);
-query_by_traversal!(
-    /// A [`Dst`] queried through its software decoder (the paper's DST\*,
-    /// [`crate::AccelKind::DstSw`]): the fast CPU traversal. The batch forms trace each
-    /// rayon job's rays through one [`Dst::query`] context.
-    Dst,
-    |s| Dst::triangles(s),
-    query
-);
-query_by_traversal!(crate::cwbvh::Cwbvh, |s| s.image().triangle_slice());
-query_by_traversal!(crate::dstq::DstQ, |s| s.image().triangle_slice());
-
-/// A [`Dst`] queried through the model of the paper's hardware dual-split pipeline
-/// ([`crate::AccelKind::Dst`]): every node step is computed by the pipeline's step function.
-/// Same answers as the software decoder, several times slower on a CPU; it exists to check
-/// and simulate the hardware.
-#[derive(Clone, Copy, Debug)]
-pub struct DstPipeline<'a>(pub &'a Dst);
-
-impl RayQuery for DstPipeline<'_> {
-    #[inline]
-    fn intersect_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        self.0.closest_hit_pipeline(ray, obs)
-    }
-    #[inline]
-    fn occluded_observed<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
-        self.0.any_hit_pipeline(ray, obs)
-    }
-    fn triangles(&self) -> &[Triangle] {
-        self.0.triangles()
-    }
-}
+pub(crate) use query_by_traversal;

@@ -1,8 +1,9 @@
 //! [`TraversalSet`]: the structures a workload runs on, each traversal chosen by its
-//! [`AccelKind`]. Two sets exist: every structure of a scene ([`Structures`], all seven
-//! kinds) and one saved or built tree ([`AnyTree`], the kinds of
-//! [`TreeKind::accel_kinds`](crate::TreeKind::accel_kinds): `dst-sw` and `dst` for a DST,
-//! its own kind for a BVH). The renderer, the benchmarks and the simulator take either.
+//! [`AccelKind`]. Three sets exist: every structure of a scene ([`Structures`], every
+//! kind), the trees of some kinds ([`crate::TreeSet`]) and one saved or built tree
+//! ([`AnyTree`], the kinds of [`TreeKind::accel_kinds`](crate::TreeKind::accel_kinds):
+//! `dst-sw` and `dst` for a DST, its own kind for a BVH). The renderer, the benchmarks and
+//! the simulator take any of them.
 //!
 //! ```
 //! use dualsplit_accel::math::{Ray, Triangle, Vec3};
@@ -24,13 +25,10 @@
 //! # Ok::<(), dualsplit_accel::AccelError>(())
 //! ```
 
-use crate::dst::{Dst, DstQuery};
-use crate::dstq::DstQConfig;
 use crate::image::MemoryImage;
 use crate::observer::{NoObserver, Observer};
-use crate::tree::{AnyTree, TreeKind};
-use crate::wide::{BvhImage, BvhQuery};
-use crate::{AccelKind, Structures};
+use crate::structure::{PlainQuery, UnitMismatch};
+use crate::{AccelKind, AnyTree, Plain, Structures, TreeKind};
 use dualsplit_geometry::{Aabb, Hit, Ray};
 
 /// Structures traversed by [`AccelKind`]: what a workload (render, benchmark, simulation)
@@ -68,8 +66,8 @@ pub trait TraversalSet: Sync {
     /// (false for a kind the set lacks).
     fn any_hit<O: Observer>(&self, kind: AccelKind, ray: &Ray, obs: &mut O) -> bool;
 
-    /// The structure behind traversal `kind` when its plain queries have a query context
-    /// (the BVH kinds and the DST software decoder), which a [`Tracer`] then uses.
+    /// The query context of traversal `kind` when its plain queries have one (the BVH
+    /// kinds and the DST software decoder), which a [`Tracer`] then uses.
     fn plain(&self, kind: AccelKind) -> Option<Plain<'_>>;
 
     /// A query context for tracing rays of traversal `kind` one by one on one thread
@@ -78,15 +76,10 @@ pub trait TraversalSet: Sync {
     where
         Self: Sized,
     {
-        let ctx = match self.plain(kind) {
-            Some(Plain::Bvh(b)) => Ctx::Bvh(b.query()),
-            Some(Plain::Dst(d)) => Ctx::Dst(d.query()),
-            None => Ctx::Set,
-        };
         Tracer {
             set: self,
             kind,
-            ctx,
+            ctx: self.plain(kind),
         }
     }
 
@@ -98,8 +91,9 @@ pub trait TraversalSet: Sync {
     /// image).
     fn scene_box(&self) -> Aabb;
 
-    /// The settings of the set's quantized DST, if it has one.
-    fn dstq_config(&self) -> Option<DstQConfig>;
+    /// Whether the tree traversal `kind` reads fits the hardware unit it is simulated on
+    /// ([`crate::Structure::fits_unit`]); `Ok` for a kind the set lacks.
+    fn fits_unit(&self, kind: AccelKind) -> Result<(), UnitMismatch>;
 }
 
 impl TraversalSet for Structures {
@@ -118,13 +112,7 @@ impl TraversalSet for Structures {
     }
 
     fn plain(&self, kind: AccelKind) -> Option<Plain<'_>> {
-        match kind {
-            AccelKind::Bvh2 => Some(Plain::Bvh(&self.bvh2_image)),
-            AccelKind::Bvh4 => Some(Plain::Bvh(&self.bvh4)),
-            AccelKind::Bvh8 => Some(Plain::Bvh(&self.bvh8)),
-            AccelKind::DstSw => Some(Plain::Dst(&self.dst)),
-            _ => None,
-        }
+        self.tree(kind.tree_kind()).plain_query(kind)
     }
 
     fn image(&self, kind: AccelKind) -> &MemoryImage {
@@ -132,11 +120,11 @@ impl TraversalSet for Structures {
     }
 
     fn scene_box(&self) -> Aabb {
-        self.dst.scene_box()
+        self.tree(TreeKind::REFERENCE).scene_box()
     }
 
-    fn dstq_config(&self) -> Option<DstQConfig> {
-        Some(*self.dstq.config())
+    fn fits_unit(&self, kind: AccelKind) -> Result<(), UnitMismatch> {
+        self.tree(kind.tree_kind()).fits_unit()
     }
 }
 
@@ -156,13 +144,10 @@ impl TraversalSet for AnyTree {
     }
 
     fn plain(&self, kind: AccelKind) -> Option<Plain<'_>> {
-        match (self, kind) {
-            (AnyTree::Bvh(b), k) if TreeKind::of_accel(k) == b.kind() => {
-                Some(Plain::Bvh(&b.encoded))
-            }
-            (AnyTree::Dst(d), AccelKind::DstSw) => Some(Plain::Dst(d.dst())),
-            _ => None,
+        if kind.tree_kind() != self.kind() {
+            return None;
         }
+        self.plain_query(kind)
     }
 
     fn image(&self, _kind: AccelKind) -> &MemoryImage {
@@ -170,50 +155,22 @@ impl TraversalSet for AnyTree {
     }
 
     fn scene_box(&self) -> Aabb {
-        match self {
-            AnyTree::Dst(d) => d.dst().scene_box(),
-            AnyTree::DstQ(q) => q.dstq().scene_box(),
-            // The BVH2's root box is the union of the triangles' boxes (min and max are
-            // exact, so the order does not matter).
-            AnyTree::Bvh(_) | AnyTree::Cwbvh(_) => self
-                .image()
-                .triangle_slice()
-                .iter()
-                .fold(Aabb::EMPTY, |acc, t| acc.union(t.bounds())),
-        }
+        AnyTree::scene_box(self)
     }
 
-    fn dstq_config(&self) -> Option<DstQConfig> {
-        match self {
-            AnyTree::DstQ(q) => Some(*q.dstq().config()),
-            _ => None,
+    fn fits_unit(&self, kind: AccelKind) -> Result<(), UnitMismatch> {
+        if kind.tree_kind() != self.kind() {
+            return Ok(());
         }
+        AnyTree::fits_unit(self)
     }
-}
-
-/// The structure behind a traversal whose plain queries have a query context
-/// ([`TraversalSet::plain`]).
-#[derive(Clone, Copy)]
-pub enum Plain<'a> {
-    /// A BVH image (its CPU-side copy's [`BvhQuery`]).
-    Bvh(&'a BvhImage),
-    /// A DST, traversed by its software decoder ([`DstQuery`]).
-    Dst(&'a Dst),
-}
-
-/// A [`Tracer`]'s context.
-enum Ctx<'a> {
-    Bvh(BvhQuery<'a>),
-    Dst(DstQuery<'a>),
-    /// None: the set's plain queries.
-    Set,
 }
 
 /// A query context over traversal `kind` of a [`TraversalSet`], for tracing rays one by one
 /// on one thread without observing them (a renderer's or benchmark's inner loop; the
-/// counterpart of Embree's `RTCIntersectContext`): the BVH kinds run through a
-/// [`BvhQuery`], which holds their CPU-side copy's arrays and a traversal stack, the DST
-/// software decoder through a [`DstQuery`], the others through the set's plain queries.
+/// counterpart of Embree's `RTCIntersectContext`): a traversal whose structure has a query
+/// context ([`crate::Structure::Query`]: the BVHs' holds their CPU-side copy's arrays and a
+/// traversal stack) runs through it, the others through the set's plain queries.
 /// The answers are [`TraversalSet::closest_hit`]'s and [`TraversalSet::any_hit`]'s with a
 /// [`NoObserver`], bit for bit. Made by [`TraversalSet::tracer`].
 ///
@@ -231,7 +188,7 @@ enum Ctx<'a> {
 pub struct Tracer<'a, S> {
     set: &'a S,
     kind: AccelKind,
-    ctx: Ctx<'a>,
+    ctx: Option<Plain<'a>>,
 }
 
 impl<S: TraversalSet> Tracer<'_, S> {
@@ -239,9 +196,8 @@ impl<S: TraversalSet> Tracer<'_, S> {
     #[inline]
     pub fn closest_hit(&mut self, ray: &Ray) -> Option<Hit> {
         match &mut self.ctx {
-            Ctx::Bvh(q) => q.closest_hit(ray),
-            Ctx::Dst(q) => q.closest_hit(ray),
-            Ctx::Set => self.set.closest_hit(self.kind, ray, &mut NoObserver),
+            Some(q) => q.closest_hit(ray),
+            None => self.set.closest_hit(self.kind, ray, &mut NoObserver),
         }
     }
 
@@ -250,9 +206,8 @@ impl<S: TraversalSet> Tracer<'_, S> {
     #[inline]
     pub fn any_hit(&mut self, ray: &Ray) -> bool {
         match &mut self.ctx {
-            Ctx::Bvh(q) => q.any_hit(ray),
-            Ctx::Dst(q) => q.any_hit(ray),
-            Ctx::Set => self.set.any_hit(self.kind, ray, &mut NoObserver),
+            Some(q) => q.any_hit(ray),
+            None => self.set.any_hit(self.kind, ray, &mut NoObserver),
         }
     }
 }

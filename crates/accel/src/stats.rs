@@ -16,7 +16,6 @@
 //! 96.6 % and 83.0 %.
 
 use crate::dst::DstStats;
-use crate::wide::BvhImage;
 use serde::Serialize;
 
 /// Bytes in one MiB (the paper reports sizes in MiB).
@@ -57,84 +56,58 @@ pub struct StructureStats {
 }
 
 impl StructureStats {
-    /// Statistics of `s`, with percentages relative to `bvh2_total` bytes.
-    pub fn of(name: &str, s: &BvhImage, bvh2_total: u64) -> Self {
-        let bytes_total = s.bytes_total();
+    /// The statistics of a structure called `name` with these node counts and region
+    /// sizes, with percentages relative to `bvh2_total` bytes; no SAH cost (NaN), no build
+    /// time, no DST breakdown until the `with_` methods add them.
+    pub fn new(
+        name: &str,
+        internal_nodes: u64,
+        leaves: u64,
+        bytes_nodes: u64,
+        bytes_indices: u64,
+        bvh2_total: u64,
+    ) -> Self {
+        let bytes_total = bytes_nodes + bytes_indices;
         Self {
             name: name.to_string(),
-            nodes: (s.internal_nodes + s.leaves) as u64,
-            internal_nodes: s.internal_nodes as u64,
-            leaves: s.leaves as u64,
-            bytes_nodes: s.image.node_bytes(),
-            bytes_indices: s.image.index_bytes(),
+            nodes: internal_nodes + leaves,
+            internal_nodes,
+            leaves,
+            bytes_nodes,
+            bytes_indices,
             bytes_total,
             percent_of_bvh2: 100.0 * bytes_total as f64 / bvh2_total.max(1) as f64,
-            sah_cost: s.sah_cost,
-            build_ms: s.time.as_secs_f64() * 1e3,
+            sah_cost: f32::NAN,
+            build_ms: 0.0,
             convert_ms: None,
             dst: None,
         }
     }
 
-    /// Statistics of a DST, with percentages relative to `bvh2_total` bytes. Its node bytes
-    /// include the 24-byte scene box stored beside the tree; `sah_cost` is NaN (the DST's
-    /// cost model is not the BVH's SAH).
-    pub fn of_dst(d: &DstStats, convert_ms: f64, bvh2_total: u64) -> Self {
-        let bytes_total = d.total_bytes;
+    /// The same with SAH cost `sah_cost`.
+    pub fn with_sah_cost(self, sah_cost: f32) -> Self {
+        Self { sah_cost, ..self }
+    }
+
+    /// The same with build time `build_ms`.
+    pub fn with_build_ms(self, build_ms: f64) -> Self {
+        Self { build_ms, ..self }
+    }
+
+    /// The same with conversion time `convert_ms`, which is also its build time.
+    pub fn with_convert_ms(self, convert_ms: f64) -> Self {
         Self {
-            name: "dst".to_string(),
-            nodes: d.internal_nodes() + d.leaves,
-            internal_nodes: d.internal_nodes(),
-            leaves: d.leaves + d.carving_leaves,
-            bytes_nodes: bytes_total - d.index_bytes,
-            bytes_indices: d.index_bytes,
-            bytes_total,
-            percent_of_bvh2: 100.0 * bytes_total as f64 / bvh2_total.max(1) as f64,
-            sah_cost: f32::NAN,
             build_ms: convert_ms,
             convert_ms: Some(convert_ms),
-            dst: Some(*d),
+            ..self
         }
     }
 
-    /// Statistics of the compressed BVH8, with percentages relative to `bvh2_total` bytes.
-    pub fn of_cwbvh(c: &crate::cwbvh::Cwbvh, bvh2_total: u64) -> Self {
-        let bytes_total = c.bytes_total();
+    /// The same with the DST breakdown `dst`.
+    pub fn with_dst(self, dst: DstStats) -> Self {
         Self {
-            name: "cwbvh".to_string(),
-            nodes: (c.internal_nodes() + c.leaves()) as u64,
-            internal_nodes: c.internal_nodes() as u64,
-            leaves: c.leaves() as u64,
-            bytes_nodes: c.image().node_bytes(),
-            bytes_indices: c.image().index_bytes(),
-            bytes_total,
-            percent_of_bvh2: 100.0 * bytes_total as f64 / bvh2_total.max(1) as f64,
-            sah_cost: f32::NAN,
-            build_ms: c.time().as_secs_f64() * 1e3,
-            convert_ms: None,
-            dst: None,
-        }
-    }
-
-    /// Statistics of the quantized DST, with percentages relative to `bvh2_total` bytes;
-    /// `convert_ms` is its encoding from the DST.
-    pub fn of_dstq(q: &crate::dstq::DstQ, convert_ms: f64, bvh2_total: u64) -> Self {
-        let bytes_total = q.bytes_total();
-        // One walk counts the records.
-        let s = q.stats();
-        Self {
-            name: "dst-q".to_string(),
-            nodes: s.internal_nodes() + s.leaf_count(),
-            internal_nodes: s.internal_nodes(),
-            leaves: s.leaf_count(),
-            bytes_nodes: bytes_total - q.image().index_bytes(),
-            bytes_indices: q.image().index_bytes(),
-            bytes_total,
-            percent_of_bvh2: 100.0 * bytes_total as f64 / bvh2_total.max(1) as f64,
-            sah_cost: f32::NAN,
-            build_ms: convert_ms,
-            convert_ms: Some(convert_ms),
-            dst: None,
+            dst: Some(dst),
+            ..self
         }
     }
 }

@@ -1,8 +1,9 @@
 //! [`TreeSet`]: only the structures a run asks for, each derived from one BVH2 of the scene,
 //! as one [`TraversalSet`]. A run that simulates or renders a few traversals builds their
-//! trees and nothing else ([`Structures`](crate::Structures) builds all six).
+//! trees and nothing else ([`Structures`](crate::Structures) builds all of them).
 //!
-//! Each tree is the one [`AnyTree::derive`] makes (the same as `dualsplit build` saves), so
+//! Each tree is the one [`AnyTree::derive`] makes (the same as `dualsplit build` saves), a
+//! structure derived from another reusing it when the set has it, so
 //! a traversal answers every ray exactly as it does in [`Structures`](crate::Structures),
 //! and its memory image is the same, word for word.
 //!
@@ -18,12 +19,11 @@
 //! # Ok::<(), dualsplit_accel::AccelError>(())
 //! ```
 
-use crate::dstq::DstQConfig;
 use crate::image::{MemoryImage, SharedTriangles};
 use crate::observer::Observer;
-use crate::set::{Plain, TraversalSet};
-use crate::tree::{AnyTree, Bvh2Tree, TreeKind};
-use crate::{AccelError, AccelKind, BuildConfig};
+use crate::set::TraversalSet;
+use crate::structure::UnitMismatch;
+use crate::{AccelError, AccelKind, AnyTree, BuildConfig, Bvh2Tree, Plain, Presets, TreeKind};
 use dualsplit_geometry::{Aabb, Hit, Ray};
 
 /// The trees of some traversals, derived from one BVH2 (at least one tree).
@@ -50,12 +50,8 @@ impl TreeSet {
             .collect();
         let mut trees = Vec::with_capacity(wanted.len());
         for &t in &wanted {
-            if let Some(tree) = AnyTree::derive(&bvh2, t) {
-                trees.push(tree?);
-            }
-        }
-        if wanted.first() == Some(&TreeKind::Bvh2) {
-            trees.insert(0, AnyTree::from(bvh2.into_tree()));
+            let tree = AnyTree::derive_with(&bvh2, t, &Presets::default(), &trees)?;
+            trees.push(tree);
         }
         let kinds = AccelKind::ALL
             .into_iter()
@@ -107,7 +103,8 @@ impl TraversalSet for TreeSet {
         TraversalSet::scene_box(&self.trees[0])
     }
 
-    fn dstq_config(&self) -> Option<DstQConfig> {
-        self.trees.iter().find_map(TraversalSet::dstq_config)
+    fn fits_unit(&self, kind: AccelKind) -> Result<(), UnitMismatch> {
+        self.tree(kind)
+            .map_or(Ok(()), |t| TraversalSet::fits_unit(t, kind))
     }
 }

@@ -11,7 +11,7 @@ pub const MAX_MESSAGES: usize = 20;
 /// What [`validate_image`] found.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct ValidationReport {
-    /// Structure name (`bvh2`, `bvh4`, `bvh8`).
+    /// Structure name (its command-line name).
     pub structure: &'static str,
     /// Internal nodes reached from the root.
     pub internal_nodes: usize,
@@ -30,37 +30,12 @@ pub struct ValidationReport {
 }
 
 impl ValidationReport {
-    /// The report of [`crate::dst::Dst::validate`] in this shape: the DST must rebuild every
-    /// box of `bvh` exactly from its planes and reference every triangle once.
-    pub fn of_dst(dst: &crate::dst::Dst, bvh: &crate::Bvh2) -> Self {
-        let mut rep = ValidationReport {
-            structure: "dst",
-            internal_nodes: 0,
-            leaves: 0,
-            triangles_referenced: 0,
-            triangles: dst.triangles().len(),
-            max_depth: 0,
-            error_count: 0,
-            errors: Vec::new(),
-        };
-        match dst.validate(bvh) {
-            Ok(v) => {
-                rep.internal_nodes = v.internal_nodes as usize;
-                rep.leaves = v.leaves as usize;
-                rep.triangles_referenced = v.index_entries as usize;
-                rep.max_depth = v.max_depth as usize;
-            }
-            Err(e) => rep.error(e.to_string()),
-        }
-        rep
-    }
-
     /// True when the report holds no violation.
     pub fn is_ok(&self) -> bool {
         self.error_count == 0
     }
 
-    fn error(&mut self, msg: String) {
+    pub(crate) fn error(&mut self, msg: String) {
         self.error_count += 1;
         if self.errors.len() < MAX_MESSAGES {
             self.errors.push(msg);

@@ -153,7 +153,7 @@ fn scene_case(spec: &str, cfg: &BuildConfig) {
     let dst = DstTree::from_bvh2(&bvh2, &DstConfig::hardware()).expect("dst");
     assert_eq!(
         dst.image().words,
-        s.dst.image().words,
+        s.dst().image().words,
         "{spec} dst: same image"
     );
     assert_eq!(dst.stats().kind, Some(TreeKind::Dst));

@@ -96,7 +96,7 @@ fn equivalence_on(name: &str, scene: &dualsplit_scene::Scene, min_rays: usize) {
         set.par_iter()
             .enumerate()
             .for_each_init(tracers, |tracers, (i, ray)| {
-                let want = hit_bits(s.bvh2_image.closest_hit_image(ray, &mut NoObserver));
+                let want = hit_bits(s.bvh2_image().closest_hit_image(ray, &mut NoObserver));
                 for (kind, t) in KINDS.iter().zip(tracers.iter_mut()) {
                     assert_eq!(
                         hit_bits(t.closest_hit(ray)),
@@ -138,7 +138,7 @@ fn equivalence_on(name: &str, scene: &dualsplit_scene::Scene, min_rays: usize) {
         .enumerate()
         .for_each_init(tracers, |tracers, (i, ray)| {
             let want = s
-                .bvh2_image
+                .bvh2_image()
                 .closest_hit_image(ray, &mut NoObserver)
                 .is_some();
             for (kind, t) in KINDS.iter().zip(tracers.iter_mut()) {

@@ -29,11 +29,11 @@ const RAYS: usize = if cfg!(debug_assertions) {
     40_000
 };
 
-/// A scene's BVH2 (as its reference image), BVH8 and compressed BVH8.
+/// A scene's BVH2 (as its reference image) and compressed BVH8 (checked against the BVH8
+/// it is encoded from).
 struct Built {
     tris: Vec<Triangle>,
     bvh2: BvhImage,
-    bvh8: BvhImage,
     cw: Cwbvh,
 }
 
@@ -58,7 +58,6 @@ fn try_build_with(tris: &[Triangle], cfg: &BuildConfig) -> Result<Built, ImageEr
     Ok(Built {
         tris: tris.to_vec(),
         bvh2,
-        bvh8,
         cw,
     })
 }
@@ -519,78 +518,4 @@ fn validate_catches_corruption() {
     let mut bad = img.clone();
     bad.nodes = 0..NODE_WORDS - 1;
     assert!(Cwbvh::from_image(bad).is_err());
-}
-
-/// Counts the child boxes hit (`NodeStep::Bvh` hits), nodes and triangle tests.
-#[derive(Default, Clone, Copy)]
-struct BoxHits {
-    hits: u64,
-    nodes: u64,
-    tris: u64,
-}
-impl Observer for BoxHits {
-    fn step(&mut self, s: NodeStep) {
-        if let NodeStep::Bvh { hits, .. } = s {
-            self.hits += hits as u64;
-            self.nodes += 1;
-        }
-    }
-    fn triangle_test(&mut self, _: dualsplit_geometry::PrimId, _: bool) {
-        self.tris += 1;
-    }
-}
-
-/// The figures of `docs/cwbvh-encoding.md`: sizes against BVH8 and BVH2, quantization
-/// growth, and per ray the child boxes hit, nodes visited and triangles tested by the
-/// compressed BVH8 against the BVH8 (same tree, exact boxes) on recorded rays.
-#[test]
-#[ignore = "prints figures; run with --ignored --nocapture"]
-fn figures() {
-    for name in ["dragon_res4.ply.gz", "bunny.ply.gz"] {
-        let Some(scene) = shipped(name) else { continue };
-        let b = build(&scene.triangles, 4);
-        let s = Structures::build(&scene.triangles, &BuildConfig::default());
-        let rays = record_rays(&scene, &s, 200, 40_000);
-        println!(
-            "{name}: {} triangles; bytes cwbvh {} bvh8 {} bvh2 {} ({:.1} % of BVH8, {:.1} % of BVH2); {} nodes, {} leaves",
-            b.tris.len(),
-            b.cw.bytes_total(),
-            b.bvh8.bytes_total(),
-            b.bvh2.bytes_total(),
-            100.0 * b.cw.bytes_total() as f64 / b.bvh8.bytes_total() as f64,
-            100.0 * b.cw.bytes_total() as f64 / b.bvh2.bytes_total() as f64,
-            b.cw.internal_nodes(),
-            b.cw.leaves(),
-        );
-        println!("  {:?}", b.cw.quantization_stats());
-        for (what, set, any) in [
-            ("primary", &rays.primary, false),
-            ("diffuse", &rays.diffuse, false),
-            ("shadow", &rays.shadow, true),
-        ] {
-            let (mut q, mut x) = (BoxHits::default(), BoxHits::default());
-            for ray in set.iter() {
-                if any {
-                    b.cw.any_hit_image(ray, &mut q);
-                    b.bvh8.any_hit_image(ray, &mut x);
-                } else {
-                    b.cw.closest_hit_image(ray, &mut q);
-                    b.bvh8.closest_hit_image(ray, &mut x);
-                }
-            }
-            let n = set.len() as f64;
-            println!(
-                "  {what} ({} rays): box hits/ray cwbvh {:.3} bvh8 {:.3} (+{:.3}, +{:.2} %); nodes/ray {:.3} vs {:.3}; triangle tests/ray {:.3} vs {:.3}",
-                set.len(),
-                q.hits as f64 / n,
-                x.hits as f64 / n,
-                (q.hits as f64 - x.hits as f64) / n,
-                100.0 * (q.hits as f64 / x.hits as f64 - 1.0),
-                q.nodes as f64 / n,
-                x.nodes as f64 / n,
-                q.tris as f64 / n,
-                x.tris as f64 / n,
-            );
-        }
-    }
 }

@@ -5,7 +5,7 @@
 //! `docs/dstq-encoding.md` (`measure_table`, ignored: run it with
 //! `cargo test --release -p dualsplit-accel --test dstq measure_table -- --ignored --nocapture`).
 
-use dualsplit_accel::dst::{Dst, DstConfig, HeaderOffset, Partitioning};
+use dualsplit_accel::dst::{DstConfig, HeaderOffset, Partitioning};
 use dualsplit_accel::dstq::frame::{choose_exponent, decode, q_max, quantize_down, quantize_up};
 use dualsplit_accel::dstq::layout::ROOT_BIT;
 use dualsplit_accel::dstq::record::{read_bits, write_bits};
@@ -19,7 +19,6 @@ use dualsplit_testkit::oracle::{key, oracle_closest};
 use dualsplit_testkit::rays::{random_rays, record_rays};
 use dualsplit_testkit::scenes::{random_scene, shipped};
 use proptest::prelude::*;
-use std::collections::HashSet;
 
 /// Every supported config: k ∈ {4, 6, 8, 10, 12, 16} × 64 and 128-byte clusters.
 fn configs() -> Vec<DstQConfig> {
@@ -59,8 +58,8 @@ fn build_all(s: &Structures, what: &str) -> Vec<DstQ> {
     configs()
         .into_iter()
         .map(|cfg| {
-            let q = DstQ::from_dst(&s.dst, &cfg).expect("dst-q converts");
-            let rep = q.validate(&s.dst);
+            let q = DstQ::from_dst(s.dst(), &cfg).expect("dst-q converts");
+            let rep = q.validate(s.dst());
             assert!(rep.is_ok(), "{what} {cfg:?}: {rep:?}");
             assert!(q.validate_structure().is_ok(), "{what} {cfg:?}");
             q
@@ -330,7 +329,7 @@ fn shipped_case(name: &str, n: usize) {
     let s = Structures::build(&scene.triangles, &BuildConfig::default());
     let qs = build_all(&s, name);
     let sets = record_rays(&scene, &s, 48, n);
-    let b = s.dst.scene_box();
+    let b = s.dst().scene_box();
     let random = random_rays(&mut Pcg32::new(5, 5), &scene.triangles, &b, n);
     for q in &qs {
         let what = format!("{name} {:?}", q.config());
@@ -365,7 +364,7 @@ fn observer_reports_word_accurate_fetches() {
     }
     let tris = random_scene(4, 40, 0, 1.0);
     let s = Structures::build(&tris, &BuildConfig::default());
-    let b = s.dst.scene_box();
+    let b = s.dst().scene_box();
     let rays = random_rays(&mut Pcg32::new(1, 2), &tris, &b, 200);
     for q in build_all(&s, "observer") {
         let node_end = q.image().node_bytes();
@@ -382,7 +381,7 @@ fn observer_reports_word_accurate_fetches() {
             }
             // Exact DST work is a lower bound of the quantized work.
             let (mut e, mut o) = (CountingObserver::default(), CountingObserver::default());
-            s.dst.closest_hit(ray, &mut e);
+            s.dst().closest_hit(ray, &mut e);
             q.closest_hit(ray, &mut o);
             assert!(o.nodes >= e.nodes && o.triangle_tests >= e.triangle_tests);
         }
@@ -419,7 +418,7 @@ fn first_record(q: &DstQ, kind: DstNodeKind) -> Option<u32> {
 fn validate_catches_a_shrunk_plane() {
     let s = dragon_or_random();
     for cfg in configs() {
-        let q = DstQ::from_dst(&s.dst, &cfg).unwrap();
+        let q = DstQ::from_dst(s.dst(), &cfg).unwrap();
         let bit = first_record(&q, DstNodeKind::Split).expect("a split in the root block");
         let k = cfg.bits as usize;
         let mut img = q.image().clone();
@@ -430,7 +429,7 @@ fn validate_catches_a_shrunk_plane() {
         assert_ne!(read_bits(&img.words, p0, k as u32), 0);
         write_bits(&mut img.words, p0, k as u32, 0);
         let bad = DstQ::from_image(img, q.scene_box(), cfg).expect("still well formed");
-        let rep = bad.validate(&s.dst);
+        let rep = bad.validate(s.dst());
         assert!(!rep.is_ok(), "{cfg:?}");
         assert!(
             rep.errors.iter().any(|e| e.contains("not conservative")),
@@ -440,7 +439,7 @@ fn validate_catches_a_shrunk_plane() {
         let mut img = q.image().clone();
         write_bits(&mut img.words, p0 + k, k as u32, q_max(k as u32));
         let bad = DstQ::from_image(img, q.scene_box(), cfg).unwrap();
-        assert!(!bad.validate(&s.dst).is_ok(), "{cfg:?}");
+        assert!(!bad.validate(s.dst()).is_ok(), "{cfg:?}");
     }
 }
 
@@ -448,7 +447,7 @@ fn validate_catches_a_shrunk_plane() {
 fn validate_catches_bad_offsets() {
     let s = dragon_or_random();
     let cfg = DstQConfig::default();
-    let q = DstQ::from_dst(&s.dst, &cfg).unwrap();
+    let q = DstQ::from_dst(s.dst(), &cfg).unwrap();
     let bit = first_record(&q, DstNodeKind::Split).unwrap() as usize;
     let fmt = cfg.record_format();
     let h = QHeader::read(read_bits(&q.image().words, bit, 32), &fmt);
@@ -491,7 +490,7 @@ proptest! {
         let tris = random_scene(seed, 30, 0, 1.0);
         let s = Structures::build(&tris, &BuildConfig::default());
         let cfg = DstQConfig::default();
-        let q = DstQ::from_dst(&s.dst, &cfg).unwrap();
+        let q = DstQ::from_dst(s.dst(), &cfg).unwrap();
         let mut img = q.image().clone();
         let n = img.nodes.len().max(1) as u32;
         for (at, v) in edits {
@@ -501,144 +500,12 @@ proptest! {
             }
         }
         if let Ok(t) = DstQ::from_image(img, q.scene_box(), cfg) {
-            let _ = t.validate(&s.dst);
-            let b = s.dst.scene_box();
+            let _ = t.validate(s.dst());
+            let b = s.dst().scene_box();
             for ray in random_rays(&mut Pcg32::new(seed, 3), &tris, &b, 8) {
                 t.closest_hit(&ray, &mut CountingObserver::default());
             }
         }
-    }
-}
-
-// ---------------------------------------------------------------- measurement
-
-/// Per-ray work of one structure on one ray set.
-#[derive(Default, Clone, Copy)]
-struct Work {
-    nodes: f64,
-    tris: f64,
-    bytes: f64,
-    lines: f64,
-}
-
-/// Counts bytes and the distinct 64-byte lines a ray touches.
-#[derive(Default)]
-struct Lines {
-    c: CountingObserver,
-    lines: HashSet<u64>,
-}
-impl Observer for Lines {
-    fn fetch(&mut self, addr: ByteAddr, bytes: u32) {
-        self.c.fetch(addr, bytes);
-        for l in addr.0 / 64..=(addr.0 + bytes as u64 - 1) / 64 {
-            self.lines.insert(l);
-        }
-    }
-    fn step(&mut self, s: dualsplit_accel::NodeStep) {
-        self.c.step(s);
-    }
-    fn triangle_test(&mut self, p: dualsplit_geometry::PrimId, h: bool) {
-        self.c.triangle_test(p, h);
-    }
-}
-
-fn work(rays: &[Ray], mut f: impl FnMut(&Ray, &mut Lines)) -> Work {
-    let mut w = Work::default();
-    for r in rays {
-        let mut o = Lines::default();
-        f(r, &mut o);
-        w.nodes += o.c.nodes as f64;
-        w.tris += o.c.triangle_tests as f64;
-        w.bytes += o.c.bytes as f64;
-        w.lines += o.lines.len() as f64;
-    }
-    let n = rays.len().max(1) as f64;
-    Work {
-        nodes: w.nodes / n,
-        tris: w.tris / n,
-        bytes: w.bytes / n,
-        lines: w.lines / n,
-    }
-}
-
-fn measure(name: &str, configs: &[DstQConfig]) {
-    let Some(scene) = shipped(name) else {
-        return;
-    };
-    let s = Structures::build(&scene.triangles, &BuildConfig::default());
-    let sets = record_rays(&scene, &s, 128, 16384);
-    let b = s.dst.scene_box();
-    let random = random_rays(&mut Pcg32::new(5, 5), &scene.triangles, &b, 16384);
-    let sets = [("primary", &sets.primary), ("random", &random)];
-    let dst: &Dst = &s.dst;
-    let dst_bytes = dst.stats().total_bytes as f64;
-    let bvh2_bytes = s.bvh2_image.bytes_total() as f64;
-    let exact: Vec<Work> = sets
-        .iter()
-        .map(|(_, r)| {
-            work(r, |ray, o| {
-                dst.closest_hit(ray, o);
-            })
-        })
-        .collect();
-    println!(
-        "\n{name}: exact DST {:.3} MiB ({:.1} % of BVH2 {:.3} MiB)",
-        dst_bytes / 1048576.0,
-        100.0 * dst_bytes / bvh2_bytes,
-        bvh2_bytes / 1048576.0
-    );
-    for ((set, rays), e) in sets.iter().zip(&exact) {
-        println!(
-            "  exact DST, {set} ({} rays): {:.2} nodes, {:.2} triangles, {:.0} B, {:.2} lines per ray",
-            rays.len(),
-            e.nodes,
-            e.tris,
-            e.bytes,
-            e.lines
-        );
-    }
-    println!(
-        "| k | line | MiB | % DST | % BVH2 | B/node | fill | clusters | prim B/ray | prim lines | prim +nodes | prim +tris | rand B/ray | rand lines | rand +nodes | rand +tris |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for cfg in configs {
-        let q = DstQ::from_dst(dst, cfg).unwrap();
-        assert!(q.validate(dst).is_ok());
-        let st = q.stats();
-        let tot = q.bytes_total() as f64;
-        let mut row = format!(
-            "| {} | {} | {:.3} | {:.1} | {:.1} | {:.2} | {:.0} % | {} |",
-            cfg.bits,
-            cfg.cluster_bytes,
-            tot / 1048576.0,
-            100.0 * tot / dst_bytes,
-            100.0 * tot / bvh2_bytes,
-            st.bytes_per_node(),
-            100.0 * st.fill(),
-            st.clusters
-        );
-        for ((_, rays), e) in sets.iter().zip(&exact) {
-            let w = work(rays, |ray, o| {
-                q.closest_hit(ray, o);
-            });
-            row += &format!(
-                " {:.0} | {:.2} | {:+.1} % | {:+.1} % |",
-                w.bytes,
-                w.lines,
-                100.0 * (w.nodes / e.nodes - 1.0),
-                100.0 * (w.tris / e.tris - 1.0)
-            );
-        }
-        println!("{row}");
-    }
-}
-
-#[test]
-#[ignore = "prints the measurement table of docs/dstq-encoding.md (release build, about 5 s)"]
-fn measure_table() {
-    let cfgs = configs();
-    for name in ["dragon_res4.ply.gz", "bunny.ply.gz"] {
-        measure(name, &cfgs);
     }
 }
 
@@ -662,8 +529,8 @@ fn worked_example_words() {
         ..BuildConfig::default()
     };
     let s = Structures::try_build_with(&tris, &bcfg, &DstConfig::hardware()).unwrap();
-    let q = DstQ::from_dst(&s.dst, &DstQConfig::default()).unwrap();
-    assert!(q.validate(&s.dst).is_ok());
+    let q = DstQ::from_dst(s.dst(), &DstQConfig::default()).unwrap();
+    assert!(q.validate(s.dst()).is_ok());
     let img = q.image();
     assert_eq!(img.nodes.len(), 16, "one 64-byte line");
     assert_eq!(

@@ -95,7 +95,7 @@ fn unit_traverse(q: &DstQ, ray: &Ray, any: bool) -> (Option<Hit>, u64) {
 
 fn check(name: &str, tris: &[Triangle], rays: &[Ray]) {
     let s = Structures::build(tris, &BuildConfig::default());
-    let q = &s.dstq;
+    let q = s.dstq();
     assert_eq!(q.config().bits, UNIT_BITS);
     for (i, ray) in rays.iter().enumerate() {
         let mut obs = CountingObserver::default();

@@ -11,11 +11,63 @@ use std::path::Path;
 /// Parses a structure name.
 pub fn parse_accel(s: &str) -> Result<AccelKind, String> {
     AccelKind::parse(s).ok_or_else(|| {
-        let names: Vec<_> = AccelKind::ALL.iter().map(|k| k.name()).collect();
         format!(
             "unknown structure `{s}` (expected one of {})",
-            names.join(", ")
+            AccelKind::names()
         )
+    })
+}
+
+/// A value parser that takes the names of a registry: `parse` reads one, and `--help`
+/// lists `names` as the flag's possible values, so help, parser and registry cannot
+/// disagree.
+#[derive(Clone)]
+pub struct Names<T: Clone + Send + Sync + 'static> {
+    parse: fn(&str) -> Result<T, String>,
+    names: fn() -> Vec<&'static str>,
+}
+
+impl<T: Clone + Send + Sync + 'static> Names<T> {
+    /// The parser of one registry's names.
+    pub fn new(parse: fn(&str) -> Result<T, String>, names: fn() -> Vec<&'static str>) -> Self {
+        Self { parse, names }
+    }
+}
+
+impl<T: Clone + Send + Sync + 'static> clap::builder::TypedValueParser for Names<T> {
+    type Value = T;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<T, clap::Error> {
+        clap::builder::TypedValueParser::parse_ref(&self.parse, cmd, arg, value)
+    }
+
+    fn possible_values(
+        &self,
+    ) -> Option<Box<dyn Iterator<Item = clap::builder::PossibleValue> + '_>> {
+        Some(Box::new(
+            (self.names)()
+                .into_iter()
+                .map(clap::builder::PossibleValue::new),
+        ))
+    }
+}
+
+/// `--accel` of the commands that trace one traversal: [`AccelKind`]'s names.
+pub fn accel_names() -> Names<AccelKind> {
+    Names::new(parse_accel, || AccelKind::ALL.map(AccelKind::name).to_vec())
+}
+
+/// `--accel` of the commands that simulate: [`SimAccel`]'s names and `all`.
+pub fn sim_accel_names() -> Names<SimAccelArg> {
+    Names::new(parse_sim_accel, || {
+        let mut names: Vec<&str> = SimAccel::ALL.iter().map(|a| a.name()).collect();
+        names.push("all");
+        names
     })
 }
 
@@ -34,10 +86,9 @@ pub fn parse_sim_accel(s: &str) -> Result<SimAccelArg, String> {
         return Ok(SimAccelArg::All);
     }
     SimAccel::parse(s).map(SimAccelArg::One).ok_or_else(|| {
-        let names: Vec<_> = SimAccel::ALL.iter().map(|k| k.name()).collect();
         format!(
             "unknown configuration `{s}` (expected one of {} or all)",
-            names.join(", ")
+            SimAccel::names()
         )
     })
 }
@@ -182,10 +233,11 @@ mod tests {
 
     #[test]
     fn sim_accel_lists_keep_order_and_drop_repeats() {
-        let items = ["dst", "bvh2", "all"].map(|s| parse_sim_accel(s).unwrap());
+        let (a, b) = (SimAccel::ALL[SimAccel::ALL.len() - 1], SimAccel::ALL[0]);
+        let items = [a.name(), b.name(), "all"].map(|s| parse_sim_accel(s).unwrap());
         let got = sim_accels(&items);
         assert_eq!(got.len(), SimAccel::ALL.len());
-        assert_eq!(&got[..2], &[SimAccel::Dst, SimAccel::Bvh2]);
+        assert_eq!(&got[..2], &[a, b]);
         assert!(parse_sim_accel("bvh3").is_err());
     }
 

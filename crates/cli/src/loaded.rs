@@ -226,11 +226,11 @@ impl TraversalSet for Loaded {
         }
     }
 
-    fn dstq_config(&self) -> Option<dualsplit_accel::dstq::DstQConfig> {
+    fn fits_unit(&self, kind: AccelKind) -> Result<(), dualsplit_accel::UnitMismatch> {
         match self {
-            Loaded::Built { structures, .. } => TraversalSet::dstq_config(structures),
-            Loaded::Some { set, .. } => TraversalSet::dstq_config(set),
-            Loaded::Saved { tree, .. } => TraversalSet::dstq_config(tree),
+            Loaded::Built { structures, .. } => TraversalSet::fits_unit(structures, kind),
+            Loaded::Some { set, .. } => TraversalSet::fits_unit(set, kind),
+            Loaded::Saved { tree, .. } => TraversalSet::fits_unit(tree, kind),
         }
     }
 }

@@ -269,7 +269,68 @@ fn flag_names(word: &str) -> Vec<String> {
         .collect()
 }
 
-/// Problems with a synopsis: an unknown subcommand, or flags it does not have.
+/// The values `--help` says `flag` accepts (`[possible values: a, b]`), or `None` when it
+/// lists none (a free-form value).
+fn possible_values(help: &str, flag: &str) -> Option<BTreeSet<String>> {
+    // The flag's entry: from its line to the next flag's.
+    let mut entry = String::new();
+    let mut inside = false;
+    for line in help.lines() {
+        let t = line.trim_start();
+        if t.starts_with('-') {
+            inside = t
+                .split(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+                .any(|w| w == flag);
+        }
+        if inside {
+            entry.push(' ');
+            entry.push_str(t);
+        }
+    }
+    let start = entry.find("[possible values: ")? + "[possible values: ".len();
+    let end = start + entry[start..].find(']')?;
+    Some(
+        entry[start..end]
+            .split(',')
+            .map(|v| v.trim().to_string())
+            .filter(|v| !v.is_empty())
+            .collect(),
+    )
+}
+
+/// The alternatives a synopsis gives a flag's value (`--accel dst|bvh2`, `--accel=a|b`):
+/// (flag, values) for each flag whose value is a list of `|`-separated plain names (no
+/// placeholder, list or repetition).
+fn value_alternatives(argv: &[String]) -> Vec<(String, BTreeSet<String>)> {
+    let mut out = Vec::new();
+    for (i, w) in argv.iter().enumerate() {
+        let w = w.trim_start_matches('[');
+        let (flag, value) = match w.split_once('=') {
+            Some((f, v)) if f.starts_with("--") => (f, v.to_string()),
+            _ if w.starts_with("--") && !w.contains(['[', ']']) => match argv.get(i + 1) {
+                Some(v) => (w, v.clone()),
+                None => continue,
+            },
+            _ => continue,
+        };
+        let value = value.trim_end_matches(']');
+        let plain = |v: &str| {
+            !v.is_empty()
+                && v.chars()
+                    .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || "-+".contains(c))
+        };
+        if value.contains('|') && value.split('|').all(plain) {
+            out.push((
+                flag.to_string(),
+                value.split('|').map(String::from).collect(),
+            ));
+        }
+    }
+    out
+}
+
+/// Problems with a synopsis: an unknown subcommand, flags it does not have, or a flag's
+/// alternatives (`--accel a|b|c`) that are not exactly the values its `--help` lists.
 fn check_synopsis(c: &DocCommand) -> Option<String> {
     let Some(path) = command_path(&c.argv) else {
         return Some("no subcommand".into());
@@ -285,7 +346,22 @@ fn check_synopsis(c: &DocCommand) -> Option<String> {
         .flat_map(|w| flag_names(w))
         .filter(|f| f != "--" && !flags.contains(f))
         .collect();
-    (!unknown.is_empty()).then(|| format!("`{sub}` has no {}", unknown.join(", ")))
+    if !unknown.is_empty() {
+        return Some(format!("`{sub}` has no {}", unknown.join(", ")));
+    }
+    let help = help_of(&path).ok()?;
+    for (flag, listed) in value_alternatives(&c.argv) {
+        if let Some(accepted) = possible_values(&help, &flag)
+            && listed != accepted
+        {
+            return Some(format!(
+                "`{sub} {flag}` lists {} but accepts {}",
+                listed.iter().cloned().collect::<Vec<_>>().join("|"),
+                accepted.iter().cloned().collect::<Vec<_>>().join("|")
+            ));
+        }
+    }
+    None
 }
 
 /// Whether a word (or the value after `--flag=`) names a relative file path.
@@ -382,6 +458,32 @@ fn a_made_up_flag_or_subcommand_fails() {
     assert!(e.contains("--peers"), "{e}");
     assert!(check_synopsis(&doc(&["simulate", "[--eye/--targte]"], true)).is_some());
     assert!(check_synopsis(&doc(&["nosuch", "SCENE"], true)).is_some());
+}
+
+/// A synopsis that lists a flag's values must list exactly the ones it accepts (the
+/// registry's names for `--accel`).
+#[test]
+fn a_synopsis_lists_exactly_the_values_a_flag_accepts() {
+    let doc = |argv: Vec<String>| DocCommand {
+        at: "test".into(),
+        argv,
+        synopsis: true,
+    };
+    let names: Vec<&str> = dualsplit_accel::TreeKind::ALL.map(|k| k.name()).to_vec();
+    let all = names.join("|");
+    let line = |v: &str| {
+        doc(vec![
+            "build".into(),
+            "SCENE".into(),
+            "--accel".into(),
+            v.into(),
+        ])
+    };
+    assert_eq!(check_synopsis(&line(&all)), None);
+    let e = check_synopsis(&line(&names[1..].join("|"))).expect("a value left out fails");
+    assert!(e.contains("accepts"), "{e}");
+    let e = check_synopsis(&line(&format!("{all}|nosuch"))).expect("a made-up value fails");
+    assert!(e.contains("nosuch"), "{e}");
 }
 
 #[test]

@@ -55,7 +55,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .find(|set| set.kind.name() == kind)
         .ok_or(usage)?;
     // Made here, not by the first query, so that no side's counts include building.
-    s.bvh8.cpu();
+    s.bvh8().cpu();
     let embree = EmbreeScene::new(&scene.triangles)?;
     let shadow = set.kind == RayKind::Shadow;
     // The root's box is the scene's.

@@ -162,8 +162,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         tree.leaves.len(),
         tris as f64 / leaves,
         build.as_secs_f64() * 1e3,
-        s.bvh8.internal_nodes,
-        s.bvh8.leaves,
+        s.bvh8().internal_nodes,
+        s.bvh8().leaves,
     )?;
     writeln!(
         out,
@@ -177,8 +177,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let level = SimdLevel::detect();
     let merge = merge_limit();
     let copies = [
-        ("ours", s.bvh8.cpu_copy_with(level, merge)),
-        ("ours, no merge", s.bvh8.cpu_copy_with(level, 0)),
+        ("ours", s.bvh8().cpu_copy_with(level, merge)),
+        ("ours, no merge", s.bvh8().cpu_copy_with(level, 0)),
         ("Embree's tree", theirs.cpu_copy_with(level, merge)),
         ("Embree's tree, no merge", theirs.cpu_copy_with(level, 0)),
         ("Embree's split tree", split_img.cpu_copy_with(level, merge)),
@@ -225,7 +225,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     for set in &sets {
         write!(out, "{:8}", set.kind.name())?;
-        for img in [&s.bvh8, &theirs, &split_img] {
+        for img in [s.bvh8(), &theirs, &split_img] {
             let w = work(img, set);
             write!(out, " {:8.2} {:8.1} {:8.2} |", w[0], w[1], w[2])?;
         }

@@ -1,8 +1,9 @@
 //! The simulated configurations: which structure, traversed how, on which units.
 //!
 //! Every configuration is registered once, in the `sim_accels!` invocation below: its
-//! variant, command-line name, the paper's label, the traversal it runs, its ray-box pipes
-//! for the "+" configurations, its chart colour, and its compiled kernels, one per workload
+//! variant, command-line name, the paper's label, the traversal it runs, the TM unit that
+//! tests its nodes ([`NodeUnit`]), its ray-box pipes for the "+" configurations, its chart
+//! colour, and its compiled kernels, one per workload
 //! and variant (`kernels/build/<name>-{cast,path}{,-parity,-loads,-parity-loads}.elf`, which `kernels/Makefile`'s
 //! `CONFIGS` builds; a test checks the two lists agree). The CLI, the simulator, the kernel table, the
 //! calibration and the charts read it from here (`docs/extending.md`).
@@ -27,7 +28,8 @@ macro_rules! kernel {
 macro_rules! sim_accels {
     ($(
         $(#[doc = $doc:literal])*
-        $v:ident = $name:literal, $label:literal, $kind:ident, parallel: $par:expr, color: $rgb:expr;
+        $v:ident = $name:literal, $label:literal, $kind:ident, unit: $unit:ident,
+            parallel: $par:expr, color: $rgb:expr;
     )*) => {
         /// The simulated configurations: the paper's eight (§4) and the quantized structures'
         /// three (beyond the paper).
@@ -52,6 +54,7 @@ macro_rules! sim_accels {
                 name: $name,
                 label: $label,
                 kind: AccelKind::$kind,
+                unit: NodeUnit::$unit,
                 parallel: $par,
                 color: $rgb,
                 kernels: [
@@ -78,6 +81,8 @@ struct Info {
     name: &'static str,
     label: &'static str,
     kind: AccelKind,
+    /// The unit that tests its nodes.
+    unit: NodeUnit,
     /// Ray-box pipes testing all of a node's children in one issue slot (the "+"
     /// configurations), if any.
     parallel: Option<u32>,
@@ -86,33 +91,86 @@ struct Info {
     kernels: [[&'static [u8]; KernelsConfig::ALL.len()]; 2],
 }
 
+/// The TM unit that tests a configuration's nodes: what its kernels issue a node to, and
+/// what the `fast` model charges a node step as.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum NodeUnit {
+    /// The ray-box pipelines, one child box per op.
+    BoxPipe,
+    /// The quantized ray-box pipelines: one issue per node, every one of its 8 slots
+    /// dequantized and tested (`rt.qboxn`).
+    QuantizedBoxPipe,
+    /// None: the kernel decodes dual-split nodes with its own instructions (DST\*).
+    SoftwareDualSplit,
+    /// The dual-split pipeline (`rt.dstp`).
+    DualSplitPipe,
+    /// The quantized dual-split pipeline (`rt.dstqp`).
+    QuantizedDualSplitPipe,
+}
+
+impl NodeUnit {
+    /// A dual-split tree's nodes (stack entries carry `[t_min, t_max]`), on a pipeline or
+    /// in software.
+    pub fn is_dual_split(self) -> bool {
+        matches!(
+            self,
+            NodeUnit::SoftwareDualSplit
+                | NodeUnit::DualSplitPipe
+                | NodeUnit::QuantizedDualSplitPipe
+        )
+    }
+
+    /// A dual-split pipeline, exact or quantized.
+    pub fn is_dual_split_pipe(self) -> bool {
+        matches!(
+            self,
+            NodeUnit::DualSplitPipe | NodeUnit::QuantizedDualSplitPipe
+        )
+    }
+}
+
 sim_accels! {
     /// BVH2, child boxes tested one after another on the TM's ray-box pipeline.
-    Bvh2 = "bvh2", "BVH2", Bvh2, parallel: None, color: [31, 90, 180];
+    Bvh2 = "bvh2", "BVH2", Bvh2, unit: BoxPipe,
+        parallel: None, color: [31, 90, 180];
     /// BVH2 with 2 ray-box pipelines (all child boxes in parallel).
-    Bvh2Plus = "bvh2+", "BVH2+", Bvh2, parallel: Some(2), color: [110, 160, 230];
+    Bvh2Plus = "bvh2+", "BVH2+", Bvh2, unit: BoxPipe,
+        parallel: Some(2), color: [110, 160, 230];
     /// BVH4, serial box tests.
-    Bvh4 = "bvh4", "BVH4", Bvh4, parallel: None, color: [30, 130, 60];
+    Bvh4 = "bvh4", "BVH4", Bvh4, unit: BoxPipe,
+        parallel: None, color: [30, 130, 60];
     /// BVH4 with 4 ray-box pipelines.
-    Bvh4Plus = "bvh4+", "BVH4+", Bvh4, parallel: Some(4), color: [120, 200, 120];
+    Bvh4Plus = "bvh4+", "BVH4+", Bvh4, unit: BoxPipe,
+        parallel: Some(4), color: [120, 200, 120];
     /// BVH8, serial box tests.
-    Bvh8 = "bvh8", "BVH8", Bvh8, parallel: None, color: [200, 110, 0];
+    Bvh8 = "bvh8", "BVH8", Bvh8, unit: BoxPipe,
+        parallel: None, color: [200, 110, 0];
     /// BVH8 with 8 ray-box pipelines.
-    Bvh8Plus = "bvh8+", "BVH8+", Bvh8, parallel: Some(8), color: [245, 180, 80];
+    Bvh8Plus = "bvh8+", "BVH8+", Bvh8, unit: BoxPipe,
+        parallel: Some(8), color: [245, 180, 80];
     /// DST decoded in software (DST*).
-    DstSw = "dst-sw", "DST*", DstSw, parallel: None, color: [130, 70, 170];
+    DstSw = "dst-sw", "DST*", DstSw, unit: SoftwareDualSplit,
+        parallel: None, color: [130, 70, 170];
     /// DST on the dual-split pipeline.
-    Dst = "dst", "DST", Dst, parallel: None, color: [210, 30, 40];
+    Dst = "dst", "DST", Dst, unit: DualSplitPipe,
+        parallel: None, color: [210, 30, 40];
     /// Compressed BVH8 (beyond the paper): one quantized ray-box pipeline, the 8 child
     /// tests of a node one after another.
-    Cwbvh = "cwbvh", "CWBVH", Cwbvh, parallel: None, color: [90, 90, 90];
+    Cwbvh = "cwbvh", "CWBVH", Cwbvh, unit: QuantizedBoxPipe,
+        parallel: None, color: [90, 90, 90];
     /// Compressed BVH8 with 8 quantized ray-box pipelines (all children in one issue).
-    CwbvhPlus = "cwbvh+", "CWBVH+", Cwbvh, parallel: Some(8), color: [170, 170, 170];
+    CwbvhPlus = "cwbvh+", "CWBVH+", Cwbvh, unit: QuantizedBoxPipe,
+        parallel: Some(8), color: [170, 170, 170];
     /// Quantized DST on the quantized dual-split pipeline (beyond the paper).
-    DstQ = "dst-q", "DST-Q", DstQ, parallel: None, color: [240, 110, 160];
+    DstQ = "dst-q", "DST-Q", DstQ, unit: QuantizedDualSplitPipe,
+        parallel: None, color: [240, 110, 160];
 }
 
 impl SimAccel {
+    /// The configuration simulated when none is named: the DST on the paper's dual-split
+    /// pipeline.
+    pub const DEFAULT: SimAccel = SimAccel::Dst;
+
     /// The paper's eight configurations (§4, Tables 4–7), in its table order.
     pub const PAPER: [SimAccel; 8] = [
         SimAccel::Bvh2,
@@ -149,6 +207,10 @@ impl SimAccel {
     pub fn parse(s: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|k| k.name() == s)
     }
+    /// The command-line names, comma-separated, for help and messages.
+    pub fn names() -> String {
+        Self::ALL.map(SimAccel::name).join(", ")
+    }
     /// The traversal this configuration runs.
     pub fn kind(self) -> AccelKind {
         self.info().kind
@@ -158,13 +220,14 @@ impl SimAccel {
     pub fn parallel_boxes(self) -> bool {
         self.info().parallel.is_some()
     }
-    /// DST, DST\* and DST-Q: the traversal of a dual-split tree (stack entries carry
-    /// `[t_min, t_max]`).
+    /// The unit that tests its nodes.
+    pub fn node_unit(self) -> NodeUnit {
+        self.info().unit
+    }
+    /// The traversal of a dual-split tree (stack entries carry `[t_min, t_max]`):
+    /// [`NodeUnit::is_dual_split`].
     pub fn is_dst(self) -> bool {
-        matches!(
-            self.kind(),
-            AccelKind::Dst | AccelKind::DstSw | AccelKind::DstQ
-        )
+        self.node_unit().is_dual_split()
     }
     /// One of the paper's eight configurations ([`SimAccel::PAPER`]).
     pub fn in_paper(self) -> bool {
@@ -176,13 +239,13 @@ impl SimAccel {
         self.info().parallel.unwrap_or(cfg.units.box_pipes)
     }
     /// The pipelines of each TM in this configuration: [`SimAccel::box_pipes`] ray-box pipes,
-    /// quantized for the CWBVH configurations, and a quantized dual-split pipeline for
-    /// DST-Q.
+    /// quantized when its [`NodeUnit`] is, and a quantized dual-split pipeline when its unit
+    /// is that.
     pub fn pipes(self, units: &UnitConfig) -> TmPipes {
         TmPipes {
             box_pipes: self.info().parallel.unwrap_or(units.box_pipes),
-            quantized_boxes: self.kind() == AccelKind::Cwbvh,
-            quantized_dst: self.kind() == AccelKind::DstQ,
+            quantized_boxes: self.node_unit() == NodeUnit::QuantizedBoxPipe,
+            quantized_dst: self.node_unit() == NodeUnit::QuantizedDualSplitPipe,
         }
     }
     /// The colour of its series in the report's charts (RGB).

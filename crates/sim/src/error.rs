@@ -26,20 +26,11 @@ pub enum SimError {
     /// A committed kernel did not load.
     #[error("kernel: {0}")]
     Kernel(#[from] ElfError),
-    /// A quantized DST whose plane bits or cluster size are not the quantized dual-split
-    /// unit's (`dualsplit_accel::dstq::unit`).
-    #[error(
-        "dst-q with {bits}-bit planes in {cluster_bytes}-byte clusters: the quantized dual-split \
-         unit decodes {unit_bits}-bit planes in {unit_bytes}-byte clusters only",
-        unit_bits = dualsplit_accel::dstq::unit::UNIT_BITS,
-        unit_bytes = dualsplit_accel::dstq::unit::UNIT_CLUSTER_BYTES
-    )]
-    DstQGeometry {
-        /// The tree's plane bits.
-        bits: u32,
-        /// The tree's cluster size.
-        cluster_bytes: u32,
-    },
+    /// A tree its configuration's hardware unit cannot run: an encoding the unit does not
+    /// decode, or a node region its addresses do not reach
+    /// ([`dualsplit_accel::Structure::fits_unit`]).
+    #[error(transparent)]
+    Unit(#[from] dualsplit_accel::UnitMismatch),
     /// The frame does not fit the compiled kernels' 32-bit memory map (`docs/isa.md`).
     #[error("the {region} takes {bytes} bytes; the kernels' memory map holds at most {limit}")]
     MemoryMap {

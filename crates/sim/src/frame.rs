@@ -6,8 +6,7 @@ use crate::error::SimError;
 use crate::footprint;
 use crate::model::{ThreadModel, fast, rv32};
 use crate::result::SimResult;
-use dualsplit_accel::dstq::unit::unit_supports;
-use dualsplit_accel::{AccelKind, TraversalSet};
+use dualsplit_accel::TraversalSet;
 use dualsplit_render::RenderSettings;
 use dualsplit_scene::Scene;
 
@@ -91,33 +90,6 @@ pub fn check_model(cfg: &SimConfig, model: ThreadModel) -> Result<(), SimError> 
     Ok(())
 }
 
-/// DST-Q runs on a unit of fixed geometry (`dstq::unit`): its tree must have the unit's
-/// plane bits and cluster size, and its records' names (cluster word address << 9 | bit
-/// position) must fit 32 bits (a node region up to 32 MiB).
-fn check_quantized_dst<S: TraversalSet>(structures: &S, accel: SimAccel) -> Result<(), SimError> {
-    if accel.kind() != AccelKind::DstQ {
-        return Ok(());
-    }
-    if let Some(cfg) = structures.dstq_config()
-        && !unit_supports(&cfg)
-    {
-        return Err(SimError::DstQGeometry {
-            bits: cfg.bits,
-            cluster_bytes: cfg.cluster_bytes,
-        });
-    }
-    let bytes = structures.image(accel.kind()).node_bytes();
-    let limit = dualsplit_accel::dstq::unit::UNIT_MAX_NODE_BYTES;
-    if bytes > limit {
-        return Err(SimError::MemoryMap {
-            region: "DST-Q node region (records named by a 23-bit cluster word address and a 9-bit position)",
-            bytes,
-            limit,
-        });
-    }
-    Ok(())
-}
-
 /// Simulates one frame; `progress` is called with (pixels done, pixels total).
 pub fn simulate<S: TraversalSet>(
     frame: &FrameRequest<'_, S>,
@@ -146,7 +118,7 @@ pub fn simulate<S: TraversalSet>(
     }
     footprint::check(cfg, accel, model, frame.pixels())?;
     check_model(cfg, model)?;
-    check_quantized_dst(structures, accel)?;
+    structures.fits_unit(accel.kind())?;
     // `kernels.shadows = false` turns the frame's shadow rays off.
     let shadowless = RenderSettings {
         shadows: false,

@@ -59,7 +59,7 @@ mod shares;
 /// frames are recomputed.
 pub const MODEL_VERSION: u32 = 12;
 
-pub use accel::SimAccel;
+pub use accel::{NodeUnit, SimAccel};
 pub use config::{
     CacheConfig, ConfigError, DramConfig, EnergyConfig, KernelsConfig, NodeFetch, SimConfig,
     UnitConfig,

@@ -109,8 +109,9 @@ fn fast_model_is_within_ten_percent_on_the_dragon_box() {
         .into_iter()
         .flat_map(|wl| SimAccel::ALL.into_iter().map(move |accel| (wl, accel)))
         .collect();
-    // Each simulation runs on one thread; the 22 frames (every configuration, both
-    // workloads), each in both thread models, run on the rayon pool, collected in order.
+    // Each simulation runs on one thread; the frames (every configuration in both
+    // workloads: 2 × `SimAccel::ALL.len()`), each in both thread models, run on the rayon
+    // pool, collected in order.
     let results: Vec<[SimResult; 2]> = frames
         .par_iter()
         .map(|&(wl, accel)| {

@@ -2,8 +2,13 @@
 //! `src/hw/` import nothing from the thread models (`src/model/`) or from what is built on
 //! them, and no two files of `src/` import each other in a circle.
 //!
-//! Imports are read from the source: every `crate::a::b…` path outside comments and outside
-//! the trailing `#[cfg(test)]` module, resolved to the longest module path that is a file.
+//! Imports are read from the source, outside comments and outside the trailing
+//! `#[cfg(test)]` module: every path that starts with `crate::`, `super::` or `self::`, with
+//! a child module the file declares (`mod x;`), or with a name a `use` brought in
+//! (`use crate::model::rv32;` then `rv32::frame::run`), resolved to the longest module path
+//! that is a file. The circles still known are listed in [`KNOWN_CIRCLES`], each by the one
+//! import that closes it; the test fails on any other circle, and on a listed import that
+//! is gone (so the list only shrinks).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -108,35 +113,218 @@ fn imports(mods: &BTreeMap<String, String>) -> BTreeMap<String, BTreeSet<String>
     let mut out = BTreeMap::new();
     for (name, src) in mods {
         let mut deps = BTreeSet::new();
-        for (i, _) in src.match_indices("crate::") {
-            let rest = &src[i + 7..];
-            let end = rest
-                .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
-                .unwrap_or(rest.len());
-            let base = rest[..end].trim_end_matches(':');
-            let mut targets = vec![base.to_string()];
-            // `crate::a::{b, c::d}`: each item of the group.
-            if rest[end..].starts_with('{') {
-                let group = &rest[end + 1..rest[end..].find('}').map_or(end, |j| end + j)];
-                targets = group
-                    .split(',')
-                    .map(|t| t.trim().split([' ', ':']).next().unwrap_or(""))
-                    .filter(|t| !t.is_empty() && *t != "self")
-                    .map(|t| format!("{base}::{t}"))
-                    .collect();
-                targets.push(base.to_string());
-            }
-            for t in targets {
-                let m = resolve(&t);
-                let inside = m.is_empty() || name == &m || name.starts_with(&format!("{m}::"));
-                if !inside {
-                    deps.insert(m);
-                }
+        for path in absolute_paths(name, src, mods) {
+            let m = resolve(&path);
+            let inside = m.is_empty() || name == &m || name.starts_with(&format!("{m}::"));
+            if !inside {
+                deps.insert(m);
             }
         }
         out.insert(name.clone(), deps);
     }
     out
+}
+
+/// The parent of module `m` (`` for a top-level module).
+fn parent(m: &str) -> String {
+    m.rsplit_once("::")
+        .map_or(String::new(), |(p, _)| p.to_string())
+}
+
+/// `base::rest`, or `rest` when `base` is the crate root.
+fn join(base: &str, rest: &str) -> String {
+    if base.is_empty() {
+        rest.to_string()
+    } else if rest.is_empty() {
+        base.to_string()
+    } else {
+        format!("{base}::{rest}")
+    }
+}
+
+/// The use trees of `src`: (bound name, path as written) for every leaf of every `use`
+/// declaration (`use a::{b, c::d as e};` gives (b, a::b) and (e, a::c::d)).
+fn use_bindings(src: &str) -> Vec<(String, String)> {
+    fn leaves(prefix: &str, tree: &str, out: &mut Vec<(String, String)>) {
+        let tree = tree.trim();
+        if let Some(i) = tree.find('{') {
+            let base = tree[..i].trim().trim_end_matches("::");
+            let inner = &tree[i + 1..tree.rfind('}').unwrap_or(tree.len())];
+            // Split the group at top-level commas.
+            let (mut depth, mut start) = (0, 0);
+            for (j, c) in inner.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => {
+                        leaves(&join_use(prefix, base), &inner[start..j], out);
+                        start = j + 1;
+                    }
+                    _ => {}
+                }
+            }
+            leaves(&join_use(prefix, base), &inner[start..], out);
+            return;
+        }
+        if tree.is_empty() || tree == "*" {
+            return;
+        }
+        let (path, alias) = match tree.split_once(" as ") {
+            Some((p, a)) => (p.trim(), Some(a.trim())),
+            None => (tree, None),
+        };
+        let full = join_use(prefix, path);
+        let last = full.rsplit("::").next().unwrap_or(&full).to_string();
+        let (full, name) = if last == "self" {
+            let p = full.trim_end_matches("::self").to_string();
+            let n = p.rsplit("::").next().unwrap_or(&p).to_string();
+            (p, n)
+        } else {
+            (full.clone(), last)
+        };
+        out.push((alias.unwrap_or(&name).to_string(), full));
+    }
+    fn join_use(a: &str, b: &str) -> String {
+        match (a.is_empty(), b.is_empty()) {
+            (true, _) => b.to_string(),
+            (_, true) => a.to_string(),
+            _ => format!("{a}::{b}"),
+        }
+    }
+    let mut out = Vec::new();
+    let flat: String = src.split_whitespace().collect::<Vec<_>>().join(" ");
+    let mut rest = flat.as_str();
+    while let Some(i) = rest.find("use ") {
+        let before_ok = i == 0 || !rest[..i].ends_with(|c: char| c.is_alphanumeric() || c == '_');
+        let after = &rest[i + 4..];
+        let end = after.find(';').unwrap_or(after.len());
+        if before_ok {
+            leaves("", &after[..end], &mut out);
+        }
+        rest = &after[end.min(after.len())..];
+    }
+    out
+}
+
+/// Every path of `src` (the code of module `name`) that names a module of the crate, made
+/// absolute from the crate root: `crate::…`, `super::…`, `self::…`, a child module's
+/// `x::…`, and a name bound by a `use` of one of these.
+fn absolute_paths(name: &str, src: &str, mods: &BTreeMap<String, String>) -> Vec<String> {
+    let children: BTreeSet<String> = mods
+        .keys()
+        .filter(|m| parent(m) == name && !m.is_empty() && *m != name)
+        .map(|m| m.rsplit("::").next().unwrap_or(m).to_string())
+        .collect();
+    // A path's first segment made absolute, or `None` for another crate's path.
+    let start = |first: &str, bound: &BTreeMap<String, String>| -> Option<String> {
+        match first {
+            "crate" => Some(String::new()),
+            "super" => Some(parent(name)),
+            "self" => Some(name.to_string()),
+            c if children.contains(c) => Some(join(name, c)),
+            b => bound.get(b).cloned(),
+        }
+    };
+    let absolute = |path: &str, bound: &BTreeMap<String, String>| -> Option<String> {
+        let mut segs = path.split("::");
+        let mut abs = start(segs.next()?, bound)?;
+        for s in segs {
+            abs = match s {
+                "super" => parent(&abs),
+                "self" => abs,
+                s => join(&abs, s),
+            };
+        }
+        Some(abs)
+    };
+    let mut bound = BTreeMap::new();
+    let mut out = Vec::new();
+    for (n, p) in use_bindings(src) {
+        if let Some(abs) = absolute(&p, &bound) {
+            out.push(abs.clone());
+            bound.insert(n, abs);
+        }
+    }
+    // Paths in the code: `a::b…` not preceded by `::` or an identifier character.
+    let bytes = src.as_bytes();
+    let ident = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
+    let mut i = 0;
+    while i < bytes.len() {
+        if ident(bytes[i]) && (i == 0 || !(ident(bytes[i - 1]) || bytes[i - 1] == b':')) {
+            let mut j = i;
+            while j < bytes.len()
+                && (ident(bytes[j]) || (bytes[j] == b':' && bytes.get(j + 1) == Some(&b':')))
+            {
+                j += if bytes[j] == b':' { 2 } else { 1 };
+            }
+            let path = src[i..j].trim_end_matches(':');
+            if path.contains("::")
+                && let Some(abs) = absolute(path, &bound)
+            {
+                out.push(abs);
+            }
+            i = j.max(i + 1);
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// The imports that close the circles still known, each with its reason: the test drops
+/// them before it looks for circles, and fails when one is gone.
+const KNOWN_CIRCLES: &[(&str, &str, &str)] = &[
+    (
+        "model::rv32::isa",
+        "model::rv32::decode",
+        "the ISA table names decode's Op (issue 58, item 3: Op moves beside the table)",
+    ),
+    (
+        "frame",
+        "model::rv32::frame",
+        "simulate() calls the thread models, which take its FrameRequest (issue 58, item 3)",
+    ),
+    (
+        "frame",
+        "model::fast::frame",
+        "simulate() calls the thread models, which take its FrameRequest (issue 58, item 3)",
+    ),
+];
+
+/// A circle of imports in `deps`, as the path that closes it, or `None`.
+fn find_circle(deps: &BTreeMap<String, BTreeSet<String>>) -> Option<String> {
+    fn visit(
+        m: &str,
+        deps: &BTreeMap<String, BTreeSet<String>>,
+        state: &mut BTreeMap<String, u8>,
+        path: &mut Vec<String>,
+    ) -> Option<String> {
+        state.insert(m.to_string(), 1);
+        path.push(m.to_string());
+        for d in deps.get(m).into_iter().flatten() {
+            match state.get(d.as_str()) {
+                Some(1) => return Some(format!("{} -> {d}", path.join(" -> "))),
+                Some(_) => {}
+                None => {
+                    if let Some(c) = visit(d, deps, state, path) {
+                        return Some(c);
+                    }
+                }
+            }
+        }
+        path.pop();
+        state.insert(m.to_string(), 2);
+        None
+    }
+    let mut state = BTreeMap::new();
+    for m in deps.keys().filter(|m| !m.is_empty()) {
+        if !state.contains_key(m.as_str())
+            && let Some(c) = visit(m, deps, &mut state, &mut Vec::new())
+        {
+            return Some(c);
+        }
+    }
+    None
 }
 
 #[test]
@@ -161,30 +349,55 @@ fn hardware_units_import_no_thread_model() {
 #[test]
 fn no_two_files_import_each_other_in_a_circle() {
     let mods = modules();
+    let mut deps = imports(&mods);
+    for (from, to, why) in KNOWN_CIRCLES {
+        let edge = deps.get_mut(*from).map(|d| d.remove(*to));
+        assert_eq!(
+            edge,
+            Some(true),
+            "the known import {from} -> {to} ({why}) is gone: drop it from KNOWN_CIRCLES"
+        );
+    }
+    if let Some(c) = find_circle(&deps) {
+        panic!("import circle: {c}");
+    }
+}
+
+/// The reading of imports finds each kind of path, and a circle through them is found.
+#[test]
+fn a_circle_through_relative_paths_is_found() {
+    let src = |s: &str| s.to_string();
+    let mods: BTreeMap<String, String> = [
+        (String::new(), src("mod a;\nmod b;")),
+        (src("a"), src("mod inner;\npub use inner::Thing;")),
+        (
+            src("a::inner"),
+            src("use super::super::b::{self, Other};\nfn f() { b::g(); }"),
+        ),
+        (src("b"), src("use crate::c as see;\nfn g() { see::h(); }")),
+        (src("c"), src("fn h() { super::a::Thing::new(); }")),
+        (
+            src("d"),
+            src("fn k() { std::mem::swap(x, y); other_crate::x(); }"),
+        ),
+    ]
+    .into();
     let deps = imports(&mods);
-    // Depth-first search for a back edge.
-    fn visit(
-        m: &str,
-        deps: &BTreeMap<String, BTreeSet<String>>,
-        state: &mut BTreeMap<String, u8>,
-        path: &mut Vec<String>,
-    ) {
-        state.insert(m.to_string(), 1);
-        path.push(m.to_string());
-        for d in deps.get(m).into_iter().flatten() {
-            match state.get(d.as_str()) {
-                Some(1) => panic!("import circle: {} -> {d}", path.join(" -> ")),
-                Some(_) => {}
-                None => visit(d, deps, state, path),
-            }
-        }
-        path.pop();
-        state.insert(m.to_string(), 2);
-    }
-    let mut state = BTreeMap::new();
-    for m in deps.keys().filter(|m| !m.is_empty()) {
-        if !state.contains_key(m.as_str()) {
-            visit(m, &deps, &mut state, &mut Vec::new());
-        }
-    }
+    let set = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<BTreeSet<_>>();
+    assert_eq!(deps["a::inner"], set(&["b"]));
+    assert_eq!(deps["b"], set(&["c"]));
+    assert_eq!(
+        deps["c"],
+        set(&["a::inner"]),
+        "the re-export leads to a::inner"
+    );
+    assert_eq!(deps["d"], set(&[]), "other crates' paths are not imports");
+    let c = find_circle(&deps).expect("a::inner -> b -> c -> a::inner");
+    assert!(
+        c.contains("a::inner") && c.contains("b") && c.contains("c"),
+        "{c}"
+    );
+    let mut broken = deps.clone();
+    broken.get_mut("c").unwrap().clear();
+    assert_eq!(find_circle(&broken), None);
 }

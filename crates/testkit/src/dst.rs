@@ -39,12 +39,12 @@ pub fn build(tris: &[Triangle], cfg: &DstConfig) -> Built {
 pub fn build_with(tris: &[Triangle], bcfg: &BuildConfig, cfg: &DstConfig) -> Built {
     let reference = Structures::try_build_with(tris, bcfg, cfg).expect("structures");
     reference
-        .dst
+        .dst()
         .validate(&reference.bvh2)
         .expect("DST validates against its BVH2");
     Built {
         bvh: reference.bvh2.clone(),
-        dst: reference.dst.clone(),
+        dst: reference.dst().clone(),
         reference,
     }
 }

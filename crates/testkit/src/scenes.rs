@@ -4,9 +4,11 @@
 //! A shipped mesh is looked up by file name in the repository's `scenes/` folder (the small
 //! meshes committed with the code), then in the folder of the large meshes: the one named by
 //! the `DUALSPLIT_SHARED_SCENES` environment variable, else `shared/scenes` beside the
-//! checkout. [`shipped`] and [`shipped_path`] return `None` with a printed reason when
-//! neither folder holds the file, so a test needing a large mesh skips on a fresh clone; when
-//! the `CI` environment variable is set they panic with that reason instead.
+//! checkout. [`shipped`] and [`shipped_path`] return `None` when neither folder holds the
+//! file, so a test needing a large mesh skips on a fresh clone, and report the skip on the
+//! process's own standard error, past the test harness's capture (a passing test's output
+//! is otherwise swallowed): `skipped scene: NAME not found in DIRS`. When the `CI`
+//! environment variable is set they panic with that reason instead.
 
 use dualsplit_geometry::{Pcg32, Triangle, Vec3};
 use dualsplit_scene::{Camera, Light, LoadStats, Scene};
@@ -43,7 +45,8 @@ pub fn shared_dir() -> PathBuf {
 
 /// Path of the shipped mesh `name`: in [`repo_dir`] if there, else in [`shared_dir`].
 ///
-/// When neither holds it, prints `skipped: NAME not found in DIRS` and returns `None`.
+/// When neither holds it, reports `skipped scene: NAME not found in DIRS` ([`report_skip`])
+/// and returns `None`.
 ///
 /// # Panics
 /// When neither folder holds it and the `CI` environment variable is set, naming both.
@@ -61,8 +64,23 @@ pub fn shipped_path(name: &str) -> Option<PathBuf> {
         std::env::var_os("CI").is_none(),
         "{reason} (required when CI is set)"
     );
-    eprintln!("skipped: {reason}");
+    report_skip(&reason);
     None
+}
+
+/// Writes `skipped scene: REASON` to the process's standard error itself, so that the line
+/// shows in `cargo test`'s output even for a passing test (whose `eprintln!` the harness
+/// captures and drops).
+pub fn report_skip(reason: &str) {
+    use std::io::Write;
+    let line = format!("skipped scene: {reason}\n");
+    let direct = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/stderr")
+        .and_then(|mut f| f.write_all(line.as_bytes()));
+    if direct.is_err() {
+        eprint!("{line}");
+    }
 }
 
 /// Loads the shipped mesh `name` found by [`shipped_path`] with `dualsplit_scene::load`;

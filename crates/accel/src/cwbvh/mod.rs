@@ -30,6 +30,7 @@ mod encode;
 mod node;
 mod saved;
 mod traverse;
+mod tree;
 mod validate;
 
 pub use encode::NAME;
@@ -38,6 +39,7 @@ pub use node::{
     decode, quantize_axis, scale_of,
 };
 pub(crate) use saved::check_structure;
+pub use tree::{CwbvhFields, CwbvhTree};
 
 use crate::image::{ImageError, MemoryImage, SharedTriangles};
 use crate::observer::Observer;

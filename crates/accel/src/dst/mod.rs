@@ -41,13 +41,16 @@ mod from_bvh2;
 mod header;
 pub mod pipeline;
 mod reference;
+mod saved;
 mod stats;
 pub(crate) mod traverse;
+mod tree;
 mod validate;
 
 pub use fast::DstQuery;
 pub use header::{AxisPair, Corner, HeaderOffset, OFFSET_LIMIT};
 pub use stats::{DstStats, DstTraceStats, bvh2_size_bytes};
+pub use tree::{DstDecoding, DstFields, DstPipeline, DstTree};
 pub use validate::DstValidation;
 
 use crate::image::MemoryImage;

@@ -45,11 +45,13 @@ pub mod record;
 mod saved;
 mod stats;
 mod traverse;
+mod tree;
 pub mod unit;
 mod validate;
 
 pub use record::{CHILD_LIMIT, ChildRef, LeftRecord, QHeader, RecordFormat};
 pub use stats::DstQStats;
+pub use tree::{DstQFields, DstQTree};
 
 use crate::dst::DstError;
 use crate::image::MemoryImage;

@@ -44,19 +44,19 @@ mod structure;
 
 pub use header::{CHECKSUM_BYTES, FORMAT_VERSION, HEADER_BYTES, MAGIC, WORDS_OFFSET};
 
+pub(crate) use header::check_cost;
+pub use header::{FieldReader, FieldWriter};
+pub use structure::Violation;
+pub(crate) use structure::{Regions, Runs, check_bvh, check_regions, counts, violation};
+
 use crate::BuildConfig;
-use crate::cwbvh::Cwbvh;
-use crate::dst::Dst;
-use crate::dstq::DstQ;
 use crate::image::{MemoryImage, SharedTriangles, Words};
-use crate::tree::{AnyTree, BuildStats, BvhTree, CwbvhTree, DstQTree, DstTree, TreeKind};
-use crate::wide::BvhImage;
+use crate::registry::{AnyFields, AnyTree};
 use dualsplit_geometry::Triangle;
-use header::{Extra, Header};
+use header::Header;
 use sha2::{Digest, Sha256};
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
-use std::time::Duration;
 
 /// Why a saved tree could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -139,7 +139,7 @@ pub enum SavedError {
 }
 
 impl SavedError {
-    fn malformed(s: String) -> Self {
+    pub(crate) fn malformed(s: String) -> Self {
         SavedError::Malformed(s)
     }
 
@@ -213,47 +213,26 @@ impl<W: Write> HashingWriter<W> {
 }
 
 impl AnyTree {
-    /// The structure's own header fields.
-    fn extra(&self) -> Extra {
-        match self {
-            AnyTree::Bvh(b) => Extra::Bvh {
-                internal_nodes: b.encoded.internal_nodes as u64,
-                leaves: b.encoded.leaves as u64,
-                sah_cost: b.encoded.sah_cost,
-            },
-            AnyTree::Dst(d) => Extra::Dst {
-                config: *d.dst.config(),
-                scene_box: d.dst.scene_box(),
-                stats: d.dst.stats(),
-            },
-            AnyTree::Cwbvh(c) => Extra::Cwbvh {
-                internal_nodes: c.cwbvh.internal_nodes() as u64,
-                leaves: c.cwbvh.leaves() as u64,
-            },
-            AnyTree::DstQ(q) => Extra::DstQ {
-                config: *q.dstq.config(),
-                scene_box: q.dstq.scene_box(),
-            },
-        }
-    }
-
     /// Checks everything a traversal of this tree's image relies on, as loading a saved
     /// tree does (`docs/tree-format.md`, "Checks on load"): child offsets and index runs
     /// inside their regions, every node reached once from the root (no cycle), runs ended
     /// by [`crate::image::RUN_END`] and not overlapping, triangle ids below the triangle
-    /// count, valid DST node headers, and the counts the header records. Linear time.
+    /// count, each structure's own node checks, and the counts the header records. Linear time.
     pub fn check_structure(&self) -> Result<(), SavedError> {
-        structure::check(self, &self.extra()).map_err(|v| SavedError::Structure {
-            structure: self.kind().name(),
-            word: v.word as u64,
-            what: v.what,
-        })
+        let img = Regions::of(self.image());
+        check_regions(&img)
+            .and_then(|()| AnyFields::of(self).check_tree(self))
+            .map_err(|v| SavedError::Structure {
+                structure: self.kind().name(),
+                word: v.word as u64,
+                what: v.what,
+            })
     }
 
     /// The file header of this tree.
     fn header(&self) -> Header {
         let img = self.image();
-        let extra = self.extra();
+        let extra = AnyFields::of(self);
         let (n, i, t) = (
             img.nodes.len() as u64,
             img.indices.len() as u64,
@@ -282,17 +261,7 @@ impl AnyTree {
     /// negative or non-finite cost is refused (`InvalidInput`): loading would refuse it.
     pub fn write_to<W: Write>(&self, w: W) -> io::Result<()> {
         let h = self.header();
-        let checked = header::check_build(&h.build).and_then(|()| match &h.extra {
-            Extra::Dst { config, .. } => [
-                ("split", config.costs.split),
-                ("single_carve", config.costs.single_carve),
-                ("dual_carve", config.costs.dual_carve),
-                ("triangle", config.costs.triangle),
-            ]
-            .into_iter()
-            .try_for_each(|(n, c)| header::check_cost("DST cost", n, c)),
-            _ => Ok(()),
-        });
+        let checked = header::check_build(&h.build).and_then(|()| h.extra.check());
         if let Err(e) = checked {
             return Err(io::Error::new(io::ErrorKind::InvalidInput, e.to_string()));
         }
@@ -419,7 +388,8 @@ impl AnyTree {
         // The file's triangles (checksummed with everything else) against the scene's, bit
         // for bit: cheaper than hashing the scene, and exact. The hashes only name them.
         if let Some(scene) = scene
-            && bytemuck::cast_slice::<Triangle, u8>(&tris) != bytemuck::cast_slice(scene)
+            && bytemuck::cast_slice::<Triangle, u8>(&tris)
+                != bytemuck::cast_slice::<Triangle, u8>(scene)
         {
             return Err(SavedError::WrongScene {
                 expected: hex(&triangle_hash(scene)),
@@ -443,7 +413,7 @@ impl AnyTree {
         }
         // The DST's and DST-Q's scene box is where their traversals start (the first slab
         // test): it must be exactly the bounds of the file's triangles, as a build makes it.
-        if let Extra::Dst { scene_box, .. } | Extra::DstQ { scene_box, .. } = &h.extra {
+        if let Some(scene_box) = &h.extra.scene_box() {
             let bounds = tris
                 .iter()
                 .fold(dualsplit_geometry::Aabb::EMPTY, |b, t| b.union(t.bounds()));
@@ -539,61 +509,5 @@ fn assemble(h: &Header, words: Words, tris: SharedTriangles) -> AnyTree {
         triangles: tri_start..tri_start + 9 * tris.len(),
         triangle_data: tris,
     };
-    match h.extra {
-        Extra::Bvh {
-            internal_nodes,
-            leaves,
-            sah_cost,
-        } => {
-            let encoded = BvhImage {
-                arity: match h.kind {
-                    TreeKind::Bvh2 => 2,
-                    TreeKind::Bvh4 => 4,
-                    _ => 8,
-                },
-                image,
-                internal_nodes: internal_nodes as usize,
-                leaves: leaves as usize,
-                sah_cost,
-                time: Duration::ZERO,
-                cpu: Default::default(),
-            };
-            AnyTree::Bvh(BvhTree {
-                stats: BuildStats::of_bvh(h.kind, &encoded, 0.0),
-                encoded,
-                config: h.build,
-            })
-        }
-        Extra::Dst {
-            config,
-            scene_box,
-            stats,
-        } => {
-            let dst = Dst::from_parts(image, scene_box, config, stats);
-            AnyTree::Dst(DstTree {
-                stats: BuildStats::of_dst(&dst, 0.0),
-                dst,
-                config: h.build,
-            })
-        }
-        Extra::Cwbvh {
-            internal_nodes,
-            leaves,
-        } => {
-            let cwbvh = Cwbvh::from_parts(image, internal_nodes as usize, leaves as usize);
-            AnyTree::Cwbvh(CwbvhTree {
-                stats: BuildStats::of_cwbvh(&cwbvh, 0.0),
-                cwbvh,
-                config: h.build,
-            })
-        }
-        Extra::DstQ { config, scene_box } => {
-            let dstq = DstQ::from_parts(image, scene_box, config);
-            AnyTree::DstQ(DstQTree {
-                stats: BuildStats::of_dstq(&dstq, 0.0),
-                dstq,
-                config: h.build,
-            })
-        }
-    }
+    h.extra.assemble(h.kind, image, h.build)
 }

@@ -20,10 +20,12 @@ mod node4;
 mod node8;
 pub(crate) mod simd;
 pub mod traverse;
+mod tree;
 
 pub use collapse::CollapseConfig;
 pub use node4::Node4;
 pub use node8::Node8;
+pub use tree::{Bvh2Tree, BvhFields, BvhTree};
 
 use crate::bvh2::Node2;
 use crate::image::{ImageError, MemoryImage};

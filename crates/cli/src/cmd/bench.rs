@@ -15,7 +15,7 @@
 //! only (`--accel` must name one of them), on rays recorded with its own first traversal
 //! (`dualsplit check --tree` is what compares a saved tree with a fresh BVH2).
 use super::render::{get_structures, load_scene};
-use crate::args::{parse_accel, parse_res, parse_workload};
+use crate::args::{accel_names, parse_res, parse_workload};
 use crate::loaded::Loaded;
 use crate::output::JsonOut;
 use crate::progress::Ctx;
@@ -77,12 +77,12 @@ pub struct Args {
     /// (hairball, forest, atrium, cornell).
     #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
-    /// Structures to measure, comma-separated (bvh2, bvh4, bvh8, dst-sw, dst, cwbvh, dst-q);
-    /// default all (with --tree, all of the saved structure's traversals).
-    #[arg(long, value_delimiter = ',', value_parser = parse_accel)]
+    /// Traversals to measure, comma-separated; default all (with --tree, all of the saved
+    /// structure's traversals).
+    #[arg(long, value_delimiter = ',', value_parser = accel_names())]
     accel: Vec<AccelKind>,
     /// Measure the tree saved in FILE by `dualsplit build` instead of building; it must come
-    /// from SCENE (its triangles are checked). Only its traversals exist (dst-sw and dst
+    /// from SCENE (its triangles are checked). Only its traversals exist (both decoders
     /// for a DST, its own kind for a BVH); the rays and their expected answers come from its
     /// first one (`check --tree` compares a saved tree with a fresh BVH2).
     #[arg(long, value_name = "FILE")]

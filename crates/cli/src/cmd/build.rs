@@ -23,9 +23,9 @@ pub struct Args {
     /// Scene: a file (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params.
     #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
-    /// The structure to build: dst (hardware preset), bvh2, bvh4, bvh8, cwbvh (compressed
-    /// BVH8) or dst-q (quantized DST).
-    #[arg(long, value_parser = parse_tree_kind)]
+    /// The structure to build (with the default presets: the DST's hardware preset, the
+    /// default BVH8 collapse and quantized DST).
+    #[arg(long, value_parser = tree_kind_names())]
     accel: TreeKind,
     /// The tree file to write.
     #[arg(short, long)]
@@ -35,11 +35,15 @@ pub struct Args {
     json: Option<PathBuf>,
 }
 
-/// Parses a [`TreeKind`] name: `dst`, `bvh2`, `bvh4`, `bvh8`, `cwbvh` or `dst-q`.
+/// Parses a [`TreeKind`] name (one of [`TreeKind::names`]).
 pub fn parse_tree_kind(s: &str) -> Result<TreeKind, String> {
-    TreeKind::parse(s).ok_or_else(|| {
-        let names: Vec<&str> = TreeKind::ALL.iter().map(|k| k.name()).collect();
-        format!("unknown structure `{s}` ({})", names.join(", "))
+    TreeKind::parse(s).ok_or_else(|| format!("unknown structure `{s}` ({})", TreeKind::names()))
+}
+
+/// `--accel` of `build`: [`TreeKind`]'s names.
+fn tree_kind_names() -> crate::args::Names<TreeKind> {
+    crate::args::Names::new(parse_tree_kind, || {
+        TreeKind::ALL.map(TreeKind::name).to_vec()
     })
 }
 

@@ -4,7 +4,7 @@
 //! `--vary KEY=V1,V2,...` sweeps over any key of the hardware config TOML.
 
 use super::report::{Resolved, SIM_RAYS_PER_SECOND, SIM_RAYS_PER_SECOND_RV32};
-use crate::args::{SimAccelArg, parse_sim_accel, parse_workload, sim_accels};
+use crate::args::{SimAccelArg, parse_workload, sim_accel_names, sim_accels};
 use crate::progress::Ctx;
 use anyhow::Context;
 use dualsplit_render::Workload;
@@ -24,8 +24,8 @@ pub struct Args {
     /// The study's directory: plan.json goes there, results into its cache/.
     #[arg(long)]
     out: PathBuf,
-    /// Configurations to simulate (default: all eight).
-    #[arg(long, value_delimiter = ',', value_parser = parse_sim_accel)]
+    /// Configurations to simulate (default: all).
+    #[arg(long, value_delimiter = ',', value_parser = sim_accel_names())]
     accel: Vec<SimAccelArg>,
     /// Workloads to simulate (default: cast,path).
     #[arg(long, value_delimiter = ',', value_parser = parse_workload)]

@@ -5,7 +5,7 @@
 //! DST) and must be one of its traversals.
 //!
 //! Also holds the scene loading step with its spinner that `bench` shares.
-use crate::args::{View, parse_accel, parse_res, parse_scene, parse_workload};
+use crate::args::{View, accel_names, parse_res, parse_scene, parse_workload};
 use crate::loaded::Loaded;
 use crate::progress::Ctx;
 use anyhow::Context;
@@ -23,9 +23,9 @@ pub struct Args {
     /// (hairball, forest, atrium, cornell).
     #[arg(value_parser = parse_scene)]
     scene: String,
-    /// Structure: bvh2, bvh4, bvh8, dst-sw, dst, cwbvh or dst-q (default bvh2; with --tree,
-    /// the saved structure's traversal: dst-sw for a DST).
-    #[arg(long, value_parser = parse_accel)]
+    /// Traversal (default: the reference, the BVH2's; with --tree, the saved structure's
+    /// first traversal: the software decoder for a DST).
+    #[arg(long, value_parser = accel_names())]
     accel: Option<AccelKind>,
     /// Render with the tree saved in FILE by `dualsplit build` instead of building; it must
     /// come from SCENE (its triangles are checked). Only its traversals exist: dst-sw
@@ -128,7 +128,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     };
     dualsplit_render::validate(&scene, &settings)?;
     // Only the structure of the traversal rendered is built.
-    let wanted = args.accel.unwrap_or(AccelKind::Bvh2);
+    let wanted = args.accel.unwrap_or(AccelKind::REFERENCE);
     let structures = get_structures(&scene, args.tree.as_deref(), &[wanted], ctx, false)?;
     let accel = match args.accel {
         Some(k) => {
@@ -136,7 +136,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             k
         }
         None if args.tree.is_some() => structures.reference(),
-        None => AccelKind::Bvh2,
+        None => AccelKind::REFERENCE,
     };
     let bar = ctx.bar(
         tile_count(&settings),

@@ -59,7 +59,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     let stats = s.stats();
     let (primary, _, diffuse) = super::rays::record(&scene, &s, args.rays, ctx);
     let rays: Vec<_> = primary.into_iter().chain(diffuse).collect();
-    let base = s.bvh2_image.bytes_total();
+    let base = s.bvh2_image().bytes_total();
     let sp = ctx.spinner("converting DST variants");
     let mut variants = Vec::new();
     for (name, cfg) in [
@@ -76,8 +76,8 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     ] {
         // The hardware/identical tree is the one `Structures` already built.
         let converted;
-        let d = if cfg == *s.dst.config() {
-            &s.dst
+        let d = if cfg == *s.dst().config() {
+            s.dst()
         } else {
             converted = Dst::from_bvh2(&s.bvh2, s.triangles.clone(), &cfg)
                 .with_context(|| format!("converting the DST ({name})"))?;

@@ -9,7 +9,7 @@
 //! * closest hits (16 bytes): `f32 t`, `i32 prim`, `f32 u`, `f32 v`; a miss is
 //!   `t = +inf`, `prim = -1`, `u = v = 0` (the Python package's `Tree.intersect` arrays);
 //! * with `--occluded`, one byte per ray: 1 when it hits any triangle, else 0.
-use crate::args::{parse_accel, parse_scene};
+use crate::args::{accel_names, parse_scene};
 use crate::loaded::Loaded;
 use crate::progress::Ctx;
 use anyhow::Context;
@@ -27,9 +27,9 @@ pub struct Args {
     /// The rays: 32-byte little-endian records (origin, direction, t_min, t_max as f32).
     #[arg(long, value_name = "FILE")]
     rays: PathBuf,
-    /// Traversal: bvh2, bvh4, bvh8, dst-sw, dst, cwbvh or dst-q (default bvh2; with --tree,
-    /// the saved structure's first traversal).
-    #[arg(long, value_parser = parse_accel)]
+    /// Traversal (default: the reference, the BVH2's; with --tree, the saved structure's
+    /// first traversal).
+    #[arg(long, value_parser = accel_names())]
     accel: Option<AccelKind>,
     /// Trace with the tree saved in FILE by `dualsplit build` instead of building.
     #[arg(long, value_name = "FILE")]
@@ -61,7 +61,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         }
         None => match &structures {
             Loaded::Saved { .. } | Loaded::Some { .. } => structures.kinds()[0],
-            Loaded::Built { .. } => AccelKind::Bvh2,
+            Loaded::Built { .. } => AccelKind::REFERENCE,
         },
     };
     let out: Vec<u8> = if args.occluded {

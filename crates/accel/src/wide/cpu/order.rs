@@ -143,7 +143,7 @@ mod tests {
             })
             .collect();
         let s = Structures::try_build(&tris, &Default::default()).expect("structures");
-        for img in [&s.bvh2_image, &s.bvh4, &s.bvh8] {
+        for img in [s.bvh2_image(), s.bvh4(), s.bvh8()] {
             let cpu = img.cpu();
             match &cpu.nodes {
                 CpuNodes::Four(n) => check_order(n, &cpu.packets),

@@ -9,7 +9,7 @@
 //! the Python package's `simulate` calls too.
 
 use crate::args::{
-    SimAccelArg, View, parse_positive, parse_res, parse_sim_accel, parse_workload, sim_accels,
+    SimAccelArg, View, parse_positive, parse_res, parse_workload, sim_accel_names, sim_accels,
 };
 use crate::loaded::Loaded;
 use crate::output::JsonOut;
@@ -30,17 +30,16 @@ pub struct Args {
     /// (hairball, forest, atrium, cornell).
     #[arg(value_parser = crate::args::parse_scene)]
     scene: String,
-    /// Configurations, comma-separated: bvh2, bvh2+, bvh4, bvh4+, bvh8, bvh8+, dst-sw, dst,
-    /// cwbvh, cwbvh+, dst-q, or all (the eleven; side by side on --sim-threads). Only the
-    /// structures they read are built. With more than one, a comparison table follows,
-    /// relative to BVH2 when it is listed, else to the first. Default dst; with --tree,
-    /// every configuration of the saved structure (dst-sw and dst for a DST), and `all`
-    /// means those.
-    #[arg(long, value_delimiter = ',', value_parser = parse_sim_accel)]
+    /// Configurations, comma-separated, or all (every configuration; side by side on
+    /// --sim-threads). Only the structures they read are built. With more than one, a comparison
+    /// table follows, relative to the reference BVH2 when it is listed, else to the first.
+    /// Default: the DST on its pipeline; with --tree, every configuration of the saved
+    /// structure, and `all` means those.
+    #[arg(long, value_delimiter = ',', value_parser = sim_accel_names())]
     accel: Vec<SimAccelArg>,
     /// Simulate the tree saved in FILE by `dualsplit build` instead of building; it must
     /// come from SCENE (its triangles are checked). Only its configurations exist:
-    /// dst-sw and dst for a DST, bvh4 and bvh4+ for a BVH4, and so on.
+    /// the ones that run its traversals.
     #[arg(long, value_name = "FILE")]
     tree: Option<std::path::PathBuf>,
     /// Workload: cast (primary + shadow ray) or path (5 diffuse bounces).
@@ -102,7 +101,7 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
     dualsplit_render::validate(&scene, &settings)?;
     // Only the structures of the configurations asked for are built.
     let wanted: Vec<_> = if args.accel.is_empty() {
-        vec![SimAccel::Dst.kind()]
+        vec![SimAccel::DEFAULT.kind()]
     } else {
         sim_accels(&args.accel).iter().map(|a| a.kind()).collect()
     };
@@ -191,7 +190,7 @@ fn configurations(asked: &[SimAccelArg], structures: &Loaded) -> anyhow::Result<
                 .filter(|a| structures.supports(a.kind()))
                 .collect()
         } else {
-            vec![SimAccel::Dst]
+            vec![SimAccel::DEFAULT]
         });
     }
     for item in asked {

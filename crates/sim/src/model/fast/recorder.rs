@@ -10,7 +10,7 @@
 //! functional-unit class and the dependency stall cycles that the configuration's compiled
 //! kernel spends on it, fitted to the kernels' own execution ([`crate::model::fast::calibrate`]).
 
-use crate::accel::SimAccel;
+use crate::accel::{NodeUnit, SimAccel};
 use crate::hw::pipe::Pipe;
 use crate::model::fast::costs::FRAC_BITS;
 use crate::model::fast::event::{Event, bvh_pairs};
@@ -95,8 +95,8 @@ impl<'a> Recorder<'a> {
             tally,
             open: run.is_some(),
             run: run.unwrap_or_default(),
-            dst_hw: matches!(accel, SimAccel::Dst | SimAccel::DstQ),
-            quantized_boxes: matches!(accel, SimAccel::Cwbvh | SimAccel::CwbvhPlus),
+            dst_hw: accel.node_unit().is_dual_split_pipe(),
+            quantized_boxes: accel.node_unit() == NodeUnit::QuantizedBoxPipe,
             parallel_boxes: accel.parallel_boxes(),
             last,
             boxes: 0,

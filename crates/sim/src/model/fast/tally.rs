@@ -1,7 +1,7 @@
 //! What the recorders of one frame count: events, loads, atomics, and the first step that
 //! did not fit an [`Op`](crate::model::fast::op::Op).
 
-use crate::accel::SimAccel;
+use crate::accel::{NodeUnit, SimAccel};
 use crate::hw::counts::{InstrCounts, Mix};
 use crate::model::fast::costs::{Costs, DEPENDENCY, PIPELINE};
 use crate::model::fast::event::{DST_KINDS, EVENTS, Event};
@@ -97,7 +97,7 @@ impl Tally {
         } else {
             c.box_ops
         };
-        if matches!(self.accel, SimAccel::Cwbvh | SimAccel::CwbvhPlus) {
+        if self.accel.node_unit() == NodeUnit::QuantizedBoxPipe {
             // rt.qboxn: one issue and 8 quantized box ops per node, every slot tested.
             c.box_ops = 0;
             c.qbox_ops = 8 * self.boxed_nodes;
@@ -106,9 +106,9 @@ impl Tally {
         c.tri_ops = e[Event::TriTest.index()];
         let dst = &e[Event::Dst(DST_KINDS[0], ReturnCode::ALL[0]).index()..];
         let dst_leaf = &dst[4 * DstNodeKind::Leaf as usize..];
-        match self.accel {
-            SimAccel::Dst => c.dst_ops = dst.iter().sum(),
-            SimAccel::DstQ => c.qdst_ops = dst.iter().sum(),
+        match self.accel.node_unit() {
+            NodeUnit::DualSplitPipe => c.dst_ops = dst.iter().sum(),
+            NodeUnit::QuantizedDualSplitPipe => c.qdst_ops = dst.iter().sum(),
             _ => {}
         }
         c.node_steps =
