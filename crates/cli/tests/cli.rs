@@ -515,3 +515,86 @@ fn bench_compares_with_every_embree_peer_in_one_run() {
         }
     }
 }
+
+/// `--sim-threads` on `simulate` and `run-job`: the same JSON and the same stored result
+/// on one host thread and on three (the default chip's 64 TMs split three ways), and 0 is
+/// refused.
+#[test]
+fn sim_threads_change_no_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = |threads: &str| {
+        let o = dualsplit(
+            &[
+                "-q",
+                "simulate",
+                "builtin:cornell",
+                "--res",
+                "12x8",
+                "--workload",
+                "cast",
+                "--accel",
+                "bvh2,dst",
+                "--json",
+                "--sim-threads",
+                threads,
+            ],
+            dir.path(),
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        stdout(&o)
+    };
+    let one = sim("1");
+    assert!(one.contains("\"frame_ms\""), "{one}");
+    assert_eq!(sim("3"), one);
+    let o = dualsplit(
+        &["simulate", "builtin:cornell", "--sim-threads", "0"],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("positive"), "{}", stderr(&o));
+
+    // run-job: one entry stored with three threads, then again with one after removing it.
+    let o = dualsplit(
+        &[
+            "-q",
+            "plan",
+            "builtin:cornell",
+            "--res",
+            "8",
+            "--out",
+            "study",
+            "--accel",
+            "dst",
+            "--workload",
+            "cast",
+            "--tms",
+            "64",
+            "--model",
+            "fast",
+            "--sim-threads",
+            "3",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("--sim-threads"), "{}", stdout(&o));
+    let stored = |threads: &str| {
+        let o = dualsplit(
+            &["-q", "run-job", "study", "0", "--sim-threads", threads],
+            dir.path(),
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        let cache = dir.path().join("study/cache");
+        let file = std::fs::read_dir(&cache)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| !p.file_name().unwrap().to_string_lossy().starts_with('.'))
+            .expect("a stored result");
+        let text = std::fs::read_to_string(&file).unwrap();
+        std::fs::remove_file(&file).unwrap();
+        // The simulated result, without the host's name, time and wall time.
+        let v: serde_json::Value = serde_json::from_str(text.split_once('\n').unwrap().1).unwrap();
+        v["result"].to_string()
+    };
+    assert_eq!(stored("3"), stored("1"));
+}

@@ -1,15 +1,17 @@
 //! The simulator's host speed on one frame: each thread model runs the frame on one host
 //! core, `REPEATS` times, and the fastest run counts. Prints, per model, the simulated
 //! instructions, the host seconds, the simulated instructions per host second, the `fast`
-//! model's speed-up over `rv32` on the same frame, and the process's peak resident memory.
+//! model's speed-up over `rv32` on the same frame, then the `rv32` frame's speed-up on 2 …
+//! `THREADS` host threads (each thread count run `REPEATS` times, the counts alternated
+//! round by round, fastest run counts; every run's result is checked equal to the one-thread
+//! run's), and the process's peak resident memory.
 //!
-//! `cargo run --release -p dualsplit-sim --example sim_speed -- [SCENE] [RES] [ACCEL] [WORKLOAD] [REPEATS]`
+//! `cargo run --release -p dualsplit-sim --example sim_speed -- [SCENE] [RES] [ACCEL] [WORKLOAD] [REPEATS] [THREADS]`
 //!
-//! Defaults: `builtin:cornell`, 32 (×32), `bvh2`, `path`, 1. Only the structure the
-//! configuration reads is built (`TreeSet`). Host timings move with the machine's load;
-//! `docs/performance.md` gives the figures with their method (alternated runs, quiet host).
-//! A frame runs on one host thread: the simulator has no parallel frame yet, so there is no
-//! speed-up curve over threads to print.
+//! Defaults: `builtin:cornell`, 32 (×32), `bvh2`, `path`, 1, 1 (no curve). Only the
+//! structure the configuration reads is built (`TreeSet`). Host timings move with the
+//! machine's load; `docs/performance.md` gives the figures with their method (alternated
+//! runs, quiet host).
 
 use dualsplit_accel::{BuildConfig, TreeSet};
 use dualsplit_render::{RenderSettings, Workload};
@@ -24,6 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let accel = SimAccel::parse(&arg(2, "bvh2")).ok_or("unknown configuration")?;
     let workload = Workload::parse(&arg(3, "path")).ok_or("unknown workload (cast or path)")?;
     let repeats: u32 = arg(4, "1").parse::<u32>()?.max(1);
+    let max_threads: usize = arg(5, "1").parse::<usize>()?.max(1);
 
     let scene = dualsplit_scene::load(&spec)?;
     let set = TreeSet::build(
@@ -67,6 +70,33 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "fast model: {:.2}× the rv32 model's speed on this frame",
         seconds[0] / seconds[1]
     );
+    if max_threads > 1 {
+        let frame = |threads| {
+            FrameRequest::new(&scene, &set, accel, &settings, &cfg)
+                .with_model(ThreadModel::Rv32)
+                .with_threads(threads)
+        };
+        let reference = serde_json::to_string(&simulate(&frame(1), &|_, _| {})?)?;
+        let mut best = vec![f64::INFINITY; max_threads];
+        for _ in 0..repeats {
+            for (k, b) in best.iter_mut().enumerate() {
+                let t = Instant::now();
+                let r = simulate(&frame(k + 1), &|_, _| {})?;
+                *b = b.min(t.elapsed().as_secs_f64());
+                if serde_json::to_string(&r)? != reference {
+                    return Err(format!("{} host threads gave another result", k + 1).into());
+                }
+            }
+        }
+        for (k, b) in best.iter().enumerate() {
+            println!(
+                "rv32 on {} host thread{}: {b:.3} s, {:.2}× one thread (result identical)",
+                k + 1,
+                if k == 0 { "" } else { "s" },
+                best[0] / b
+            );
+        }
+    }
     match peak_rss_kib() {
         Some(kib) => println!("peak RSS: {:.1} MiB", kib as f64 / 1024.0),
         None => println!("peak RSS: not available on this system"),

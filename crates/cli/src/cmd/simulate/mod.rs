@@ -153,8 +153,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
             cfg.tps_per_tm,
             model.name()
         );
+        let per_frame = dualsplit_sim::share_threads(results.len(), args.threads.get()).1;
         for (r, host) in &results {
-            print_result(r, *host);
+            print_result(r, *host, per_frame);
         }
         if results.len() > 1 {
             outln!(
@@ -205,9 +206,9 @@ fn configurations(asked: &[SimAccelArg], structures: &Loaded) -> anyhow::Result<
 }
 
 /// Prints one configuration's result; `host` is the wall time its simulation took on this
-/// machine (one core), shown with the simulator's speed in simulated instructions per host
-/// second.
-fn print_result(r: &SimResult, host: Duration) {
+/// machine on `threads` host threads, shown with the simulator's speed in simulated
+/// instructions per host second.
+fn print_result(r: &SimResult, host: Duration, threads: usize) {
     let label = r.accel.map_or("?", |a| a.label());
     let e = &r.energy;
     let i = &r.instructions;
@@ -298,8 +299,9 @@ fn print_result(r: &SimResult, host: Duration) {
     );
     let secs = host.as_secs_f64();
     outln!(
-        "  host           {:.2} s on one core, {:.1} M simulated instructions/s (MIPS)",
+        "  host           {:.2} s on {threads} host thread{}, {:.1} M simulated instructions/s (MIPS)",
         secs,
+        if threads == 1 { "" } else { "s" },
         r.instructions.total() as f64 / secs.max(1e-9) / 1e6
     );
 }
