@@ -1,6 +1,6 @@
 //! The one structure trait, [`Structure`], and the macro that turns the registry
 //! (`registry.rs`, one line per structure) into everything that lists structures:
-//! [`AccelKind`](crate::AccelKind), [`TreeKind`](crate::TreeKind),
+//! [`crate::AccelKind`], [`crate::TreeKind`],
 //! [`AnyTree`](crate::AnyTree), the saved-tree kind codes and header fields, and the
 //! [`Plain`](crate::Plain) query contexts.
 //!

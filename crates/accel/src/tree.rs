@@ -1,5 +1,5 @@
 //! Building exactly one structure: each structure's tree type (in its folder, listed by the
-//! registry) carries its [`BuildStats`]; [`Bvh2Tree`](crate::Bvh2Tree) is the SAH BVH2
+//! registry) carries its [`BuildStats`]; [`crate::Bvh2Tree`] is the SAH BVH2
 //! every other structure is derived from, and [`AnyTree`] holds whichever one a saved file
 //! contains ([`AnyTree::derive`] makes any of them).
 //!

@@ -11,7 +11,7 @@
 //!  instruction: decode, hart, tp       charged its measured kernel cost (calibrate) │
 //!       │                                   │                                        │
 //!       └──────── engine::run: one event loop, a timing wheel of thread wake-ups ────┘
-//!                       │ Threads::step(id, &mut Chip, now) -> Wake
+//!                       │ Lane::step(id, &mut Tm, now) -> Wake; Lane::commit (L2, atomic)
 //!                       ▼
 //!  hw: Chip ── TMs (L1, ray-box / ray-triangle / dual-split pipelines, reciprocal unit,
 //!              functional-unit pools) ── L2 ── GDDR5 DRAM; the global atomic unit
@@ -26,7 +26,7 @@
 //! own traversal, then replays the recorded ops on the timing model.
 //!
 //! Layout: [`hw`] holds the hardware units and imports nothing from [`model`]; [`engine`]
-//! drives any [`engine::Threads`]; [`model::rv32`] and [`model::fast`] are the two thread
+//! drives any [`engine::Lane`]; [`model::rv32`] and [`model::fast`] are the two thread
 //! models; [`accel`] registers the simulated configurations; [`config`] is the chip's
 //! configuration (`configs/lin2020.toml`, every key with its source).
 //!

@@ -67,7 +67,7 @@ impl Bvh2Tree {
         &self.logical
     }
 
-    /// The encoded BVH2 (what [`RayQuery`] traverses and what is saved).
+    /// The encoded BVH2 (what [`crate::RayQuery`] traverses and what is saved).
     pub fn tree(&self) -> &BvhTree {
         &self.tree
     }

@@ -5,7 +5,7 @@
 //! * [`fast`]: threads replaying the real traversal's events as macro-ops, each charged the
 //!   instructions the compiled kernel spends on it, as measured by [`fast::calibrate`].
 //!
-//! Both implement [`crate::engine::Threads`] and drive the same [`crate::hw`] units.
+//! Both implement [`crate::engine::Lane`] and drive the same [`crate::hw`] units.
 
 pub mod fast;
 pub mod rv32;
