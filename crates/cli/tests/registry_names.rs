@@ -38,7 +38,7 @@ const KNOWN: &[(&str, &str, &str)] = &[
     ("crates/cli/src/cmd/stats.rs", "dst::", "the DST-preset study of `dualsplit stats`"),
     ("crates/cli/src/cmd/stats.rs", "Dst", "the DST-preset study of `dualsplit stats`"),
     // The traversal contract and the `fast` model's events carry the DST pipeline's node
-    // kinds and return codes (issue 58, item 3, moves them out of the contract).
+    // kinds and return codes (taking them out of the contract would end this).
     ("crates/accel/src/observer.rs", "dst::", "NodeStep::Dst carries the DST's ReturnCode"),
     ("crates/accel/src/observer.rs", "Dst", "NodeStep::Dst, the DST's step event"),
     ("crates/sim/src/model/fast/tally.rs", "dst::", "DST step events (ReturnCode)"),

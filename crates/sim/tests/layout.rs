@@ -277,17 +277,17 @@ const KNOWN_CIRCLES: &[(&str, &str, &str)] = &[
     (
         "model::rv32::isa",
         "model::rv32::decode",
-        "the ISA table names decode's Op (issue 58, item 3: Op moves beside the table)",
+        "the ISA table names decode's Op (to break: move Op beside the table)",
     ),
     (
         "frame",
         "model::rv32::frame",
-        "simulate() calls the thread models, which take its FrameRequest (issue 58, item 3)",
+        "simulate() calls the thread models, which take its FrameRequest (to break: move FrameRequest below both)",
     ),
     (
         "frame",
         "model::fast::frame",
-        "simulate() calls the thread models, which take its FrameRequest (issue 58, item 3)",
+        "simulate() calls the thread models, which take its FrameRequest (to break: move FrameRequest below both)",
     ),
 ];
 
