@@ -666,7 +666,7 @@ fn simulate<'py>(
     })?;
     let model = ThreadModel::parse(model).ok_or_else(|| {
         PyValueError::new_err(format!(
-            "unknown thread model `{model}` (expected rv32 or fast)"
+            "unknown thread model `{model}` (expected rv32, fast or simt)"
         ))
     })?;
     let (w, h) = match res {

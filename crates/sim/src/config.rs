@@ -32,6 +32,9 @@ pub struct SimConfig {
     pub energy: EnergyConfig,
     /// Which variant of the compiled kernels the `rv32` model runs.
     pub kernels: KernelsConfig,
+    /// The GPU chip of the `simt` model (absent on TRaX chips).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simt: Option<crate::model::simt::config::SimtConfig>,
 }
 
 /// A cache: size, line, banks, associativity and hit latency.
@@ -514,6 +517,7 @@ impl SimConfig {
                 node_fetch: NodeFetch::Loads,
                 shadows: true,
             },
+            simt: None,
         }
     }
 

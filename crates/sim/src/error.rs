@@ -65,6 +65,17 @@ pub enum SimError {
         /// The variant asked for, as its `[kernels]` keys.
         variant: String,
     },
+    /// `--model simt` on a configuration without a `[simt]` chip.
+    #[error(
+        "the simt model needs a GPU chip: a [simt] table in the configuration (configs/rtx2060.toml)"
+    )]
+    NoSimtChip,
+    /// The `simt` model stopped with warps unfinished (a bug in the model).
+    #[error("simt model: warps left unfinished at cycle {cycle}")]
+    SimtStuck {
+        /// The last cycle simulated.
+        cycle: u64,
+    },
     /// The `fast` model's measured costs are missing or unreadable.
     #[error("fast model: {0}")]
     Calibration(#[from] CalibrationError),

@@ -64,7 +64,7 @@ impl Footprint {
         let threads = tms * cfg.tps_per_tm as u64;
         let local = match model {
             ThreadModel::Rv32 => cfg.units.local_store_bytes as u64,
-            ThreadModel::Fast => 0,
+            ThreadModel::Fast | ThreadModel::Simt => 0,
         };
         let lines = |c: &crate::CacheConfig| c.size_bytes / c.line_bytes;
         let pipes = (accel.box_pipes(cfg) + cfg.units.tri_pipes + cfg.units.dst_pipes) as u64
@@ -79,7 +79,7 @@ impl Footprint {
                 + d.read_queue as u64 * QUEUE_ENTRY_BYTES);
         let per_pixel = 4 + match model {
             ThreadModel::Rv32 => 4 * FRAME_FLOATS_PER_PIXEL as u64,
-            ThreadModel::Fast => 0,
+            ThreadModel::Fast | ThreadModel::Simt => 0,
         };
         Self {
             threads: threads * (THREAD_BYTES + local),

@@ -4,7 +4,7 @@ use crate::accel::SimAccel;
 use crate::config::{KernelsConfig, SimConfig};
 use crate::error::SimError;
 use crate::footprint;
-use crate::model::{ThreadModel, fast, rv32};
+use crate::model::{ThreadModel, fast, rv32, simt};
 use crate::result::SimResult;
 use dualsplit_accel::TraversalSet;
 use dualsplit_render::RenderSettings;
@@ -136,5 +136,6 @@ pub fn simulate<S: TraversalSet>(
     match model {
         ThreadModel::Rv32 => rv32::frame::run(frame, progress),
         ThreadModel::Fast => fast::frame::run(frame, progress),
+        ThreadModel::Simt => simt::frame::run(frame, progress),
     }
 }

@@ -95,6 +95,9 @@ pub struct SimResult {
     /// The memory system's figures.
     #[serde(default)]
     pub memory: MemoryFigures,
+    /// The `simt` model's figures (RT units, SIMT efficiency, transactions).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub simt: Option<crate::model::simt::SimtFigures>,
     /// Per-pixel radiance in scanline order, as the renderer computes it from the same hits.
     #[serde(skip)]
     pub radiance: Vec<f32>,
@@ -164,6 +167,7 @@ impl SimResult {
                 lines_per_pixel: ratio(dram.reads, pixels),
                 rays_per_pixel: ratio(rays, pixels),
             },
+            simt: None,
             radiance,
         }
     }

@@ -9,6 +9,7 @@
 
 pub mod fast;
 pub mod rv32;
+pub mod simt;
 
 use serde::{Deserialize, Serialize};
 
@@ -24,20 +25,26 @@ pub enum ThreadModel {
     /// kernels ([`fast`]): faster, an approximation of
     /// [`ThreadModel::Rv32`].
     Fast,
+    /// An RTX-style SIMT GPU with an RT unit per SM, as Vulkan-Sim models it ([`simt`]):
+    /// needs a `[simt]` chip (`configs/rtx2060.toml`).
+    Simt,
 }
 
 impl ThreadModel {
-    /// Both, reference first.
+    /// The TRaX chip's two, reference first (the `simt` model runs a GPU chip instead).
     pub const ALL: [ThreadModel; 2] = [ThreadModel::Rv32, ThreadModel::Fast];
-    /// Command-line name: `rv32` or `fast`.
+    /// Every model, as [`ThreadModel::parse`] knows them.
+    pub const NAMED: [ThreadModel; 3] = [ThreadModel::Rv32, ThreadModel::Fast, ThreadModel::Simt];
+    /// Command-line name: `rv32`, `fast` or `simt`.
     pub fn name(self) -> &'static str {
         match self {
             ThreadModel::Rv32 => "rv32",
             ThreadModel::Fast => "fast",
+            ThreadModel::Simt => "simt",
         }
     }
     /// Parses a command-line name.
     pub fn parse(s: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|m| m.name() == s)
+        Self::NAMED.into_iter().find(|m| m.name() == s)
     }
 }

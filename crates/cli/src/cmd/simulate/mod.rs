@@ -55,7 +55,8 @@ pub struct Args {
     #[arg(long)]
     config: Option<std::path::PathBuf>,
     /// Thread model: rv32 (the compiled kernels, instruction by instruction; the reference)
-    /// or fast (the macro-op replay calibrated against them: within 10 %, about 5× faster).
+    /// or fast (the macro-op replay calibrated against them: within 10 %, about 5× faster),
+    /// or simt (an RTX-style GPU with an RT unit per SM; needs --config configs/rtx2060.toml).
     #[arg(long, default_value = "rv32", value_parser = parse_model)]
     model: ThreadModel,
     /// Camera and light overrides.
@@ -70,7 +71,7 @@ pub struct Args {
 
 fn parse_model(s: &str) -> Result<ThreadModel, String> {
     ThreadModel::parse(s)
-        .ok_or_else(|| format!("unknown thread model `{s}` (expected rv32 or fast)"))
+        .ok_or_else(|| format!("unknown thread model `{s}` (expected rv32, fast or simt)"))
 }
 
 /// Idle-at-end share of thread-cycles above which the chip is called not busy.
