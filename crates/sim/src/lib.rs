@@ -57,7 +57,7 @@ mod shares;
 /// Version of the timing and energy model. Bump it whenever a change alters simulated results
 /// for the same inputs; the report's result cache includes it in every key, so stale cached
 /// frames are recomputed.
-pub const MODEL_VERSION: u32 = 12;
+pub const MODEL_VERSION: u32 = 13;
 
 pub use accel::{NodeUnit, SimAccel};
 pub use config::{

@@ -1,7 +1,8 @@
 //! Golden runs: the simulated results that define "the model did not change".
 //!
-//! Both thread models ([`ThreadModel::ALL`]: the compiled kernels and the macro-op replay),
-//! every configuration of [`SimAccel::ALL`] on the `tiny` chip (`configs/tiny.toml`), both
+//! Both TRaX thread models ([`ThreadModel::ALL`]: the compiled kernels and the macro-op
+//! replay), every configuration of [`SimAccel::ALL`] on the `tiny` chip (`configs/tiny.toml`),
+//! and the `simt` model's configurations ([`RT_ACCELS`]) on `configs/rtx2060.toml`, both
 //! workloads, on `builtin:cornell` and on the shipped `dragon_res4.ply.gz` (11 K triangles,
 //! committed in the repository's `scenes/`), at small resolutions. For each run
 //! the test compares exact cycles, instructions, DRAM reads and activations, L1 and L2 hits
@@ -21,6 +22,7 @@
 
 use dualsplit_accel::Structures;
 use dualsplit_render::{RenderSettings, Workload};
+use dualsplit_sim::model::simt::RT_ACCELS;
 use dualsplit_sim::{
     FrameRequest, MODEL_VERSION, SimAccel, SimConfig, SimResult, ThreadModel, simulate,
 };
@@ -135,6 +137,12 @@ fn tiny() -> SimConfig {
     SimConfig::from_toml(&text).unwrap()
 }
 
+/// The `simt` model's GPU chip.
+fn rtx2060() -> SimConfig {
+    let text = std::fs::read_to_string(repo().join("configs/rtx2060.toml")).unwrap();
+    SimConfig::from_toml(&text).unwrap()
+}
+
 /// Runs every golden configuration; scenes that cannot be found are skipped (the caller
 /// decides whether that is allowed).
 fn run_all(missing: &mut Vec<String>) -> Vec<Golden> {
@@ -185,6 +193,18 @@ fn run_each(
                     out.push((key, r));
                 }
             }
+            for accel in RT_ACCELS {
+                let r = simulate(
+                    &FrameRequest::new(&scene, &structures, accel, &settings, &rtx2060())
+                        .with_model(ThreadModel::Simt),
+                    &|_, _| {},
+                )
+                .unwrap_or_else(|e| panic!("simt {short} {wl_name} {}: {e}", accel.name()));
+                out.push((
+                    format!("simt {short} {wl_name} {w}x{h} {}", accel.name()),
+                    r,
+                ));
+            }
         }
     }
     out
@@ -194,7 +214,8 @@ fn render_file(runs: &[Golden]) -> String {
     let mut s = String::new();
     s.push_str(
         "# Golden runs of crates/sim/tests/golden.rs: the tiny chip (configs/tiny.toml), every\n\
-         # configuration, cast and path, both thread models. Re-record only together with a MODEL_VERSION bump\n\
+         # configuration, cast and path, both TRaX thread models; the simt model on\n\
+         # configs/rtx2060.toml. Re-record only together with a MODEL_VERSION bump\n\
          # (listed in docs/simulator.md, \"Model versions\"):\n\
          #   DUALSPLIT_BLESS=1 cargo test --release -p dualsplit-sim --test golden\n\n",
     );

@@ -355,6 +355,20 @@ pub(crate) fn run<S: TraversalSet>(
         l2_hit_rate: ratio(m.l2_hits, m.l2_accesses),
         rays: k.rays,
         pixels: total,
+        caches: crate::hw::memory::CacheStats {
+            l1_accesses: rt.chunks,
+            l1_hits: rt.l1_hits,
+            l1_merged: rt.l1_merged,
+            l2_accesses: m.l2_accesses,
+            l2_hits: m.l2_hits,
+            ..Default::default()
+        },
+        dram: crate::hw::memory::dram::DramStats {
+            reads: m.dram_reads,
+            activations: m.dram_activations,
+            row_hits: m.dram_row_hits,
+            ..Default::default()
+        },
         radiance: f.radiance,
         simt: Some(figures),
         ..SimResult::default()

@@ -259,7 +259,7 @@ mod tests {
         let mut b = Memory::new(&cfg);
         let stride = (cfg.dram_channels as u64) << cfg.channel_shift;
         let last = (0..64)
-            .map(|i| b.read(1 << 30 | i * stride, 0))
+            .map(|i| b.read((1 << 30) | (i * stride), 0))
             .max()
             .unwrap();
         assert!(last >= cold + 60, "{last} vs {cold}");

@@ -16,8 +16,22 @@ pub mod mem;
 pub mod rt_unit;
 pub mod txn;
 
+use crate::SimAccel;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+
+/// The structures an RT unit holds, one configuration each: the BVHs and CWBVH test their
+/// boxes in the unit, DST and DST-Q run the dual-split step there. (The TRaX chip's other
+/// configurations differ from these only in how a TM issues a node's tests, which the RT
+/// unit does its own way.)
+pub const RT_ACCELS: [SimAccel; 6] = [
+    SimAccel::Bvh2,
+    SimAccel::Bvh4,
+    SimAccel::Bvh8,
+    SimAccel::Cwbvh,
+    SimAccel::Dst,
+    SimAccel::DstQ,
+];
 
 /// What the `simt` model reports beyond the common figures of a [`crate::SimResult`].
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
