@@ -532,6 +532,9 @@ impl SimConfig {
     /// Checks every value against its documented range ([`RANGES`]) and the relations
     /// between values the engine relies on (equal L1 and L2 lines, power-of-two sets).
     pub fn validate(&self) -> Result<(), ConfigError> {
+        if let Some(simt) = &self.simt {
+            simt.validate()?;
+        }
         // `values()` lists the keys in `RANGES`' order (tested).
         for ((key, value), range) in self.values().into_iter().zip(RANGES) {
             debug_assert_eq!(key, range.key);
