@@ -71,8 +71,12 @@ impl<'a, S: TraversalSet> FrameRequest<'a, S> {
 }
 
 /// Whether `model` runs `cfg`'s kernel variant (`[kernels]`): the `fast` model replays costs
-/// measured on the default kernels only ([`SimError::FastKernelVariant`] otherwise).
+/// measured on the default kernels only ([`SimError::FastKernelVariant`] otherwise); the
+/// `simt` model needs a `[simt]` chip ([`SimError::NoSimtChip`]).
 pub fn check_model(cfg: &SimConfig, model: ThreadModel) -> Result<(), SimError> {
+    if model == ThreadModel::Simt && cfg.simt.is_none() {
+        return Err(SimError::NoSimtChip);
+    }
     // Shadow rays or none is not a kernel variant: the fast model follows the renderer.
     let variant = KernelsConfig {
         shadows: true,

@@ -23,6 +23,8 @@ use dualsplit_sim::{SimAccel, SimConfig, SimResult, ThreadModel};
 use std::process::ExitCode;
 use std::time::Duration;
 
+mod simt;
+
 /// Arguments of `dualsplit simulate`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -142,6 +144,9 @@ pub fn run(args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
 
     if let Some(out) = json {
         out.emit(&report.to_json()?)?;
+    } else if let (ThreadModel::Simt, Some(c)) = (model, &cfg.simt) {
+        let size = (settings.width, settings.height, workload.name());
+        simt::print(&scene.name, scene.triangles.len(), size, c, &results);
     } else {
         outln!(
             "scene {} ({} triangles), {}×{} {}, {} TMs × {} TPs, {} thread model",
