@@ -118,7 +118,7 @@ def simulate(
     workload: Literal["cast", "path"] = "path",
     res: Union[int, tuple[int, int], None] = None,
     tms: Union[int, None] = None,
-    model: Literal["rv32", "fast"] = "rv32",
+    model: Literal["rv32", "fast", "simt"] = "rv32",
     config: Union[Mapping[str, Union[ConfigValue, Mapping[str, ConfigValue]]], None] = None,
     config_file: Union[str, os.PathLike[str], None] = None,
     tree: Union[Tree, None] = None,
@@ -129,4 +129,6 @@ def simulate(
     or ``{"l2": {"size_bytes": 1 << 20}}``) over ``config_file`` (default lin2020), with the
     same checks and messages as a file; ``res`` defaults to 512. ``threads`` host threads
     (default: the host's cores) run the frames side by side, splitting a frame's TMs when
-    there are fewer frames; the result is the same for any number."""
+    there are fewer frames; the result is the same for any number. ``model="simt"`` runs the
+    RTX-style GPU model instead and needs a ``[simt]`` chip (``config_file`` =
+    ``configs/rtx2060.toml``); each result then has a ``simt`` dict."""

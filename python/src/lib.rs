@@ -634,8 +634,9 @@ fn read_config(p: &std::path::Path) -> PyResult<String> {
         .map_err(|_| DualsplitError::new_err(format!("{}: not UTF-8 text", p.display())))
 }
 
-/// Simulates one frame per configuration on the TRaX-style many-core model and returns the
-/// document `dualsplit simulate --json` prints, as a dict.
+/// Simulates one frame per configuration on the TRaX-style many-core model (or, with
+/// `model="simt"` and a `[simt]` chip, the RTX-style GPU model) and returns the document
+/// `dualsplit simulate --json` prints, as a dict.
 #[pyfunction]
 #[pyo3(signature = (scene, *, accel=None, workload="path", res=None, tms=None, model="rv32", config=None, config_file=None, tree=None, threads=None))]
 #[allow(clippy::too_many_arguments)]

@@ -2,6 +2,7 @@
 simulate document, the same configuration errors."""
 
 import json
+import pathlib
 
 import numpy as np
 import pytest
@@ -194,6 +195,16 @@ def test_simulate_threads_change_no_result(cli, scene):
     assert one == sim_cli(cli, "--accel", "dst", "--sim-threads", "2")
     with pytest.raises(ValueError, match="threads"):
         dualsplit.simulate(scene, accel="dst", threads=0, **SIM)
+
+
+def test_simulate_simt_equals_the_cli_json(cli, scene):
+    rtx = pathlib.Path(__file__).resolve().parents[2] / "configs" / "rtx2060.toml"
+    got = dualsplit.simulate(scene, accel=["bvh2", "dst"], workload="cast", res=(24, 16), model="simt", config_file=rtx)
+    r = cli("simulate", SCENE, "--workload", "cast", "--res", "24x16", "--model", "simt", "--config", str(rtx), "--accel", "bvh2,dst", "--json")
+    assert got == json.loads(r.stdout)
+    assert all(x["simt"]["rt_max_warps"] == 4 for x in got["results"])
+    with pytest.raises((dualsplit.DualsplitError, ValueError), match=r"\[simt\]"):
+        dualsplit.simulate(scene, accel="bvh2", res=8, model="simt")
 
 
 def test_simulate_with_a_saved_tree_equals_the_cli(cli, tmp_path, scene):
