@@ -289,6 +289,11 @@ const KNOWN_CIRCLES: &[(&str, &str, &str)] = &[
         "model::fast::frame",
         "simulate() calls the thread models, which take its FrameRequest (to break: move FrameRequest below both)",
     ),
+    (
+        "frame",
+        "model::simt::frame",
+        "simulate() calls the thread models, which take its FrameRequest (to break: move FrameRequest below both)",
+    ),
 ];
 
 /// A circle of imports in `deps`, as the path that closes it, or `None`.

@@ -1,7 +1,7 @@
 //! The `[simt]` table: an RTX-style GPU with one ray-tracing unit per SM, as Vulkan-Sim
 //! models it (`configs/rtx2060.toml` gives every key's source).
 
-use crate::config::ConfigError;
+use crate::ranges::ConfigError;
 use serde::{Deserialize, Serialize};
 
 /// A set-associative, sectored cache: `sets` × `ways` lines of `line_bytes`, filled one
