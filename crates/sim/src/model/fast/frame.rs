@@ -8,7 +8,7 @@ use crate::config::KernelsConfig;
 use crate::error::SimError;
 use crate::frame::FrameRequest;
 use crate::hw::atomic::AtomicUnit;
-use crate::hw::{Chip, Stalls};
+use crate::hw::{Chip, Stall, Stalls};
 use crate::model::ThreadModel;
 use crate::model::fast::costs;
 use crate::model::fast::event::Event;
@@ -187,8 +187,12 @@ pub(crate) fn run<S: TraversalSet>(
     }
     // The measured dependency stalls are part of the issue runs the threads replayed.
     let mut stats = chip.stats();
-    stats.stalls.dependency += work.tracer.tally.dependency_cycles();
-    stats.stalls.pipeline_latency += work.tracer.tally.pipeline_cycles();
+    stats
+        .stalls
+        .count(Stall::Dependency, work.tracer.tally.dependency_cycles());
+    stats
+        .stalls
+        .count(Stall::PipelineLatency, work.tracer.tally.pipeline_cycles());
     Ok(SimResult::assemble(
         accel,
         ThreadModel::Fast,
