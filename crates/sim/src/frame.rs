@@ -81,9 +81,10 @@ pub fn check_model(cfg: &SimConfig, model: ThreadModel) -> Result<(), SimError> 
     if model == ThreadModel::Fast && variant != KernelsConfig::default() {
         return Err(SimError::FastKernelVariant {
             variant: format!(
-                "parity = {}, node_fetch = \"{}\"",
+                "parity = {}, node_fetch = \"{}\", child_order = \"{}\"",
                 cfg.kernels.parity,
-                cfg.kernels.node_fetch.name()
+                cfg.kernels.node_fetch.name(),
+                cfg.kernels.child_order.name()
             ),
         });
     }

@@ -61,8 +61,8 @@ pub const MODEL_VERSION: u32 = 12;
 
 pub use accel::{NodeUnit, SimAccel};
 pub use config::{
-    CacheConfig, ConfigError, DramConfig, EnergyConfig, KernelsConfig, NodeFetch, SimConfig,
-    UnitConfig,
+    CacheConfig, ChildOrder, ConfigError, DramConfig, EnergyConfig, KernelsConfig, NodeFetch,
+    SimConfig, UnitConfig,
 };
 pub use engine::share_threads;
 pub use error::SimError;

@@ -211,6 +211,7 @@ pub const RANGES: &[KeyRange] = &[
     flag("kernels.parity"),
     choice("kernels.node_fetch", &["operand", "loads"]),
     flag("kernels.shadows"),
+    choice("kernels.child_order", &["hits", "all-slots"]),
 ];
 
 impl KeyRange {
