@@ -22,6 +22,7 @@ use dualsplit_geometry::{Hit, Ray};
 impl ImageNodes for CwNode {
     const ARITY: usize = 8;
     type Open<'a> = &'a CwNode;
+    type BoxWords<'a> = [f32; 6];
 
     #[inline(always)]
     fn open<'a, O: Observer>(words: &'a [u32], w: usize, obs: &mut O) -> &'a CwNode {
@@ -30,7 +31,11 @@ impl ImageNodes for CwNode {
     }
 
     #[inline(always)]
-    fn slot<O: Observer>(node: &mut &CwNode, k: usize, _: &mut O) -> Option<Slot> {
+    fn slot<'a, O: Observer>(
+        node: &mut Self::Open<'a>,
+        k: usize,
+        _: &mut O,
+    ) -> Option<Slot<Self::BoxWords<'a>>> {
         let (word, leaf) = match node.slot(k) {
             Meta::Empty => return None,
             Meta::Internal => (node.child_node(k), false),

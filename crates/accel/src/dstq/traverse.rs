@@ -37,9 +37,11 @@ struct QRecords<'a> {
 /// A record of the quantized DST read: its header, where it is, and where its plane offsets
 /// start.
 #[derive(Clone, Copy)]
-struct QRec {
+struct QRec<'a> {
     h: QHeader,
     cluster: u32,
+    /// The cluster's words, to the end of its line.
+    cwords: &'a [u32],
     /// Bit of the first plane offset in the cluster.
     planes_bit: u32,
 }
@@ -55,12 +57,12 @@ impl QRecords<'_> {
     }
 }
 
-impl DstRecords for QRecords<'_> {
+impl<'a> DstRecords for QRecords<'a> {
     type At = (u32, u32);
-    type Rec = QRec;
+    type Rec = QRec<'a>;
 
     #[inline(always)]
-    fn read<O: Observer>(&mut self, (cluster, bit): (u32, u32), obs: &mut O) -> QRec {
+    fn read<O: Observer>(&mut self, (cluster, bit): (u32, u32), obs: &mut O) -> QRec<'a> {
         let base = cluster as usize;
         if cluster != self.frame_at {
             obs.fetch(MemoryImage::addr(base), 4 * FRAME_WORDS as u32);
@@ -70,7 +72,8 @@ impl DstRecords for QRecords<'_> {
             self.frame_at = cluster;
         }
         // A cluster never crosses its line: its records lie before the line's end.
-        let cwords = &self.words[base..(base / self.cw + 1) * self.cw];
+        let words: &'a [u32] = self.words;
+        let cwords = &words[base..(base / self.cw + 1) * self.cw];
         let h = QHeader::read(read_bits(cwords, bit as usize, 32), &self.fmt);
         let (hb, rb) = (h.header_bits(&self.fmt), h.record_bits(&self.fmt));
         let (w0, w1) = (bit / 32, (bit + rb - 1) / 32);
@@ -78,39 +81,38 @@ impl DstRecords for QRecords<'_> {
         QRec {
             h,
             cluster,
+            cwords,
             planes_bit: bit + hb,
         }
     }
     #[inline(always)]
-    fn header(rec: QRec) -> HeaderOffset {
+    fn header(rec: QRec<'a>) -> HeaderOffset {
         rec.h.exact()
     }
     #[inline(always)]
-    fn leaf_flag(rec: QRec) -> bool {
+    fn leaf_flag(rec: QRec<'a>) -> bool {
         rec.h.is_leaf_flag()
     }
     /// (The frame held is `rec`'s: a record's planes are read before the next record.)
     #[inline(always)]
-    fn planes(&self, rec: QRec, a0: usize, a1: usize) -> (f32, f32) {
-        let base = rec.cluster as usize;
-        let cwords = &self.words[base..(base / self.cw + 1) * self.cw];
-        let (k, bit) = (self.k, rec.planes_bit as usize);
+    fn planes(&self, rec: QRec<'a>, a0: usize, a1: usize) -> (f32, f32) {
+        let (cwords, k, bit) = (rec.cwords, self.k, rec.planes_bit as usize);
         (
             self.frame.plane(a0, read_bits(cwords, bit, k)),
             self.frame.plane(a1, read_bits(cwords, bit + k as usize, k)),
         )
     }
     #[inline(always)]
-    fn split_children(&self, rec: QRec) -> ((u32, u32), (u32, u32)) {
+    fn split_children(&self, rec: QRec<'a>) -> ((u32, u32), (u32, u32)) {
         let (cb, lbit) = Self::locate(rec.cluster, rec.h.child(&self.fmt));
         ((cb, lbit), (cb, lbit + rec.h.left_bits(&self.fmt)))
     }
     #[inline(always)]
-    fn child(&self, rec: QRec) -> (u32, u32) {
+    fn child(&self, rec: QRec<'a>) -> (u32, u32) {
         Self::locate(rec.cluster, rec.h.child(&self.fmt))
     }
     #[inline(always)]
-    fn run(rec: QRec) -> u32 {
+    fn run(rec: QRec<'a>) -> u32 {
         rec.h.run()
     }
 }

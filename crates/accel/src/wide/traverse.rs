@@ -19,6 +19,7 @@
 use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END, words_box};
 use crate::observer::{NodeStep, Observer};
 use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, cull_limit, widen_exit};
+use std::borrow::Borrow;
 use std::cell::Cell;
 
 #[derive(Clone, Copy)]
@@ -46,21 +47,28 @@ pub(crate) trait ImageNodes {
     const ARITY: usize;
     /// A node being expanded: the node, and where its slots' children lie.
     type Open<'a>;
+    /// A slot's box words as [`ImageNodes::slot`] gives them: a reference into the image
+    /// for a layout that stores them, the decoded words for one that does not.
+    type BoxWords<'a>: Borrow<[f32; 6]>;
     /// Reads the node at word `w` and reports its fetch (the part not reported per slot).
     fn open<'a, O: Observer>(words: &'a [u32], w: usize, obs: &mut O) -> Self::Open<'a>;
     /// Slot `k` of an open node (slots are asked in order, each once): `None` when empty,
     /// else its box's six words (min.xyz, max.xyz), its child's word and whether it is a
     /// leaf; reports the box's fetch where it is fetched apart.
-    fn slot<O: Observer>(node: &mut Self::Open<'_>, k: usize, obs: &mut O) -> Option<Slot>;
+    fn slot<'a, O: Observer>(
+        node: &mut Self::Open<'a>,
+        k: usize,
+        obs: &mut O,
+    ) -> Option<Slot<Self::BoxWords<'a>>>;
     /// The word of the index run of the leaf at word `word`, reporting what is fetched to
     /// find it.
     fn leaf_run<O: Observer>(words: &[u32], word: usize, obs: &mut O) -> usize;
 }
 
 /// A non-empty slot of an open node ([`ImageNodes::slot`]).
-pub(crate) struct Slot {
+pub(crate) struct Slot<B> {
     /// The box as six words: min.xyz, max.xyz.
-    pub box_words: [f32; 6],
+    pub box_words: B,
     /// The child's word.
     pub word: u32,
     /// The child is a leaf.
@@ -79,6 +87,7 @@ pub(crate) struct OpenNode<'a, L> {
 impl<L: NodeLayout> ImageNodes for L {
     const ARITY: usize = L::ARITY;
     type Open<'a> = OpenNode<'a, L>;
+    type BoxWords<'a> = &'a [f32; 6];
 
     #[inline(always)]
     fn open<'a, O: Observer>(words: &'a [u32], w: usize, obs: &mut O) -> OpenNode<'a, L> {
@@ -98,7 +107,11 @@ impl<L: NodeLayout> ImageNodes for L {
     }
 
     #[inline(always)]
-    fn slot<O: Observer>(n: &mut OpenNode<'_, L>, k: usize, obs: &mut O) -> Option<Slot> {
+    fn slot<'a, O: Observer>(
+        n: &mut Self::Open<'a>,
+        k: usize,
+        obs: &mut O,
+    ) -> Option<Slot<Self::BoxWords<'a>>> {
         let kind = n.node.kind(k);
         if kind == ChildKind::Empty {
             return None;
@@ -107,7 +120,7 @@ impl<L: NodeLayout> ImageNodes for L {
         let word = n.addr;
         n.addr += L::child_words(kind);
         Some(Slot {
-            box_words: *n.node.box_words(k),
+            box_words: n.node.box_words(k),
             word,
             leaf: kind == ChildKind::Leaf,
         })
@@ -266,9 +279,9 @@ fn traverse_with<N: ImageNodes, O: Observer, const ANY: bool>(
                 if let Some(s) = N::slot(&mut node, $k, obs) {
                     valid += 1;
                     let (entry, exit) = if fast {
-                        slab.test(&s.box_words, ray.t_min, limit)
+                        slab.test(s.box_words.borrow(), ray.t_min, limit)
                     } else {
-                        let b = words_box(&s.box_words);
+                        let b = words_box(s.box_words.borrow());
                         r.slab(b.min, b.max, ray.t_min, limit)
                     };
                     // `entry <= exit`, false when either is NaN.
