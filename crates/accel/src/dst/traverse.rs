@@ -1,5 +1,7 @@
 //! Software traversal of the encoded DST (the paper's DST*): the readable reference that the
-//! pipeline loop is tested against (Lin et al. 2020, §3, Fig. 3).
+//! pipeline loop is tested against (Lin et al. 2020, §3, Fig. 3). It is the one step loop
+//! of the dual-split family ([`walk`]), generic over the records ([`DstRecords`]): the
+//! exact DST's here, the quantized DST's in `dstq/traverse.rs`.
 //!
 //! Each stack entry carries its `[t_min, t_max]` (the region clip, kd-tree style). Sibling
 //! regions may overlap, so traversal continues after a hit; a popped entry is discarded

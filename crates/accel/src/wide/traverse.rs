@@ -1,6 +1,8 @@
-//! The one traversal of every BVH image (BVH2, BVH4, BVH8): closest hit and any hit,
-//! reading nodes, leaf words, index runs and triangles from the [`MemoryImage`] and telling
-//! the [`Observer`] every fetch and step (the one-traversal contract: README, "What is where").
+//! The one traversal of every BVH image (BVH2, BVH4, BVH8, and the compressed BVH8 through
+//! its node, `cwbvh/traverse.rs`): closest hit and any hit, reading nodes, leaf words, index
+//! runs and triangles from the [`MemoryImage`] and telling the [`Observer`] every fetch and
+//! step (the one-traversal contract: README, "What is where"). It is generic over the node
+//! (`ImageNodes`): how a node and a leaf are read and their fetches reported, and its slots.
 //!
 //! Per internal node: fetch the node's header, fetch and slab-test every non-empty child box against
 //! `[ray.t_min, cull_limit(best_t)]` (the arithmetic of [`dualsplit_geometry::RayPre::slab`],
