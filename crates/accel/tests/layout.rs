@@ -16,7 +16,6 @@ const KNOWN_CIRCLES: &[(&str, &str, &str)] = &[
         "dst::pipeline",
         "NodeStep::Dst carries the DST's ReturnCode",
     ),
-    ("observer", "image", "the observer's addresses are ByteAddr"),
     ("saved", "registry", "a saved tree is an AnyTree"),
     ("saved::header", "registry", "the header reads AnyFields"),
     ("tree", "registry", "Tree wraps an AnyTree"),
