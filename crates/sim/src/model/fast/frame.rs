@@ -6,10 +6,8 @@
 use crate::accel::SimAccel;
 use crate::config::KernelsConfig;
 use crate::error::SimError;
-use crate::frame::FrameRequest;
 use crate::hw::atomic::AtomicUnit;
 use crate::hw::{Chip, Stall, Stalls};
-use crate::model::ThreadModel;
 use crate::model::fast::costs;
 use crate::model::fast::event::Event;
 use crate::model::fast::op::Op;
@@ -19,6 +17,7 @@ use crate::model::fast::tally::Tally;
 use crate::model::fast::thread::Thread;
 use crate::model::rv32::Program;
 use crate::model::rv32::kernels::{Params, elf, placement};
+use crate::request::{FrameRequest, ThreadModel};
 use crate::result::SimResult;
 use dualsplit_accel::TraversalSet;
 use dualsplit_render::{PixelJob, RenderSettings};

@@ -6,20 +6,20 @@
 use crate::config::{SimConfig, UnitConfig};
 use crate::engine::{self, Commit, Lane, Wake};
 use crate::error::SimError;
-use crate::frame::FrameRequest;
 use crate::hw::atomic::AtomicUnit;
 use crate::hw::counts::InstrCounts;
 use crate::hw::fu::{ClassCounts, FU_CLASSES};
 use crate::hw::l1::Resident;
 use crate::hw::tm::Tm;
 use crate::hw::{Chip, Cycle, Stalls};
-use crate::model::ThreadModel;
 use crate::model::rv32::kernels::{FRAME_FLOATS_PER_PIXEL, Params, elf, placement};
 use crate::model::rv32::placement::Placement;
 use crate::model::rv32::tp::Tp;
 use crate::model::rv32::{
     ExecError, FRAME_BUFFER_ADDR, FrameMemory, ImageView, PARAMS_ADDR, PROGRAM_BASE, Program,
 };
+use crate::request::FrameRequest;
+use crate::request::ThreadModel;
 use crate::result::SimResult;
 use dualsplit_accel::TraversalSet;
 use std::ops::Range;
