@@ -77,6 +77,64 @@ static inline int child_kind_no_box(const Node *n, int k)
 }
 #endif
 
+#if KERNEL_PARITY && KERNEL_SORT_ALL
+/* kernels.child_order = "all-slots" (a reading of §4.4's "additional operations for child
+ * node ordering", not a source): every slot's entry distance, a miss as +inf, is sorted by a
+ * sorting network keyed on (entry, slot), which gives the insertion order of BVH_ORDER
+ * (nearest first, ties in slot order) at a fixed cost per node. */
+struct Slot {
+    float t;
+    uint32_t word;
+    uint32_t slot;
+};
+
+#define SORT_CE(s, a, b)                                                               \
+    do {                                                                               \
+        if (s[b].t < s[a].t || (s[b].t == s[a].t && s[b].slot < s[a].slot)) {          \
+            struct Slot x_ = s[a];                                                     \
+            s[a] = s[b];                                                               \
+            s[b] = x_;                                                                 \
+        }                                                                              \
+    } while (0)
+
+/* Optimal networks: 1, 5 and 19 compare-exchanges (Knuth, TAOCP vol. 3, §5.3.4). */
+#if BVH_ARITY == 2
+#define SORT_SLOTS(s) SORT_CE(s, 0, 1)
+#elif BVH_ARITY == 4
+#define SORT_SLOTS(s)                                                                  \
+    do {                                                                               \
+        SORT_CE(s, 0, 1);                                                              \
+        SORT_CE(s, 2, 3);                                                              \
+        SORT_CE(s, 0, 2);                                                              \
+        SORT_CE(s, 1, 3);                                                              \
+        SORT_CE(s, 1, 2);                                                              \
+    } while (0)
+#else
+#define SORT_SLOTS(s)                                                                  \
+    do {                                                                               \
+        SORT_CE(s, 0, 2);                                                              \
+        SORT_CE(s, 1, 3);                                                              \
+        SORT_CE(s, 4, 6);                                                              \
+        SORT_CE(s, 5, 7);                                                              \
+        SORT_CE(s, 0, 4);                                                              \
+        SORT_CE(s, 1, 5);                                                              \
+        SORT_CE(s, 2, 6);                                                              \
+        SORT_CE(s, 3, 7);                                                              \
+        SORT_CE(s, 0, 1);                                                              \
+        SORT_CE(s, 2, 3);                                                              \
+        SORT_CE(s, 4, 5);                                                              \
+        SORT_CE(s, 6, 7);                                                              \
+        SORT_CE(s, 2, 4);                                                              \
+        SORT_CE(s, 3, 5);                                                              \
+        SORT_CE(s, 1, 4);                                                              \
+        SORT_CE(s, 3, 6);                                                              \
+        SORT_CE(s, 1, 2);                                                              \
+        SORT_CE(s, 3, 4);                                                              \
+        SORT_CE(s, 5, 6);                                                              \
+    } while (0)
+#endif
+#endif
+
 static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, struct Hit *best)
 {
     (void)pre;
@@ -95,6 +153,7 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
         if (sp > STACK_SIZE - BVH_ARITY)
             kernel_fault(); /* deeper than any tree the builder makes */
         int base = sp;
+        (void)base; /* BVH_ORDER's; the all-slots order pushes without it */
         uint32_t addr = node_offset(node);
 #if BVH_WIDE_BOX
         uint32_t mask = RT_BOXN(BVH_ARITY, node->box, t_min, limit);
@@ -107,7 +166,19 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
 /* A hit child (entry distance `entry`, slot kind `kind`, first word `addr`) joins the
  * traversal order (BVH_ORDER). */
 #define ORDER_HIT(entry, kind) BVH_ORDER(entry, kind == CHILD_LEAF ? addr | ENTRY_LEAF : addr)
-#if KERNEL_PARITY
+#if KERNEL_PARITY && KERNEL_SORT_ALL
+        /* Every slot's box is tested (as below) and its entry noted for the sort. */
+        struct Slot slots[BVH_ARITY];
+#define CHILD(k)                                                                       \
+    do {                                                                               \
+        int kind = child_kind_no_box(node, k);                                         \
+        float entry = BOX_ENTRY(k);                                                    \
+        slots[k].t = entry == entry ? entry : __builtin_inff();                        \
+        slots[k].word = kind == CHILD_LEAF ? addr | ENTRY_LEAF : addr;                 \
+        slots[k].slot = k;                                                             \
+        addr += kind == CHILD_INTERNAL ? NODE_WORDS : kind == CHILD_LEAF ? 1u : 0u;    \
+    } while (0)
+#elif KERNEL_PARITY
 /* Every slot's box is tested, empty slots included ("ray-box intersection tests are executed
  * serially for each box in a BVH node", Lin et al. 2020, §4), and the hits are ordered
  * ("additional operations for child node ordering", §4.4). */
@@ -147,5 +218,21 @@ static int traverse(const struct Ray *ray, const struct RayPre *pre, int any, st
 #endif
 #undef CHILD
 #undef BOX_ENTRY
+#if KERNEL_PARITY && KERNEL_SORT_ALL
+        SORT_SLOTS(slots);
+        /* The hits (misses sorted last): the nearest to `cur`, the others pushed
+         * far-first, as BVH_ORDER leaves them. */
+        if (slots[0].t != __builtin_inff()) {
+            for (int i = BVH_ARITY - 1; i > 0; i--) {
+                if (slots[i].t != __builtin_inff()) {
+                    struct Entry c = {slots[i].t, slots[i].word};
+                    stack[sp++] = c;
+                }
+            }
+            struct Entry c = {slots[0].t, slots[0].word};
+            cur = c;
+            have_cur = 1;
+        }
+#endif
     }
 }

@@ -22,6 +22,8 @@ S=${DUALSPLIT_SCENES:-../shared/scenes}
 JOBS=${JOBS:-$(nproc)}
 RES=${RES:-256}
 D=target/release/dualsplit
+# The paper's eight configurations (the structures beyond the paper are not studied here).
+PAPER=bvh2,bvh2+,bvh4,bvh4+,bvh8,bvh8+,dst-sw,dst
 mkdir -p "$OUT/scenes" "$OUT/cache"
 BOX=$OUT/scenes/dragon_box.ply.gz
 RECON=$OUT/scenes/dragon_box_recon.ply.gz
@@ -36,7 +38,8 @@ study() {
   local name=$1 res=$2
   shift 2
   rm -rf "${OUT:?}/$name"
-  $D -q plan --model rv32 --tms 64 --res "$res" --out "$OUT/$name" "$@" >/dev/null
+  $D -q plan --model rv32 --tms 64 --res "$res" --accel "$PAPER" --out "$OUT/$name" "$@" \
+    >/dev/null
   rm -rf "${OUT:?}/$name/cache"
   ln -s ../cache "$OUT/$name/cache"
   echo "$name"

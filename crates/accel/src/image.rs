@@ -43,7 +43,7 @@
 
 mod words;
 
-use crate::observer::Observer;
+use crate::observer::{ByteAddr, Observer};
 use dualsplit_geometry::{Aabb, PrimId, Triangle, Vec3};
 use std::ops::Range;
 use std::sync::Arc;
@@ -144,11 +144,6 @@ impl MemoryImage {
         self.triangle_slice()[prim.index()]
     }
 }
-
-/// A byte address in a memory image (word `i` is at byte `4 i`): what a traversal reports
-/// to its [`Observer`] for every read, and where the simulator's loads go.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct ByteAddr(pub u64);
 
 /// Errors while encoding a memory image.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

@@ -83,8 +83,8 @@ pub mod math {
 }
 
 pub use build::{BuildConfig, Bvh2, Bvh2Node};
-pub use image::{ByteAddr, ImageError, MemoryImage, SharedTriangles};
-pub use observer::{CountingObserver, DstNodeKind, NoObserver, NodeStep, Observer};
+pub use image::{ImageError, MemoryImage, SharedTriangles};
+pub use observer::{ByteAddr, CountingObserver, DstNodeKind, NoObserver, NodeStep, Observer};
 pub use stats::StructureStats;
 pub use validate::ValidationReport;
 pub use wide::{BvhImage, BvhQuery, CollapseConfig, WideBvh};

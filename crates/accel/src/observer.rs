@@ -3,8 +3,12 @@
 //! statistics use [`CountingObserver`]; the simulator records macro-operations.
 
 use crate::dst::pipeline::ReturnCode;
-use crate::image::ByteAddr;
 use dualsplit_geometry::PrimId;
+
+/// A byte address in a memory image (word `i` is at byte `4 i`): what a traversal reports
+/// to its [`Observer`] for every read, and where the simulator's loads go.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct ByteAddr(pub u64);
 
 /// The kind of a dual-split tree node (the pipeline's derived 2-bit "node type").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]

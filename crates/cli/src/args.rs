@@ -257,8 +257,8 @@ mod tests {
 #[derive(clap::Args, Clone, Debug)]
 pub struct Scope {
     /// Scenes: files (.obj, .ply, .gltf, .glb, optionally .gz) or builtin:NAME?params
-    /// (hairball, forest, atrium, cornell). Without any: the reconstructed Dragon Box when
-    /// the scenes folder holds it, and the atrium, forest and hairball builtins at reduced
+    /// (hairball, forest, atrium, cornell). Without any: the Dragon Box (`dragon_box.ply.gz`:
+    /// SimTRaX's scene, or the reconstruction, as its bounds tell) when the scenes folder holds it, and the atrium, forest and hairball builtins at reduced
     /// sizes.
     #[arg(value_name = "SCENES", value_parser = crate::args::parse_scene)]
     pub specs: Vec<String>,
@@ -269,7 +269,7 @@ pub struct Scope {
     /// for the other tables), full-size scenes, 32/64/128 TMs.
     #[arg(long)]
     pub full: bool,
-    /// Folder of the shipped meshes (reconstructed Dragon Box, Dragon Sponza). Default: the
+    /// Folder of the shipped meshes (Dragon Box, Dragon Sponza). Default: the
     /// DUALSPLIT_SCENES environment variable, else shared/scenes beside the checkout.
     #[arg(long = "scenes", value_name = "DIR")]
     pub scenes_dir: Option<std::path::PathBuf>,

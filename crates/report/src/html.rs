@@ -101,7 +101,7 @@ pub fn index_html(data: &ReportData) -> Result<String, ReportError> {
         "<p class=\"meta\">Reproduces the results section of Lin, Vasiou, Yuksel, Kopta and Brunvand, HPG 2020 (§4, Tables 3–7, Figures 7–9). \
 Simulated at {}×{}, 1 spp, {} TMs for Tables 4–6, TM scaling over {} TMs{}; the threads {}. Code version {}. Grey columns and faded bars are the paper's published values; \
 scenes marked “stand-in” are not the paper's meshes, so compare trends rather than values. \
-Dragon Box is the reconstructed Dragon Box: the Stanford dragon in an open 10-triangle box, since the paper does not describe its box. \
+Dragon Box is SimTRaX's scene (the Stanford dragon in a closed 12-triangle box, the camera inside it; <code>dualsplit scene dragon-box</code>) wherever that file is found; the scene table names which Dragon Box a run used. \
 The paper states its resolution (1024×1024) only for Table 4; it states none for Table 5 or the other tables.</p>",
         st.width,
         st.height,

@@ -127,9 +127,10 @@ pub fn scene_id(i: usize, s: &SceneReport) -> String {
 fn paper_note(s: &SceneReport) -> String {
     match &s.paper {
         Some(m) if m.same_mesh => format!(
-            "{}: the paper's {} scene (the reconstructed Dragon Box: the paper does not describe its box, ours is an open 10-triangle box around the Stanford dragon; Crytek Sponza: the published mesh).",
+            "{}: the paper's {} scene ({}).",
             s.name,
-            m.scene.label()
+            m.scene.label(),
+            m.describe()
         ),
         Some(m) => format!(
             "{}: a stand-in for the paper's {} ({} triangles here, {} in the paper); compare shapes, not values.",

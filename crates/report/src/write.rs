@@ -28,7 +28,7 @@ pub fn report_md(data: &ReportData) -> String {
     let st = &data.settings;
     let _ = writeln!(
         m,
-        "Lin et al. 2020, §4. Simulated at {}×{}, {} TMs (scaling over {} TMs). Columns whose heading starts with \"paper\" are the published values; stand-in scenes are labelled. Dragon Box is the reconstructed Dragon Box: the Stanford dragon in an open 10-triangle box, since the paper does not describe its box. The paper states its resolution (1024×1024) only for Table 4; it states none for Table 5 or the other tables.\n",
+        "Lin et al. 2020, §4. Simulated at {}×{}, {} TMs (scaling over {} TMs). Columns whose heading starts with \"paper\" are the published values; stand-in scenes are labelled. Dragon Box is SimTRaX's scene (the Stanford dragon in a closed 12-triangle box, the camera inside it; `dualsplit scene dragon-box`) wherever that file is found; the scene table names which Dragon Box a run used. The paper states its resolution (1024×1024) only for Table 4; it states none for Table 5 or the other tables.\n",
         st.width,
         st.height,
         st.base_tms,

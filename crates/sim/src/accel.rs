@@ -4,7 +4,7 @@
 //! variant, command-line name, the paper's label, the traversal it runs, the TM unit that
 //! tests its nodes ([`NodeUnit`]), its ray-box pipes for the "+" configurations, its chart
 //! colour, and its compiled kernels, one per workload
-//! and variant (`kernels/build/<name>-{cast,path}{,-parity,-loads,-parity-loads}.elf`, which `kernels/Makefile`'s
+//! and variant (`kernels/build/<name>-{cast,path}{,-parity,-loads,-parity-loads,-parity-loads-sortall}.elf`, which `kernels/Makefile`'s
 //! `CONFIGS` builds; a test checks the two lists agree). The CLI, the simulator, the kernel table, the
 //! calibration and the charts read it from here (`docs/extending.md`).
 
@@ -63,12 +63,14 @@ macro_rules! sim_accels {
                         kernel!(concat!($name, "-cast-parity.elf")),
                         kernel!(concat!($name, "-cast-loads.elf")),
                         kernel!(concat!($name, "-cast-parity-loads.elf")),
+                        kernel!(concat!($name, "-cast-parity-loads-sortall.elf")),
                     ],
                     [
                         kernel!(concat!($name, "-path.elf")),
                         kernel!(concat!($name, "-path-parity.elf")),
                         kernel!(concat!($name, "-path-loads.elf")),
                         kernel!(concat!($name, "-path-parity-loads.elf")),
+                        kernel!(concat!($name, "-path-parity-loads-sortall.elf")),
                     ],
                 ],
             },

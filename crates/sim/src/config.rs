@@ -306,6 +306,38 @@ pub struct KernelsConfig {
     /// (`RenderSettings::shadows`). A key of the chip's configuration so that a study can
     /// vary it; the paper does not say whether its path tracer casts shadow rays.
     pub shadows: bool,
+    /// How the serial and "+" BVH kernels order a node's hit children (a reading of §4.4's
+    /// "additional operations for child node ordering"; the paper does not give the
+    /// method). Only with `parity` and `node_fetch = "loads"` (the other variants are not
+    /// built with it).
+    pub child_order: ChildOrder,
+}
+
+/// How a BVH kernel puts a node's hit children in traversal order. Both give the same
+/// order (nearest first, ties in slot order), so the same rays visit the same nodes; they
+/// differ in the instructions spent on it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ChildOrder {
+    /// Each hit child is inserted into the order as its box test returns (an insertion
+    /// sort of the hits only): the renderer's traversal, written as kernel code.
+    #[default]
+    Hits,
+    /// Every slot's entry distance, a miss as +∞, is sorted by a sorting network over all
+    /// of the node's slots (1, 5 and 19 compare-exchanges for BVH2, BVH4 and BVH8), then
+    /// the hits are pushed: a fixed cost per node, as a hardware-minded kernel might do it.
+    /// A reading of §4.4, not a source.
+    AllSlots,
+}
+
+impl ChildOrder {
+    /// Its TOML spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            ChildOrder::Hits => "hits",
+            ChildOrder::AllSlots => "all-slots",
+        }
+    }
 }
 
 impl Default for KernelsConfig {
@@ -314,6 +346,7 @@ impl Default for KernelsConfig {
             parity: true,
             node_fetch: NodeFetch::Loads,
             shadows: true,
+            child_order: ChildOrder::Hits,
         }
     }
 }
@@ -344,40 +377,60 @@ impl NodeFetch {
 
 impl KernelsConfig {
     /// The variant's index among [`KernelsConfig::ALL`] (`shadows` is read at run time
-    /// from the parameter block, not a variant of the compiled kernels).
+    /// from the parameter block, not a variant of the compiled kernels). `child_order =
+    /// "all-slots"` is built with `parity` and `"loads"` only ([`SimConfig::validate`]).
     pub fn index(self) -> usize {
+        if self.child_order == ChildOrder::AllSlots {
+            return 4;
+        }
         self.parity as usize | ((self.node_fetch == NodeFetch::Loads) as usize) << 1
     }
 
     /// Every variant of the compiled kernels, in the order of [`KernelsConfig::index`]
     /// (with shadow rays).
-    pub const ALL: [KernelsConfig; 4] = [
+    pub const ALL: [KernelsConfig; 5] = [
         KernelsConfig {
             parity: false,
             node_fetch: NodeFetch::Operand,
             shadows: true,
+            child_order: ChildOrder::Hits,
         },
         KernelsConfig {
             parity: true,
             node_fetch: NodeFetch::Operand,
             shadows: true,
+            child_order: ChildOrder::Hits,
         },
         KernelsConfig {
             parity: false,
             node_fetch: NodeFetch::Loads,
             shadows: true,
+            child_order: ChildOrder::Hits,
         },
         KernelsConfig {
             parity: true,
             node_fetch: NodeFetch::Loads,
             shadows: true,
+            child_order: ChildOrder::Hits,
+        },
+        KernelsConfig {
+            parity: true,
+            node_fetch: NodeFetch::Loads,
+            shadows: true,
+            child_order: ChildOrder::AllSlots,
         },
     ];
 
     /// The suffix of its kernels' file names (`kernels/Makefile`): `""`, `-parity`,
-    /// `-loads` or `-parity-loads`.
+    /// `-loads`, `-parity-loads` or `-parity-loads-sortall`.
     pub fn suffix(self) -> &'static str {
-        ["", "-parity", "-loads", "-parity-loads"][self.index()]
+        [
+            "",
+            "-parity",
+            "-loads",
+            "-parity-loads",
+            "-parity-loads-sortall",
+        ][self.index()]
     }
 }
 
@@ -516,6 +569,7 @@ impl SimConfig {
                 parity: true,
                 node_fetch: NodeFetch::Loads,
                 shadows: true,
+                child_order: ChildOrder::Hits,
             },
             simt: None,
         }
@@ -572,6 +626,15 @@ impl SimConfig {
                      t_rfc plus t_ras ({} ticks), or t_refi be 0 for no refresh",
                     d.t_rp + d.t_rfc * burst + d.t_ras
                 ),
+            });
+        }
+        let k = &self.kernels;
+        if k.child_order == ChildOrder::AllSlots && !(k.parity && k.node_fetch == NodeFetch::Loads)
+        {
+            return Err(ConfigError::Invalid {
+                field: "kernels.child_order",
+                value: k.child_order.name().into(),
+                reason: "the all-slots kernels are built with parity = true and node_fetch = \"loads\" only".into(),
             });
         }
         if self.l1.line_bytes != self.l2.line_bytes {
@@ -688,6 +751,10 @@ impl SimConfig {
                 Value::Choice(self.kernels.node_fetch.name()),
             ),
             ("kernels.shadows", Flag(self.kernels.shadows)),
+            (
+                "kernels.child_order",
+                Value::Choice(self.kernels.child_order.name()),
+            ),
         ]
     }
 

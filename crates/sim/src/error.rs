@@ -59,7 +59,7 @@ pub enum SimError {
     },
     /// The `fast` model replays costs measured on the default kernels only.
     #[error(
-        "the fast model is calibrated on the default kernels ([kernels] parity = true, node_fetch = \"loads\"); kernels with {variant} need --model rv32"
+        "the fast model is calibrated on the default kernels ([kernels] parity = true, node_fetch = \"loads\", child_order = \"hits\"); kernels with {variant} need --model rv32"
     )]
     FastKernelVariant {
         /// The variant asked for, as its `[kernels]` keys.

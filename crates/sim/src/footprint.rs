@@ -18,8 +18,8 @@
 
 use crate::accel::SimAccel;
 use crate::config::SimConfig;
-use crate::model::ThreadModel;
 use crate::model::rv32::kernels::FRAME_FLOATS_PER_PIXEL;
+use crate::request::ThreadModel;
 
 /// Per thread, besides its local store: the `rv32` hart and scoreboard or the fast model's
 /// thread and pixel state.

@@ -51,6 +51,7 @@ mod frame;
 pub mod hw;
 pub mod model;
 pub mod ranges;
+mod request;
 mod result;
 mod shares;
 
@@ -61,17 +62,17 @@ pub const MODEL_VERSION: u32 = 13;
 
 pub use accel::{NodeUnit, SimAccel};
 pub use config::{
-    CacheConfig, ConfigError, DramConfig, EnergyConfig, KernelsConfig, NodeFetch, SimConfig,
-    UnitConfig,
+    CacheConfig, ChildOrder, ConfigError, DramConfig, EnergyConfig, KernelsConfig, NodeFetch,
+    SimConfig, UnitConfig,
 };
 pub use engine::share_threads;
 pub use error::SimError;
-pub use frame::{FrameRequest, check_model, simulate};
+pub use frame::{check_model, simulate};
 pub use hw::counts::UnitStats;
 pub use hw::counts::{InstrCounts, Mix};
 pub use hw::energy::EnergySplit;
 pub use hw::memory::{CacheStats, DramStats};
 pub use hw::{ChipStats, Cycle, Stalls, Tick};
-pub use model::ThreadModel;
+pub use request::{FrameRequest, ThreadModel};
 pub use result::{MemoryFigures, SimResult, Utilisation};
 pub use shares::StallShares;

@@ -138,7 +138,7 @@ pub const RANGES: &[KeyRange] = &[
     int("dram.t_rp", 0, MAX_LATENCY, "ticks"),
     int("dram.t_ras", 0, MAX_LATENCY, "ticks"),
     int("dram.t_rc", 0, MAX_LATENCY, "ticks"),
-    // The activate window is a 64-tick bitmask per channel (`memory/dram.rs`).
+    // The activate window is a 64-tick bitmask per channel (`hw/memory/dram/channel.rs`, a `SparseSlots` span).
     int("dram.t_rrd", 0, 64, "ticks"),
     int("dram.t_rtp", 0, MAX_LATENCY, "ticks"),
     int("dram.t_ccd", 0, MAX_LATENCY, "ticks"),
@@ -211,6 +211,7 @@ pub const RANGES: &[KeyRange] = &[
     flag("kernels.parity"),
     choice("kernels.node_fetch", &["operand", "loads"]),
     flag("kernels.shadows"),
+    choice("kernels.child_order", &["hits", "all-slots"]),
 ];
 
 impl KeyRange {

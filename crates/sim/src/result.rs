@@ -7,7 +7,7 @@ use crate::hw::counts::UnitStats;
 use crate::hw::energy::{self, EnergySplit};
 use crate::hw::memory::{CacheStats, DramStats};
 use crate::hw::{ChipStats, Cycle, Stalls};
-use crate::model::ThreadModel;
+use crate::request::ThreadModel;
 use serde::{Deserialize, Serialize};
 
 /// Pipeline utilisation: ops / (cycles × pipes × TMs).

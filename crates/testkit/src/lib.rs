@@ -29,6 +29,7 @@
 
 pub mod dst;
 pub mod grazing;
+pub mod layout;
 pub mod oracle;
 pub mod rays;
 pub mod scenes;

@@ -8,7 +8,8 @@
 //! node's addressing requires.
 
 use super::node::{CwNode, LEAF_OFFSET_LIMIT, Meta, NODE_WORDS};
-use crate::image::{ImageError, MemoryImage, RUN_END, SharedTriangles};
+use crate::image::{ImageError, MemoryImage, SharedTriangles};
+use crate::wide::encode::{index_words, write_run};
 use crate::wide::{WideBvh, WideChild};
 
 /// Structure name in errors and reports.
@@ -22,15 +23,7 @@ pub fn encode(
 ) -> Result<MemoryImage, ImageError> {
     assert!(wide.arity <= 8, "tree wider than a BVH8 node");
     let node_words = wide.nodes.len().max(1) * NODE_WORDS;
-    let index_words: usize = wide
-        .nodes
-        .iter()
-        .flat_map(|n| &n.children)
-        .map(|c| match c.1 {
-            WideChild::Leaf { count, .. } => count as usize,
-            WideChild::Node(_) => 0,
-        })
-        .sum();
+    let index_words = index_words(wide);
     let mut img = MemoryImage::with_triangles(node_words, index_words, triangles);
     if wide.nodes.is_empty() {
         let root = CwNode::empty(NODE_WORDS as u32, node_words as u32);
@@ -101,17 +94,7 @@ impl Encoder<'_> {
                     }
                     let ids = &self.prim_ids[first as usize..(first + count) as usize];
                     assert!(!ids.is_empty(), "a leaf holds at least one triangle");
-                    let run = self.next_index;
-                    for (j, &p) in ids.iter().enumerate() {
-                        if p >= RUN_END {
-                            return Err(ImageError::PrimOverflow {
-                                given: p as u64,
-                                limit: RUN_END as u64 - 1,
-                            });
-                        }
-                        let last = if j + 1 == ids.len() { RUN_END } else { 0 };
-                        self.words[run + j] = p | last;
-                    }
+                    write_run(self.words, self.next_index, ids)?;
                     self.next_index += ids.len();
                     slots.push((b, Meta::leaf(offset as u32, count)));
                 }

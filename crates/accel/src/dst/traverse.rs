@@ -1,5 +1,7 @@
 //! Software traversal of the encoded DST (the paper's DST*): the readable reference that the
-//! pipeline loop is tested against (Lin et al. 2020, §3, Fig. 3).
+//! pipeline loop is tested against (Lin et al. 2020, §3, Fig. 3). It is the one step loop
+//! of the dual-split family ([`walk`]), generic over the records ([`DstRecords`]): the
+//! exact DST's here, the quantized DST's in `dstq/traverse.rs`.
 //!
 //! Each stack entry carries its `[t_min, t_max]` (the region clip, kd-tree style). Sibling
 //! regions may overlap, so traversal continues after a hit; a popped entry is discarded
@@ -17,12 +19,13 @@ use super::header::HeaderOffset;
 use super::pipeline::{ReturnCode, le_or_nan};
 use crate::image::{MemoryImage, RUN_END};
 use crate::observer::{DstNodeKind, NodeStep, Observer};
-use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, Triangle, cull_limit, widen_exit};
+use dualsplit_geometry::{Aabb, Hit, PrimId, Ray, RayPre, Triangle, cull_limit, widen_exit};
 
-/// A traversal-stack entry: a node word index and its ray interval.
+/// A traversal-stack entry: a node (its word index in the exact DST, its cluster and bit in
+/// the quantized one) and its ray interval.
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Entry {
-    pub node: u32,
+pub(crate) struct Entry<A = u32> {
+    pub node: A,
     pub t_min: f32,
     pub t_max: f32,
 }
@@ -31,13 +34,13 @@ const INLINE: usize = 64;
 
 /// The traversal stack: 64 entries inline (deeper than any SAH tree in practice), spilling
 /// to the heap beyond that so no tree depth can overflow it.
-pub(super) struct Stack {
-    inline: [Entry; INLINE],
+pub(crate) struct Stack<A = u32> {
+    inline: [Entry<A>; INLINE],
     len: usize,
-    spill: Vec<Entry>,
+    spill: Vec<Entry<A>>,
 }
 
-impl Stack {
+impl<A: Copy + Default> Stack<A> {
     #[inline(always)]
     pub fn new() -> Self {
         Self {
@@ -47,7 +50,7 @@ impl Stack {
         }
     }
     #[inline(always)]
-    pub fn push(&mut self, e: Entry) {
+    pub fn push(&mut self, e: Entry<A>) {
         if self.len < INLINE {
             self.inline[self.len] = e;
         } else {
@@ -56,7 +59,7 @@ impl Stack {
         self.len += 1;
     }
     #[inline(always)]
-    pub fn pop(&mut self) -> Option<Entry> {
+    pub fn pop(&mut self) -> Option<Entry<A>> {
         if self.len == 0 {
             return None;
         }
@@ -147,21 +150,32 @@ pub(crate) enum RunResult {
     Occluded,
 }
 
+/// Starts a ray of a non-empty tree: clips it to the scene box `b` (on
+/// `[ray.t_min, cull_limit(ray.t_max)]`, as the BVH culls), returning the ray and the root
+/// interval, or `None` when it misses the scene. Untraceable rays miss
+/// (`Ray::is_traceable`), in every structure alike.
+#[inline(always)]
+pub(crate) fn clip(b: Aabb, ray: &Ray) -> Option<(RayPre, f32, f32)> {
+    if !ray.is_traceable() {
+        return None;
+    }
+    let r = ray.precompute();
+    let (t_min, t_max) = r.slab(b.min, b.max, ray.t_min, cull_limit(ray.t_max));
+    if t_min > t_max {
+        return None;
+    }
+    Some((r, t_min, t_max))
+}
+
 impl<'a> Tracer<'a> {
     /// Starts a ray: clips it to the scene box (on `[ray.t_min, cull_limit(ray.t_max)]`, as
     /// the BVH culls), returning the root interval or `None` when it misses the scene.
     #[inline(always)]
     pub fn start(dst: &'a Dst, ray: &Ray) -> Option<(Self, f32, f32)> {
-        // Untraceable rays miss (`Ray::is_traceable`), in every structure alike.
-        if dst.is_empty() || !ray.is_traceable() {
+        if dst.is_empty() {
             return None;
         }
-        let r = ray.precompute();
-        let b = dst.scene_box;
-        let (t_min, t_max) = r.slab(b.min, b.max, ray.t_min, cull_limit(ray.t_max));
-        if t_min > t_max {
-            return None;
-        }
+        let (r, t_min, t_max) = clip(dst.scene_box, ray)?;
         let img = &dst.image;
         Some((
             Self {
@@ -293,6 +307,219 @@ pub(crate) fn dual_carve(
     (lo, hi)
 }
 
+/// The node records of a DST image, as the one DST traversal ([`walk`]) reads them: the
+/// exact DST's 12-byte nodes and 4-byte leaves, or the quantized DST's bit-packed records.
+/// Node rules, distances and return codes are the walk's; a layout gives the header, the
+/// two planes, and where the children and the run are.
+pub(crate) trait DstRecords {
+    /// Where a record is.
+    type At: Copy + Default;
+    /// A record read.
+    type Rec: Copy;
+    /// Reads the record at `at`, reporting its fetches.
+    fn read<O: Observer>(&mut self, at: Self::At, obs: &mut O) -> Self::Rec;
+    /// The record's node header in the exact DST's form (kind, axes, corner type).
+    fn header(rec: Self::Rec) -> HeaderOffset;
+    /// Bit L: the record ends in a triangle run.
+    fn leaf_flag(rec: Self::Rec) -> bool;
+    /// The planes P0 (on axis `a0`) and P1 (on axis `a1`).
+    fn planes(&self, rec: Self::Rec, a0: usize, a1: usize) -> (f32, f32);
+    /// A splitting node's left and right children.
+    fn split_children(&self, rec: Self::Rec) -> (Self::At, Self::At);
+    /// A carving node's child.
+    fn child(&self, rec: Self::Rec) -> Self::At;
+    /// The first index entry of a leaf's run.
+    fn run(rec: Self::Rec) -> u32;
+}
+
+/// The exact DST's records: one header word, and the two plane words of an internal node.
+struct ExactRecords<'a> {
+    words: &'a [u32],
+}
+
+/// A record of the exact DST read: its header and its planes (zero for a plain leaf).
+#[derive(Clone, Copy)]
+struct ExactRec {
+    w: HeaderOffset,
+    p0: f32,
+    p1: f32,
+}
+
+impl DstRecords for ExactRecords<'_> {
+    type At = u32;
+    type Rec = ExactRec;
+
+    #[inline(always)]
+    fn read<O: Observer>(&mut self, node: u32, obs: &mut O) -> ExactRec {
+        let at = node as usize;
+        let w = HeaderOffset::from_bits(self.words[at]);
+        if w.is_plain_leaf() {
+            obs.fetch(MemoryImage::addr(at), 4);
+            ExactRec {
+                w,
+                p0: 0.0,
+                p1: 0.0,
+            }
+        } else {
+            obs.fetch(MemoryImage::addr(at), 12);
+            ExactRec {
+                w,
+                p0: f32::from_bits(self.words[at + 1]),
+                p1: f32::from_bits(self.words[at + 2]),
+            }
+        }
+    }
+    #[inline(always)]
+    fn header(rec: ExactRec) -> HeaderOffset {
+        rec.w
+    }
+    #[inline(always)]
+    fn leaf_flag(rec: ExactRec) -> bool {
+        rec.w.is_leaf_flag()
+    }
+    #[inline(always)]
+    fn planes(&self, rec: ExactRec, _: usize, _: usize) -> (f32, f32) {
+        (rec.p0, rec.p1)
+    }
+    #[inline(always)]
+    fn split_children(&self, rec: ExactRec) -> (u32, u32) {
+        let left = rec.w.offset();
+        (left, left + rec.w.left_size())
+    }
+    #[inline(always)]
+    fn child(&self, rec: ExactRec) -> u32 {
+        rec.w.offset()
+    }
+    #[inline(always)]
+    fn run(rec: ExactRec) -> u32 {
+        rec.w.offset()
+    }
+}
+
+/// The one DST traversal (the exact DST's and the quantized DST's), from the root record
+/// `root` on the clipped interval `[t_min, t_max]` of `r`: the node rules of Lin et al.
+/// 2020, §3, Figs. 2–3, each step reported to `obs`, each run tested on the ray's own
+/// interval `[ray.t_min, best_t]`, popped entries culled against `cull_limit(best_t)`.
+#[inline(always)]
+pub(crate) fn walk<R: DstRecords, O: Observer, const ANY: bool>(
+    recs: &mut R,
+    runs: &IndexRun<'_>,
+    r: &RayPre,
+    root: R::At,
+    (mut t_min, mut t_max): (f32, f32),
+    obs: &mut O,
+) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
+    let mut best_t = r.ray.t_max;
+    let mut stack = Stack::<R::At>::new();
+    let mut node = root;
+    loop {
+        let rec = recs.read(node, obs);
+        let w = R::header(rec);
+        // `Some(run)` when the node ends in a triangle run; `None` when it pops.
+        let run = match w.node_kind() {
+            DstNodeKind::Leaf => {
+                obs.step(dst_step(DstNodeKind::Leaf, ReturnCode::Leaf, false));
+                Some(R::run(rec))
+            }
+            DstNodeKind::Split => {
+                let a = w.axis();
+                let (p0, p1) = recs.planes(rec, a, a);
+                let (left, right) = recs.split_children(rec);
+                // t1: where the ray leaves the near child's half-space (exit role,
+                // widened); t2: where it enters the far one (Lin et al. 2020, Fig. 3).
+                let (near, far, t1, t2) = if r.neg[a] {
+                    (right, left, r.exit_t(a, p1), r.plane_t(a, p0))
+                } else {
+                    (left, right, r.exit_t(a, p0), r.plane_t(a, p1))
+                };
+                let near_hit = le_or_nan(t_min, t1);
+                let far_hit = le_or_nan(t2, t_max);
+                obs.step(dst_step(
+                    DstNodeKind::Split,
+                    ReturnCode::from_bits(near_hit as u8 + far_hit as u8),
+                    false,
+                ));
+                match (near_hit, far_hit) {
+                    (true, true) => {
+                        stack.push(Entry {
+                            node: far,
+                            t_min: t_min.max(t2),
+                            t_max,
+                        });
+                        obs.push();
+                        node = near;
+                        t_max = t_max.min(t1);
+                        continue;
+                    }
+                    (true, false) => {
+                        node = near;
+                        t_max = t_max.min(t1);
+                        continue;
+                    }
+                    (false, true) => {
+                        node = far;
+                        t_min = t_min.max(t2);
+                        continue;
+                    }
+                    (false, false) => None,
+                }
+            }
+            kind => {
+                // Carving: exit planes clamp t_max, entry planes raise t_min.
+                let (lo, hi) = if kind == DstNodeKind::SingleCarve {
+                    let a = w.axis();
+                    let (p0, p1) = recs.planes(rec, a, a);
+                    // t1: the exit plane after the sign swap (widened); t2: entry.
+                    let (t1, t2) = if r.neg[a] {
+                        (r.exit_t(a, p1), r.plane_t(a, p0))
+                    } else {
+                        (r.exit_t(a, p0), r.plane_t(a, p1))
+                    };
+                    (t_min.max(t2), t_max.min(t1))
+                } else {
+                    let (a0, a1) = w.axis_pair().axes();
+                    let (p0, p1) = recs.planes(rec, a0, a1);
+                    let t = (r.plane_t(a0, p0), r.plane_t(a1, p1));
+                    dual_carve(&r.neg, w, t, t_min, t_max)
+                };
+                let hit = le_or_nan(lo, hi);
+                let leaf = R::leaf_flag(rec);
+                let code = ReturnCode::from_bits(hit as u8 * (1 + 2 * leaf as u8));
+                obs.step(dst_step(kind, code, leaf));
+                if hit {
+                    t_min = lo;
+                    t_max = hi;
+                    if !leaf {
+                        node = recs.child(rec);
+                        continue;
+                    }
+                    Some(R::run(rec))
+                } else {
+                    None
+                }
+            }
+        };
+        if let Some(first) = run
+            && let RunResult::Occluded = runs.test::<O, ANY>(first, r, &mut best, &mut best_t, obs)
+        {
+            return best;
+        }
+        // Pop the next entry that can still hold a closer hit, clamping its t_max.
+        let limit = cull_limit(best_t);
+        loop {
+            let Some(e) = stack.pop() else {
+                return best;
+            };
+            obs.pop();
+            if le_or_nan(e.t_min, limit) {
+                (node, t_min, t_max) = (e.node, e.t_min, e.t_max.min(limit));
+                break;
+            }
+        }
+    }
+}
+
 impl Dst {
     /// Closest hit of `ray` (software decoder, DST*), ordered by `(t, prim)`. With an
     /// observer that observes nothing ([`Observer::OBSERVES_NOTHING`]) it runs the plain
@@ -316,90 +543,18 @@ impl Dst {
 
     #[inline(always)]
     fn traverse<O: Observer, const ANY: bool>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        let (mut tr, mut t_min, mut t_max) = Tracer::start(self, ray)?;
-        let mut node = 0u32;
-        loop {
-            let (w, p0, p1) = tr.fetch_node(node, obs);
-            // `Some(run)` when the node ends in a triangle run; `None` when it pops.
-            let run = match w.node_kind() {
-                DstNodeKind::Leaf => {
-                    obs.step(dst_step(DstNodeKind::Leaf, ReturnCode::Leaf, false));
-                    Some(w.offset())
-                }
-                DstNodeKind::Split => {
-                    let a = w.axis();
-                    let left = w.offset();
-                    let right = left + w.left_size();
-                    // t1: where the ray leaves the near child's half-space (exit role,
-                    // widened); t2: where it enters the far one (Lin et al. 2020, Fig. 3).
-                    let (near, far, t1, t2) = if tr.r.neg[a] {
-                        (right, left, tr.r.exit_t(a, p1), tr.r.plane_t(a, p0))
-                    } else {
-                        (left, right, tr.r.exit_t(a, p0), tr.r.plane_t(a, p1))
-                    };
-                    let near_hit = le_or_nan(t_min, t1);
-                    let far_hit = le_or_nan(t2, t_max);
-                    obs.step(dst_step(
-                        DstNodeKind::Split,
-                        ReturnCode::from_bits(near_hit as u8 + far_hit as u8),
-                        false,
-                    ));
-                    let (push, next) =
-                        split_next(near_hit, far_hit, (near, far), (t1, t2), t_min, t_max);
-                    if let Some(e) = push {
-                        tr.stack.push(e);
-                        obs.push();
-                    }
-                    match next {
-                        Some((n, lo, hi)) => {
-                            (node, t_min, t_max) = (n, lo, hi);
-                            continue;
-                        }
-                        None => None,
-                    }
-                }
-                kind => {
-                    // Carving: exit planes clamp t_max, entry planes raise t_min.
-                    let (lo, hi) = if kind == DstNodeKind::SingleCarve {
-                        let a = w.axis();
-                        // t1: the exit plane after the sign swap (widened); t2: entry.
-                        let (t1, t2) = if tr.r.neg[a] {
-                            (tr.r.exit_t(a, p1), tr.r.plane_t(a, p0))
-                        } else {
-                            (tr.r.exit_t(a, p0), tr.r.plane_t(a, p1))
-                        };
-                        (t_min.max(t2), t_max.min(t1))
-                    } else {
-                        let (a0, a1) = w.axis_pair().axes();
-                        let t = (tr.r.plane_t(a0, p0), tr.r.plane_t(a1, p1));
-                        dual_carve(&tr.r.neg, w, t, t_min, t_max)
-                    };
-                    let hit = le_or_nan(lo, hi);
-                    let leaf = w.is_leaf_flag();
-                    let code = ReturnCode::from_bits(hit as u8 * (1 + 2 * leaf as u8));
-                    obs.step(dst_step(kind, code, leaf));
-                    if hit {
-                        t_min = lo;
-                        t_max = hi;
-                        if !leaf {
-                            node = w.offset();
-                            continue;
-                        }
-                        Some(w.offset())
-                    } else {
-                        None
-                    }
-                }
-            };
-            if let Some(first) = run
-                && let RunResult::Occluded = tr.test_run::<O, ANY>(first, obs)
-            {
-                return tr.best;
-            }
-            let Some(e) = tr.pop(obs) else {
-                return tr.best;
-            };
-            (node, t_min, t_max) = (e.node, e.t_min, e.t_max);
+        if self.is_empty() {
+            return None;
         }
+        let (r, t_min, t_max) = clip(self.scene_box, ray)?;
+        let img = &self.image;
+        let runs = IndexRun {
+            words: &img.words,
+            index_base: img.indices.start,
+            tri_base: img.triangles.start,
+            tris: self.triangles(),
+        };
+        let mut recs = ExactRecords { words: &img.words };
+        walk::<_, O, ANY>(&mut recs, &runs, &r, 0, (t_min, t_max), obs)
     }
 }

@@ -18,15 +18,7 @@ pub fn encode<L: NodeLayout>(
     assert!(wide.arity <= L::ARITY, "tree wider than the node layout");
     let leaves = wide.leaf_count();
     let node_words = wide.nodes.len() * L::WORDS + leaves;
-    let index_words: usize = wide
-        .nodes
-        .iter()
-        .flat_map(|n| &n.children)
-        .map(|c| match c.1 {
-            WideChild::Leaf { count, .. } => count as usize,
-            WideChild::Node(_) => 0,
-        })
-        .sum();
+    let index_words = index_words(wide);
     let mut img = MemoryImage::with_triangles(node_words, index_words, triangles);
     let mut e = Encoder {
         wide,
@@ -39,6 +31,34 @@ pub fn encode<L: NodeLayout>(
     debug_assert_eq!(e.next_node, node_words);
     debug_assert_eq!(e.next_index, node_words + index_words);
     Ok(img)
+}
+
+/// Triangle-index entries of `wide`'s leaves: the index region's words.
+pub(crate) fn index_words(wide: &WideBvh) -> usize {
+    wide.nodes
+        .iter()
+        .flat_map(|n| &n.children)
+        .map(|c| match c.1 {
+            WideChild::Leaf { count, .. } => count as usize,
+            WideChild::Node(_) => 0,
+        })
+        .sum()
+}
+
+/// Writes the triangle ids `ids` as an index run from word `run` of `words`, [`RUN_END`] on
+/// the last (the run of every BVH image, the compressed BVH8's too).
+pub(crate) fn write_run(words: &mut [u32], run: usize, ids: &[u32]) -> Result<(), ImageError> {
+    for (j, &p) in ids.iter().enumerate() {
+        if p >= RUN_END {
+            return Err(ImageError::PrimOverflow {
+                given: p as u64,
+                limit: RUN_END as u64 - 1,
+            });
+        }
+        let last = if j + 1 == ids.len() { RUN_END } else { 0 };
+        words[run + j] = p | last;
+    }
+    Ok(())
 }
 
 struct Encoder<'a> {
@@ -93,16 +113,7 @@ impl Encoder<'_> {
                     }
                     self.words[addr] = run as u32;
                     let ids = &self.prim_ids[first as usize..(first + count) as usize];
-                    for (j, &p) in ids.iter().enumerate() {
-                        if p >= RUN_END {
-                            return Err(ImageError::PrimOverflow {
-                                given: p as u64,
-                                limit: RUN_END as u64 - 1,
-                            });
-                        }
-                        let last = if j + 1 == ids.len() { RUN_END } else { 0 };
-                        self.words[run + j] = p | last;
-                    }
+                    write_run(self.words, run, ids)?;
                     self.next_index += ids.len();
                 }
             }

@@ -1,6 +1,8 @@
-//! The one traversal of every BVH image (BVH2, BVH4, BVH8): closest hit and any hit,
-//! reading nodes, leaf words, index runs and triangles from the [`MemoryImage`] and telling
-//! the [`Observer`] every fetch and step (the one-traversal contract: README, "What is where").
+//! The one traversal of every BVH image (BVH2, BVH4, BVH8, and the compressed BVH8 through
+//! its node, `cwbvh/traverse.rs`): closest hit and any hit, reading nodes, leaf words, index
+//! runs and triangles from the [`MemoryImage`] and telling the [`Observer`] every fetch and
+//! step (the one-traversal contract: README, "What is where"). It is generic over the node
+//! (`ImageNodes`): how a node and a leaf are read and their fetches reported, and its slots.
 //!
 //! Per internal node: fetch the node's header, fetch and slab-test every non-empty child box against
 //! `[ray.t_min, cull_limit(best_t)]` (the arithmetic of [`dualsplit_geometry::RayPre::slab`],
@@ -16,14 +18,16 @@
 //! [`Hit::closer_than`]'s `(t, prim)` order.
 //! Any hit returns at the first accepted triangle and culls against `ray.t_max`.
 
-use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};
+use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END, words_box};
 use crate::observer::{NodeStep, Observer};
 use dualsplit_geometry::{Hit, PrimId, Ray, RayPre, cull_limit, widen_exit};
+use std::borrow::Borrow;
 use std::cell::Cell;
 
 #[derive(Clone, Copy)]
 struct Entry {
     t: f32,
+    /// A node's word, or a leaf's (the [`ImageNodes::leaf_run`] of the layout reads it).
     word: u32,
     leaf: bool,
 }
@@ -37,10 +41,114 @@ thread_local! {
     static STACK: Cell<Vec<Entry>> = const { Cell::new(Vec::new()) };
 }
 
+/// What the one BVH image traversal ([`traverse_nodes`]) needs of a node layout: how a node
+/// and a leaf are read and reported, and the node's slots in order. Every [`NodeLayout`]
+/// (BVH2, BVH4, BVH8) is one; the compressed BVH8's node is another.
+pub(crate) trait ImageNodes {
+    /// Child slots.
+    const ARITY: usize;
+    /// A node being expanded: the node, and where its slots' children lie.
+    type Open<'a>;
+    /// A slot's box words as [`ImageNodes::slot`] gives them: a reference into the image
+    /// for a layout that stores them, the decoded words for one that does not.
+    type BoxWords<'a>: Borrow<[f32; 6]>;
+    /// Reads the node at word `w` and reports its fetch (the part not reported per slot).
+    fn open<'a, O: Observer>(words: &'a [u32], w: usize, obs: &mut O) -> Self::Open<'a>;
+    /// Slot `k` of an open node (slots are asked in order, each once): `None` when empty,
+    /// else its box's six words (min.xyz, max.xyz), its child's word and whether it is a
+    /// leaf; reports the box's fetch where it is fetched apart.
+    fn slot<'a, O: Observer>(
+        node: &mut Self::Open<'a>,
+        k: usize,
+        obs: &mut O,
+    ) -> Option<Slot<Self::BoxWords<'a>>>;
+    /// The word of the index run of the leaf at word `word`, reporting what is fetched to
+    /// find it.
+    fn leaf_run<O: Observer>(words: &[u32], word: usize, obs: &mut O) -> usize;
+}
+
+/// A non-empty slot of an open node ([`ImageNodes::slot`]).
+pub(crate) struct Slot<B> {
+    /// The box as six words: min.xyz, max.xyz.
+    pub box_words: B,
+    /// The child's word.
+    pub word: u32,
+    /// The child is a leaf.
+    pub leaf: bool,
+}
+
+/// A BVH2/4/8 node being expanded: its children lie consecutively from its offset.
+pub(crate) struct OpenNode<'a, L> {
+    node: &'a L,
+    /// The node's word.
+    w: usize,
+    /// The word of the next slot's child.
+    addr: u32,
+}
+
+impl<L: NodeLayout> ImageNodes for L {
+    const ARITY: usize = L::ARITY;
+    type Open<'a> = OpenNode<'a, L>;
+    type BoxWords<'a> = &'a [f32; 6];
+
+    #[inline(always)]
+    fn open<'a, O: Observer>(words: &'a [u32], w: usize, obs: &mut O) -> OpenNode<'a, L> {
+        // The node's header (after its boxes in every layout), then each present child's
+        // box as it is tested.
+        let boxes = 6 * L::ARITY;
+        obs.fetch(
+            MemoryImage::addr(w + boxes),
+            ((L::WORDS - boxes) * 4) as u32,
+        );
+        let node = L::read(words, w);
+        OpenNode {
+            node,
+            w,
+            addr: node.offset(),
+        }
+    }
+
+    #[inline(always)]
+    fn slot<'a, O: Observer>(
+        n: &mut Self::Open<'a>,
+        k: usize,
+        obs: &mut O,
+    ) -> Option<Slot<Self::BoxWords<'a>>> {
+        let kind = n.node.kind(k);
+        if kind == ChildKind::Empty {
+            return None;
+        }
+        obs.fetch_box(MemoryImage::addr(n.w + 6 * k), 24);
+        let word = n.addr;
+        n.addr += L::child_words(kind);
+        Some(Slot {
+            box_words: n.node.box_words(k),
+            word,
+            leaf: kind == ChildKind::Leaf,
+        })
+    }
+
+    #[inline(always)]
+    fn leaf_run<O: Observer>(words: &[u32], w: usize, obs: &mut O) -> usize {
+        obs.fetch(MemoryImage::addr(w), 4);
+        words[w] as usize
+    }
+}
+
 /// Traverses the image with node layout `L`. `ANY`: stop at the first hit (shadow rays).
 /// Returns the closest hit (or, with `ANY`, the first hit found).
 #[inline]
 pub fn traverse<L: NodeLayout, O: Observer, const ANY: bool>(
+    img: &MemoryImage,
+    ray: &Ray,
+    obs: &mut O,
+) -> Option<Hit> {
+    traverse_nodes::<L, O, ANY>(img, ray, obs)
+}
+
+/// [`traverse`] for any [`ImageNodes`] (the compressed BVH8's too).
+#[inline]
+pub(crate) fn traverse_nodes<N: ImageNodes, O: Observer, const ANY: bool>(
     img: &MemoryImage,
     ray: &Ray,
     obs: &mut O,
@@ -52,7 +160,7 @@ pub fn traverse<L: NodeLayout, O: Observer, const ANY: bool>(
     }
     let mut stack = STACK.take();
     stack.clear();
-    let hit = traverse_with::<L, O, ANY>(img, ray, obs, &mut stack);
+    let hit = traverse_with::<N, O, ANY>(img, ray, obs, &mut stack);
     STACK.set(stack);
     hit
 }
@@ -70,7 +178,7 @@ pub(crate) enum RunOutcome {
 /// Tests the triangle-index run at word `run` of `img` (ended by [`RUN_END`]) on
 /// `[ray.t_min, best_t]`, keeping the closest hit by `(t, prim)` in `best` and its `t` in
 /// `best_t`, reporting the run's fetch, the leaf step, each triangle's fetch and test to
-/// `obs`. The leaf test of every BVH image traversal (this one and the compressed BVH8's).
+/// `obs`. The leaf test of every BVH image traversal (and the toy structure's).
 #[inline(always)]
 pub(crate) fn test_run<O: Observer, const ANY: bool>(
     img: &MemoryImage,
@@ -112,9 +220,9 @@ pub(crate) fn test_run<O: Observer, const ANY: bool>(
     outcome
 }
 
-/// [`traverse`] with the stack's buffer given.
+/// [`traverse_nodes`] with the stack's buffer given.
 #[inline(always)]
-fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
+fn traverse_with<N: ImageNodes, O: Observer, const ANY: bool>(
     img: &MemoryImage,
     ray: &Ray,
     obs: &mut O,
@@ -149,9 +257,7 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
             },
         };
         if e.leaf {
-            let w = e.word as usize;
-            obs.fetch(MemoryImage::addr(w), 4);
-            let run = words[w] as usize;
+            let run = N::leaf_run(words, e.word as usize, obs);
             match test_run::<O, ANY>(img, run, &r, ray, obs, &mut best, &mut best_t) {
                 RunOutcome::AnyHit => return best,
                 RunOutcome::Closer => {
@@ -162,42 +268,31 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
             }
             continue;
         }
-        let w = e.word as usize;
-        // The node's header (after its boxes in every layout), then each present child's
-        // box as it is tested.
-        let boxes = 6 * L::ARITY;
-        obs.fetch(
-            MemoryImage::addr(w + boxes),
-            ((L::WORDS - boxes) * 4) as u32,
-        );
-        let node = L::read(words, w);
+        let mut node = N::open(words, e.word as usize, obs);
         // The hit children: the nearest in `near`, the others on the stack above `base`,
         // nearest on top; order by entry distance, ties in slot order.
         let base = stack.len();
         let mut near: Option<Entry> = None;
         let (mut valid, mut nhit) = (0u8, 0u8);
-        let mut addr = node.offset();
-        // One slot's test and sort step (a macro, so that BVH2's two slots are unrolled
-        // with constant slot numbers: the decode folds).
+        // One slot's test and sort step (a macro, so that the slots are unrolled with
+        // constant slot numbers: the decode folds).
         macro_rules! child {
             ($k:expr) => {{
-                let k: usize = $k;
-                let kind = node.kind(k);
-                if kind != ChildKind::Empty {
+                if let Some(s) = N::slot(&mut node, $k, obs) {
                     valid += 1;
-                    obs.fetch_box(MemoryImage::addr(w + 6 * k), 24);
                     let (entry, exit) = if fast {
-                        slab.test(node.box_words(k), ray.t_min, limit)
+                        slab.test(s.box_words.borrow(), ray.t_min, limit)
                     } else {
-                        let b = node.child_bounds(k);
+                        let b = words_box(s.box_words.borrow());
                         r.slab(b.min, b.max, ray.t_min, limit)
                     };
+                    // `entry <= exit`, false when either is NaN.
                     if entry <= exit {
                         nhit += 1;
                         let e = Entry {
                             t: entry,
-                            word: addr,
-                            leaf: kind == ChildKind::Leaf,
+                            word: s.word,
+                            leaf: s.leaf,
                         };
                         match near {
                             None => near = Some(e),
@@ -220,10 +315,9 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
                         }
                     }
                 }
-                addr += L::child_words(kind);
             }};
         }
-        match L::ARITY {
+        match N::ARITY {
             2 => {
                 child!(0);
                 child!(1);
@@ -245,13 +339,13 @@ fn traverse_with<L: NodeLayout, O: Observer, const ANY: bool>(
                 child!(7);
             }
             _ => {
-                for k in 0..L::ARITY {
+                for k in 0..N::ARITY {
                     child!(k);
                 }
             }
         }
         obs.step(NodeStep::Bvh {
-            arity: L::ARITY as u8,
+            arity: N::ARITY as u8,
             valid,
             hits: nhit,
         });

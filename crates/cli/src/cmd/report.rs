@@ -22,7 +22,7 @@ use std::time::Instant;
 
 /// Default stand-ins: the builtins at reduced sizes, keeping the paper's scene characters
 /// (hairball ↔ Hairball, forest ↔ Vegetation, atrium ↔ Crytek Sponza). The default report
-/// also takes the reconstructed Dragon Box from the scenes folder when it is there.
+/// also takes the Dragon Box (`dragon_box.ply.gz`) from the scenes folder when it is there.
 pub const DEFAULT_SCENES: [&str; 3] = [
     "builtin:atrium?triangles=30000",
     "builtin:forest?triangles=40000",

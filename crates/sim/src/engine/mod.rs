@@ -45,7 +45,7 @@ pub(crate) mod wheel;
 use crate::hw::atomic::AtomicUnit;
 use crate::hw::memory::L2;
 use crate::hw::tm::Tm;
-use crate::hw::{Chip, Cycle, Stalls};
+use crate::hw::{Chip, Cycle, Stall, Stalls};
 use std::ops::Range;
 use std::sync::{Mutex, PoisonError};
 use sync::{Meeting, Turns};
@@ -219,7 +219,7 @@ pub fn run<L: Lane>(
     let mut error: Option<(usize, L::Error)> = None;
     for l in left {
         chip_stalls.add(&l.stalls);
-        chip_stalls.idle += l.finish.iter().map(|&f| end - f).sum::<u64>();
+        chip_stalls.count(Stall::Idle, l.finish.iter().map(|&f| end - f).sum::<u64>());
         if let Some((tm, e)) = l.error
             && error.as_ref().is_none_or(|(t, _)| tm < *t)
         {

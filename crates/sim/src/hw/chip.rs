@@ -22,19 +22,6 @@ pub struct Chip {
     stalls: Stalls,
 }
 
-/// The units one thread drives: its TM's, the L2 behind them, the chip's atomic unit, and
-/// the counters of where the threads' cycles went.
-pub struct Units<'a> {
-    /// The thread's TM.
-    pub tm: &'a mut Tm,
-    /// The L2 (for the TM's misses).
-    pub l2: &'a mut L2,
-    /// The global atomic unit.
-    pub atomic: &'a mut AtomicUnit,
-    /// The threads' stall counters.
-    pub stalls: &'a mut Stalls,
-}
-
 /// The chip's counters.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ChipStats {
@@ -58,17 +45,6 @@ impl Chip {
             l2: L2::new(cfg),
             atomic: AtomicUnit::new(cfg.units.atomic_latency),
             stalls: Stalls::default(),
-        }
-    }
-
-    /// The units a thread on TM `tm` drives.
-    #[inline(always)]
-    pub fn units(&mut self, tm: usize) -> Units<'_> {
-        Units {
-            tm: &mut self.tms[tm],
-            l2: &mut self.l2,
-            atomic: &mut self.atomic,
-            stalls: &mut self.stalls,
         }
     }
 

@@ -11,7 +11,7 @@ use crate::hw::Cycle;
 use crate::hw::window::Window;
 
 /// A fetch made by [`ICaches::try_fetch`]: the cycle it is made in, and whether it was
-/// counted yet.
+/// counted yet (or needs no counting: no limit).
 #[derive(Clone, Copy, Debug)]
 pub struct Fetch {
     /// The cycle of the fetch.
@@ -24,7 +24,8 @@ impl Fetch {
     /// The instruction issues: the fetch is counted.
     #[inline]
     pub fn keep(self, ic: &mut ICaches) {
-        if !self.taken && ic.limit != 0 {
+        // `taken` is set without a limit too: there is nothing to count.
+        if !self.taken {
             ic.banks.take(self.bank as usize, self.at.get());
         }
     }
@@ -32,7 +33,7 @@ impl Fetch {
     /// The instruction does not issue now: the fetch is not counted.
     #[inline]
     pub fn give_back(self, ic: &mut ICaches) {
-        if self.taken {
+        if self.taken && ic.limit != 0 {
             ic.banks.untake(self.bank as usize, self.at.get());
         }
     }
@@ -92,7 +93,7 @@ impl ICaches {
             return Fetch {
                 at: c,
                 bank: 0,
-                taken: false,
+                taken: true,
             };
         }
         let bank = self.bank(cache, pc);

@@ -32,6 +32,6 @@ pub mod tm;
 pub mod window;
 
 pub use addr::WordAddr;
-pub use chip::{Chip, ChipStats, Units};
+pub use chip::{Chip, ChipStats};
 pub use cycle::{Cycle, Tick};
-pub use stalls::Stalls;
+pub use stalls::{Stall, Stalls};

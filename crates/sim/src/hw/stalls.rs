@@ -32,7 +32,52 @@ pub struct Stalls {
     pub icache: u64,
 }
 
+/// One cause of a stall: the counter of [`Stalls`] a thread model counts a wait under.
+/// Both thread models count every stalled cycle through [`Stalls::count`], and a pending
+/// result remembers the cause its wait will be counted under as one of these.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stall {
+    /// [`Stalls::memory`].
+    Memory,
+    /// [`Stalls::pipeline_latency`].
+    PipelineLatency,
+    /// [`Stalls::pipeline_busy`].
+    PipelineBusy,
+    /// [`Stalls::fpinv`].
+    Fpinv,
+    /// [`Stalls::l1_bank`].
+    L1Bank,
+    /// [`Stalls::atomic`].
+    Atomic,
+    /// [`Stalls::idle`].
+    Idle,
+    /// [`Stalls::dependency`].
+    Dependency,
+    /// [`Stalls::fu_busy`].
+    FuBusy,
+    /// [`Stalls::icache`].
+    Icache,
+}
+
 impl Stalls {
+    /// Counts `cycles` stalled thread-cycles under `cause`.
+    #[inline(always)]
+    pub fn count(&mut self, cause: Stall, cycles: u64) {
+        let c = match cause {
+            Stall::Memory => &mut self.memory,
+            Stall::PipelineLatency => &mut self.pipeline_latency,
+            Stall::PipelineBusy => &mut self.pipeline_busy,
+            Stall::Fpinv => &mut self.fpinv,
+            Stall::L1Bank => &mut self.l1_bank,
+            Stall::Atomic => &mut self.atomic,
+            Stall::Idle => &mut self.idle,
+            Stall::Dependency => &mut self.dependency,
+            Stall::FuBusy => &mut self.fu_busy,
+            Stall::Icache => &mut self.icache,
+        };
+        *c += cycles;
+    }
+
     /// Adds `o`'s counts to these.
     pub fn add(&mut self, o: &Stalls) {
         let Stalls {

@@ -19,8 +19,8 @@ use crate::config::SimConfig;
 use crate::hw::Cycle;
 use crate::hw::addr::WordAddr;
 use crate::hw::counts::UnitStats;
-use crate::hw::fu::Pools;
-use crate::hw::icache::ICaches;
+use crate::hw::fu::{Pool, Pools};
+use crate::hw::icache::{Fetch, ICaches};
 use crate::hw::issued::Issued;
 use crate::hw::l1::{Backing, L1};
 use crate::hw::memory::CacheStats;
@@ -34,9 +34,9 @@ pub struct Tm {
     fpinv: Vec<Slots>,
     fpinv_latency: u64,
     /// The shared pools of the compiled kernels' threads.
-    pub pools: Pools,
+    pools: Pools,
     /// The instruction caches' fetch slots (compiled kernels).
-    pub icache: ICaches,
+    icache: ICaches,
     units: UnitStats,
 }
 
@@ -91,6 +91,38 @@ impl Tm {
     #[inline(always)]
     pub fn pipe(&mut self, pipe: Pipe, n: u8, parallel: bool, at: Cycle) -> Issued {
         self.pipes.issue(pipe, n, parallel, at, &mut self.units)
+    }
+
+    /// A fetch of the instruction at `pc` from instruction cache `cache`, from cycle `at`
+    /// ([`ICaches::try_fetch`]); the thread then keeps it or gives it back.
+    #[inline(always)]
+    pub fn fetch(&mut self, cache: usize, pc: u32, at: Cycle) -> Fetch {
+        self.icache.try_fetch(cache, pc, at)
+    }
+
+    /// The fetch `f`'s instruction issues: the fetch is counted ([`Fetch::keep`]).
+    #[inline(always)]
+    pub fn keep(&mut self, f: Fetch) {
+        f.keep(&mut self.icache);
+    }
+
+    /// The fetch `f`'s instruction does not issue now ([`Fetch::give_back`]).
+    #[inline(always)]
+    pub fn give_back(&mut self, f: Fetch) {
+        f.give_back(&mut self.icache);
+    }
+
+    /// One operation on pool `p`, requested at `at`: the cycle it takes a unit
+    /// ([`Pools::reserve`]).
+    #[inline(always)]
+    pub fn reserve_pool(&mut self, p: Pool, at: Cycle) -> Cycle {
+        self.pools.reserve(p, at)
+    }
+
+    /// Pool `p`'s result latency.
+    #[inline(always)]
+    pub fn pool_latency(&self, p: Pool) -> u64 {
+        self.pools.latency(p)
     }
 
     /// One reciprocal on the TM's shared reciprocal unit(s), requested at `at`.

@@ -42,14 +42,17 @@ impl Window {
         (((c % HISTORY) as usize) << self.shift) | row
     }
 
+    /// The ring index of `row` in cycle `c`, when `c` lies in the window.
+    #[inline(always)]
+    fn slot(&self, row: usize, c: u64) -> Option<usize> {
+        // One compare: a cycle before the window wraps to a large difference.
+        (c.wrapping_sub(self.base) < HISTORY).then(|| self.index(row, c))
+    }
+
     /// Uses of `row` in cycle `c` (0 for a cycle outside the window).
     #[inline]
     pub fn count(&self, row: usize, c: u64) -> u8 {
-        if c < self.base || c >= self.base + HISTORY {
-            0
-        } else {
-            self.counts[self.index(row, c)]
-        }
+        self.slot(row, c).map_or(0, |i| self.counts[i])
     }
 
     /// The first cycle at or after `c` in which `row` has been used fewer than `limit`
@@ -94,13 +97,26 @@ impl Window {
     /// does not slide) and returns `(cycle, false)`; [`Window::take`] then takes it.
     #[inline]
     pub fn reserve_in_window(&mut self, row: usize, c: u64, limit: u8) -> (u64, bool) {
-        let s = self.first_free(row, c, limit);
-        if s >= self.base && s < self.base + HISTORY {
-            let i = self.index(row, s);
+        // Most requests find their own cycle free: one look-up.
+        if let Some(i) = self.slot(row, c)
+            && self.counts[i] < limit
+        {
             self.counts[i] += 1;
-            (s, true)
-        } else {
-            (s, false)
+            return (c, true);
+        }
+        self.reserve_later(row, c, limit)
+    }
+
+    /// [`Window::reserve_in_window`] when cycle `c` itself is full or past the window.
+    #[inline(never)]
+    fn reserve_later(&mut self, row: usize, c: u64, limit: u8) -> (u64, bool) {
+        let s = self.first_free(row, c, limit);
+        match self.slot(row, s) {
+            Some(i) => {
+                self.counts[i] += 1;
+                (s, true)
+            }
+            None => (s, false),
         }
     }
 

@@ -6,10 +6,8 @@
 use crate::accel::SimAccel;
 use crate::config::KernelsConfig;
 use crate::error::SimError;
-use crate::frame::FrameRequest;
 use crate::hw::atomic::AtomicUnit;
-use crate::hw::{Chip, Stalls};
-use crate::model::ThreadModel;
+use crate::hw::{Chip, Stall, Stalls};
 use crate::model::fast::costs;
 use crate::model::fast::event::Event;
 use crate::model::fast::op::Op;
@@ -19,6 +17,7 @@ use crate::model::fast::tally::Tally;
 use crate::model::fast::thread::Thread;
 use crate::model::rv32::Program;
 use crate::model::rv32::kernels::{Params, elf, placement};
+use crate::request::{FrameRequest, ThreadModel};
 use crate::result::SimResult;
 use dualsplit_accel::TraversalSet;
 use dualsplit_render::{PixelJob, RenderSettings};
@@ -187,8 +186,12 @@ pub(crate) fn run<S: TraversalSet>(
     }
     // The measured dependency stalls are part of the issue runs the threads replayed.
     let mut stats = chip.stats();
-    stats.stalls.dependency += work.tracer.tally.dependency_cycles();
-    stats.stalls.pipeline_latency += work.tracer.tally.pipeline_cycles();
+    stats
+        .stalls
+        .count(Stall::Dependency, work.tracer.tally.dependency_cycles());
+    stats
+        .stalls
+        .count(Stall::PipelineLatency, work.tracer.tally.pipeline_cycles());
     Ok(SimResult::assemble(
         accel,
         ThreadModel::Fast,

@@ -16,16 +16,8 @@ use crate::hw::issued::Issued;
 use crate::hw::l1::Resident;
 use crate::hw::memory::L2;
 use crate::hw::tm::Tm;
-use crate::hw::{Stalls, WordAddr};
+use crate::hw::{Stall, Stalls, WordAddr};
 use crate::model::fast::op::Op;
-
-/// Which resource a thread's pending result comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Cause {
-    Memory,
-    Fpinv,
-    Atomic,
-}
 
 /// How far [`Thread::run`] got.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,7 +41,8 @@ pub struct Thread {
     t: Cycle,
     /// The cycle its last outstanding result arrives.
     ready: Cycle,
-    cause: Cause,
+    /// What its last outstanding result comes from: the cause a wait for it counts under.
+    cause: Stall,
     /// The macro-ops of its current work item.
     ops: Vec<Op>,
     pc: usize,
@@ -67,7 +60,7 @@ impl Thread {
             tm: tm as u32,
             t: Cycle::ZERO,
             ready: Cycle::ZERO,
-            cause: Cause::Memory,
+            cause: Stall::Memory,
             ops: Vec::new(),
             pc: 0,
             next: None,
@@ -118,9 +111,9 @@ impl Thread {
     /// unit's latency (it is needed before the next instruction that consumes results).
     pub fn atomic(&mut self, unit: &mut AtomicUnit, stalls: &mut Stalls) {
         let r = unit.increment(self.t);
-        stalls.atomic += r.busy;
+        stalls.count(Stall::Atomic, r.busy);
         self.t = r.next_issue;
-        self.result(r.ready, Cause::Atomic);
+        self.result(r.ready, Stall::Atomic);
     }
 
     /// Runs ops while they can start at or before `now`: [`Ran::Asleep`] when the next
@@ -164,14 +157,14 @@ impl Thread {
                         // A miss: the L2 is the commit phase's.
                         None => return Ran::Commit,
                     };
-                    stalls.l1_bank += r.busy;
-                    self.done(r, Cause::Memory);
+                    stalls.count(Stall::L1Bank, r.busy);
+                    self.done(r, Stall::Memory);
                 }
                 Op::Pipe { pipe, n, parallel } => {
                     // The pipe's latency as the kernel exposes it is measured, part of the
                     // issue runs (`model/fast/calibrate.rs`); here only its occupancy is timed.
                     let r = tm.pipe(pipe, n, parallel, self.t);
-                    stalls.pipeline_busy += r.busy;
+                    stalls.count(Stall::PipelineBusy, r.busy);
                     self.t = r.next_issue;
                 }
             }
@@ -243,16 +236,12 @@ impl Thread {
     fn wait(&mut self, until: Cycle, stalls: &mut Stalls) {
         if until > self.t {
             let d = until - self.t;
-            match self.cause {
-                Cause::Memory => stalls.memory += d,
-                Cause::Fpinv => stalls.fpinv += d,
-                Cause::Atomic => stalls.atomic += d,
-            }
+            stalls.count(self.cause, d);
             self.t = until;
         }
     }
 
-    fn result(&mut self, at: Cycle, cause: Cause) {
+    fn result(&mut self, at: Cycle, cause: Stall) {
         if at > self.ready {
             self.ready = at;
             self.cause = cause;
@@ -261,7 +250,7 @@ impl Thread {
 
     /// A request issued: the thread goes on at its next issue slot, its result pending.
     #[inline(always)]
-    fn done(&mut self, r: Issued, cause: Cause) {
+    fn done(&mut self, r: Issued, cause: Stall) {
         self.t = r.next_issue;
         self.result(r.ready, cause);
     }
@@ -272,8 +261,8 @@ impl Thread {
         let mut c = self.t;
         for _ in 0..fpinv {
             let r = tm.reciprocal(c);
-            stalls.fpinv += r.busy;
-            self.result(r.ready, Cause::Fpinv);
+            stalls.count(Stall::Fpinv, r.busy);
+            self.result(r.ready, Stall::Fpinv);
             c = r.next_issue;
         }
         self.t = c + (n - fpinv as u32) as u64;

@@ -15,7 +15,8 @@
 //! has no section headers) is decoded once; words that do not decode become
 //! [`Op::Illegal`] and are an error only if executed.
 
-use super::decode::{Instr, Op, decode, illegal};
+use super::decode::{Instr, decode, illegal};
+use super::isa::Op;
 use object::Endianness;
 use object::elf;
 use object::read::elf::{FileHeader, ProgramHeader, SectionHeader};

@@ -6,20 +6,20 @@
 use crate::config::{SimConfig, UnitConfig};
 use crate::engine::{self, Commit, Lane, Wake};
 use crate::error::SimError;
-use crate::frame::FrameRequest;
 use crate::hw::atomic::AtomicUnit;
 use crate::hw::counts::InstrCounts;
 use crate::hw::fu::{ClassCounts, FU_CLASSES};
 use crate::hw::l1::Resident;
 use crate::hw::tm::Tm;
 use crate::hw::{Chip, Cycle, Stalls};
-use crate::model::ThreadModel;
 use crate::model::rv32::kernels::{FRAME_FLOATS_PER_PIXEL, Params, elf, placement};
 use crate::model::rv32::placement::Placement;
 use crate::model::rv32::tp::Tp;
 use crate::model::rv32::{
     ExecError, FRAME_BUFFER_ADDR, FrameMemory, ImageView, PARAMS_ADDR, PROGRAM_BASE, Program,
 };
+use crate::request::FrameRequest;
+use crate::request::ThreadModel;
 use crate::result::SimResult;
 use dualsplit_accel::TraversalSet;
 use std::ops::Range;
@@ -30,7 +30,6 @@ pub(crate) struct Compiled<'a, 'm> {
     pub(crate) tps: &'a mut [Tp],
     /// The chip's TMs the TPs are on.
     pub(crate) tms: Range<usize>,
-    pub(crate) tps_per_tm: usize,
     pub(crate) prog: &'a Program,
     /// The frame's memory as the local phase reads it.
     pub(crate) image: ImageView<'m>,
@@ -61,7 +60,8 @@ impl<'a, 'm: 'a> Lane for Compiled<'a, 'm> {
 
     #[inline]
     fn tm_of(&self, id: usize) -> usize {
-        id / self.tps_per_tm
+        // The TP's own field, not a division by the TPs per TM.
+        self.tps[id].tm() - self.tms.start
     }
 
     /// Each thread is woken at the cycle its next instruction on a shared unit can issue.
@@ -141,7 +141,6 @@ pub(crate) fn run_tps(
         lanes.push(Compiled {
             tps: mine,
             tms,
-            tps_per_tm: per_tm,
             prog,
             image,
             placement,

@@ -1,7 +1,8 @@
 //! One hardware thread (a TP's thread): architectural state and the functional executor.
 
-use super::decode::{CSR_FCSR, CSR_FRM, Info, Instr, Op, decode};
+use super::decode::{CSR_FCSR, CSR_FRM, Info, Instr, decode};
 use super::elf::Program;
+use super::isa::Op;
 use super::isa::PIPE_INPUT_WORDS;
 use super::memory::{LOCAL_STORE_ADDR, MemFault, Memory};
 use crate::hw::fu::FuClass;

@@ -5,7 +5,148 @@
 //! checks that all three say the same. Adding an instruction is one row here, one `.insn`
 //! in `rt.h`, one row in `isa.md`, and its [`Op`] in the executor (`docs/extending.md`).
 
-use super::decode::Op;
+/// The operation of a decoded instruction. Operands are in [`Instr`](super::decode::Instr).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+#[allow(missing_docs)] // the RISC-V mnemonics, one variant each
+pub enum Op {
+    Lui,
+    Auipc,
+    Jal,
+    Jalr,
+    Beq,
+    Bne,
+    Blt,
+    Bge,
+    Bltu,
+    Bgeu,
+    Lb,
+    Lh,
+    Lw,
+    Lbu,
+    Lhu,
+    Sb,
+    Sh,
+    Sw,
+    Addi,
+    Slti,
+    Sltiu,
+    Xori,
+    Ori,
+    Andi,
+    Slli,
+    Srli,
+    Srai,
+    Add,
+    Sub,
+    Sll,
+    Slt,
+    Sltu,
+    Xor,
+    Srl,
+    Sra,
+    Or,
+    And,
+    Mul,
+    Mulh,
+    Mulhsu,
+    Mulhu,
+    Div,
+    Divu,
+    Rem,
+    Remu,
+    /// `fence` (a no-op: one thread, in-order memory).
+    Fence,
+    /// `ebreak`: ends the thread.
+    Ebreak,
+    /// `csrrw` (`imm` = CSR number).
+    Csrrw,
+    Csrrs,
+    Csrrc,
+    /// `csrrwi` (`rs1` = the 5-bit immediate).
+    Csrrwi,
+    Csrrsi,
+    Csrrci,
+    Flw,
+    Fsw,
+    FmaddS,
+    FmsubS,
+    FnmsubS,
+    FnmaddS,
+    FaddS,
+    FsubS,
+    FmulS,
+    FdivS,
+    FsqrtS,
+    FsgnjS,
+    FsgnjnS,
+    FsgnjxS,
+    FminS,
+    FmaxS,
+    /// `fcvt.w.s` (`imm` = rounding mode).
+    FcvtWS,
+    /// `fcvt.wu.s` (`imm` = rounding mode).
+    FcvtWuS,
+    FmvXW,
+    FeqS,
+    FltS,
+    FleS,
+    FclassS,
+    FcvtSW,
+    FcvtSWu,
+    FmvWX,
+    /// `rt.setorg`: `R.o = (f[rs1], f[rs2], f[rs3])`.
+    RtSetOrg,
+    /// `rt.setinv`: `R.inv = (f[rs1], f[rs2], f[rs3])`.
+    RtSetInv,
+    /// `rt.setshear`: `R.shear = (f[rs1], f[rs2], f[rs3])`.
+    RtSetShear,
+    /// `rt.setk`: `R.k` from `x[rs1] = kx | ky << 2 | kz << 4`.
+    RtSetK,
+    /// `rt.rcp`: `f[rd] = 1 / f[rs1]`.
+    RtRcp,
+    /// `rt.atominc`: `x[rd] = G[x[rs1]]++`.
+    RtAtomInc,
+    /// `rt.srand`: the random key `K = (x[rs1], x[rs2], x[rs3])` (pixel x, y, sample).
+    RtSRand,
+    /// `rt.rand` (`imm` = dim): `f[rd]` = the renderer's random number of
+    /// `[K, x[rs1], x[rs2], dim]` (bounce, seed) in `[0, 1)`.
+    RtRand,
+    /// `rt.box`: `f[rd]` = entry distance or NaN; the exit distance to `B.exit`.
+    RtBox,
+    /// `rt.boxn` (`imm` = N = 2, 4, 8): `x[rd]` = hit mask, entries to `B`.
+    RtBoxN,
+    /// `rt.boxget` (`imm` = k): `f[rd] = B[k]` (k = 0–7), `B.exit` (k = 8).
+    RtBoxGet,
+    /// `rt.tri`: `f[rd]` = `t` or NaN.
+    RtTri,
+    /// `rt.dst`: `x[rd] = code | offset << 2`, the rest to `D`.
+    RtDst,
+    /// `rt.dstget` (`imm` = field 0, 1, 2, 3).
+    RtDstGet,
+    /// `rt.ldp` / `rt.ldph`: `P[k] = mem[x[rs1] + imm]`, `k = rd + 32 · rs2` (0–47; the
+    /// two fields name no register).
+    RtLdp,
+    /// `rt.boxp`: `rt.box` on the box in `P[0..6]`.
+    RtBoxP,
+    /// `rt.boxnp` (`imm` = N): `rt.boxn` on the N boxes in `P[0..6N]`.
+    RtBoxNP,
+    /// `rt.trip`: `rt.tri` on the triangle in `P[0..9]`.
+    RtTriP,
+    /// `rt.dstp`: `rt.dst` on the node in `P[0..3]`.
+    RtDstP,
+    /// `rt.qboxn`: the 8 dequantized child boxes of the 80-byte CWBVH node at `x[rs1]`,
+    /// `x[rd]` = hit mask, entries to `B`.
+    RtQBoxN,
+    /// `rt.qboxnp`: `rt.qboxn` on the node in `P[0..20]`.
+    RtQBoxNP,
+    /// `rt.dstqp`: the DST-Q record named by `x[rs1]` (cluster word address << 9 | bit
+    /// position; frame in `P[32..36]`, the record's words in `P[36..39]`): `x[rd]` = the next
+    /// record's name or the run's index entry, the rest (code included) to `D`.
+    RtDstQP,
+    /// A word that does not decode (`imm` = the word); executing it is an error.
+    Illegal,
+}
 
 /// Opcode of the custom-0 space (`rt.set*`, `rt.rcp`, `rt.atominc`, `rt.srand`, `rt.rand`).
 pub const OPCODE_CUSTOM0: u32 = 0x0B;

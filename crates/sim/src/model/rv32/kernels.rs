@@ -161,8 +161,8 @@ pub fn placement(
 }
 
 /// The file name of a kernel: `<config>-<workload><variant>.elf` (variant suffix `""`,
-/// `-parity`, `-loads` or `-parity-loads`, [`KernelsConfig::suffix`]), as `kernels/Makefile`
-/// names it.
+/// `-parity`, `-loads`, `-parity-loads` or `-parity-loads-sortall`,
+/// [`KernelsConfig::suffix`]), as `kernels/Makefile` names it.
 pub fn elf_name(accel: SimAccel, workload: Workload, variant: KernelsConfig) -> String {
     format!(
         "{}-{}{}.elf",
@@ -213,7 +213,7 @@ mod tests {
         let mk = kernels_file("Makefile");
         assert!(mk.contains("CONFIGS := bvh2 bvh2+ bvh4 bvh4+ bvh8 bvh8+ dst-sw dst"));
         assert!(mk.contains("WORKLOADS := cast path"));
-        assert!(mk.contains("VARIANTS := base parity loads parity-loads"));
+        assert!(mk.contains("VARIANTS := base parity loads parity-loads parity-loads-sortall"));
     }
 
     /// The C header spells the constants the Rust side uses.

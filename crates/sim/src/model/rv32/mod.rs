@@ -80,9 +80,10 @@ pub(crate) mod tests;
 pub mod tp;
 
 pub use crate::hw::fu::FuClass;
-pub use decode::{DecodeError, Info, Instr, Latches, Op, Reg, decode};
+pub use decode::{DecodeError, Info, Instr, Latches, Reg, decode};
 pub use elf::{ElfError, PROGRAM_BASE, PROGRAM_END, Program};
 pub use hart::{CANONICAL_NAN, DstLatch, ExecError, Hart, MemAccess, Retired};
+pub use isa::Op;
 pub use memory::{
     FRAME_BUFFER_ADDR, FrameMemory, GLOBAL_REGISTERS, ImageView, LOCAL_STORE_ADDR, MemFault,
     Memory, PARAMS_ADDR,

@@ -33,12 +33,12 @@
 use crate::config::UnitConfig;
 use crate::engine::Wake;
 use crate::hw::atomic::AtomicUnit;
-use crate::hw::fu::{ClassCounts, FuClass, Pool, Pools, fu_index};
+use crate::hw::fu::{ClassCounts, FuClass, Pool, fu_index};
 use crate::hw::issued::Issued;
 use crate::hw::l1::{Backing, Resident};
 use crate::hw::pipe::Pipe;
 use crate::hw::tm::Tm;
-use crate::hw::{Cycle, Stalls, WordAddr};
+use crate::hw::{Cycle, Stall, Stalls, WordAddr};
 use crate::model::rv32::hart::executed_class;
 use crate::model::rv32::placement::Placement;
 use crate::model::rv32::{
@@ -63,11 +63,11 @@ const READS_ANY_LATCH: u8 =
 
 /// The producers of the scoreboard's slots at the start: a latch's is fixed (`R` is
 /// written by the TP's own moves, `B` and `D` by a ray pipeline, `P` by loads).
-const LATCH_PRODUCERS: [Producer; SLOTS] = {
-    let mut p = [Producer::Unit; SLOTS];
-    p[BOX_SLOT] = Producer::Pipeline;
-    p[DST_SLOT] = Producer::Pipeline;
-    p[PIPE_SLOT] = Producer::Memory;
+const LATCH_PRODUCERS: [Stall; SLOTS] = {
+    let mut p = [Stall::Dependency; SLOTS];
+    p[BOX_SLOT] = Stall::PipelineLatency;
+    p[DST_SLOT] = Stall::PipelineLatency;
+    p[PIPE_SLOT] = Stall::Memory;
     p
 };
 
@@ -82,19 +82,6 @@ fn latch_slots(l: Latches) -> [usize; 4] {
         slot(Latches::READS_DST, DST_SLOT),
         slot(Latches::READS_PIPE, PIPE_SLOT),
     ]
-}
-
-/// Why a register is not ready yet: the kind of unit that produces it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Producer {
-    /// A functional unit's latency (ALU, FP, pools, reciprocal unit, local store).
-    Unit,
-    /// A load from the L1.
-    Memory,
-    /// A ray pipeline.
-    Pipeline,
-    /// The global atomic unit.
-    Atomic,
 }
 
 /// A ray-tracing instruction whose memory words are on their way: it issues on its
@@ -143,7 +130,7 @@ pub struct Tp {
     /// them), and a slot that is always ready ([`NO_SLOT`], read for an absent operand);
     /// and what produces each.
     ready: [Cycle; SLOTS],
-    producer: [Producer; SLOTS],
+    producer: [Stall; SLOTS],
     /// The latest result of any instruction so far.
     last: Cycle,
     waiting: Option<Waiting>,
@@ -214,7 +201,7 @@ impl Tp {
         if let Some(w) = self.waiting.take() {
             // Its words have arrived (the thread slept until then): the pipeline op issues.
             let r = tm.pipe(w.pipe, w.n, w.n > 1, self.t);
-            stalls.pipeline_busy += r.busy;
+            stalls.count(Stall::PipelineBusy, r.busy);
             self.finish_pipe(r, w);
         }
         let mut executed = false;
@@ -250,21 +237,14 @@ impl Tp {
                 );
             }
             if at > self.t {
-                let why = self.producer_of(&info, at);
-                let d = at - self.t;
-                match why {
-                    Producer::Unit => stalls.dependency += d,
-                    Producer::Memory => stalls.memory += d,
-                    Producer::Pipeline => stalls.pipeline_latency += d,
-                    Producer::Atomic => stalls.atomic += d,
-                }
+                stalls.count(self.producer_of(&info, at), at - self.t);
                 self.t = at;
             }
             let pc = self.hart.pc;
-            let fetch = tm.icache.try_fetch(self.icache as usize, pc, fetch_from);
+            let fetch = tm.fetch(self.icache as usize, pc, fetch_from);
             let fetched = fetch.at;
             if fetched > self.t {
-                stalls.icache += fetched - self.t;
+                stalls.count(Stall::Icache, fetched - self.t);
                 self.t = fetched;
             }
             let (shared_unit, global_store) = match info.fu {
@@ -278,24 +258,24 @@ impl Tp {
             };
             if (shared_unit && self.t > now) || self.t > now + LOOKAHEAD {
                 // Not issued yet: its fetch is made again when the thread next runs.
-                fetch.give_back(&mut tm.icache);
+                tm.give_back(fetch);
                 return Ok(Wake::At(self.t));
             }
             if !COMMIT && (global_store || info.fu == FuClass::Atomic) {
                 // The frame buffer and the global registers are the commit phase's.
-                fetch.give_back(&mut tm.icache);
+                tm.give_back(fetch);
                 return Ok(Wake::Commit);
             }
             let acc = match self.hart.exec_access(ins, prog, mem) {
                 Ok(acc) => acc,
                 Err(ExecError::Elsewhere { .. }) if !COMMIT => {
                     // A read of the frame buffer: nothing was executed.
-                    fetch.give_back(&mut tm.icache);
+                    tm.give_back(fetch);
                     return Ok(Wake::Commit);
                 }
                 Err(e) => return Err(e),
             };
-            fetch.keep(&mut tm.icache);
+            tm.keep(fetch);
             executed = true;
             // The executed class (a load or store whose address is the local store's).
             let fu = executed_class(info.fu, &acc);
@@ -307,37 +287,35 @@ impl Tp {
             let (slot, lat, p) = match fu {
                 // A TP's own units (paper §2.3), or TM pools as SimTRaX's configs share them.
                 FuClass::IntAlu | FuClass::FpMove if cfg.int_units > 0 => {
-                    pool(&mut tm.pools, Pool::IntAlu, t, stalls)
+                    pool(tm, Pool::IntAlu, t, stalls)
                 }
-                FuClass::FpAdd if cfg.fpadd_units > 0 => {
-                    pool(&mut tm.pools, Pool::FpAdd, t, stalls)
-                }
+                FuClass::FpAdd if cfg.fpadd_units > 0 => pool(tm, Pool::FpAdd, t, stalls),
                 FuClass::FpMul | FuClass::FpFma if cfg.fpmul_units > 0 => {
-                    pool(&mut tm.pools, Pool::FpMul, t, stalls)
+                    pool(tm, Pool::FpMul, t, stalls)
                 }
-                FuClass::IntAlu | FuClass::FpMove => (t, cfg.int_latency, Producer::Unit),
-                FuClass::FpAdd => (t, cfg.fpadd_latency, Producer::Unit),
-                FuClass::FpMul | FuClass::FpFma => (t, cfg.fpmul_latency, Producer::Unit),
+                FuClass::IntAlu | FuClass::FpMove => (t, cfg.int_latency, Stall::Dependency),
+                FuClass::FpAdd => (t, cfg.fpadd_latency, Stall::Dependency),
+                FuClass::FpMul | FuClass::FpFma => (t, cfg.fpmul_latency, Stall::Dependency),
                 FuClass::LocalLoad | FuClass::LocalStore => {
-                    (t, cfg.local_store_latency, Producer::Unit)
+                    (t, cfg.local_store_latency, Stall::Dependency)
                 }
-                FuClass::FpCmp => pool(&mut tm.pools, Pool::FpCmp, t, stalls),
-                FuClass::FpMinMax => pool(&mut tm.pools, Pool::FpMinMax, t, stalls),
-                FuClass::FpConv => pool(&mut tm.pools, Pool::Conv, t, stalls),
-                FuClass::Branch => pool(&mut tm.pools, Pool::Branch, t, stalls),
-                FuClass::IntMul => pool(&mut tm.pools, Pool::IntMul, t, stalls),
+                FuClass::FpCmp => pool(tm, Pool::FpCmp, t, stalls),
+                FuClass::FpMinMax => pool(tm, Pool::FpMinMax, t, stalls),
+                FuClass::FpConv => pool(tm, Pool::Conv, t, stalls),
+                FuClass::Branch => pool(tm, Pool::Branch, t, stalls),
+                FuClass::IntMul => pool(tm, Pool::IntMul, t, stalls),
                 FuClass::IntDiv | FuClass::FpDiv | FuClass::FpSqrt | FuClass::Rcp => {
                     let i = tm.reciprocal(t);
-                    stalls.fu_busy += i.busy;
-                    one_slot(i, Producer::Unit)
+                    stalls.count(Stall::FuBusy, i.busy);
+                    one_slot(i, Stall::Dependency)
                 }
                 FuClass::Atomic => {
                     let (_, atomic) = shared
                         .as_mut()
                         .expect("the commit phase has the atomic unit");
                     let i = atomic.increment(t);
-                    stalls.atomic += i.busy;
-                    one_slot(i, Producer::Atomic)
+                    stalls.count(Stall::Atomic, i.busy);
+                    one_slot(i, Stall::Atomic)
                 }
                 FuClass::Store => {
                     let (l2, _) = shared.as_mut().expect("the commit phase has the L2");
@@ -348,7 +326,7 @@ impl Tp {
                         t,
                         now,
                     );
-                    stalls.l1_bank += i.busy;
+                    stalls.count(Stall::L1Bank, i.busy);
                     self.t = i.next_issue;
                     self.last = self.last.max(i.ready);
                     continue;
@@ -381,7 +359,7 @@ impl Tp {
                     {
                         // A register form: its words are in P (waited for above).
                         let p = tm.pipe(w.pipe, w.n, w.n > 1, t);
-                        stalls.pipeline_busy += p.busy;
+                        stalls.count(Stall::PipelineBusy, p.busy);
                         self.finish_pipe(p, w);
                         continue;
                     }
@@ -435,7 +413,7 @@ impl Tp {
         match access {
             Access::Load { dst, writes_pipe } => {
                 self.t = i.next_issue;
-                self.write(dst, i.ready, Producer::Memory);
+                self.write(dst, i.ready, Stall::Memory);
                 if writes_pipe {
                     self.ready[PIPE_SLOT] = self.ready[PIPE_SLOT].max(i.ready);
                 }
@@ -444,14 +422,14 @@ impl Tp {
                 // The words are in the unit's operand latches at `i.ready`; the instruction
                 // holds the issue stage until then.
                 let arrive = i.ready.max(i.next_issue);
-                stalls.memory += arrive - i.next_issue;
+                stalls.count(Stall::Memory, arrive - i.next_issue);
                 self.t = arrive;
                 if arrive > now {
                     self.waiting = Some(w);
                     return Some(Wake::At(arrive));
                 }
                 let p = tm.pipe(w.pipe, w.n, w.n > 1, arrive);
-                stalls.pipeline_busy += p.busy;
+                stalls.count(Stall::PipelineBusy, p.busy);
                 self.finish_pipe(p, w);
             }
         }
@@ -462,19 +440,19 @@ impl Tp {
     /// latches `R`, `B`, `D`, `P`) whose result arrives at `at`, the last of them: the
     /// cause a wait for the operands is counted under.
     #[cold]
-    fn producer_of(&self, info: &Info, at: Cycle) -> Producer {
+    fn producer_of(&self, info: &Info, at: Cycle) -> Stall {
         let regs = info.src.map(|r| r.index().unwrap_or(NO_SLOT));
         regs.iter()
             .chain(latch_slots(info.latches).iter())
             .find(|&&k| self.ready[k] == at)
-            .map_or(Producer::Unit, |&k| self.producer[k])
+            .map_or(Stall::Dependency, |&k| self.producer[k])
     }
 
     /// A pipeline op issued with timing `r`: its results in the destination register and
     /// the latches it writes.
     fn finish_pipe(&mut self, r: Issued, w: Waiting) {
         self.t = r.next_issue;
-        self.write(w.dst, r.ready, Producer::Pipeline);
+        self.write(w.dst, r.ready, Stall::PipelineLatency);
         if w.latches.has(Latches::WRITES_BOX) {
             self.ready[BOX_SLOT] = r.ready;
         }
@@ -484,7 +462,7 @@ impl Tp {
     }
 
     #[inline]
-    fn write(&mut self, dst: Option<usize>, at: Cycle, p: Producer) {
+    fn write(&mut self, dst: Option<usize>, at: Cycle, p: Stall) {
         if let Some(i) = dst {
             self.ready[i] = at;
             self.producer[i] = p;
@@ -512,23 +490,23 @@ fn l1_load<B: Backing>(
         t,
         now,
     );
-    stalls.l1_bank += i.busy;
+    stalls.count(Stall::L1Bank, i.busy);
     i
 }
 
 /// A one-slot request's timing as (issue cycle, latency, producer).
 #[inline]
-fn one_slot(i: Issued, p: Producer) -> (Cycle, u64, Producer) {
+fn one_slot(i: Issued, p: Stall) -> (Cycle, u64, Stall) {
     let slot = i.next_issue - 1;
     (slot, i.ready - slot, p)
 }
 
 /// One operation on a pool from cycle `t`: (issue cycle, latency, producer).
 #[inline]
-fn pool(pools: &mut Pools, p: Pool, t: Cycle, stalls: &mut Stalls) -> (Cycle, u64, Producer) {
-    let s = pools.reserve(p, t);
-    stalls.fu_busy += s - t;
-    (s, pools.latency(p), Producer::Unit)
+fn pool(tm: &mut Tm, p: Pool, t: Cycle, stalls: &mut Stalls) -> (Cycle, u64, Stall) {
+    let s = tm.reserve_pool(p, t);
+    stalls.count(Stall::FuBusy, s - t);
+    (s, tm.pool_latency(p), Stall::Dependency)
 }
 
 /// Whether an instruction of class `fu` uses a unit shared with other threads that keeps a

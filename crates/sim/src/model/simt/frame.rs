@@ -10,8 +10,6 @@
 //! unit together ([`super::rt_unit`]).
 
 use crate::error::SimError;
-use crate::frame::FrameRequest;
-use crate::model::ThreadModel;
 use crate::model::fast::costs::{self, Costs, FRAC_BITS};
 use crate::model::fast::event::Event;
 use crate::model::simt::SimtFigures;
@@ -19,6 +17,8 @@ use crate::model::simt::config::SimtConfig;
 use crate::model::simt::mem::Memory;
 use crate::model::simt::rt_unit::{RtUnit, RtWarp, lane};
 use crate::model::simt::txn::{TxnKind, TxnRecorder};
+use crate::request::FrameRequest;
+use crate::request::ThreadModel;
 use crate::result::SimResult;
 use dualsplit_accel::TraversalSet;
 use dualsplit_render::{PixelJob, RayKind, TraceResult};

@@ -1,9 +1,10 @@
 //! Tests of the `simt` model on builtin scenes.
 
 use crate::config::SimConfig;
-use crate::frame::{FrameRequest, simulate};
-use crate::model::ThreadModel;
+use crate::frame::simulate;
 use crate::model::simt::config::SimtConfig;
+use crate::request::FrameRequest;
+use crate::request::ThreadModel;
 use crate::{SimAccel, SimResult};
 use dualsplit_accel::Structures;
 use dualsplit_render::{RenderSettings, Workload};
