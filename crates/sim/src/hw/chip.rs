@@ -3,8 +3,9 @@
 //! Hardware (Lin et al. 2020, §2.3, §4, Table 1): `tms` thread multiprocessors of
 //! `tps_per_tm` thread processors each; each TM has its L1, pipelines, reciprocal unit and
 //! functional-unit pools ([`Tm`]); all TMs share the L2 and the DRAM ([`L2`]) and the global
-//! atomic unit from which threads take their pixels ([`AtomicUnit`]). A thread model drives
-//! them through [`Chip::units`], the event loop through [`Chip::parts`] (`engine::run`).
+//! atomic unit from which threads take their pixels ([`AtomicUnit`]). The event loop takes
+//! them apart ([`Chip::parts`], `engine::run`): a thread reaches its TM's units through the
+//! [`Tm`]'s methods, and the L2 and atomic unit in the commit phase.
 
 use crate::config::SimConfig;
 use crate::hw::atomic::AtomicUnit;
