@@ -2,7 +2,7 @@
 //!
 //! Both TRaX thread models ([`ThreadModel::ALL`]: the compiled kernels and the macro-op
 //! replay), every configuration of [`SimAccel::ALL`] on the `tiny` chip (`configs/tiny.toml`),
-//! and the `simt` model's configurations ([`RT_ACCELS`]) on `configs/rtx2060.toml`, both
+//! and the `simt` model's configurations ([`rt_accels`]) on `configs/rtx2060.toml`, both
 //! workloads, on `builtin:cornell` and on the shipped `dragon_res4.ply.gz` (11 K triangles,
 //! committed in the repository's `scenes/`), at small resolutions. For each run
 //! the test compares exact cycles, instructions, DRAM reads and activations, L1 and L2 hits
@@ -22,7 +22,7 @@
 
 use dualsplit_accel::Structures;
 use dualsplit_render::{RenderSettings, Workload};
-use dualsplit_sim::model::simt::RT_ACCELS;
+use dualsplit_sim::model::simt::rt_accels;
 use dualsplit_sim::{
     FrameRequest, MODEL_VERSION, SimAccel, SimConfig, SimResult, ThreadModel, simulate,
 };
@@ -193,7 +193,7 @@ fn run_each(
                     out.push((key, r));
                 }
             }
-            for accel in RT_ACCELS {
+            for accel in rt_accels() {
                 let r = simulate(
                     &FrameRequest::new(&scene, &structures, accel, &settings, &rtx2060())
                         .with_model(ThreadModel::Simt),

@@ -16,22 +16,20 @@ pub mod mem;
 pub mod rt_unit;
 pub mod txn;
 
-use crate::SimAccel;
+use crate::{NodeUnit, SimAccel};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-/// The structures an RT unit holds, one configuration each: the BVHs and CWBVH test their
-/// boxes in the unit, DST and DST-Q run the dual-split step there. (The TRaX chip's other
-/// configurations differ from these only in how a TM issues a node's tests, which the RT
-/// unit does its own way.)
-pub const RT_ACCELS: [SimAccel; 6] = [
-    SimAccel::Bvh2,
-    SimAccel::Bvh4,
-    SimAccel::Bvh8,
-    SimAccel::Cwbvh,
-    SimAccel::Dst,
-    SimAccel::DstQ,
-];
+/// The structures an RT unit holds, one configuration each, from the registry: the
+/// configurations whose nodes a hardware unit tests (the BVHs and CWBVH test their boxes in
+/// the unit, DST and DST-Q run the dual-split step there), without the "+" ones. (The TRaX
+/// chip's "+" configurations differ from these only in how a TM issues a node's tests,
+/// which the RT unit does its own way; DST\* decodes its nodes in software.)
+pub fn rt_accels() -> impl Iterator<Item = SimAccel> {
+    SimAccel::ALL
+        .into_iter()
+        .filter(|a| !a.parallel_boxes() && a.node_unit() != NodeUnit::SoftwareDualSplit)
+}
 
 /// What the `simt` model reports beyond the common figures of a [`crate::SimResult`].
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
