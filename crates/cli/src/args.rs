@@ -277,7 +277,7 @@ pub struct Scope {
     #[arg(long, value_delimiter = ',', default_value = "32,64,128", value_parser = crate::args::parse_positive)]
     pub tms: Vec<u32>,
     /// Thread model: rv32 (the compiled kernels instruction by instruction, the reference)
-    /// or fast (the replay calibrated against them: about 5× faster, within 10 %), or simt
+    /// or fast (the replay calibrated against them: about 5× faster, frame times within 13 %), or simt
     /// (an RTX-style GPU; with --config configs/rtx2060.toml, whose simt.* keys --vary
     /// sweeps). Default: fast, rv32 with --full.
     #[arg(long)]

@@ -116,7 +116,7 @@ The paper states its resolution (1024×1024) only for Table 4; it states none fo
             dualsplit_sim::ThreadModel::Rv32 =>
                 "execute the compiled RV32IMF kernels instruction by instruction (thread model rv32)",
             dualsplit_sim::ThreadModel::Fast =>
-                "replay the traversal with per-event costs measured from the compiled kernels (thread model fast, within 10 % of the kernels' frame time, energy and DRAM lines)",
+                "replay the traversal with per-event costs measured from the compiled kernels (thread model fast, within 13 % of the kernels' frame time and 10 % of their energy and DRAM lines)",
             dualsplit_sim::ThreadModel::Simt =>
                 "run warps on an RTX-style GPU with an RT unit per SM, as Vulkan-Sim models it (thread model simt)",
         },

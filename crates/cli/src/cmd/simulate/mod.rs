@@ -57,7 +57,7 @@ pub struct Args {
     #[arg(long)]
     config: Option<std::path::PathBuf>,
     /// Thread model: rv32 (the compiled kernels, instruction by instruction; the reference)
-    /// or fast (the macro-op replay calibrated against them: within 10 %, about 5× faster),
+    /// or fast (the macro-op replay calibrated against them: frame times within 13 %, about 5× faster),
     /// or simt (an RTX-style GPU with an RT unit per SM; needs --config configs/rtx2060.toml).
     #[arg(long, default_value = "rv32", value_parser = parse_model)]
     model: ThreadModel,

@@ -10,11 +10,12 @@
 //! * [`thread`]: one replaying thread (its ops against the TM's units);
 //! * [`calibrate`]: measuring the costs from the compiled kernels.
 
-/// The `fast` model's largest frame-time error against the `rv32` model measured on the
-/// frames the calibration never saw (`tests/calibration.rs`, which fails when a frame
-/// exceeds it; `docs/simulator.md`, "The `fast` model's calibration"): two configurations
-/// whose `fast` frame times differ by less than this have no resolved order.
-pub const FRAME_TIME_ERROR: f64 = 0.09;
+/// The `fast` model's largest frame-time error against the `rv32` model measured on frames
+/// the calibration never saw, rounded up: 12.1 % (BVH8+ path tracing on SimTRaX's Dragon
+/// Box at 256×256; `docs/simulator.md`, "The `fast` model's calibration", has every
+/// ratio). `tests/calibration.rs` fails when one of its frames exceeds it. Two
+/// configurations whose `fast` frame times differ by less than this have no resolved order.
+pub const FRAME_TIME_ERROR: f64 = 0.13;
 
 pub mod calibrate;
 pub mod costs;
