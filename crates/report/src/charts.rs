@@ -283,3 +283,119 @@ pub fn fig9(data: &ReportData, s: &SceneReport) -> Result<Option<String>, Report
     }
     Ok(Some(svg))
 }
+
+/// "On an RTX-style GPU": frame time (µs) of each swept structure against warps per RT unit
+/// (left) and MSHRs (right), log-2 axes at the swept values, the RTX 2060's value dashed.
+/// `None` when no sweep frame succeeded.
+pub fn rtx_sweep(rtx: &crate::data::RtxData) -> Result<Option<String>, ReportError> {
+    use crate::rtx::{SWEEP_MSHR, SWEEP_WARPS, SWEEP_WORKLOAD, swept};
+    register_font();
+    let series = |mshr: bool| -> Vec<(SimAccel, Vec<(f64, f64)>)> {
+        let values: &[u32] = if mshr { &SWEEP_MSHR } else { &SWEEP_WARPS };
+        swept()
+            .into_iter()
+            .map(|a| {
+                let pts = values
+                    .iter()
+                    .filter_map(|&v| {
+                        let (w, m) = if mshr {
+                            (rtx.base_warps, v)
+                        } else {
+                            (v, rtx.base_mshr)
+                        };
+                        let r = rtx.get(a, SWEEP_WORKLOAD, w, m)?;
+                        Some((f64::from(v), r.frame_ms * 1e3))
+                    })
+                    .collect();
+                (a, pts)
+            })
+            .collect()
+    };
+    let (warps, mshrs) = (series(false), series(true));
+    if warps.iter().chain(&mshrs).all(|(_, p)| p.is_empty()) {
+        return Ok(None);
+    }
+    let err = chart_err("rtx-sweep");
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 320)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+        let (panels, key) = root.split_horizontally(800);
+        for (i, a) in swept().into_iter().enumerate() {
+            let y = 40 + 20 * i as i32;
+            key.draw(&PathElement::new(
+                [(6, y), (30, y)],
+                color(a).stroke_width(3),
+            ))
+            .map_err(|e| err(e.to_string()))?;
+            key.draw(&Text::new(a.label(), (36, y - 7), ("sans-serif", 13)))
+                .map_err(|e| err(e.to_string()))?;
+        }
+        let (left, right) = panels.split_horizontally(400);
+        for (area, data, values, base, what) in [
+            (
+                &left,
+                &warps,
+                &SWEEP_WARPS[..],
+                rtx.base_warps,
+                "warps per RT unit",
+            ),
+            (
+                &right,
+                &mshrs,
+                &SWEEP_MSHR[..],
+                rtx.base_mshr,
+                "MSHRs per RT unit",
+            ),
+        ] {
+            let xmin = f64::from(values[0]);
+            let xmax = f64::from(values[values.len() - 1]);
+            let ymax = data
+                .iter()
+                .flat_map(|(_, p)| p.iter().map(|q| q.1))
+                .fold(0.0f64, f64::max)
+                * 1.1;
+            let ticks: Vec<f64> = values.iter().map(|&v| f64::from(v)).collect();
+            let x_axis = ((xmin / 1.15)..(xmax * 1.15))
+                .log_scale()
+                .with_key_points(ticks);
+            let mut chart = ChartBuilder::on(area)
+                .caption(what, ("sans-serif", 15))
+                .margin(8)
+                .x_label_area_size(30)
+                .y_label_area_size(52)
+                .build_cartesian_2d(x_axis, 0f64..ymax.max(1e-9))
+                .map_err(|e| err(e.to_string()))?;
+            chart
+                .configure_mesh()
+                .x_label_formatter(&|x| format!("{x:.0}"))
+                .y_label_formatter(&|y| units::compact(*y))
+                .light_line_style(WHITE.mix(0.0))
+                .x_desc(what)
+                .y_desc("frame time (µs)")
+                .axis_desc_style(("sans-serif", 12))
+                .draw()
+                .map_err(|e| err(e.to_string()))?;
+            let b = f64::from(base);
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(b, 0.0), (b, ymax)],
+                    4,
+                    4,
+                    BLACK.mix(0.4).stroke_width(1),
+                ))
+                .map_err(|e| err(e.to_string()))?;
+            for (a, pts) in data {
+                let c = color(*a).mix(1.0);
+                chart
+                    .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
+                    .map_err(|e| err(e.to_string()))?;
+                chart
+                    .draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))
+                    .map_err(|e| err(e.to_string()))?;
+            }
+        }
+        root.present().map_err(|e| err(e.to_string()))?;
+    }
+    Ok(Some(svg))
+}

@@ -27,6 +27,80 @@ pub struct ReportData {
     pub scene_files: crate::scenes::SceneFiles,
     /// The paper's published values (Lin et al. 2020, Tables 3–7).
     pub paper: PaperValues,
+    /// "On an RTX-style GPU": frames of the `simt` model on one scene, when the report
+    /// ran them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtx: Option<RtxData>,
+}
+
+/// The frames of "On an RTX-style GPU" ([`crate::rtx`]): the `simt` thread model on the
+/// RTX 2060 configuration (`configs/rtx2060.toml`), one scene, cast and path, and a sweep of
+/// warps per RT unit and MSHRs.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RtxData {
+    /// The scene's name.
+    pub scene: String,
+    /// Its spec.
+    pub spec: String,
+    /// Square resolution of the frames.
+    pub res: u32,
+    /// The configuration's warps per RT unit (`rt_max_warps`).
+    pub base_warps: u32,
+    /// The configuration's MSHR limit (`rt_max_mshr`).
+    pub base_mshr: u32,
+    /// The configuration's peak DRAM bandwidth, GB/s.
+    pub peak_dram_gbps: f64,
+    /// Every frame, base configuration and sweep points.
+    pub runs: Vec<RtxRun>,
+}
+
+/// One frame of the `simt` model.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RtxRun {
+    /// The structure.
+    pub accel: SimAccel,
+    /// The workload.
+    pub workload: Workload,
+    /// Warps per RT unit.
+    pub rt_max_warps: u32,
+    /// MSHRs per RT unit.
+    pub rt_max_mshr: u32,
+    /// The result, or why there is none.
+    #[serde(with = "crate::plain")]
+    pub result: Result<SimResult, String>,
+}
+
+impl RtxData {
+    /// The frame of (`accel`, `workload`) with `warps` and `mshr`, if it succeeded.
+    pub fn get(
+        &self,
+        accel: SimAccel,
+        workload: Workload,
+        warps: u32,
+        mshr: u32,
+    ) -> Option<&SimResult> {
+        self.runs
+            .iter()
+            .find(|r| {
+                r.accel == accel
+                    && r.workload == workload
+                    && r.rt_max_warps == warps
+                    && r.rt_max_mshr == mshr
+            })
+            .and_then(|r| r.result.as_ref().ok())
+    }
+
+    /// The frame of (`accel`, `workload`) on the configuration as it stands.
+    pub fn base(&self, accel: SimAccel, workload: Workload) -> Option<&SimResult> {
+        self.get(accel, workload, self.base_warps, self.base_mshr)
+    }
+
+    /// The first error of any frame.
+    pub fn error(&self) -> Option<&str> {
+        self.runs
+            .iter()
+            .find_map(|r| r.result.as_ref().err().map(String::as_str))
+    }
 }
 
 /// The parameters of a report.

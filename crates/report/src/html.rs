@@ -185,6 +185,24 @@ The paper states its resolution (1024×1024) only for Table 4; it states none fo
                     }
                 }
             }
+            "rtx" => {
+                if let Some(svg) = data
+                    .rtx
+                    .as_ref()
+                    .map(charts::rtx_sweep)
+                    .transpose()?
+                    .flatten()
+                {
+                    cs.push((
+                        format!(
+                            "Frame time of {} ({}) against warps per RT unit (left) and MSHRs (right); dashed: the RTX 2060's value.",
+                            crate::rtx::SWEEP_WORKLOAD.name(),
+                            data.rtx.as_ref().map_or("", |r| r.scene.as_str())
+                        ),
+                        svg,
+                    ));
+                }
+            }
             _ => {}
         }
         h.push_str(&section_html(&sec, &cs));

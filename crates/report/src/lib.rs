@@ -32,6 +32,7 @@ pub mod memory;
 pub mod paper;
 mod plain;
 pub mod produce;
+pub mod rtx;
 pub mod scenes;
 pub mod simulate;
 pub mod study;

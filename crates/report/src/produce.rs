@@ -14,8 +14,8 @@
 use crate::ReportError;
 use crate::cache::{CODE_VERSION, Cache, CacheKey, SCHEMA};
 use crate::data::{
-    BuildTime, CpuData, ReportData, ReportSettings, SceneReport, SimRun, Skipped, StructureSize,
-    Throughput, TraversalCounts,
+    BuildTime, CpuData, ReportData, ReportSettings, RtxData, RtxRun, SceneReport, SimRun, Skipped,
+    StructureSize, Throughput, TraversalCounts,
 };
 use crate::paper::{PaperMatch, PaperScene, PaperValues};
 use base64::Engine;
@@ -103,6 +103,10 @@ struct SimJob {
     workload: Workload,
     tms: u32,
     key: CacheKey,
+    /// The chip: the report's TRaX chip, or the RTX 2060 of "On an RTX-style GPU".
+    cfg: SimConfig,
+    /// Whether this is a frame of "On an RTX-style GPU" (simulated by the `simt` model).
+    rtx: bool,
 }
 
 /// Computes a report, piece by piece, reusing cached pieces.
@@ -114,6 +118,9 @@ pub struct Producer<'a> {
     computed: AtomicU64,
     /// Host threads for the simulations ([`Producer::sim_threads`]).
     sim_threads: usize,
+    /// The `simt` simulator of "On an RTX-style GPU" ([`Producer::with_rtx`]); without
+    /// it the report has no such section.
+    rtx: Option<&'a SimulateFn<'a>>,
 }
 
 impl<'a> Producer<'a> {
@@ -131,6 +138,17 @@ impl<'a> Producer<'a> {
             simulate,
             computed: AtomicU64::new(0),
             sim_threads: SIM_WORKERS,
+            rtx: None,
+        }
+    }
+
+    /// Adds "On an RTX-style GPU" ([`crate::rtx`]): its frames are simulated with
+    /// `simulate` (the `simt` thread model: [`real_simulator`]`(ThreadModel::Simt)`) on the
+    /// compiled-in RTX 2060 configuration, queued with the report's other frames.
+    pub fn with_rtx(self, simulate: &'a SimulateFn<'a>) -> Self {
+        Self {
+            rtx: Some(simulate),
+            ..self
         }
     }
 
@@ -275,13 +293,61 @@ impl<'a> Producer<'a> {
                         workload,
                         tms,
                         key,
+                        cfg,
+                        rtx: false,
+                    }),
+                }
+            }
+        }
+        // "On an RTX-style GPU": its frames, on one scene, queued with the others.
+        let rtx_cfg = match self.rtx {
+            Some(_) if !scenes.is_empty() => {
+                Some(crate::rtx::config().map_err(|message| ReportError::Build {
+                    scene: "configs/rtx2060.toml".into(),
+                    message,
+                })?)
+            }
+            _ => None,
+        };
+        let rtx_scene =
+            crate::rtx::scene_index(&scenes.iter().map(|s| s.spec.clone()).collect::<Vec<_>>());
+        let mut rtx_runs = Vec::new();
+        if let Some(base) = &rtx_cfg {
+            for (accel, workload, warps, mshr) in crate::rtx::plan(base) {
+                let cfg = crate::rtx::with_point(base, warps, mshr);
+                let key = CacheKey::new(
+                    "simt",
+                    &hashes[rtx_scene],
+                    &format!("{}@simt", accel.name()),
+                    workload.name(),
+                    &serde_json::to_string(&cfg).unwrap_or_default(),
+                    (crate::rtx::RES, crate::rtx::RES),
+                );
+                match self.cache.get::<SimResult>(&key) {
+                    Some(r) => rtx_runs.push(RtxRun {
+                        accel,
+                        workload,
+                        rt_max_warps: warps,
+                        rt_max_mshr: mshr,
+                        result: Ok(r),
+                    }),
+                    None => missing.push_back(SimJob {
+                        scene: rtx_scene,
+                        accel,
+                        workload,
+                        tms: 0,
+                        key,
+                        cfg,
+                        rtx: true,
                     }),
                 }
             }
         }
         let pixels = u64::from(self.settings.width) * u64::from(self.settings.height);
+        let rtx_pixels = u64::from(crate::rtx::RES) * u64::from(crate::rtx::RES);
+        let job_pixels = |j: &SimJob| if j.rtx { rtx_pixels } else { pixels };
         self.progress
-            .begin("simulating", missing.len() as u64 * pixels);
+            .begin("simulating", missing.iter().map(job_pixels).sum());
         let (workers, per_frame) = dualsplit_sim::share_threads(missing.len(), self.sim_threads);
         let queue = Mutex::new(missing);
         let done: Mutex<Vec<(SimJob, Result<SimResult, String>)>> = Mutex::new(Vec::new());
@@ -297,7 +363,7 @@ impl<'a> Producer<'a> {
                         let structures = match get(job.scene) {
                             Ok(s) => s,
                             Err(e) => {
-                                self.progress.advance(pixels);
+                                self.progress.advance(job_pixels(&job));
                                 if let Ok(mut d) = done.lock() {
                                     d.push((job, Err(format!("not simulated: {e}"))));
                                 }
@@ -307,7 +373,7 @@ impl<'a> Producer<'a> {
                         if matches!(job.accel, SimAccel::Dst | SimAccel::DstSw)
                             && let Err(e) = structure_bytes(structures, AccelKind::Dst)
                         {
-                            self.progress.advance(pixels);
+                            self.progress.advance(job_pixels(&job));
                             if let Ok(mut d) = done.lock() {
                                 d.push((job, Err(format!("not simulated: {e}"))));
                             }
@@ -318,17 +384,24 @@ impl<'a> Producer<'a> {
                             let prev = last.swap(d, Ordering::Relaxed);
                             self.progress.advance(d.saturating_sub(prev));
                         };
-                        let result = (self.simulate)(
+                        let (simulate, settings) = match self.rtx {
+                            Some(rtx) if job.rtx => (
+                                rtx,
+                                RenderSettings::new(crate::rtx::RES, crate::rtx::RES, job.workload),
+                            ),
+                            _ => (self.simulate, self.sim_settings(job.workload)),
+                        };
+                        let result = simulate(
                             &scenes[job.scene],
                             structures,
                             job.accel,
-                            &self.sim_settings(job.workload),
-                            &self.sim_config(job.tms),
+                            &settings,
+                            &job.cfg,
                             per_frame,
                             &report,
                         );
                         self.progress
-                            .advance(pixels.saturating_sub(last.load(Ordering::Relaxed)));
+                            .advance(job_pixels(&job).saturating_sub(last.load(Ordering::Relaxed)));
                         if let Ok(r) = &result {
                             self.computed.fetch_add(1, Ordering::Relaxed);
                             if let Err(e) = self.cache.put(&job.key, r)
@@ -349,6 +422,17 @@ impl<'a> Producer<'a> {
             return Err(e);
         }
         for (job, result) in done.into_inner().unwrap_or_default() {
+            if job.rtx {
+                let (rt_max_warps, rt_max_mshr) = crate::rtx::point(&job.cfg);
+                rtx_runs.push(RtxRun {
+                    accel: job.accel,
+                    workload: job.workload,
+                    rt_max_warps,
+                    rt_max_mshr,
+                    result,
+                });
+                continue;
+            }
             runs[job.scene].push(SimRun {
                 accel: job.accel,
                 workload: job.workload,
@@ -380,6 +464,24 @@ impl<'a> Producer<'a> {
                 render_res: RENDER_RES,
             });
         }
+        let rtx = rtx_cfg.map(|base| {
+            let plan = crate::rtx::plan(&base);
+            let at = |r: &RtxRun| {
+                plan.iter()
+                    .position(|p| *p == (r.accel, r.workload, r.rt_max_warps, r.rt_max_mshr))
+            };
+            rtx_runs.sort_by_key(at);
+            let (base_warps, base_mshr) = crate::rtx::point(&base);
+            RtxData {
+                scene: scenes[rtx_scene].name.clone(),
+                spec: scenes[rtx_scene].spec.clone(),
+                res: crate::rtx::RES,
+                base_warps,
+                base_mshr,
+                peak_dram_gbps: crate::rtx::peak_dram_gbps(&base),
+                runs: rtx_runs,
+            }
+        });
         Ok(ReportData {
             code_version: format!("{CODE_VERSION}{SCHEMA}+sim{}", dualsplit_sim::MODEL_VERSION),
             settings: self.settings.clone(),
@@ -387,6 +489,7 @@ impl<'a> Producer<'a> {
             skipped,
             scene_files: Default::default(),
             paper: PaperValues::published(),
+            rtx,
         })
     }
 

@@ -539,6 +539,7 @@ mod tests {
             skipped: vec![],
             scene_files: Default::default(),
             paper: PaperValues::published(),
+            rtx: None,
         }
     }
 

@@ -728,7 +728,7 @@ pub fn cpu(data: &ReportData) -> Section {
 
 /// Every section in page order.
 pub fn sections(data: &ReportData) -> Vec<Section> {
-    vec![
+    let mut v = vec![
         table3(data),
         table45(data, Workload::Cast),
         table45(data, Workload::Path),
@@ -736,8 +736,10 @@ pub fn sections(data: &ReportData) -> Vec<Section> {
         table6(data),
         table7(data),
         crate::beyond::section(data),
-        cpu(data),
-    ]
+    ];
+    v.extend(crate::rtx::section(data));
+    v.push(cpu(data));
+    v
 }
 
 /// The paper scene a scene corresponds to, for charts.

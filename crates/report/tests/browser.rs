@@ -119,6 +119,7 @@ fn synthetic_report() -> ReportData {
         skipped: vec![],
         scene_files: Default::default(),
         paper: PaperValues::published(),
+        rtx: None,
     }
 }
 

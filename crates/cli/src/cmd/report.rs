@@ -10,7 +10,7 @@ use anyhow::Context;
 use dualsplit_render::Workload;
 use dualsplit_report::data::{ReportSettings, Skipped};
 use dualsplit_report::paper::PaperScene;
-use dualsplit_report::produce::{BEYOND_TMS, real_simulator, sim_jobs};
+use dualsplit_report::produce::{BEYOND_TMS, SIM_WORKERS, real_simulator, sim_jobs};
 use dualsplit_report::scenes::{self, SceneFiles};
 use dualsplit_report::{Cache, Producer, Progress};
 use dualsplit_sim::{SimAccel, ThreadModel};
@@ -66,6 +66,10 @@ pub struct Args {
     /// without loading anything.
     #[arg(long)]
     dry_run: bool,
+    /// Leave out "On an RTX-style GPU" (the simt model's frames on one scene, about 20
+    /// CPU-seconds cold).
+    #[arg(long)]
+    no_rtx: bool,
     /// Assemble the study in DIR (made by `dualsplit plan`, filled by `run-job`) from the
     /// results in DIR/cache/ into DIR/report/ (or --out when given); missing entries are
     /// listed, not run.
@@ -118,6 +122,7 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         tms: &scope.tms,
         base_tms: scope.base_tms,
         thread_model: scope.thread_model,
+        rtx: !args.no_rtx,
     };
     eprintln!("{}", plan.describe());
     if args.dry_run {
@@ -163,12 +168,16 @@ pub fn run(mut args: Args, ctx: &Ctx) -> anyhow::Result<ExitCode> {
         thread_model: scope.thread_model,
     };
     let simulate = real_simulator(scope.thread_model);
+    let simt = real_simulator(ThreadModel::Simt);
     let bars = Bars {
         ctx,
         bar: Mutex::new(None),
     };
-    let producer = Producer::new(Cache::new(out.join("cache")), settings, &bars, &*simulate)
+    let mut producer = Producer::new(Cache::new(out.join("cache")), settings, &bars, &*simulate)
         .sim_threads(args.threads.get());
+    if !args.no_rtx {
+        producer = producer.with_rtx(&*simt);
+    }
     let mut data = producer.run(&scenes, skipped)?;
     data.scene_files = scope.scene_files;
     let written = dualsplit_report::write_report(&data, &out)?;
@@ -292,9 +301,21 @@ struct Plan<'a> {
     tms: &'a [u32],
     base_tms: u32,
     thread_model: ThreadModel,
+    /// Whether "On an RTX-style GPU" runs.
+    rtx: bool,
 }
 
 impl Plan<'_> {
+    /// Frames of "On an RTX-style GPU" and their scene, when it runs.
+    fn rtx_frames(&self) -> Option<(usize, &str)> {
+        if !self.rtx || self.specs.is_empty() {
+            return None;
+        }
+        let cfg = dualsplit_report::rtx::config().ok()?;
+        let scene = &self.specs[dualsplit_report::rtx::scene_index(self.specs)];
+        Some((dualsplit_report::rtx::plan(&cfg).len(), scene))
+    }
+
     /// Every scene's simulated jobs ([`dualsplit_report::produce::sim_jobs`]).
     fn jobs(&self) -> Vec<(SimAccel, Workload, u32)> {
         Producer::scaling_specs(self.specs)
@@ -321,11 +342,16 @@ impl Plan<'_> {
             Workload::Path => 6.0,
         };
         let rays: f64 = self.jobs().iter().map(|j| pixels * per_pixel(j.1)).sum();
+        let rtx = if self.rtx_frames().is_some() {
+            dualsplit_report::rtx::CPU_SECONDS / SIM_WORKERS as f64
+        } else {
+            0.0
+        };
         rays / match self.thread_model {
             ThreadModel::Rv32 => SIM_RAYS_PER_SECOND_RV32,
             // Not measured for the simt model: the fast model's speed is the estimate.
             ThreadModel::Fast | ThreadModel::Simt => SIM_RAYS_PER_SECOND,
-        }
+        } + rtx
     }
 
     fn describe(&self) -> String {
@@ -342,7 +368,7 @@ impl Plan<'_> {
             "plan: {} scenes ({}) at {r}×{r}, {} thread model; {base} frames at {} TMs \
              ({} configurations, cast and path) and {scaling} frames at other TM counts (the \
              paper's configurations at {:?} TMs on the scaling scenes, and BVH2, BVH8, BVH8+, \
-             DST and the quantized structures at {BEYOND_TMS}); simulations roughly {when} \
+             DST and the quantized structures at {BEYOND_TMS}){}; simulations roughly {when} \
              on a 2-core machine (cached frames are skipped)",
             self.specs.len(),
             self.specs.join(", "),
@@ -350,6 +376,11 @@ impl Plan<'_> {
             self.base_tms,
             SimAccel::ALL.len(),
             self.tms,
+            self.rtx_frames().map_or_else(String::new, |(n, scene)| format!(
+                "; and {n} frames of \"On an RTX-style GPU\" (simt model, {scene} at {r2}×{r2}; \
+                 --no-rtx leaves them out)",
+                r2 = dualsplit_report::rtx::RES
+            )),
             r = self.res,
         )
     }
