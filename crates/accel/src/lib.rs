@@ -84,7 +84,9 @@ pub mod math {
 
 pub use build::{BuildConfig, Bvh2, Bvh2Node};
 pub use image::{ImageError, MemoryImage, SharedTriangles};
-pub use observer::{ByteAddr, CountingObserver, DstNodeKind, NoObserver, NodeStep, Observer};
+pub use observer::{
+    ByteAddr, CountingObserver, DstNodeKind, NoObserver, NodeStep, Observer, StepOutcome,
+};
 pub use stats::StructureStats;
 pub use validate::ValidationReport;
 pub use wide::{BvhImage, BvhQuery, CollapseConfig, WideBvh};
@@ -94,8 +96,8 @@ pub use query::RayQuery;
 pub use rayon;
 pub use registry::*;
 pub use set::{Tracer, TraversalSet};
+pub use stats::BuildStats;
 pub use structure::{Structure, UnitMismatch};
-pub use tree::BuildStats;
 pub use tree_set::TreeSet;
 
 use dualsplit_geometry::{Hit, Ray, Triangle};

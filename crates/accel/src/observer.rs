@@ -2,7 +2,6 @@
 //! does to an [`Observer`]. The CPU path passes [`NoObserver`], which compiles away;
 //! statistics use [`CountingObserver`]; the simulator records macro-operations.
 
-use crate::dst::pipeline::ReturnCode;
 use dualsplit_geometry::PrimId;
 
 /// A byte address in a memory image (word `i` is at byte `4 i`): what a traversal reports
@@ -23,6 +22,28 @@ pub enum DstNodeKind {
     Leaf,
 }
 
+/// Where a node step sends the ray, by how far it goes: nowhere (the stack is popped), into
+/// one child, into both children (one entered, one pushed), or into the node's triangles.
+/// A structure reports its own step results in these terms (the dual-split pipeline's
+/// return codes 0–3 are these, in this order).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum StepOutcome {
+    /// No child is entered.
+    Miss = 0,
+    /// One child is entered.
+    OneChild = 1,
+    /// Both children are entered: one now, the other pushed.
+    BothChildren = 2,
+    /// The node's triangles are tested.
+    Leaf = 3,
+}
+
+impl StepOutcome {
+    /// The four outcomes, in order.
+    pub const ALL: [StepOutcome; 4] = [Self::Miss, Self::OneChild, Self::BothChildren, Self::Leaf];
+}
+
 /// One step of a traversal kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum NodeStep {
@@ -36,13 +57,13 @@ pub enum NodeStep {
         /// Children whose box the ray intersects.
         hits: u8,
     },
-    /// A dual-split tree node step: the node's kind and the pipeline's return code
+    /// A dual-split tree node step: the node's kind and where the step sends the ray
     /// (Lin et al. 2020, §3).
     Dst {
         /// Node kind.
         kind: DstNodeKind,
-        /// The return code: miss, one child, both children, leaf.
-        code: ReturnCode,
+        /// Where the step sends the ray: no child, one child, both children, the leaf.
+        outcome: StepOutcome,
         /// For a carving node acting as a leaf (L bit set).
         carving_leaf: bool,
     },
@@ -108,7 +129,7 @@ pub struct CountingObserver {
     pub bytes: u64,
     /// Stack pushes.
     pub pushes: u64,
-    /// DST steps by pipeline return code 0–3.
+    /// DST steps by [`StepOutcome`], in its order.
     pub dst_codes: [u64; 4],
 }
 
@@ -124,12 +145,12 @@ impl Observer for CountingObserver {
                 self.nodes += 1;
                 self.box_tests += valid as u64;
             }
-            NodeStep::Dst { kind, code, .. } => {
+            NodeStep::Dst { kind, outcome, .. } => {
                 if kind != DstNodeKind::Leaf {
                     self.nodes += 1;
                     self.plane_tests += 2;
                 }
-                self.dst_codes[code as usize] += 1;
+                self.dst_codes[outcome as usize] += 1;
             }
             NodeStep::Leaf { .. } => self.leaves += 1,
         }

@@ -119,3 +119,46 @@ macro_rules! query_by_traversal {
 }
 
 pub(crate) use query_by_traversal;
+
+/// `RayQuery` for a tree type through the structure inside it (`|s| &s.inner`).
+macro_rules! query_via {
+    ($ty:ty, |$s:ident| $inner:expr) => {
+        impl $crate::query::RayQuery for $ty {
+            #[inline]
+            fn intersect_observed<O: $crate::observer::Observer>(
+                &self,
+                ray: &dualsplit_geometry::Ray,
+                obs: &mut O,
+            ) -> Option<dualsplit_geometry::Hit> {
+                let $s = self;
+                $crate::query::RayQuery::intersect_observed($inner, ray, obs)
+            }
+            #[inline]
+            fn occluded_observed<O: $crate::observer::Observer>(
+                &self,
+                ray: &dualsplit_geometry::Ray,
+                obs: &mut O,
+            ) -> bool {
+                let $s = self;
+                $crate::query::RayQuery::occluded_observed($inner, ray, obs)
+            }
+            fn triangles(&self) -> &[dualsplit_geometry::Triangle] {
+                let $s = self;
+                $crate::query::RayQuery::triangles($inner)
+            }
+            fn intersect_batch(
+                &self,
+                rays: &[dualsplit_geometry::Ray],
+            ) -> Vec<Option<dualsplit_geometry::Hit>> {
+                let $s = self;
+                $crate::query::RayQuery::intersect_batch($inner, rays)
+            }
+            fn occluded_batch(&self, rays: &[dualsplit_geometry::Ray]) -> Vec<bool> {
+                let $s = self;
+                $crate::query::RayQuery::occluded_batch($inner, rays)
+            }
+        }
+    };
+}
+
+pub(crate) use query_via;

@@ -13,9 +13,9 @@
 use crate::image::MemoryImage;
 use crate::observer::Observer;
 use crate::query::RayQuery;
-use crate::saved::{FieldReader, FieldWriter, SavedError, Violation};
-use crate::stats::StructureStats;
-use crate::tree::BuildStats;
+pub use crate::saved::SavedFields;
+use crate::saved::Violation;
+use crate::stats::{BuildStats, StructureStats};
 use crate::validate::ValidationReport;
 use crate::wide::Bvh2Tree;
 use crate::{AccelError, AccelKind, BuildConfig, Bvh2, Presets, TreeKind};
@@ -109,26 +109,6 @@ pub trait Structure: RayQuery + Sized + Clone + std::fmt::Debug + Send + Sync {
     /// Checks everything a traversal of the tree's image relies on
     /// (`docs/tree-format.md`, "Checks on load") and the counts `fields` records.
     fn check_saved(&self, fields: &Self::Fields) -> Result<(), Violation>;
-}
-
-/// A structure's own fields of the saved-tree header.
-pub trait SavedFields: Copy + std::fmt::Debug + PartialEq {
-    /// Writes the fields in the header's order.
-    fn write(&self, out: &mut FieldWriter);
-
-    /// Reads the fields of a tree of kind `kind`, refusing values no build makes.
-    fn read(kind: TreeKind, input: &mut FieldReader) -> Result<Self, SavedError>;
-
-    /// Refuses fields that loading would refuse (checked before a tree is written).
-    fn check(&self) -> Result<(), SavedError> {
-        Ok(())
-    }
-
-    /// The scene box the header records, for the structures that store one: loading checks
-    /// it is exactly the bounds of the file's triangles.
-    fn scene_box(&self) -> Option<Aabb> {
-        None
-    }
 }
 
 /// Tracing rays one by one without observing them, through a structure's query context
@@ -545,39 +525,37 @@ macro_rules! structures {
             $( #[cfg($cfg)] $tv(<$tty as Structure>::Fields), )+
         }
 
-        impl AnyFields {
-            /// The fields of `tree`.
-            pub(crate) fn of(tree: &AnyTree) -> Self {
-                match tree {
-                    $( #[cfg($cfg)] AnyTree::$tv(t) => AnyFields::$tv(Structure::saved_fields(t)), )+
-                }
-            }
-
-            /// Reads the fields of a tree of kind `kind`.
-            pub(crate) fn read(kind: TreeKind, input: &mut FieldReader) -> Result<Self, SavedError> {
+        impl SavedFields for AnyFields {
+            fn read(kind: TreeKind, input: &mut FieldReader) -> Result<Self, SavedError> {
                 Ok(match kind {
                     $( #[cfg($cfg)] $(TreeKind::$kv)|+ => AnyFields::$tv(SavedFields::read(kind, input)?), )+
                 })
             }
 
-            /// Writes the fields.
-            pub(crate) fn write(&self, out: &mut FieldWriter) {
+            fn write(&self, out: &mut FieldWriter) {
                 match self {
                     $( #[cfg($cfg)] AnyFields::$tv(f) => f.write(out), )+
                 }
             }
 
-            /// [`SavedFields::check`].
-            pub(crate) fn check(&self) -> Result<(), SavedError> {
+            fn check(&self) -> Result<(), SavedError> {
                 match self {
                     $( #[cfg($cfg)] AnyFields::$tv(f) => f.check(), )+
                 }
             }
 
-            /// [`SavedFields::scene_box`].
-            pub(crate) fn scene_box(&self) -> Option<Aabb> {
+            fn scene_box(&self) -> Option<Aabb> {
                 match self {
                     $( #[cfg($cfg)] AnyFields::$tv(f) => f.scene_box(), )+
+                }
+            }
+        }
+
+        impl AnyFields {
+            /// The fields of `tree`.
+            pub(crate) fn of(tree: &AnyTree) -> Self {
+                match tree {
+                    $( #[cfg($cfg)] AnyTree::$tv(t) => AnyFields::$tv(Structure::saved_fields(t)), )+
                 }
             }
 

@@ -1,7 +1,9 @@
-//! Building exactly one structure: each structure's tree type (in its folder, listed by the
-//! registry) carries its [`BuildStats`]; [`crate::Bvh2Tree`] is the SAH BVH2
-//! every other structure is derived from, and [`AnyTree`] holds whichever one a saved file
-//! contains ([`AnyTree::derive`] makes any of them).
+//! One structure of any kind: [`AnyTree`] (the registry's enum of the tree types, in
+//! `registry.rs`) as it is derived ([`AnyTree::derive`]), saved and loaded
+//! ([`AnyTree::save`], [`AnyTree::load`]: the format of [`crate::saved`], which this file
+//! gives the registry's kinds and header fields). Each structure's tree type lives in its
+//! folder and carries its [`BuildStats`](crate::BuildStats); [`crate::Bvh2Tree`] is the SAH
+//! BVH2 every other structure is derived from.
 //!
 //! ```
 //! use dualsplit_accel::math::{Ray, Triangle, Vec3};
@@ -19,57 +21,12 @@
 //! threads with [`rayon::ThreadPool::install`] or the `*_in` constructors.
 
 use crate::image::MemoryImage;
-use crate::registry::{AnyTree, Presets, TreeKind};
-use crate::{AccelError, Bvh2Tree};
-use serde::Serialize;
-
-/// Size and time of one structure's build, all times in milliseconds.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct BuildStats {
-    /// Which structure.
-    pub kind: Option<TreeKind>,
-    /// Wall time of this structure's own step, encoding included, in milliseconds: the SAH
-    /// build of a BVH2, the collapse of a BVH4 or BVH8 (from a built BVH2), the conversion of
-    /// a DST (from a built BVH2). A host measurement; 0 for a loaded tree.
-    pub build_ms: f64,
-    /// Internal nodes.
-    pub internal_nodes: u64,
-    /// Leaves (leaf words; for a DST, plain leaves and carving nodes acting as leaves).
-    pub leaves: u64,
-    /// Bytes of the node region.
-    pub node_bytes: u64,
-    /// Bytes of the triangle-index region.
-    pub index_bytes: u64,
-    /// Triangles referenced (the triangle region holds 36 bytes each).
-    pub triangles: u64,
-}
-
-impl BuildStats {
-    /// The statistics of a tree of `kind` with `image`, the node counts given and its
-    /// build time.
-    pub(crate) fn of_image(
-        kind: TreeKind,
-        image: &MemoryImage,
-        internal_nodes: u64,
-        leaves: u64,
-        build_ms: f64,
-    ) -> Self {
-        Self {
-            kind: Some(kind),
-            build_ms,
-            internal_nodes,
-            leaves,
-            node_bytes: image.node_bytes(),
-            index_bytes: image.index_bytes(),
-            triangles: image.triangle_slice().len() as u64,
-        }
-    }
-
-    /// Node plus index bytes (the size the paper's Table 3 compares).
-    pub fn bytes_total(&self) -> u64 {
-        self.node_bytes + self.index_bytes
-    }
-}
+use crate::registry::{AnyFields, AnyTree, Presets, TreeKind};
+use crate::saved::{self, SavedError, SavedTree, Violation};
+use crate::{AccelError, BuildConfig, Bvh2Tree};
+use dualsplit_geometry::Triangle;
+use std::io::{self, Read, Write};
+use std::path::Path;
 
 impl AnyTree {
     /// The structure of `kind` derived from `bvh2` with the default settings `dualsplit
@@ -88,45 +45,92 @@ impl AnyTree {
     }
 }
 
-/// `RayQuery` for a tree type through the structure inside it (`|s| &s.inner`).
-macro_rules! query_via {
-    ($ty:ty, |$s:ident| $inner:expr) => {
-        impl $crate::query::RayQuery for $ty {
-            #[inline]
-            fn intersect_observed<O: $crate::observer::Observer>(
-                &self,
-                ray: &dualsplit_geometry::Ray,
-                obs: &mut O,
-            ) -> Option<dualsplit_geometry::Hit> {
-                let $s = self;
-                $crate::query::RayQuery::intersect_observed($inner, ray, obs)
-            }
-            #[inline]
-            fn occluded_observed<O: $crate::observer::Observer>(
-                &self,
-                ray: &dualsplit_geometry::Ray,
-                obs: &mut O,
-            ) -> bool {
-                let $s = self;
-                $crate::query::RayQuery::occluded_observed($inner, ray, obs)
-            }
-            fn triangles(&self) -> &[dualsplit_geometry::Triangle] {
-                let $s = self;
-                $crate::query::RayQuery::triangles($inner)
-            }
-            fn intersect_batch(
-                &self,
-                rays: &[dualsplit_geometry::Ray],
-            ) -> Vec<Option<dualsplit_geometry::Hit>> {
-                let $s = self;
-                $crate::query::RayQuery::intersect_batch($inner, rays)
-            }
-            fn occluded_batch(&self, rays: &[dualsplit_geometry::Ray]) -> Vec<bool> {
-                let $s = self;
-                $crate::query::RayQuery::occluded_batch($inner, rays)
-            }
-        }
-    };
+impl SavedTree for AnyTree {
+    type Fields = AnyFields;
+
+    fn kind(&self) -> TreeKind {
+        AnyTree::kind(self)
+    }
+
+    fn image(&self) -> &MemoryImage {
+        AnyTree::image(self)
+    }
+
+    fn config(&self) -> &BuildConfig {
+        AnyTree::config(self)
+    }
+
+    fn fields(&self) -> AnyFields {
+        AnyFields::of(self)
+    }
+
+    fn check_fields(&self, fields: &AnyFields) -> Result<(), Violation> {
+        fields.check_tree(self)
+    }
+
+    fn assemble(kind: TreeKind, image: MemoryImage, build: BuildConfig, fields: AnyFields) -> Self {
+        fields.assemble(kind, image, build)
+    }
 }
 
-pub(crate) use query_via;
+/// The saved-tree file ([`crate::saved`], `docs/tree-format.md`).
+impl AnyTree {
+    /// Checks everything a traversal of this tree's image relies on, as loading a saved
+    /// tree does (`docs/tree-format.md`, "Checks on load"): child offsets and index runs
+    /// inside their regions, every node reached once from the root (no cycle), runs ended
+    /// by [`crate::image::RUN_END`] and not overlapping, triangle ids below the triangle
+    /// count, each structure's own node checks, and the counts the header records. Linear time.
+    pub fn check_structure(&self) -> Result<(), SavedError> {
+        saved::check_structure(self)
+    }
+
+    /// Writes the tree in the saved-tree format to `w`. The same tree always gives the
+    /// same bytes (no time stamps; build times are not stored). A tree built with a
+    /// negative or non-finite cost is refused (`InvalidInput`): loading would refuse it.
+    pub fn write_to<W: Write>(&self, w: W) -> io::Result<()> {
+        saved::write_to(self, w)
+    }
+
+    /// The saved-tree file as bytes (empty for a tree [`AnyTree::write_to`] refuses).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut v = Vec::new();
+        // Writing to a Vec cannot fail; a refused tree writes nothing.
+        if self.write_to(&mut v).is_err() {
+            v.clear();
+        }
+        v
+    }
+
+    /// Saves the tree to `path` (created or replaced).
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), SavedError> {
+        let path = path.as_ref();
+        let io = |source| SavedError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let f = std::fs::File::create(path).map_err(io)?;
+        self.write_to(io::BufWriter::with_capacity(1 << 20, f))
+            .map_err(io)
+    }
+
+    /// Reads a saved tree of `len` bytes from `r`. With `scene`, the tree must have been
+    /// built from exactly these triangles ([`SavedError::WrongScene`] otherwise).
+    pub fn read_from<R: Read>(
+        r: R,
+        len: u64,
+        scene: Option<&[Triangle]>,
+    ) -> Result<AnyTree, SavedError> {
+        saved::read_from(r, len, scene)
+    }
+
+    /// Reads a saved tree from bytes (see [`AnyTree::read_from`]).
+    pub fn from_bytes(bytes: &[u8], scene: Option<&[Triangle]>) -> Result<AnyTree, SavedError> {
+        Self::read_from(bytes, bytes.len() as u64, scene)
+    }
+
+    /// Loads the saved tree at `path`. With `scene`, the tree must have been built from
+    /// exactly these triangles. Errors name the file.
+    pub fn load(path: impl AsRef<Path>, scene: Option<&[Triangle]>) -> Result<AnyTree, SavedError> {
+        saved::load(path.as_ref(), scene)
+    }
+}

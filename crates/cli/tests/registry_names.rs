@@ -37,12 +37,9 @@ const KNOWN: &[(&str, &str, &str)] = &[
     // `dualsplit stats` compares the DST's conversion presets (the paper's §4.2 study).
     ("crates/cli/src/cmd/stats.rs", "dst::", "the DST-preset study of `dualsplit stats`"),
     ("crates/cli/src/cmd/stats.rs", "Dst", "the DST-preset study of `dualsplit stats`"),
-    // The traversal contract and the `fast` model's events carry the DST pipeline's node
-    // kinds and return codes (taking them out of the contract would end this).
-    ("crates/accel/src/observer.rs", "dst::", "NodeStep::Dst carries the DST's ReturnCode"),
+    // The traversal contract and the `fast` model's events have a dual-split node step
+    // (its node kind and its `StepOutcome`), as they have a BVH node step.
     ("crates/accel/src/observer.rs", "Dst", "NodeStep::Dst, the DST's step event"),
-    ("crates/sim/src/model/fast/tally.rs", "dst::", "DST step events (ReturnCode)"),
-    ("crates/sim/src/model/fast/event.rs", "dst::", "DST step events (ReturnCode)"),
     ("crates/sim/src/model/fast/event.rs", "Dst", "Event::Dst, the DST's step event"),
     // `dualsplit stats --json`'s schema has the DST's node-kind breakdown.
     ("crates/accel/src/stats.rs", "dst::", "StructureStats::dst (DstStats), a JSON field"),

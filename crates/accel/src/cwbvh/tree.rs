@@ -4,10 +4,10 @@
 use super::{Cwbvh, check_structure};
 use crate::image::MemoryImage;
 use crate::observer::Observer;
-use crate::saved::{FieldReader, FieldWriter, SavedError, Violation, counts};
-use crate::stats::StructureStats;
-use crate::structure::{NoQuery, SavedFields, Structure, own_frame};
-use crate::tree::{BuildStats, query_via};
+use crate::query::query_via;
+use crate::saved::{FieldReader, FieldWriter, SavedError, SavedFields, Violation, counts};
+use crate::stats::{BuildStats, StructureStats};
+use crate::structure::{NoQuery, Structure, own_frame};
 use crate::validate::ValidationReport;
 use crate::wide::{CollapseConfig, WideBvh};
 use crate::{

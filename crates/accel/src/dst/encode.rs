@@ -22,8 +22,8 @@
 //! Loading a saved tree replays that sequential allocation and rejects any other layout
 //! (`saved/structure.rs`): a change here changes the saved-tree format.
 
-use super::from_bvh2::{Chain, ChainDp, StepTable, plan_split, plane_values};
 use super::header::{HeaderOffset, OFFSET_LIMIT};
+use super::plan::{Chain, Planner, StepTable, plane_values};
 use super::stats::DstStats;
 use super::{Dst, DstConfig, DstError};
 use crate::build::Bvh2;
@@ -205,26 +205,26 @@ fn slot_size(bvh: &Bvh2, n: u32, chain: Chain) -> usize {
     }
 }
 
-struct Encoder<'a> {
+struct Encoder<'a, P> {
     bvh: &'a Bvh2,
     triangles: usize,
     cfg: &'a DstConfig,
     steps: StepTable,
-    planner: Planner,
+    planner: &'a P,
 }
 
 /// What the sequential plan pass carries down a subtree.
-struct SeqPlan {
+struct SeqPlan<S> {
     /// The records of the internal nodes planned so far, depth-first.
     recs: Vec<Rec>,
     /// Nodes still allowed: a cycle in a malformed BVH runs it out instead of recursing
     /// forever.
     budget: usize,
-    /// The two children's chain DPs, reused from node to node.
-    dps: [ChainDp; 2],
+    /// The planner's working memory, reused from node to node.
+    scratch: S,
 }
 
-impl Encoder<'_> {
+impl<P: Planner> Encoder<'_, P> {
     /// Checks BVH node `n`'s box and child links, or a leaf's triangle range (what planning
     /// and emission index with); for a leaf entered with `chain`, returns its size.
     #[inline(always)]
@@ -267,11 +267,8 @@ impl Encoder<'_> {
     /// The record of internal BVH node `n` (its subtree sizes are filled in by
     /// [`Encoder::close`]).
     #[inline(always)]
-    fn new_rec(&self, n: u32, dps: &mut [ChainDp; 2]) -> Rec {
-        let p = match self.planner {
-            Planner::Fast => plan_split(self.bvh, n, self.cfg, dps),
-            Planner::Reference => super::reference::plan_split(self.bvh, n, self.cfg),
-        };
+    fn new_rec(&self, n: u32, scratch: &mut P::Scratch) -> Rec {
+        let p = self.planner.plan_split(self.bvh, n, self.cfg, scratch);
         Rec {
             chains: [p.left_chain, p.right_chain],
             left_entries: 0,
@@ -300,7 +297,12 @@ impl Encoder<'_> {
     /// depth-first order. Inlined into its caller, so that a leaf costs no call: only
     /// internal nodes recurse ([`Encoder::plan_inner`]).
     #[inline(always)]
-    fn plan_seq(&self, n: u32, chain: Chain, s: &mut SeqPlan) -> Result<Size, DstError> {
+    fn plan_seq(
+        &self,
+        n: u32,
+        chain: Chain,
+        s: &mut SeqPlan<P::Scratch>,
+    ) -> Result<Size, DstError> {
         s.budget = s.budget.checked_sub(1).ok_or(DstError::BadBvhLink {
             node: n,
             child: n,
@@ -313,9 +315,14 @@ impl Encoder<'_> {
     }
 
     /// [`Encoder::plan_seq`] for internal node `n`, already checked.
-    fn plan_inner(&self, n: u32, chain: Chain, s: &mut SeqPlan) -> Result<Size, DstError> {
+    fn plan_inner(
+        &self,
+        n: u32,
+        chain: Chain,
+        s: &mut SeqPlan<P::Scratch>,
+    ) -> Result<Size, DstError> {
         let slot = s.recs.len();
-        let rec = self.new_rec(n, &mut s.dps);
+        let rec = self.new_rec(n, &mut s.scratch);
         s.recs.push(rec);
         let ([cl, cr], [ch_l, ch_r]) = (rec.children(self.bvh, n), rec.chains);
         let l = self.plan_seq(cl, ch_l, s)?;
@@ -331,7 +338,7 @@ impl Encoder<'_> {
                 // move.
                 recs: Vec::with_capacity(self.bvh.nodes.len() >> PARALLEL_DEPTH),
                 budget: self.bvh.nodes.len(),
-                dps: [ChainDp::new(), ChainDp::new()],
+                scratch: self.planner.scratch(),
             };
             let size = self.plan_seq(n, chain, &mut s)?;
             return Ok((Plan::Seq(s.recs), size));
@@ -339,7 +346,7 @@ impl Encoder<'_> {
         if let Some(leaf) = self.check_node(n, chain)? {
             return Ok((Plan::Seq(Vec::new()), leaf));
         }
-        let mut rec = self.new_rec(n, &mut [ChainDp::new(), ChainDp::new()]);
+        let mut rec = self.new_rec(n, &mut self.planner.scratch());
         let [cl, cr] = rec.children(self.bvh, n);
         let (l, r) = rayon::join(
             || self.plan(cl, rec.chains[0], depth + 1),
@@ -532,22 +539,13 @@ impl Encoder<'_> {
     }
 }
 
-/// Who makes the decisions the encoder emits.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Planner {
-    /// The fast chain DP of [`super::from_bvh2`].
-    Fast,
-    /// The plain DP of [`super::reference`].
-    Reference,
-}
-
 /// Converts `bvh` into a DST over `triangles` with the decisions of `planner`: plans every
 /// split, checks the image fits the 26-bit offsets, then emits it (see the module doc).
-pub(super) fn encode(
+pub(super) fn encode<P: Planner>(
     bvh: &Bvh2,
     triangles: SharedTriangles,
     cfg: &DstConfig,
-    planner: Planner,
+    planner: &P,
 ) -> Result<Dst, DstError> {
     let enc = Encoder {
         bvh,

@@ -4,11 +4,12 @@
 //!
 //! ```text
 //!  Bvh2 ──from_bvh2.rs──▶ per BVH node: carving chain (SAH, DP over faces) + split order
-//!                 │        (reference.rs: the same decisions as plain loops, for tests)
-//!                 │
+//!                 │        (reference.rs: the same decisions as plain loops, for tests;
+//!                 │         both are plan.rs's Planner, and decide in plan.rs's terms)
 //!                 └─encode.rs──▶ MemoryImage: node words | index runs | triangles
 //!                                 │
 //!        traverse.rs (DST*, branchy reference) ◀─┴─▶ pipeline.rs (branch-free step function)
+//!                                                    pipeline_traverse.rs (the loop it drives)
 //!                  validate.rs (rebuild every BVH box)   stats.rs (sizes, per-ray counts)
 //! ```
 //!
@@ -40,6 +41,8 @@ mod fast;
 mod from_bvh2;
 mod header;
 pub mod pipeline;
+mod pipeline_traverse;
+mod plan;
 mod reference;
 mod saved;
 mod stats;

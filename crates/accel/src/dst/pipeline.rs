@@ -1,5 +1,6 @@
 //! The hardware dual-split pipeline as a pure step function (Lin et al. 2020, §3, Fig. 6,
-//! Appendices A–C, Figs. 10–12), and traversal loops driven only by it.
+//! Appendices A–C, Figs. 10–12). The traversal loop driven only by it is
+//! `dst/pipeline_traverse.rs` ([`Dst::closest_hit_pipeline`](super::Dst::closest_hit_pipeline)).
 //!
 //! The function is written like the datapath: every stage runs for every node type and
 //! 2:1 multiplexers ([`mux`]) pick operands and results, steered by header bits and the ray's
@@ -27,11 +28,9 @@
 //! hardware unit could fold it into a constant multiplier (or skip it, trading the rare
 //! grazing miss for the area).
 
-use super::Dst;
 use super::header::HeaderOffset;
-use super::traverse::{Entry, RunResult, Tracer};
-use crate::observer::{NodeStep, Observer};
-use dualsplit_geometry::{EXIT_WIDEN, Hit, Ray};
+use crate::observer::StepOutcome;
+use dualsplit_geometry::EXIT_WIDEN;
 
 /// The pipeline's 2-bit return code, numbered as in the paper (Lin et al. 2020, §3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -47,6 +46,19 @@ pub enum ReturnCode {
     /// 3: leaf (plain leaf or carving node acting as a leaf) — intersect the triangle run
     /// at `offset`.
     Leaf = 3,
+}
+
+impl From<ReturnCode> for StepOutcome {
+    /// The code in the traversal contract's terms: the same four results, in the same order.
+    #[inline(always)]
+    fn from(c: ReturnCode) -> Self {
+        match c {
+            ReturnCode::Miss => StepOutcome::Miss,
+            ReturnCode::OneChild => StepOutcome::OneChild,
+            ReturnCode::BothChildren => StepOutcome::BothChildren,
+            ReturnCode::Leaf => StepOutcome::Leaf,
+        }
+    }
 }
 
 impl ReturnCode {
@@ -189,72 +201,5 @@ pub fn step(i: &PipelineInput) -> PipelineOutput {
         offset_stack: far,
         t_min_out,
         t_max_out,
-    }
-}
-
-impl Dst {
-    /// Closest hit of `ray`, every node step computed by the pipeline function [`step`].
-    pub fn closest_hit_pipeline<O: Observer>(&self, ray: &Ray, obs: &mut O) -> Option<Hit> {
-        self.traverse_pipeline::<O, false>(ray, obs)
-    }
-
-    /// Any hit of `ray` within `[t_min, t_max]`, driven by the pipeline function [`step`].
-    pub fn any_hit_pipeline<O: Observer>(&self, ray: &Ray, obs: &mut O) -> bool {
-        self.traverse_pipeline::<O, true>(ray, obs).is_some()
-    }
-
-    #[inline(always)]
-    fn traverse_pipeline<O: Observer, const ANY: bool>(
-        &self,
-        ray: &Ray,
-        obs: &mut O,
-    ) -> Option<Hit> {
-        let (mut tr, mut t_min, mut t_max) = Tracer::start(self, ray)?;
-        let origin = tr.r.ray.origin.to_array();
-        let inv_dir = tr.r.inv_dir.to_array();
-        let mut node = 0u32;
-        loop {
-            let (word, p0, p1) = tr.fetch_node(node, obs);
-            let out = step(&PipelineInput {
-                word,
-                p0,
-                p1,
-                origin,
-                inv_dir,
-                t_min,
-                t_max,
-            });
-            obs.step(NodeStep::Dst {
-                kind: word.node_kind(),
-                code: out.code,
-                carving_leaf: word.is_carving() & word.is_leaf_flag(),
-            });
-            match out.code {
-                ReturnCode::OneChild => {
-                    (node, t_min, t_max) = (out.offset, out.t_min_out, out.t_max_out);
-                    continue;
-                }
-                ReturnCode::BothChildren => {
-                    tr.stack.push(Entry {
-                        node: out.offset_stack,
-                        t_min: out.t_min_out,
-                        t_max,
-                    });
-                    obs.push();
-                    (node, t_max) = (out.offset, out.t_max_out);
-                    continue;
-                }
-                ReturnCode::Leaf => {
-                    if let RunResult::Occluded = tr.test_run::<O, ANY>(out.offset, obs) {
-                        return tr.best;
-                    }
-                }
-                ReturnCode::Miss => {}
-            }
-            let Some(e) = tr.pop(obs) else {
-                return tr.best;
-            };
-            (node, t_min, t_max) = (e.node, e.t_min, e.t_max);
-        }
     }
 }

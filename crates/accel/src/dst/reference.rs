@@ -13,7 +13,8 @@
 //! face of each child for free, so it enters the child's chain in that face's state, and the
 //! split that costs least over 3 axes × 2 child orders wins.
 
-use super::from_bvh2::{Chain, SplitPlan, face, leaf_tris, max_face, min_face};
+use super::encode::encode;
+use super::plan::{Chain, Planner, SplitPlan, face, leaf_tris, max_face, min_face};
 use super::{Dst, DstConfig, DstCosts, DstError};
 use crate::build::Bvh2;
 use crate::image::SharedTriangles;
@@ -31,19 +32,27 @@ impl Dst {
         triangles: impl Into<SharedTriangles>,
         cfg: &DstConfig,
     ) -> Result<Dst, DstError> {
-        super::encode::encode(
-            bvh,
-            triangles.into(),
-            cfg,
-            super::encode::Planner::Reference,
-        )
+        encode(bvh, triangles.into(), cfg, &ReferencePlanner)
+    }
+}
+
+/// The reference planner: [`plan_split`], with nothing reused from node to node.
+pub(super) struct ReferencePlanner;
+
+impl Planner for ReferencePlanner {
+    type Scratch = ();
+
+    fn scratch(&self) {}
+
+    fn plan_split(&self, bvh: &Bvh2, n: u32, cfg: &DstConfig, (): &mut ()) -> SplitPlan {
+        plan_split(bvh, n, cfg)
     }
 }
 
 /// The split of internal BVH node `n`: the axis and child order whose split plus both
 /// children's cheapest chains cost least (the first in axis order, then the BVH's child
 /// order, on ties).
-pub(super) fn plan_split(bvh: &Bvh2, n: u32, cfg: &DstConfig) -> SplitPlan {
+fn plan_split(bvh: &Bvh2, n: u32, cfg: &DstConfig) -> SplitPlan {
     let node = &bvh.nodes[n as usize];
     let chains = node.children().map(|c| {
         let child = &bvh.nodes[c as usize].bounds;

@@ -245,7 +245,7 @@ impl<'a> Tracer<'a> {
 fn dst_step(kind: DstNodeKind, code: ReturnCode, carving_leaf: bool) -> NodeStep {
     NodeStep::Dst {
         kind,
-        code,
+        outcome: code.into(),
         carving_leaf,
     }
 }

@@ -6,10 +6,10 @@ use super::{Dst, DstConfig, DstCosts, DstQuery, DstStats, Partitioning};
 use crate::image::MemoryImage;
 use crate::observer::Observer;
 use crate::query::RayQuery;
-use crate::saved::{FieldReader, FieldWriter, SavedError, Violation, check_cost};
-use crate::stats::StructureStats;
-use crate::structure::{PlainQuery, SavedFields, Structure, own_frame};
-use crate::tree::{BuildStats, query_via};
+use crate::query::query_via;
+use crate::saved::{FieldReader, FieldWriter, SavedError, SavedFields, Violation, check_cost};
+use crate::stats::{BuildStats, StructureStats};
+use crate::structure::{PlainQuery, Structure, own_frame};
 use crate::validate::ValidationReport;
 use crate::{
     AccelError, AccelKind, AnyTree, BuildConfig, Bvh2, Bvh2Tree, Presets, Structures, TreeKind,

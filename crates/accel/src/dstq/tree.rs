@@ -7,10 +7,10 @@ use super::{DstQ, DstQConfig};
 use crate::dst::{Dst, DstConfig, DstTree};
 use crate::image::MemoryImage;
 use crate::observer::Observer;
-use crate::saved::{FieldReader, FieldWriter, SavedError, Violation, violation};
-use crate::stats::StructureStats;
-use crate::structure::{NoQuery, SavedFields, Structure, UnitMismatch, own_frame};
-use crate::tree::{BuildStats, query_via};
+use crate::query::query_via;
+use crate::saved::{FieldReader, FieldWriter, SavedError, SavedFields, Violation, violation};
+use crate::stats::{BuildStats, StructureStats};
+use crate::structure::{NoQuery, Structure, UnitMismatch, own_frame};
 use crate::validate::ValidationReport;
 use crate::{
     AccelError, AccelKind, AnyTree, BuildConfig, Bvh2, Bvh2Tree, Presets, Structures, TreeKind,

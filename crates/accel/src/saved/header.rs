@@ -2,7 +2,6 @@
 //! encoding and the checks made on it before anything is allocated.
 
 use super::SavedError;
-use crate::registry::AnyFields;
 use crate::{BuildConfig, TreeKind};
 use dualsplit_geometry::{Aabb, Vec3};
 
@@ -18,9 +17,29 @@ pub const WORDS_OFFSET: u64 = 4096;
 /// Bytes of the SHA-256 checksum that ends the file.
 pub const CHECKSUM_BYTES: u64 = 32;
 
-/// The decoded header.
+/// A structure's own fields of the saved-tree header, after the fields every file has.
+pub trait SavedFields: Copy + std::fmt::Debug + PartialEq {
+    /// Writes the fields in the header's order.
+    fn write(&self, out: &mut FieldWriter);
+
+    /// Reads the fields of a tree of kind `kind`, refusing values no build makes.
+    fn read(kind: TreeKind, input: &mut FieldReader) -> Result<Self, SavedError>;
+
+    /// Refuses fields that loading would refuse (checked before a tree is written).
+    fn check(&self) -> Result<(), SavedError> {
+        Ok(())
+    }
+
+    /// The scene box the header records, for the structures that store one: loading checks
+    /// it is exactly the bounds of the file's triangles.
+    fn scene_box(&self) -> Option<Aabb> {
+        None
+    }
+}
+
+/// The decoded header, with the structure's own fields `F`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct Header {
+pub(super) struct Header<F> {
     pub kind: TreeKind,
     pub node_words: u64,
     pub index_words: u64,
@@ -28,7 +47,7 @@ pub(super) struct Header {
     pub file_bytes: u64,
     pub triangle_hash: [u8; 32],
     pub build: BuildConfig,
-    pub extra: AnyFields,
+    pub extra: F,
 }
 
 /// The file size a header with these region sizes implies, or `None` on overflow.
@@ -126,7 +145,7 @@ pub(crate) fn check_cost(what: &str, name: &str, c: f32) -> Result<(), SavedErro
     }
 }
 
-impl Header {
+impl<F: SavedFields> Header<F> {
     /// The header's `HEADER_BYTES` bytes.
     pub fn encode(&self) -> Vec<u8> {
         let mut o = FieldWriter(Vec::with_capacity(HEADER_BYTES));
@@ -153,7 +172,7 @@ impl Header {
     /// Decodes and checks a header read from a file of `actual_bytes` bytes: magic,
     /// version, kind, and region sizes that add up to the file's size (so nothing larger
     /// than the file is ever allocated).
-    pub fn decode(h: &[u8; HEADER_BYTES], actual_bytes: u64) -> Result<Header, SavedError> {
+    pub fn decode(h: &[u8; HEADER_BYTES], actual_bytes: u64) -> Result<Self, SavedError> {
         let mut i = FieldReader(h);
         if i.take::<8>() != MAGIC {
             return Err(SavedError::NotATree);
@@ -202,7 +221,7 @@ impl Header {
             parallel_threshold: i.u32(),
         };
         check_build(&build)?;
-        let extra = AnyFields::read(kind, &mut i)?;
+        let extra = F::read(kind, &mut i)?;
         Ok(Header {
             kind,
             node_words,

@@ -9,10 +9,9 @@
 
 use crate::image::{MemoryImage, RUN_END, SharedTriangles};
 use crate::observer::Observer;
-use crate::saved::{FieldReader, FieldWriter, SavedError, Violation};
-use crate::stats::StructureStats;
-use crate::structure::{NoQuery, SavedFields, Structure};
-use crate::tree::BuildStats;
+use crate::saved::{FieldReader, FieldWriter, SavedError, SavedFields, Violation};
+use crate::stats::{BuildStats, StructureStats};
+use crate::structure::{NoQuery, Structure};
 use crate::validate::ValidationReport;
 use crate::wide::traverse::test_run;
 use crate::{AccelError, AccelKind, AnyTree, BuildConfig, Bvh2, Bvh2Tree, Presets, TreeKind};

@@ -73,10 +73,12 @@
 //! | file | what it holds |
 //! |---|---|
 //! | `layout.rs` | the nodes ([`Chunk`], [`Chunk8`]), child words and triangle packets |
+//! | `lanes.rs` | a node read as lanes, with its box test (the `Lanes` trait) |
 //! | `copy.rs` | copying the image into them |
 //! | `merge.rs` | leaf merging: subtrees of at most [`MERGE_MAX`] triangles as one leaf |
 //! | `order.rs` | the order of a node's children: the likeliest to stop a shadow ray first |
-//! | `isa.rs` | the instruction sets ([`SimdLevel`]) and the dispatch of a ray to one |
+//! | `isa.rs` | the instruction sets ([`SimdLevel`]) |
+//! | `dispatch.rs` | the dispatch of a ray to the loop compiled for one of them |
 //! | `traverse.rs` | the traversal loop, its stack and the leaf test |
 //! | `ray.rs` | the ray's SIMD constants, the 4-wide box test and the packet's first stage |
 //!
@@ -87,7 +89,9 @@
 //! [`PAGES_MIN_BYTES`]: crate::image::PAGES_MIN_BYTES
 
 mod copy;
+mod dispatch;
 mod isa;
+mod lanes;
 mod layout;
 mod merge;
 mod order;
@@ -95,8 +99,9 @@ mod ray;
 mod traverse;
 
 pub(crate) use copy::pack_entries;
+pub(crate) use dispatch::PackedHit;
 pub use isa::SimdLevel;
-pub(crate) use isa::{PackedHit, avx2_token};
+pub(crate) use isa::avx2_token;
 pub use layout::{Chunk, Chunk8, EMPTY, LANES, LEAF, TriPacket};
 pub use merge::{MERGE_LIMIT_MAX, MERGE_MAX, merge_limit, merge_limit_from_env};
 pub(crate) use ray::RaySimd;
@@ -105,9 +110,9 @@ pub(crate) use traverse::test_leaf;
 use super::simd::Avx2;
 use crate::image::{MemoryImage, NodeLayout, Pages};
 use copy::copy;
+use dispatch::dispatch;
 use dualsplit_geometry::{Hit, Ray, cull_limit};
-use isa::dispatch;
-use layout::Lanes;
+use lanes::Lanes;
 use traverse::{Entry, STACK};
 
 /// The nodes of a [`CpuBvh`], one per node of the image, the root first.
@@ -280,7 +285,7 @@ impl CpuQuery<'_> {
 #[cfg(test)]
 mod tests {
     use super::isa::Sse2;
-    use super::layout::Lanes;
+    use super::lanes::Lanes;
     use super::ray::{keep_max, keep_max_portable, keep_min, keep_min_portable};
     use super::*;
     use crate::image::RUN_END;

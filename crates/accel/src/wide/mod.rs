@@ -19,13 +19,15 @@ pub mod encode;
 mod node4;
 mod node8;
 pub(crate) mod simd;
+mod structure;
 pub mod traverse;
 mod tree;
 
 pub use collapse::CollapseConfig;
 pub use node4::Node4;
 pub use node8::Node8;
-pub use tree::{Bvh2Tree, BvhFields, BvhTree};
+pub use structure::BvhFields;
+pub use tree::{Bvh2Tree, BvhTree};
 
 use crate::bvh2::Node2;
 use crate::image::{ImageError, MemoryImage};

@@ -1,6 +1,7 @@
 //! Copying a BVH image into the CPU-side nodes and triangle packets.
 
-use super::layout::{EMPTY, EMPTY_PACKET, LANES, LEAF, Lanes, TriPacket};
+use super::lanes::Lanes;
+use super::layout::{EMPTY, EMPTY_PACKET, LANES, LEAF, TriPacket};
 use super::merge::gather;
 use super::order::order_lanes;
 use crate::image::{ChildKind, MemoryImage, NodeLayout, RUN_END};

@@ -18,7 +18,8 @@
 //! docs): this changes speed only. Figures: `docs/cpu-traversal.md`, "Shadow rays: the
 //! likeliest occluder first".
 
-use super::layout::{LANES, LEAF, Lanes, TriPacket};
+use super::lanes::Lanes;
+use super::layout::{LANES, LEAF, TriPacket};
 use super::traverse::lane_triangle;
 use crate::image::{RUN_END, words_box};
 use dualsplit_geometry::Triangle;

@@ -1,7 +1,8 @@
 //! The traversal of the copy: the node loop, the stack, and the leaf test.
 
 use super::isa::Isa;
-use super::layout::{EMPTY, LANES, LEAF, Lanes, TriPacket};
+use super::lanes::Lanes;
+use super::layout::{EMPTY, LANES, LEAF, TriPacket};
 use super::ray::RaySimd;
 use crate::image::RUN_END;
 use crate::wide::simd::Avx2;

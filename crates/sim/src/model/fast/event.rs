@@ -1,8 +1,7 @@
 //! The traversal and workload events the `fast` model charges its kernel's measured
 //! instructions for.
 
-use dualsplit_accel::DstNodeKind;
-use dualsplit_accel::dst::pipeline::ReturnCode;
+use dualsplit_accel::{DstNodeKind, StepOutcome};
 
 /// A traversal or workload event the `fast` model charges its kernel's instructions for.
 /// Their costs are measured per configuration and workload ([`crate::model::fast::calibrate`]).
@@ -38,8 +37,9 @@ pub enum Event {
     BvhHit,
     /// One compare-exchange of the entry-distance sort (`hits·(hits − 1)/2` per node).
     BvhSortPair,
-    /// A DST node step of this kind and return code (Lin et al. 2020, §3).
-    Dst(DstNodeKind, ReturnCode),
+    /// A DST node step of this kind and outcome (the pipeline's return code, Lin et al.
+    /// 2020, §3).
+    Dst(DstNodeKind, StepOutcome),
 }
 
 /// Number of [`Event`] indices.
@@ -108,7 +108,7 @@ impl Event {
             all[e.index()] = e;
         }
         for k in DST_KINDS {
-            for c in ReturnCode::ALL {
+            for c in StepOutcome::ALL {
                 all[Event::Dst(k, c).index()] = Event::Dst(k, c);
             }
         }

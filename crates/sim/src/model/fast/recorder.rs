@@ -305,7 +305,7 @@ impl Observer for Recorder<'_> {
                 self.charge(Event::BvhHit.index(), hits);
                 self.charge(Event::BvhSortPair.index(), bvh_pairs(hits));
             }
-            NodeStep::Dst { kind, code, .. } => {
+            NodeStep::Dst { kind, outcome, .. } => {
                 if self.dst_hw {
                     self.push_op(Op::Pipe {
                         pipe: Pipe::DualSplit,
@@ -313,7 +313,7 @@ impl Observer for Recorder<'_> {
                         parallel: false,
                     });
                 }
-                self.charge(Event::Dst(kind, code).index(), 1);
+                self.charge(Event::Dst(kind, outcome).index(), 1);
             }
             NodeStep::Leaf { .. } => self.charge(Event::Leaf.index(), 1),
         }
@@ -381,8 +381,7 @@ mod tests {
     use crate::hw::counts::{InstrCounts, Mix};
     use crate::model::fast::costs::{Costs, L1_WORDS, TARGETS};
     use crate::model::fast::event::{DST_KINDS, EVENTS};
-    use dualsplit_accel::DstNodeKind;
-    use dualsplit_accel::dst::pipeline::ReturnCode;
+    use dualsplit_accel::{DstNodeKind, StepOutcome};
     use dualsplit_geometry::Pcg32;
 
     /// Costs with random fractional instruction counts per event (leaked: tallies take
@@ -439,7 +438,7 @@ mod tests {
             }
             2 => r.step(NodeStep::Dst {
                 kind: DST_KINDS[rng.below(4) as usize],
-                code: ReturnCode::ALL[rng.below(4) as usize],
+                outcome: StepOutcome::ALL[rng.below(4) as usize],
                 carving_leaf: rng.below(2) == 1,
             }),
             3 => r.step(NodeStep::Leaf {
@@ -690,7 +689,7 @@ mod tests {
     fn dst_on_the_pipeline_is_one_pipeline_op_per_step() {
         let step = NodeStep::Dst {
             kind: DstNodeKind::Split,
-            code: ReturnCode::BothChildren,
+            outcome: StepOutcome::BothChildren,
             carving_leaf: false,
         };
         for (accel, pipe_ops) in [(SimAccel::Dst, 1), (SimAccel::DstSw, 0)] {
@@ -700,7 +699,7 @@ mod tests {
             r.step(step);
             assert_eq!(r.tally().counts().dst_ops, pipe_ops);
             assert_eq!(r.tally().counts().node_steps, 1);
-            let e = Event::Dst(DstNodeKind::Split, ReturnCode::BothChildren);
+            let e = Event::Dst(DstNodeKind::Split, StepOutcome::BothChildren);
             assert_eq!(r.tally().events()[e.index()], 1);
         }
     }

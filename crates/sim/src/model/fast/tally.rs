@@ -6,8 +6,7 @@ use crate::hw::counts::{InstrCounts, Mix};
 use crate::model::fast::costs::{Costs, DEPENDENCY, PIPELINE};
 use crate::model::fast::event::{DST_KINDS, EVENTS, Event};
 use crate::model::fast::op::OpRangeError;
-use dualsplit_accel::DstNodeKind;
-use dualsplit_accel::dst::pipeline::ReturnCode;
+use dualsplit_accel::{DstNodeKind, StepOutcome};
 
 /// What the recorders of one frame count, summed over every ray: events, loads and atomics,
 /// and the first step that did not fit an [`Op`](crate::model::fast::op::Op).
@@ -104,7 +103,7 @@ impl Tally {
             c.box_issues = self.boxed_nodes;
         }
         c.tri_ops = e[Event::TriTest.index()];
-        let dst = &e[Event::Dst(DST_KINDS[0], ReturnCode::ALL[0]).index()..];
+        let dst = &e[Event::Dst(DST_KINDS[0], StepOutcome::ALL[0]).index()..];
         let dst_leaf = &dst[4 * DstNodeKind::Leaf as usize..];
         match self.accel.node_unit() {
             NodeUnit::DualSplitPipe => c.dst_ops = dst.iter().sum(),
