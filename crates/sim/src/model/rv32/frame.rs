@@ -15,6 +15,7 @@ use crate::hw::{Chip, Cycle, Stalls};
 use crate::model::rv32::kernels::{FRAME_FLOATS_PER_PIXEL, Params, elf, placement};
 use crate::model::rv32::placement::Placement;
 use crate::model::rv32::tp::Tp;
+use crate::model::rv32::uop::Uops;
 use crate::model::rv32::{
     ExecError, FRAME_BUFFER_ADDR, FrameMemory, ImageView, PARAMS_ADDR, PROGRAM_BASE, Program,
 };
@@ -31,6 +32,8 @@ pub(crate) struct Compiled<'a, 'm> {
     /// The chip's TMs the TPs are on.
     pub(crate) tms: Range<usize>,
     pub(crate) prog: &'a Program,
+    /// `prog`'s instructions with their issue under `cfg`.
+    pub(crate) uops: &'a Uops,
     /// The frame's memory as the local phase reads it.
     pub(crate) image: ImageView<'m>,
     pub(crate) placement: &'a Placement,
@@ -75,6 +78,7 @@ impl<'a, 'm: 'a> Lane for Compiled<'a, 'm> {
     ) -> Result<Wake, ExecError> {
         self.tps[id].run::<false, _, _>(
             self.prog,
+            self.uops,
             &mut self.image,
             self.cfg,
             tm,
@@ -96,6 +100,7 @@ impl<'a, 'm: 'a> Lane for Compiled<'a, 'm> {
     ) -> Result<Wake, ExecError> {
         self.tps[id].run::<true, _, _>(
             self.prog,
+            self.uops,
             shared.model.mem,
             self.cfg,
             tm,
@@ -132,6 +137,7 @@ pub(crate) fn run_tps(
 ) -> Result<(Cycle, ClassCounts), ExecError> {
     let per_tm = cfg.tps_per_tm as usize;
     let image = mem.view();
+    let uops = Uops::new(prog, &cfg.units);
     let mut rest: &mut [Tp] = tps;
     let mut lanes = Vec::new();
     for tms in engine::groups(cfg.tms as usize, host_threads) {
@@ -142,6 +148,7 @@ pub(crate) fn run_tps(
             tps: mine,
             tms,
             prog,
+            uops: &uops,
             image,
             placement,
             cfg: &cfg.units,

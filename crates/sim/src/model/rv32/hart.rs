@@ -583,6 +583,151 @@ impl Hart {
         self.execute(ins, prog, mem).map(|(acc, _)| acc)
     }
 
+    /// Executes `ins` when it is a register operation: integer and floating-point
+    /// arithmetic, `lui`, `auipc`, branches, jumps, `fence`, `rt.rcp` and `rt.rand` (no
+    /// memory access, no latch, no error); returns whether it was a taken branch or a jump.
+    /// Returns `None`, changing nothing, for any other instruction ([`Hart::execute`] runs
+    /// it). The `rv32` timing model calls it inline, before the out-of-line executor.
+    #[inline(always)]
+    pub fn exec_register(&mut self, ins: &Instr) -> Option<bool> {
+        use Op::*;
+        let (pc, imm) = (self.pc, ins.imm);
+        // `& 31` lets the compiler drop the register files' bounds checks.
+        let (rd, rs1, rs2, rs3) = (
+            ins.rd as usize & 31,
+            ins.rs1 as usize & 31,
+            ins.rs2 as usize & 31,
+            ins.rs3 as usize & 31,
+        );
+        let a = || self.x[rs1];
+        let b = || self.x[rs2];
+        let fa = || f32::from_bits(self.f[rs1]);
+        let fb = || f32::from_bits(self.f[rs2]);
+        let fc = || f32::from_bits(self.f[rs3]);
+        let mut next = pc.wrapping_add(4);
+        let link = next;
+        let mut taken = false;
+        let mut branch = |c: bool| {
+            if c {
+                next = pc.wrapping_add(imm as u32);
+                taken = true;
+            }
+        };
+        // The value of `x[rd]` (`Ok`) or `f[rd]` (`Err`), if any.
+        let out: Option<Result<u32, u32>> = match ins.op {
+            Lui => Some(Ok(imm as u32)),
+            Auipc => Some(Ok(pc.wrapping_add(imm as u32))),
+            Jal => {
+                branch(true);
+                Some(Ok(link))
+            }
+            Jalr => {
+                // Read before the link write (rd may be rs1).
+                next = a().wrapping_add(imm as u32) & !1;
+                taken = true;
+                Some(Ok(link))
+            }
+            Beq => {
+                branch(a() == b());
+                None
+            }
+            Bne => {
+                branch(a() != b());
+                None
+            }
+            Blt => {
+                branch((a() as i32) < (b() as i32));
+                None
+            }
+            Bge => {
+                branch((a() as i32) >= (b() as i32));
+                None
+            }
+            Bltu => {
+                branch(a() < b());
+                None
+            }
+            Bgeu => {
+                branch(a() >= b());
+                None
+            }
+            Addi => Some(Ok(a().wrapping_add(imm as u32))),
+            Slti => Some(Ok(((a() as i32) < imm) as u32)),
+            Sltiu => Some(Ok((a() < imm as u32) as u32)),
+            Xori => Some(Ok(a() ^ imm as u32)),
+            Ori => Some(Ok(a() | imm as u32)),
+            Andi => Some(Ok(a() & imm as u32)),
+            Slli => Some(Ok(a() << imm)),
+            Srli => Some(Ok(a() >> imm)),
+            Srai => Some(Ok(((a() as i32) >> imm) as u32)),
+            Add => Some(Ok(a().wrapping_add(b()))),
+            Sub => Some(Ok(a().wrapping_sub(b()))),
+            Sll => Some(Ok(a() << (b() & 31))),
+            Slt => Some(Ok(((a() as i32) < (b() as i32)) as u32)),
+            Sltu => Some(Ok((a() < b()) as u32)),
+            Xor => Some(Ok(a() ^ b())),
+            Srl => Some(Ok(a() >> (b() & 31))),
+            Sra => Some(Ok(((a() as i32) >> (b() & 31)) as u32)),
+            Or => Some(Ok(a() | b())),
+            And => Some(Ok(a() & b())),
+            Mul => Some(Ok(a().wrapping_mul(b()))),
+            Mulh => Some(Ok(((a() as i32 as i64 * b() as i32 as i64) >> 32) as u32)),
+            Mulhsu => Some(Ok(((a() as i32 as i64 * b() as i64) >> 32) as u32)),
+            Mulhu => Some(Ok(((a() as u64 * b() as u64) >> 32) as u32)),
+            Div => Some(Ok(if b() == 0 {
+                u32::MAX
+            } else {
+                (a() as i32).wrapping_div(b() as i32) as u32
+            })),
+            Divu => Some(Ok(a().checked_div(b()).unwrap_or(u32::MAX))),
+            Rem => Some(Ok(if b() == 0 {
+                a()
+            } else {
+                (a() as i32).wrapping_rem(b() as i32) as u32
+            })),
+            Remu => Some(Ok(if b() == 0 { a() } else { a() % b() })),
+            Fence => None,
+            FmaddS => Some(Err(canon(fa().mul_add(fb(), fc())))),
+            FmsubS => Some(Err(canon(fa().mul_add(fb(), -fc())))),
+            FnmsubS => Some(Err(canon((-fa()).mul_add(fb(), fc())))),
+            FnmaddS => Some(Err(canon((-fa()).mul_add(fb(), -fc())))),
+            FaddS => Some(Err(canon(fa() + fb()))),
+            FsubS => Some(Err(canon(fa() - fb()))),
+            FmulS => Some(Err(canon(fa() * fb()))),
+            FdivS => Some(Err(canon(fa() / fb()))),
+            FsqrtS => Some(Err(canon(fa().sqrt()))),
+            FsgnjS => Some(Err(
+                (self.f[rs1] & 0x7FFF_FFFF) | (self.f[rs2] & 0x8000_0000)
+            )),
+            FsgnjnS => Some(Err(
+                (self.f[rs1] & 0x7FFF_FFFF) | (!self.f[rs2] & 0x8000_0000)
+            )),
+            FsgnjxS => Some(Err(self.f[rs1] ^ (self.f[rs2] & 0x8000_0000))),
+            FminS => Some(Err(fmin(self.f[rs1], self.f[rs2]))),
+            FmaxS => Some(Err(fmax(self.f[rs1], self.f[rs2]))),
+            FcvtWS => Some(Ok(fcvt_w_s(self.f[rs1], imm))),
+            FcvtWuS => Some(Ok(fcvt_wu_s(self.f[rs1], imm))),
+            FmvXW => Some(Ok(self.f[rs1])),
+            FeqS => Some(Ok((fa() == fb()) as u32)),
+            FltS => Some(Ok((fa() < fb()) as u32)),
+            FleS => Some(Ok((fa() <= fb()) as u32)),
+            FclassS => Some(Ok(fclass(self.f[rs1]))),
+            FcvtSW => Some(Err((a() as i32 as f32).to_bits())),
+            FcvtSWu => Some(Err((a() as f32).to_bits())),
+            FmvWX => Some(Err(a())),
+            RtRcp => Some(Err(canon(1.0 / fa()))),
+            RtRand => Some(Err(rt_rand(self.rand_key, a(), b(), imm as u32))),
+            _ => return None,
+        };
+        match out {
+            Some(Ok(v)) if rd != 0 => self.x[rd] = v,
+            Some(Err(v)) => self.f[rd] = v,
+            _ => {}
+        }
+        self.pc = next;
+        Some(taken)
+    }
+
     /// Executes `ins`: its memory access and whether it was a taken branch or a jump.
     #[inline(always)]
     fn execute<M: Memory>(
@@ -591,6 +736,9 @@ impl Hart {
         prog: &Program,
         mem: &mut M,
     ) -> Result<(MemAccess, bool), ExecError> {
+        if let Some(taken) = self.exec_register(ins) {
+            return Ok((MemAccess::NONE, taken));
+        }
         let pc = self.pc;
         let (op, imm) = (ins.op, ins.imm);
         // Register numbers are read where used; `& 31` lets the compiler drop the register
@@ -613,7 +761,6 @@ impl Hart {
         }
         let mut next = pc.wrapping_add(4);
         let mut acc = MemAccess::NONE;
-        let mut taken = false;
         // Operands are read by the arms that use them (reading all five up front costs
         // more than the dispatch).
         macro_rules! a {
@@ -656,35 +803,8 @@ impl Hart {
                 self.f[rd!()] = $v;
             }};
         }
-        macro_rules! branch {
-            ($c:expr) => {{
-                if $c {
-                    next = pc.wrapping_add(imm as u32);
-                    taken = true;
-                }
-            }};
-        }
         use Op::*;
         match op {
-            Lui => wx!(imm as u32),
-            Auipc => wx!(pc.wrapping_add(imm as u32)),
-            Jal => {
-                wx!(next);
-                next = pc.wrapping_add(imm as u32);
-                taken = true;
-            }
-            Jalr => {
-                let target = ea!() & !1; // read before the link write (rd may be rs1)
-                wx!(next);
-                next = target;
-                taken = true;
-            }
-            Beq => branch!(a!() == b!()),
-            Bne => branch!(a!() != b!()),
-            Blt => branch!((a!() as i32) < (b!() as i32)),
-            Bge => branch!((a!() as i32) >= (b!() as i32)),
-            Bltu => branch!(a!() < b!()),
-            Bgeu => branch!(a!() >= b!()),
             Lb => wx!(self.load::<1, M>(prog, mem, ea!(), &mut acc)?[0] as i8 as i32 as u32),
             Lbu => wx!(self.load::<1, M>(prog, mem, ea!(), &mut acc)?[0] as u32),
             Lh => {
@@ -713,42 +833,6 @@ impl Hart {
                 let v = self.f[rs2!()];
                 self.store::<4, M>(mem, ea!(), v.to_le_bytes(), &mut acc)?
             }
-            Addi => wx!(ea!()),
-            Slti => wx!(((a!() as i32) < imm) as u32),
-            Sltiu => wx!((a!() < imm as u32) as u32),
-            Xori => wx!(a!() ^ imm as u32),
-            Ori => wx!(a!() | imm as u32),
-            Andi => wx!(a!() & imm as u32),
-            Slli => wx!(a!() << imm),
-            Srli => wx!(a!() >> imm),
-            Srai => wx!(((a!() as i32) >> imm) as u32),
-            Add => wx!(a!().wrapping_add(b!())),
-            Sub => wx!(a!().wrapping_sub(b!())),
-            Sll => wx!(a!() << (b!() & 31)),
-            Slt => wx!(((a!() as i32) < (b!() as i32)) as u32),
-            Sltu => wx!((a!() < b!()) as u32),
-            Xor => wx!(a!() ^ b!()),
-            Srl => wx!(a!() >> (b!() & 31)),
-            Sra => wx!(((a!() as i32) >> (b!() & 31)) as u32),
-            Or => wx!(a!() | b!()),
-            And => wx!(a!() & b!()),
-            Mul => wx!(a!().wrapping_mul(b!())),
-            Mulh => wx!(((a!() as i32 as i64 * b!() as i32 as i64) >> 32) as u32),
-            Mulhsu => wx!(((a!() as i32 as i64 * b!() as i64) >> 32) as u32),
-            Mulhu => wx!(((a!() as u64 * b!() as u64) >> 32) as u32),
-            Div => wx!(if b!() == 0 {
-                u32::MAX
-            } else {
-                (a!() as i32).wrapping_div(b!() as i32) as u32
-            }),
-            Divu => wx!(a!().checked_div(b!()).unwrap_or(u32::MAX)),
-            Rem => wx!(if b!() == 0 {
-                a!()
-            } else {
-                (a!() as i32).wrapping_rem(b!() as i32) as u32
-            }),
-            Remu => wx!(if b!() == 0 { a!() } else { a!() % b!() }),
-            Fence => {}
             Ebreak => {
                 self.halted = true;
                 next = pc;
@@ -776,30 +860,6 @@ impl Hart {
                 }
                 wx!(0);
             }
-            FmaddS => wf!(canon(fa!().mul_add(fb!(), fc!()))),
-            FmsubS => wf!(canon(fa!().mul_add(fb!(), -fc!()))),
-            FnmsubS => wf!(canon((-fa!()).mul_add(fb!(), fc!()))),
-            FnmaddS => wf!(canon((-fa!()).mul_add(fb!(), -fc!()))),
-            FaddS => wf!(canon(fa!() + fb!())),
-            FsubS => wf!(canon(fa!() - fb!())),
-            FmulS => wf!(canon(fa!() * fb!())),
-            FdivS => wf!(canon(fa!() / fb!())),
-            FsqrtS => wf!(canon(fa!().sqrt())),
-            FsgnjS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (self.f[rs2!()] & 0x8000_0000)),
-            FsgnjnS => wf!((self.f[rs1] & 0x7FFF_FFFF) | (!self.f[rs2!()] & 0x8000_0000)),
-            FsgnjxS => wf!(self.f[rs1] ^ (self.f[rs2!()] & 0x8000_0000)),
-            FminS => wf!(fmin(self.f[rs1], self.f[rs2!()])),
-            FmaxS => wf!(fmax(self.f[rs1], self.f[rs2!()])),
-            FcvtWS => wx!(fcvt_w_s(self.f[rs1], imm)),
-            FcvtWuS => wx!(fcvt_wu_s(self.f[rs1], imm)),
-            FmvXW => wx!(self.f[rs1]),
-            FeqS => wx!((fa!() == fb!()) as u32),
-            FltS => wx!((fa!() < fb!()) as u32),
-            FleS => wx!((fa!() <= fb!()) as u32),
-            FclassS => wx!(fclass(self.f[rs1])),
-            FcvtSW => wf!((a!() as i32 as f32).to_bits()),
-            FcvtSWu => wf!((a!() as f32).to_bits()),
-            FmvWX => wf!(a!()),
             RtSetOrg => self.ray.ray.origin = Vec3::new(fa!(), fb!(), fc!()),
             RtSetInv => {
                 self.ray.inv_dir = Vec3::new(fa!(), fb!(), fc!());
@@ -817,9 +877,7 @@ impl Hart {
                 }
                 self.ray.k = k.map(|v| v as usize);
             }
-            RtRcp => wf!(canon(1.0 / fa!())),
             RtSRand => self.rand_key = [a!(), b!(), self.x[rs3!()]],
-            RtRand => wf!(rt_rand(self.rand_key, a!(), b!(), imm as u32)),
             RtAtomInc => {
                 let old = mem.atominc(a!()).map_err(|f| self.fault(f, 0, a!()))?;
                 wx!(old);
@@ -924,10 +982,11 @@ impl Hart {
                 let reason = decode(word).err().map_or("illegal", |e| e.reason);
                 return Err(ExecError::Illegal { pc, word, reason });
             }
+            _ => unreachable!("{op:?} is a register operation (Hart::exec_register)"),
         }
         self.x[0] = 0;
         self.pc = next;
-        Ok((acc, taken))
+        Ok((acc, false))
     }
 }
 

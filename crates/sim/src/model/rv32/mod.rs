@@ -78,6 +78,7 @@ pub mod run;
 #[cfg(test)]
 pub(crate) mod tests;
 pub mod tp;
+pub(crate) mod uop;
 
 pub use crate::hw::fu::FuClass;
 pub use decode::{DecodeError, Info, Instr, Latches, Reg, decode};

@@ -41,22 +41,17 @@ use crate::hw::tm::Tm;
 use crate::hw::{Cycle, Stall, Stalls, WordAddr};
 use crate::model::rv32::hart::executed_class;
 use crate::model::rv32::placement::Placement;
+use crate::model::rv32::uop::{
+    BOX_SLOT, DST_SLOT, NO_SLOT, PIPE_SLOT, RAY_SLOT, SLOTS, Unit, Uop, Uops,
+};
 use crate::model::rv32::{
-    ExecError, Hart, Info, LOCAL_STORE_ADDR, Latches, MemAccess, Memory, Op, Program, Reg,
+    ExecError, Hart, LOCAL_STORE_ADDR, Latches, MemAccess, Memory, Op, Program,
 };
 
 /// The farthest a TP runs instructions on its own units and pools ahead of the current
 /// event time.
 pub const LOOKAHEAD: u64 = 256;
 
-/// Scoreboard slots after the 64 registers: the latches `R`, `B`, `D`, `P`, and one that
-/// is always ready.
-const RAY_SLOT: usize = 64;
-const BOX_SLOT: usize = 65;
-const DST_SLOT: usize = 66;
-const PIPE_SLOT: usize = 67;
-const NO_SLOT: usize = 68;
-const SLOTS: usize = 69;
 /// The latch bits an instruction reads.
 const READS_ANY_LATCH: u8 =
     Latches::READS_RAY | Latches::READS_BOX | Latches::READS_DST | Latches::READS_PIPE;
@@ -180,9 +175,10 @@ impl Tp {
     /// runs the instruction it stopped before, with the whole chip, and goes back to sleep
     /// until its next issue slot.
     #[allow(clippy::too_many_arguments)]
-    pub fn run<const COMMIT: bool, M: Memory, B: Backing>(
+    pub(crate) fn run<const COMMIT: bool, M: Memory, B: Backing>(
         &mut self,
         prog: &Program,
+        uops: &Uops,
         mem: &mut M,
         cfg: &UnitConfig,
         tm: &mut Tm,
@@ -210,25 +206,25 @@ impl Tp {
                 // The commit phase runs one instruction; the rest run in local phases.
                 return Ok(Wake::At(self.t));
             }
-            let Some(ins) = prog.fetch(self.hart.pc) else {
+            let Some(u) = uops.fetch(self.hart.pc) else {
                 // The executor names the faulting pc.
                 return Err(self
                     .hart
                     .step(prog, mem)
                     .expect_err("fetch outside the text"));
             };
-            let info = ins.info;
+            let ins = &u.ins;
+            let info = &ins.info;
             // The instruction is fetched when the previous one has issued (SimTRaX holds a
             // fetched instruction until it issues).
             let fetch_from = self.t;
             // Operands: the registers, then the latches read.
             let l = info.latches;
-            let reg = |r: Reg| r.index().unwrap_or(NO_SLOT);
             let mut at = self
                 .t
-                .max(self.ready[reg(info.src[0])])
-                .max(self.ready[reg(info.src[1])])
-                .max(self.ready[reg(info.src[2])]);
+                .max(self.ready[u.src[0] as usize])
+                .max(self.ready[u.src[1] as usize])
+                .max(self.ready[u.src[2] as usize]);
             if l.bits() & READS_ANY_LATCH != 0 {
                 at = at.max(
                     latch_slots(l)
@@ -237,7 +233,7 @@ impl Tp {
                 );
             }
             if at > self.t {
-                stalls.count(self.producer_of(&info, at), at - self.t);
+                stalls.count(self.producer_of(u, at), at - self.t);
                 self.t = at;
             }
             let pc = self.hart.pc;
@@ -247,14 +243,15 @@ impl Tp {
                 stalls.count(Stall::Icache, fetched - self.t);
                 self.t = fetched;
             }
-            let (shared_unit, global_store) = match info.fu {
+            let (shared_unit, global_store) = match u.unit {
                 // A load or store is the L1's unless it addresses the local store.
-                FuClass::Load | FuClass::Store => {
+                Unit::Memory => {
                     let addr = self.hart.x[ins.rs1 as usize].wrapping_add(ins.imm as u32);
                     let global = addr < LOCAL_STORE_ADDR;
                     (global, global && info.fu == FuClass::Store)
                 }
-                fu => (on_shared_unit(fu), false),
+                Unit::Other { shared } => (shared, false),
+                Unit::Own(_) | Unit::Pool(_) => (false, false),
             };
             if (shared_unit && self.t > now) || self.t > now + LOOKAHEAD {
                 // Not issued yet: its fetch is made again when the thread next runs.
@@ -266,7 +263,12 @@ impl Tp {
                 tm.give_back(fetch);
                 return Ok(Wake::Commit);
             }
-            let acc = match self.hart.exec_access(ins, prog, mem) {
+            // Register operations run inline; the rest out of line.
+            let acc = match self.hart.exec_register(ins) {
+                Some(_) => Ok(MemAccess::NONE),
+                None => self.hart.exec_access(ins, prog, mem),
+            };
+            let acc = match acc {
                 Ok(acc) => acc,
                 Err(ExecError::Elsewhere { .. }) if !COMMIT => {
                     // A read of the frame buffer: nothing was executed.
@@ -277,117 +279,131 @@ impl Tp {
             };
             tm.keep(fetch);
             executed = true;
-            // The executed class (a load or store whose address is the local store's).
-            let fu = executed_class(info.fu, &acc);
-            counts[fu_index(fu)] += 1;
             self.rays += (ins.op == Op::RtSetOrg) as u64;
-            let dst = info.dst.index();
             let t = self.t;
             // (issue cycle, result latency, producer) for units that take one slot.
-            let (slot, lat, p) = match fu {
-                // A TP's own units (paper §2.3), or TM pools as SimTRaX's configs share them.
-                FuClass::IntAlu | FuClass::FpMove if cfg.int_units > 0 => {
-                    pool(tm, Pool::IntAlu, t, stalls)
+            let (slot, lat, p) = match u.unit {
+                Unit::Own(lat) => {
+                    counts[u.class as usize] += 1;
+                    (t, lat, Stall::Dependency)
                 }
-                FuClass::FpAdd if cfg.fpadd_units > 0 => pool(tm, Pool::FpAdd, t, stalls),
-                FuClass::FpMul | FuClass::FpFma if cfg.fpmul_units > 0 => {
-                    pool(tm, Pool::FpMul, t, stalls)
+                Unit::Pool(pl) => {
+                    counts[u.class as usize] += 1;
+                    pool(tm, pl, t, stalls)
                 }
-                FuClass::IntAlu | FuClass::FpMove => (t, cfg.int_latency, Stall::Dependency),
-                FuClass::FpAdd => (t, cfg.fpadd_latency, Stall::Dependency),
-                FuClass::FpMul | FuClass::FpFma => (t, cfg.fpmul_latency, Stall::Dependency),
-                FuClass::LocalLoad | FuClass::LocalStore => {
-                    (t, cfg.local_store_latency, Stall::Dependency)
-                }
-                FuClass::FpCmp => pool(tm, Pool::FpCmp, t, stalls),
-                FuClass::FpMinMax => pool(tm, Pool::FpMinMax, t, stalls),
-                FuClass::FpConv => pool(tm, Pool::Conv, t, stalls),
-                FuClass::Branch => pool(tm, Pool::Branch, t, stalls),
-                FuClass::IntMul => pool(tm, Pool::IntMul, t, stalls),
-                FuClass::IntDiv | FuClass::FpDiv | FuClass::FpSqrt | FuClass::Rcp => {
-                    let i = tm.reciprocal(t);
-                    stalls.count(Stall::FuBusy, i.busy);
-                    one_slot(i, Stall::Dependency)
-                }
-                FuClass::Atomic => {
-                    let (_, atomic) = shared
-                        .as_mut()
-                        .expect("the commit phase has the atomic unit");
-                    let i = atomic.increment(t);
-                    stalls.count(Stall::Atomic, i.busy);
-                    one_slot(i, Stall::Atomic)
-                }
-                FuClass::Store => {
-                    let (l2, _) = shared.as_mut().expect("the commit phase has the L2");
-                    let i = tm.store(
-                        *l2,
-                        WordAddr::from_byte(placement.physical(acc.addr)),
-                        acc.words as u64,
-                        t,
-                        now,
-                    );
-                    stalls.count(Stall::L1Bank, i.busy);
-                    self.t = i.next_issue;
-                    self.last = self.last.max(i.ready);
-                    continue;
-                }
-                FuClass::Load | FuClass::BoxPipe(_) | FuClass::TriPipe | FuClass::DstPipe => {
-                    let access = match info.fu {
-                        FuClass::BoxPipe(n) => Access::Pipe(Waiting {
-                            pipe: Pipe::Box,
-                            n,
-                            dst,
-                            latches: l,
-                        }),
-                        FuClass::TriPipe | FuClass::DstPipe => Access::Pipe(Waiting {
-                            pipe: if info.fu == FuClass::TriPipe {
-                                Pipe::Triangle
-                            } else {
-                                Pipe::DualSplit
-                            },
-                            n: 1,
-                            dst,
-                            latches: l,
-                        }),
-                        _ => Access::Load {
-                            dst,
-                            writes_pipe: l.has(Latches::WRITES_PIPE),
-                        },
-                    };
-                    if let Access::Pipe(w) = access
-                        && l.has(Latches::READS_PIPE)
-                    {
-                        // A register form: its words are in P (waited for above).
-                        let p = tm.pipe(w.pipe, w.n, w.n > 1, t);
-                        stalls.count(Stall::PipelineBusy, p.busy);
-                        self.finish_pipe(p, w);
-                        continue;
-                    }
-                    let i = match shared.as_mut() {
-                        Some((l2, _)) => l1_load(tm, *l2, placement, &acc, t, now, stalls),
-                        None => {
-                            let words = acc.words as u64;
-                            let addr = WordAddr::from_byte(placement.physical(acc.addr));
-                            if !tm.holds_all(addr, words) {
-                                // A miss: the L2 is the commit phase's.
-                                self.pending = Some(Pending { acc, access, t });
-                                return Ok(Wake::Commit);
-                            }
-                            l1_load(tm, &mut Resident, placement, &acc, t, now, stalls)
+                Unit::Memory | Unit::Other { .. } => {
+                    // The executed class (a load or store whose address is the local store's).
+                    let fu = executed_class(info.fu, &acc);
+                    counts[fu_index(fu)] += 1;
+                    let dst = info.dst.index();
+                    match fu {
+                        FuClass::LocalLoad | FuClass::LocalStore => {
+                            (t, cfg.local_store_latency, Stall::Dependency)
                         }
-                    };
-                    if let Some(w) = self.finish_access(tm, i, access, now, stalls) {
-                        return Ok(w);
+                        FuClass::IntDiv | FuClass::FpDiv | FuClass::FpSqrt | FuClass::Rcp => {
+                            let i = tm.reciprocal(t);
+                            stalls.count(Stall::FuBusy, i.busy);
+                            one_slot(i, Stall::Dependency)
+                        }
+                        FuClass::Atomic => {
+                            let (_, atomic) = shared
+                                .as_mut()
+                                .expect("the commit phase has the atomic unit");
+                            let i = atomic.increment(t);
+                            stalls.count(Stall::Atomic, i.busy);
+                            one_slot(i, Stall::Atomic)
+                        }
+                        FuClass::Store => {
+                            let (l2, _) = shared.as_mut().expect("the commit phase has the L2");
+                            let i = tm.store(
+                                *l2,
+                                WordAddr::from_byte(placement.physical(acc.addr)),
+                                acc.words as u64,
+                                t,
+                                now,
+                            );
+                            stalls.count(Stall::L1Bank, i.busy);
+                            self.t = i.next_issue;
+                            self.last = self.last.max(i.ready);
+                            continue;
+                        }
+                        FuClass::Load
+                        | FuClass::BoxPipe(_)
+                        | FuClass::TriPipe
+                        | FuClass::DstPipe => {
+                            let access = match info.fu {
+                                FuClass::BoxPipe(n) => Access::Pipe(Waiting {
+                                    pipe: Pipe::Box,
+                                    n,
+                                    dst,
+                                    latches: l,
+                                }),
+                                FuClass::TriPipe | FuClass::DstPipe => Access::Pipe(Waiting {
+                                    pipe: if info.fu == FuClass::TriPipe {
+                                        Pipe::Triangle
+                                    } else {
+                                        Pipe::DualSplit
+                                    },
+                                    n: 1,
+                                    dst,
+                                    latches: l,
+                                }),
+                                _ => Access::Load {
+                                    dst,
+                                    writes_pipe: l.has(Latches::WRITES_PIPE),
+                                },
+                            };
+                            if let Access::Pipe(w) = access
+                                && l.has(Latches::READS_PIPE)
+                            {
+                                // A register form: its words are in P (waited for above).
+                                let p = tm.pipe(w.pipe, w.n, w.n > 1, t);
+                                stalls.count(Stall::PipelineBusy, p.busy);
+                                self.finish_pipe(p, w);
+                                continue;
+                            }
+                            let i = match shared.as_mut() {
+                                Some((l2, _)) => l1_load(tm, *l2, placement, &acc, t, now, stalls),
+                                None => {
+                                    let words = acc.words as u64;
+                                    let addr = WordAddr::from_byte(placement.physical(acc.addr));
+                                    if !tm.holds_all(addr, words) {
+                                        // A miss: the L2 is the commit phase's.
+                                        self.pending = Some(Pending { acc, access, t });
+                                        return Ok(Wake::Commit);
+                                    }
+                                    l1_load(tm, &mut Resident, placement, &acc, t, now, stalls)
+                                }
+                            };
+                            if let Some(w) = self.finish_access(tm, i, access, now, stalls) {
+                                return Ok(w);
+                            }
+                            continue;
+                        }
+                        FuClass::Halt => {
+                            self.last = self.last.max(self.t);
+                            return Ok(Wake::Done(self.last));
+                        }
+                        FuClass::IntAlu
+                        | FuClass::IntMul
+                        | FuClass::FpAdd
+                        | FuClass::FpMul
+                        | FuClass::FpFma
+                        | FuClass::FpCmp
+                        | FuClass::FpMinMax
+                        | FuClass::FpConv
+                        | FuClass::FpMove
+                        | FuClass::Branch => {
+                            unreachable!("{fu:?} issues on its own unit or a pool")
+                        }
                     }
-                    continue;
-                }
-                FuClass::Halt => {
-                    self.last = self.last.max(self.t);
-                    return Ok(Wake::Done(self.last));
                 }
             };
             self.t = slot + 1;
-            self.write(dst, slot + lat, p);
+            let (d, ready) = (u.dst as usize, slot + lat);
+            self.ready[d] = ready;
+            self.producer[d] = p;
+            self.last = self.last.max(ready);
             if l.has(Latches::WRITES_RAY) {
                 self.ready[RAY_SLOT] = slot + lat;
             }
@@ -436,14 +452,14 @@ impl Tp {
         None
     }
 
-    /// The producer of the first operand of `info` (the registers in order, then the
+    /// The producer of the first operand of `u` (the registers in order, then the
     /// latches `R`, `B`, `D`, `P`) whose result arrives at `at`, the last of them: the
     /// cause a wait for the operands is counted under.
     #[cold]
-    fn producer_of(&self, info: &Info, at: Cycle) -> Stall {
-        let regs = info.src.map(|r| r.index().unwrap_or(NO_SLOT));
+    fn producer_of(&self, u: &Uop, at: Cycle) -> Stall {
+        let regs = u.src.map(usize::from);
         regs.iter()
-            .chain(latch_slots(info.latches).iter())
+            .chain(latch_slots(u.ins.info.latches).iter())
             .find(|&&k| self.ready[k] == at)
             .map_or(Stall::Dependency, |&k| self.producer[k])
     }
@@ -507,24 +523,6 @@ fn pool(tm: &mut Tm, p: Pool, t: Cycle, stalls: &mut Stalls) -> (Cycle, u64, Sta
     let s = tm.reserve_pool(p, t);
     stalls.count(Stall::FuBusy, s - t);
     (s, tm.pool_latency(p), Stall::Dependency)
-}
-
-/// Whether an instruction of class `fu` uses a unit shared with other threads that keeps a
-/// reservation table bound to the current time (the L1, the ray pipelines, the reciprocal
-/// unit, the atomic unit): it issues only when its cycle has come.
-#[inline]
-fn on_shared_unit(fu: FuClass) -> bool {
-    matches!(
-        fu,
-        FuClass::BoxPipe(_)
-            | FuClass::TriPipe
-            | FuClass::DstPipe
-            | FuClass::IntDiv
-            | FuClass::FpDiv
-            | FuClass::FpSqrt
-            | FuClass::Rcp
-            | FuClass::Atomic
-    )
 }
 
 #[cfg(test)]
