@@ -198,7 +198,15 @@ impl L1 {
             addr.get() >> shift,
             (addr.get() + words.max(1) - 1) >> shift,
         );
-        (first..=last).all(|line| self.cache.holds(LineAddr::new(line)))
+        // A loop, not `(first..=last).all(..)`: an inclusive range costs a flag per step.
+        let mut line = first;
+        while self.cache.holds(LineAddr::new(line)) {
+            if line == last {
+                return true;
+            }
+            line += 1;
+        }
+        false
     }
 
     /// Reads (without effect) the L1 tag of `addr`'s line and returns a value to keep the

@@ -354,6 +354,10 @@ impl Cache {
     #[inline]
     pub fn holds(&self, line: LineAddr) -> bool {
         let line = line.get();
+        // Most L1 accesses hit a direct-mapped cache: one compare.
+        if self.find_direct(line).is_some() {
+            return true;
+        }
         let s = self.set(line);
         match &self.ways {
             Ways::Narrow(w) => {

@@ -122,8 +122,9 @@ pub struct Tp {
     /// Scoreboard: the cycle each register's pending result arrives (`x0..x31`,
     /// `f0..f31`), then the same for the ray registers `R`, the box latch `B`, the DST
     /// latch `D` and the pipeline input registers `P` (the latest of the loads that wrote
-    /// them), and a slot that is always ready ([`NO_SLOT`], read for an absent operand);
-    /// and what produces each.
+    /// them), a slot that is always ready ([`NO_SLOT`], read for an absent operand) and one
+    /// written for an absent result (`uop::SINK_SLOT`); and what produces each (the slots
+    /// of `uop.rs`).
     ready: [Cycle; SLOTS],
     producer: [Stall; SLOTS],
     /// The latest result of any instruction so far.

@@ -10,14 +10,15 @@ use crate::model::rv32::{Instr, Program, Reg};
 
 /// Scoreboard slots: the 64 registers `x0..x31`, `f0..f31`, then the latches `R`, `B`, `D`,
 /// `P`, one slot that is always ready (read for an absent operand) and one that is never
-/// read (written for an absent result).
+/// read (written for an absent result). The scoreboard has [`SLOTS`] entries, one per `u8`,
+/// so that indexing it with a slot number needs no bounds check.
 pub(crate) const RAY_SLOT: usize = 64;
 pub(crate) const BOX_SLOT: usize = 65;
 pub(crate) const DST_SLOT: usize = 66;
 pub(crate) const PIPE_SLOT: usize = 67;
 pub(crate) const NO_SLOT: usize = 68;
 pub(crate) const SINK_SLOT: usize = 69;
-pub(crate) const SLOTS: usize = 70;
+pub(crate) const SLOTS: usize = 1 << u8::BITS;
 
 /// The unit an instruction issues on, as far as it is known before it executes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
