@@ -586,8 +586,8 @@ impl Hart {
     /// Executes `ins` when it is a register operation: integer and floating-point
     /// arithmetic, `lui`, `auipc`, branches, jumps, `fence`, `rt.rcp` and `rt.rand` (no
     /// memory access, no latch, no error); returns whether it was a taken branch or a jump.
-    /// Returns `None`, changing nothing, for any other instruction ([`Hart::execute`] runs
-    /// it). The `rv32` timing model calls it inline, before the out-of-line executor.
+    /// Returns `None`, changing nothing, for any other instruction, which the out-of-line
+    /// executor runs ([`Hart::exec`]). The `rv32` timing model calls it inline first.
     #[inline(always)]
     pub fn exec_register(&mut self, ins: &Instr) -> Option<bool> {
         use Op::*;
