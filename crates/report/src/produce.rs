@@ -7,8 +7,10 @@
 //!                                                                     workload, SimConfig, res
 //! ```
 //!
-//! Structures are built only when some piece of their scene is missing. Simulations run two
-//! at a time (the machine has two cores). A simulator error is recorded in the data as
+//! A scene's structures are built only when some piece of it is missing, and then once: the
+//! CPU piece times that build and every piece after it shares the structures. Simulations
+//! run side by side, one per host thread (a frame's TMs split over threads when there are
+//! fewer frames than threads). A simulator error is recorded in the data as
 //! "simulator unavailable: `<error>`" and never cached, so it is retried next time.
 
 use crate::ReportError;
@@ -215,11 +217,13 @@ impl<'a> Producer<'a> {
     /// Produces the whole report for `scenes` (already loaded); `skipped` lists the scenes
     /// that could not be loaded.
     pub fn run(&self, scenes: &[Scene], skipped: Vec<Skipped>) -> Result<ReportData, ReportError> {
-        let structures: Vec<OnceLock<Result<Structures, String>>> =
+        // Each scene's structures are built once, the first time a piece needs them (the
+        // CPU piece reports that build's time), and shared by every piece after it.
+        let structures: Vec<OnceLock<Result<Built, String>>> =
             scenes.iter().map(|_| OnceLock::new()).collect();
         // A scene whose structures cannot be built (an image offset overflow) fails the
         // pieces that need them with a typed error instead of panicking.
-        let get = |i: usize| -> Result<&Structures, ReportError> {
+        let built = |i: usize| -> Result<&Built, ReportError> {
             structures[i]
                 .get_or_init(|| build(&scenes[i]))
                 .as_ref()
@@ -228,6 +232,7 @@ impl<'a> Producer<'a> {
                     message: message.clone(),
                 })
         };
+        let get = |i: usize| built(i).map(|b| &b.structures);
         let hashes: Vec<String> = scenes.iter().map(|s| s.content_hash()).collect();
 
         // Host pieces: CPU measurements and renders.
@@ -248,7 +253,7 @@ impl<'a> Producer<'a> {
             // cached, so it is measured again once the structure exists.
             cpu.push(self.cached(
                 &key,
-                || cpu_data(scene, self.settings.cpu_res),
+                || cpu_data(scene, built(i)?, self.settings.cpu_res),
                 |c: &CpuData| c.sizes.iter().all(|s| s.bytes.is_ok()),
             )?);
             self.progress.advance(1);
@@ -613,21 +618,32 @@ fn ray_sets(scene: &Scene, structures: &Structures, res: u32) -> [Vec<Traced>; 3
     sets
 }
 
-/// Every structure of `scene` with the report's build settings; the error as text.
-fn build(scene: &Scene) -> Result<Structures, String> {
-    Structures::try_build(&scene.triangles, &BuildConfig::high_quality()).map_err(|e| e.to_string())
+/// A scene's structures, built once for every piece of the report, with the host time
+/// their build took.
+pub struct Built {
+    /// Every structure, with the report's build settings.
+    pub structures: Structures,
+    /// Wall time of the build, in milliseconds (a measurement of this machine).
+    pub ms: f64,
 }
 
-/// Host measurements of one scene: build times, sizes, and single-thread Mrays/s per
-/// structure and ray kind, each structure checked ray by ray against BVH2 before it is
-/// timed.
-pub fn cpu_data(scene: &Scene, cpu_res: u32) -> Result<CpuData, ReportError> {
+/// Every structure of `scene` with the report's build settings, timed; the error as text.
+fn build(scene: &Scene) -> Result<Built, String> {
     let t0 = Instant::now();
-    let structures = build(scene).map_err(|message| ReportError::Build {
-        scene: scene.name.clone(),
-        message,
-    })?;
-    let all_structures_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let structures = Structures::try_build(&scene.triangles, &BuildConfig::high_quality())
+        .map_err(|e| e.to_string())?;
+    Ok(Built {
+        structures,
+        ms: t0.elapsed().as_secs_f64() * 1e3,
+    })
+}
+
+/// Host measurements of one scene from its `built` structures: build times, sizes, and
+/// single-thread Mrays/s per structure and ray kind, each structure checked ray by ray
+/// against BVH2 before it is timed.
+pub fn cpu_data(scene: &Scene, built: &Built, cpu_res: u32) -> Result<CpuData, ReportError> {
+    let structures = &built.structures;
+    let all_structures_ms = built.ms;
     let build_ms = structures
         .stats()
         .into_iter()
@@ -640,10 +656,10 @@ pub fn cpu_data(scene: &Scene, cpu_res: u32) -> Result<CpuData, ReportError> {
         .iter()
         .map(|&kind| StructureSize {
             kind,
-            bytes: structure_bytes(&structures, kind),
+            bytes: structure_bytes(structures, kind),
         })
         .collect();
-    let sets = ray_sets(scene, &structures, cpu_res);
+    let sets = ray_sets(scene, structures, cpu_res);
     let mut throughput = Vec::new();
     for (ray_kind, set) in [RayKind::Primary, RayKind::Shadow, RayKind::Diffuse]
         .into_iter()
@@ -658,7 +674,7 @@ pub fn cpu_data(scene: &Scene, cpu_res: u32) -> Result<CpuData, ReportError> {
                     ray_kind.name()
                 ))
             } else {
-                time_set(&structures, kind, ray_kind, &set)
+                time_set(structures, kind, ray_kind, &set)
             };
             throughput.push(Throughput {
                 kind,
@@ -668,7 +684,7 @@ pub fn cpu_data(scene: &Scene, cpu_res: u32) -> Result<CpuData, ReportError> {
             });
         }
     }
-    let counts = traversal_counts(&structures, &sets);
+    let counts = traversal_counts(structures, &sets);
     Ok(CpuData {
         sizes,
         build_ms,
