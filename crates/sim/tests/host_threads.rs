@@ -1,8 +1,8 @@
 //! The golden configurations on 1, 2, 3 and 7 host threads give the same result.
 //!
 //! Its own file (no shipped meshes, so CI's pass without the large meshes does not run it
-//! again): a frame on more host threads than the host has cores meets at every simulated
-//! cycle, slowly, so the frames are small.
+//! again): a frame on more host threads than the host has cores hands the commit turn from
+//! thread to thread through the kernel's scheduler, slowly, so the frames are small.
 
 use dualsplit_accel::Structures;
 use dualsplit_render::{RenderSettings, Workload};

@@ -16,16 +16,19 @@
 //!
 //! TMs are split into contiguous groups, one per host thread ([`Lane`]). A TM's local phase
 //! touches only that TM, and its threads' order within a cycle depends only on that TM's
-//! history, so the groups run their local phases in parallel; the commit phase walks the
-//! groups in TM order, one after another. The result is therefore bit-identical for any
-//! number of host threads. The frame ends when the last result of the last thread has
-//! arrived.
+//! history, so each group runs its local phases on its own, as far ahead of the others as
+//! it gets. Commit phases are taken in (cycle, group) order: a group that has something to
+//! commit at cycle `c` waits until every lower group has passed `c` and every higher group
+//! has reached it (`sync::Frontiers`, conservative parallel discrete-event simulation);
+//! groups never meet otherwise. The L2 and the atomic unit therefore see the same requests
+//! in the same order as on one host thread, and the result is bit-identical for any number
+//! of host threads. The frame ends when the last result of the last thread has arrived.
 //!
 //! ```text
-//!   engine::run ──▶ per group: a wheel of its threads' wake-ups; all groups agree on the
-//!        │          next cycle with events (sync::Meeting)
+//!   engine::run ──▶ per group: a wheel of its threads' wake-ups, and its frontier (the
+//!        │          cycle it works on) published to the others (sync::Frontiers)
 //!        ▼ Lane::step(id, TM, now) -> Wake::{At, Forward, Done, Commit}   (in parallel)
-//!        ▼ Lane::commit(id, TM, L2, atomic unit, now)                     (in TM order)
+//!        ▼ Lane::commit(id, TM, L2, atomic unit, now)          (in (cycle, TM) order)
 //!   model::rv32 (thread processors executing the compiled kernels)
 //!   model::fast (threads replaying recorded macro-ops)
 //!        │
@@ -48,7 +51,7 @@ use crate::hw::tm::Tm;
 use crate::hw::{Chip, Cycle, Stall, Stalls};
 use std::ops::Range;
 use std::sync::{Mutex, PoisonError};
-use sync::{Meeting, Turns};
+use sync::Frontiers;
 use wheel::{NONE, Wheel};
 
 pub use wheel::HOPS;
@@ -121,7 +124,7 @@ pub trait Lane: Send {
         shared: Commit<'_, Self::Shared>,
         now: Cycle,
     ) -> Result<Wake, Self::Error>;
-    /// Called once after each cycle with events, after its commit phase (progress reports).
+    /// Called after each commit phase of a group, with the shared state (progress reports).
     #[inline]
     fn after_cycle(_shared: &mut Self::Shared) {}
 }
@@ -152,11 +155,11 @@ struct Common<'a, S> {
 }
 
 /// What one lane leaves: its threads' finish cycles, its stall counts, and its first
-/// error with the chip TM it came from.
+/// error with the cycle and the chip TM it came from.
 struct Left<E> {
     finish: Vec<Cycle>,
     stalls: Stalls,
-    error: Option<(usize, E)>,
+    error: Option<(Cycle, usize, E)>,
 }
 
 /// Runs every thread of `lanes` to completion on `chip`, one host thread per lane (the
@@ -187,7 +190,7 @@ pub fn run<L: Lane>(
         model: shared,
     });
     let parties = lanes.len();
-    let (meeting, turns) = (Meeting::new(parties), Turns::new(parties));
+    let frontiers = Frontiers::new(parties);
     let left: Vec<Left<L::Error>> = if parties == 1 {
         lanes
             .iter_mut()
@@ -195,14 +198,14 @@ pub fn run<L: Lane>(
             .map(|(lane, tms)| drive(lane, tms, &common, None))
             .collect()
     } else {
-        let (meeting, turns, common) = (&meeting, &turns, &common);
+        let (frontiers, common) = (&frontiers, &common);
         std::thread::scope(|s| {
             let handles: Vec<_> = lanes
                 .iter_mut()
                 .zip(parts)
                 .enumerate()
                 .map(|(p, (lane, tms))| {
-                    s.spawn(move || drive(lane, tms, common, Some((p, meeting, turns))))
+                    s.spawn(move || drive(lane, tms, common, Some((p, frontiers))))
                 })
                 .collect();
             handles
@@ -216,39 +219,44 @@ pub fn run<L: Lane>(
         .flat_map(|l| l.finish.iter().copied())
         .max()
         .unwrap_or(Cycle::ZERO);
-    let mut error: Option<(usize, L::Error)> = None;
+    let mut error: Option<(Cycle, usize, L::Error)> = None;
     for l in left {
         chip_stalls.add(&l.stalls);
         chip_stalls.count(Stall::Idle, l.finish.iter().map(|&f| end - f).sum::<u64>());
-        if let Some((tm, e)) = l.error
-            && error.as_ref().is_none_or(|(t, _)| tm < *t)
+        if let Some((c, tm, e)) = l.error
+            && error
+                .as_ref()
+                .is_none_or(|(c0, t0, _)| (c, tm) < (*c0, *t0))
         {
-            error = Some((tm, e));
+            error = Some((c, tm, e));
         }
     }
     match error {
-        Some((_, e)) => Err(e),
+        Some((_, _, e)) => Err(e),
         None => Ok(end),
     }
 }
 
-/// Raises the meeting's poison flag if its lane panics, so the other lanes stop waiting.
-struct PoisonOnPanic<'m>(Option<&'m Meeting>);
+/// Publishes that its lane will never commit again when it ends, however it ends, and
+/// poisons the frontiers if it panics, so that the other lanes stop waiting for it.
+struct Leave<'f>(Option<(usize, &'f Frontiers)>);
 
-impl Drop for PoisonOnPanic<'_> {
+impl Drop for Leave<'_> {
     fn drop(&mut self) {
-        if let Some(m) = self.0
-            && std::thread::panicking()
-        {
-            m.poison();
+        if let Some((p, f)) = self.0 {
+            if std::thread::panicking() {
+                f.poison();
+            }
+            f.publish(p, u64::MAX);
         }
     }
 }
 
-/// Keeps `e` (from chip TM `tm`) when it is the lane's first error or from a lower TM.
-fn note<E>(error: &mut Option<(usize, E)>, tm: usize, e: E) {
-    if error.as_ref().is_none_or(|(t, _)| tm < *t) {
-        *error = Some((tm, e));
+/// Keeps `e` (from chip TM `tm`, at cycle `now`) when it is the lane's first error or from
+/// a lower TM in the same cycle.
+fn note<E>(error: &mut Option<(Cycle, usize, E)>, now: Cycle, tm: usize, e: E) {
+    if error.as_ref().is_none_or(|(c, t, _)| (now, tm) < (*c, *t)) {
+        *error = Some((now, tm, e));
     }
 }
 
@@ -263,78 +271,72 @@ fn schedule(wheel: &mut Wheel, finish: &mut [Cycle], deferred: &mut Vec<u32>, id
     }
 }
 
-/// One lane's loop: its wheel, cycle after cycle with events, its local phase and its
-/// turn of the commit phase; `sync` is its party number and the lanes' meeting and turns
-/// when there is more than one lane.
+/// One lane's loop: its wheel, cycle after cycle with events, its local phase and, when
+/// its threads asked for it, its turn of the commit phase; `sync` is its party number and
+/// the lanes' frontiers when there is more than one lane. The lane publishes each cycle it
+/// reaches as its frontier before working on it, and waits for its turn only to commit.
 fn drive<L: Lane>(
     lane: &mut L,
     tms: &mut [Tm],
     common: &Mutex<Common<'_, L::Shared>>,
-    sync: Option<(usize, &Meeting, &Turns)>,
+    sync: Option<(usize, &Frontiers)>,
 ) -> Left<L::Error> {
-    let _guard = PoisonOnPanic(sync.map(|(_, m, _)| m));
-    if let Some((p, m, _)) = sync {
-        m.join(p);
+    let _leave = Leave(sync);
+    if let Some((p, f)) = sync {
+        f.join(p);
     }
     let n = lane.count();
     let tm0 = lane.tms().start;
-    let last_party = sync.is_none_or(|(p, m, _)| p + 1 == m.parties());
     let mut wheel = Wheel::new(n);
     for i in 0..n as u32 {
         wheel.push(Cycle::ZERO, i);
     }
     let mut finish = vec![Cycle::ZERO; n];
     let mut stalls = Stalls::default();
-    let mut error: Option<(usize, L::Error)> = None;
+    let mut error: Option<(Cycle, usize, L::Error)> = None;
     let mut deferred: Vec<u32> = Vec::new();
-    let mut bucket: Option<(Cycle, u32)> = None;
-    for round in 0.. {
-        if bucket.is_none() {
-            bucket = wheel.next_bucket();
-        }
-        let mine = bucket.map_or(u64::MAX, |(c, _)| c.get());
-        let (now, abort) = match sync {
-            None => (mine, error.is_some()),
-            Some((_, m, _)) => m.meet(round, mine, error.is_some()),
-        };
-        if abort || now == u64::MAX {
-            break;
-        }
-        let now = Cycle(now);
-        if mine == now.get() {
-            let (_, first) = bucket.take().expect("a bucket at this cycle");
-            if L::TOUCH {
-                let mut touched = 0;
-                let mut id = first;
-                while id != NONE {
-                    if !wheel.is_forward(id) {
-                        touched ^= lane.touch(id as usize, &tms[lane.tm_of(id as usize)]);
-                    }
-                    id = wheel.after(id);
-                }
-                std::hint::black_box(touched);
+    while let Some((now, first)) = wheel.next_bucket() {
+        if let Some((p, f)) = sync {
+            // No lane goes on past the first cycle with a failed step.
+            if now.get() > f.failed() {
+                break;
             }
+            f.publish(p, now.get());
+        }
+        if L::TOUCH {
+            let mut touched = 0;
             let mut id = first;
             while id != NONE {
-                let next = wheel.after(id);
-                wheel.taken();
-                if let Some(to) = wheel.take_forward(id) {
-                    wheel.push(to, id);
-                    id = next;
-                    continue;
+                if !wheel.is_forward(id) {
+                    touched ^= lane.touch(id as usize, &tms[lane.tm_of(id as usize)]);
                 }
-                let tm = lane.tm_of(id as usize);
-                match lane.step(id as usize, &mut tms[tm], &mut stalls, now) {
-                    Ok(w) => schedule(&mut wheel, &mut finish, &mut deferred, id, w),
-                    Err(e) => note(&mut error, tm0 + tm, e),
-                }
-                id = next;
+                id = wheel.after(id);
             }
+            std::hint::black_box(touched);
         }
-        if let Some((p, m, t)) = sync {
-            t.wait(round, p, m);
+        let mut id = first;
+        while id != NONE {
+            let next = wheel.after(id);
+            wheel.taken();
+            if let Some(to) = wheel.take_forward(id) {
+                wheel.push(to, id);
+                id = next;
+                continue;
+            }
+            let tm = lane.tm_of(id as usize);
+            match lane.step(id as usize, &mut tms[tm], &mut stalls, now) {
+                Ok(w) => schedule(&mut wheel, &mut finish, &mut deferred, id, w),
+                Err(e) => note(&mut error, now, tm0 + tm, e),
+            }
+            id = next;
         }
-        if !deferred.is_empty() || last_party {
+        if !deferred.is_empty() {
+            if let Some((p, f)) = sync {
+                f.wait_turn(p, now.get());
+                if now.get() > f.failed() {
+                    break;
+                }
+            }
             let mut guard = common.lock().unwrap_or_else(PoisonError::into_inner);
             let g = &mut *guard;
             // By TM, then in the order the TM's threads asked (a stable sort).
@@ -349,16 +351,17 @@ fn drive<L: Lane>(
                 match lane.commit(id as usize, &mut tms[tm], &mut stalls, shared, now) {
                     Ok(Wake::Commit) => unreachable!("a commit step asked for the commit phase"),
                     Ok(w) => schedule(&mut wheel, &mut finish, &mut Vec::new(), id, w),
-                    Err(e) => note(&mut error, tm0 + tm, e),
+                    Err(e) => note(&mut error, now, tm0 + tm, e),
                 }
             }
             deferred.clear();
-            if last_party {
-                L::after_cycle(g.model);
-            }
+            L::after_cycle(g.model);
         }
-        if let Some((p, m, t)) = sync {
-            t.pass(round, p, m);
+        if error.is_some() {
+            if let Some((_, f)) = sync {
+                f.fail(now.get());
+            }
+            break;
         }
     }
     Left {

@@ -1,71 +1,69 @@
-//! How the host threads of a parallel frame meet: once per simulated cycle with events, to
-//! agree on that cycle ([`Meeting`]), and once to take their turns at the commit phase
-//! ([`Turns`]). A waiting thread spins for a few microseconds (a cycle's work on a
-//! dedicated core), then parks until the thread it waits for wakes it, so that more host
+//! How the host threads of a parallel frame keep the commit phases in order without
+//! meeting every cycle.
+//!
+//! Commits are ordered by (cycle, party): party `p`'s commit phase of cycle `c` comes after
+//! every commit of an earlier cycle and after those of the lower parties in cycle `c`. Each
+//! party publishes its **frontier**, the earliest cycle it may still commit at (the cycle
+//! it is working on; `u64::MAX` once it is done), and before committing at `c` waits until
+//! every lower party's frontier is past `c` and every higher party's has reached it
+//! ([`Frontiers::wait_turn`]). Local phases touch only the party's own TMs, so a party runs
+//! them as far ahead as it likes: it waits only when it has something to commit and another
+//! party may still commit before it. No party waits for another while that one waits for
+//! it: a party waiting at `c` holds its frontier at `c`, which lets every party whose
+//! turn comes before `(c, p)` go on.
+//!
+//! This is conservative parallel discrete-event simulation (Chandy and Misra 1979) with
+//! the frontiers as the null messages. A waiting thread spins for a while (a cycle's work
+//! on a dedicated core), then parks until a frontier it waits on moves, so that more host
 //! threads than cores (a test run beside others) do not take each other's time slices.
 
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::thread::Thread;
 
 /// Spins before parking when every party has a core of its own: about a millisecond (a
-/// `pause` takes about 40 ns on recent x86), longer than a cycle's work, so the parties
-/// meet without a system call. Measured on a 2-core host, 128² Dragon Box BVH2 path frame,
-/// two host threads: 1.74× one thread's speed; with 128 spins, 0.38× (a futex wake-up
-/// every cycle).
+/// `pause` takes about 40 ns on recent x86), longer than a cycle's work, so parties pass
+/// the turn without a system call. Source: on a 2-core host, 128² Dragon Box BVH2 path
+/// frame on two host threads, a per-cycle barrier with this spin limit gave 1.74× one
+/// thread's speed, and 0.38× with 128 spins (a futex wake-up every cycle).
 const SPINS_OWN_CORE: u32 = 16384;
 /// Spins before parking when there are more parties than cores: a waiting party gives its
 /// core to the one it waits for almost at once.
 const SPINS_SHARED_CORE: u32 = 128;
 
-/// Waits until `done` holds: spins, then parks (woken by `Meeting::wake`; a wake-up may
-/// be spurious, so `done` is tested again). Panics when `poisoned` is raised (a party
-/// panicked and will never arrive).
-#[inline]
-fn wait_until(poisoned: &AtomicBool, limit: u32, mut done: impl FnMut() -> bool) {
-    let mut spins = 0u32;
-    while !done() {
-        if poisoned.load(Ordering::Acquire) {
-            panic!("another host thread of the simulated frame panicked");
-        }
-        if spins < limit {
-            spins += 1;
-            std::hint::spin_loop();
-        } else {
-            std::thread::park();
-        }
-    }
-}
+/// A value alone on its host cache lines (128 bytes: two lines, for the adjacent-line
+/// prefetcher), so that one party publishing does not slow another's reads.
+#[repr(align(128))]
+struct Padded<T>(T);
 
-/// A barrier that also takes the minimum of the values its parties bring, and an abort
-/// flag any party may raise.
-pub(crate) struct Meeting {
-    parties: usize,
-    arrived: AtomicUsize,
-    /// Meetings completed.
-    generation: AtomicUsize,
-    /// The minimum and the abort flag of the current meeting (even generations) and of the
-    /// next (odd): a party that has left a meeting may already bring the next one's.
-    min: [AtomicU64; 2],
-    abort: [AtomicBool; 2],
-    /// A party panicked ([`Meeting::poison`]).
-    poisoned: AtomicBool,
-    /// Each party's host thread, to wake it ([`Meeting::join`]).
+/// The parties' frontiers, the first cycle any party failed at, and what parks and wakes
+/// them.
+pub(crate) struct Frontiers {
+    /// Per party, the earliest cycle it may still commit at.
+    at: Vec<Padded<AtomicU64>>,
+    /// Per party, whether it is about to park or parked (set before its last check).
+    sleeping: Vec<Padded<AtomicBool>>,
+    /// Each party's host thread, to wake it ([`Frontiers::join`]).
     threads: Vec<OnceLock<Thread>>,
+    /// The earliest cycle a party's step failed at (`u64::MAX`: none).
+    failed: AtomicU64,
+    /// A party panicked ([`Frontiers::poison`]).
+    poisoned: AtomicBool,
     /// Spins before parking.
     spins: u32,
 }
 
-impl Meeting {
+impl Frontiers {
+    /// `parties` parties, every frontier at cycle 0.
     pub(crate) fn new(parties: usize) -> Self {
         Self {
-            parties,
-            arrived: AtomicUsize::new(0),
-            generation: AtomicUsize::new(0),
-            min: [AtomicU64::new(u64::MAX), AtomicU64::new(u64::MAX)],
-            abort: [AtomicBool::new(false), AtomicBool::new(false)],
-            poisoned: AtomicBool::new(false),
+            at: (0..parties).map(|_| Padded(AtomicU64::new(0))).collect(),
+            sleeping: (0..parties)
+                .map(|_| Padded(AtomicBool::new(false)))
+                .collect(),
             threads: (0..parties).map(|_| OnceLock::new()).collect(),
+            failed: AtomicU64::new(u64::MAX),
+            poisoned: AtomicBool::new(false),
             spins: if parties <= std::thread::available_parallelism().map_or(1, usize::from) {
                 SPINS_OWN_CORE
             } else {
@@ -74,91 +72,84 @@ impl Meeting {
         }
     }
 
-    /// Registers the calling host thread as party `p`'s; every party does so before its
-    /// first meeting.
+    /// Registers the calling host thread as party `p`'s; every party does so before it
+    /// first publishes or waits.
     pub(crate) fn join(&self, p: usize) {
         let _ = self.threads[p].set(std::thread::current());
     }
 
-    /// Wakes party `p` if it is parked (and makes its next park return at once if not).
+    /// Party `p` will not commit before cycle `c` (`u64::MAX`: never again); wakes the
+    /// parties parked on it.
     #[inline]
-    fn wake(&self, p: usize) {
-        if let Some(t) = self.threads[p].get() {
+    pub(crate) fn publish(&self, p: usize, c: u64) {
+        self.at[p].0.store(c, Ordering::SeqCst);
+        self.wake_others(p);
+    }
+
+    /// Wakes every party but `p` that is parked or about to park.
+    #[inline]
+    fn wake_others(&self, p: usize) {
+        for (q, s) in self.sleeping.iter().enumerate() {
+            if q != p
+                && s.0.load(Ordering::SeqCst)
+                && let Some(t) = self.threads[q].get()
+            {
+                t.unpark();
+            }
+        }
+    }
+
+    /// Whether party `p` may commit at cycle `c`: every lower party is past `c`, every
+    /// higher one has reached it.
+    #[inline]
+    fn my_turn(&self, p: usize, c: u64) -> bool {
+        self.at.iter().enumerate().all(|(q, f)| {
+            let f = f.0.load(Ordering::SeqCst);
+            if q < p { f > c } else { q == p || f >= c }
+        })
+    }
+
+    /// Waits until party `p` may commit at cycle `c` (its own frontier is at `c`). Spins,
+    /// then parks; panics when a party has panicked (it will never publish again).
+    pub(crate) fn wait_turn(&self, p: usize, c: u64) {
+        let mut spins = 0u32;
+        while !self.my_turn(p, c) {
+            if self.poisoned.load(Ordering::Acquire) {
+                panic!("another host thread of the simulated frame panicked");
+            }
+            if spins < self.spins {
+                spins += 1;
+                std::hint::spin_loop();
+                continue;
+            }
+            // Publish the intent to park, then look again: a frontier moved after this
+            // store sees the flag and unparks (SeqCst on both sides), and an unpark before
+            // the park makes it return at once.
+            self.sleeping[p].0.store(true, Ordering::SeqCst);
+            if !self.my_turn(p, c) && !self.poisoned.load(Ordering::Acquire) {
+                std::thread::park();
+            }
+            self.sleeping[p].0.store(false, Ordering::SeqCst);
+        }
+    }
+
+    /// A step failed at cycle `c`: no party goes on past the earliest such cycle.
+    pub(crate) fn fail(&self, c: u64) {
+        self.failed.fetch_min(c, Ordering::SeqCst);
+    }
+
+    /// The earliest cycle a step failed at (`u64::MAX`: none so far).
+    #[inline]
+    pub(crate) fn failed(&self) -> u64 {
+        self.failed.load(Ordering::SeqCst)
+    }
+
+    /// Raised by a party that panics, so that the others panic instead of waiting for it.
+    pub(crate) fn poison(&self) {
+        self.poisoned.store(true, Ordering::SeqCst);
+        for t in self.threads.iter().filter_map(OnceLock::get) {
             t.unpark();
         }
-    }
-
-    /// The number of parties.
-    pub(crate) fn parties(&self) -> usize {
-        self.parties
-    }
-
-    /// Raised by a party that panics, so that the others panic instead of waiting for it
-    /// (at this meeting or at a turn).
-    pub(crate) fn poison(&self) {
-        self.poisoned.store(true, Ordering::Release);
-        for p in 0..self.parties {
-            self.wake(p);
-        }
-    }
-
-    /// Meeting number `g` (each party counts its own, from 0): brings `value`, waits for
-    /// every party, and returns the least value brought and whether any party aborted.
-    pub(crate) fn meet(&self, g: usize, value: u64, abort: bool) -> (u64, bool) {
-        if abort {
-            self.abort[g & 1].store(true, Ordering::Relaxed);
-        }
-        let slot = &self.min[g & 1];
-        slot.fetch_min(value, Ordering::AcqRel);
-        if self.arrived.fetch_add(1, Ordering::AcqRel) + 1 == self.parties {
-            self.arrived.store(0, Ordering::Relaxed);
-            // The next meeting's slot is fresh before anyone can reach it; this one's
-            // stays readable until every party has left it (it is reset two meetings on).
-            self.min[(g + 1) & 1].store(u64::MAX, Ordering::Relaxed);
-            self.abort[(g + 1) & 1].store(false, Ordering::Relaxed);
-            self.generation.store(g + 1, Ordering::Release);
-            for p in 0..self.parties {
-                self.wake(p);
-            }
-        } else {
-            wait_until(&self.poisoned, self.spins, || {
-                self.generation.load(Ordering::Acquire) > g
-            });
-        }
-        (
-            slot.load(Ordering::Acquire),
-            self.abort[g & 1].load(Ordering::Relaxed),
-        )
-    }
-}
-
-/// Turns in a fixed order: party `p` of `parties` takes round `r`'s turn after party
-/// `p − 1`, and party 0 after party `parties − 1` of round `r − 1`.
-pub(crate) struct Turns {
-    parties: usize,
-    next: AtomicUsize,
-}
-
-impl Turns {
-    pub(crate) fn new(parties: usize) -> Self {
-        Self {
-            parties,
-            next: AtomicUsize::new(0),
-        }
-    }
-
-    /// Waits for party `p`'s turn of round `r` (panics when `m` is poisoned).
-    pub(crate) fn wait(&self, r: usize, p: usize, m: &Meeting) {
-        let me = r * self.parties + p;
-        wait_until(&m.poisoned, m.spins, || {
-            self.next.load(Ordering::Acquire) == me
-        });
-    }
-
-    /// Ends party `p`'s turn of round `r` and wakes the next party.
-    pub(crate) fn pass(&self, r: usize, p: usize, m: &Meeting) {
-        self.next.store(r * self.parties + p + 1, Ordering::Release);
-        m.wake((p + 1) % self.parties);
     }
 }
 
@@ -166,74 +157,69 @@ impl Turns {
 mod tests {
     use super::*;
 
-    /// Every party learns the least value of each meeting, over many meetings with
-    /// values that change, and turns come in party order.
+    /// Commits come in (cycle, party) order for parties with different, sparse commit
+    /// cycles, whatever the interleaving of their host threads.
     #[test]
-    fn meetings_agree_on_the_minimum_and_turns_keep_their_order() {
+    fn commits_come_in_cycle_then_party_order() {
         for parties in [1, 2, 3, 5] {
-            let meeting = Meeting::new(parties);
-            let turns = Turns::new(parties);
+            let f = Frontiers::new(parties);
             let order = std::sync::Mutex::new(Vec::new());
-            let seen: Vec<Vec<u64>> = std::thread::scope(|s| {
-                let hs: Vec<_> = (0..parties)
-                    .map(|p| {
-                        let (meeting, turns, order) = (&meeting, &turns, &order);
-                        s.spawn(move || {
-                            let mut seen = Vec::new();
-                            for g in 0..500 {
-                                let v = ((g * 7 + p * 13) % 11) as u64;
-                                if g == 0 {
-                                    meeting.join(p);
-                                }
-                                let (m, abort) = meeting.meet(g, v, false);
-                                assert!(!abort);
-                                seen.push(m);
-                                turns.wait(g, p, meeting);
-                                order.lock().unwrap().push((g, p));
-                                turns.pass(g, p, meeting);
+            std::thread::scope(|s| {
+                for p in 0..parties {
+                    let (f, order) = (&f, &order);
+                    s.spawn(move || {
+                        f.join(p);
+                        // Party p works at the cycles ≡ 0 mod p + 1 and commits at every
+                        // second of them.
+                        let step = p as u64 + 1;
+                        for (k, c) in (0..400).step_by(step as usize).enumerate() {
+                            f.publish(p, c);
+                            if k % 2 == 0 {
+                                f.wait_turn(p, c);
+                                order.lock().unwrap().push((c, p));
                             }
-                            seen
-                        })
-                    })
-                    .collect();
-                hs.into_iter().map(|h| h.join().unwrap()).collect()
+                        }
+                        f.publish(p, u64::MAX);
+                    });
+                }
             });
-            let want: Vec<u64> = (0..500)
-                .map(|g| {
-                    (0..parties)
-                        .map(|p| ((g * 7 + p * 13) % 11) as u64)
-                        .min()
-                        .unwrap()
-                })
-                .collect();
-            for s in &seen {
-                assert_eq!(s, &want, "{parties} parties");
-            }
             let order = order.into_inner().unwrap();
-            let expected: Vec<_> = (0..500)
-                .flat_map(|g| (0..parties).map(move |p| (g, p)))
-                .collect();
-            assert_eq!(order, expected);
+            let mut sorted = order.clone();
+            sorted.sort_unstable();
+            assert_eq!(order, sorted, "{parties} parties");
+            let want: usize = (0..parties)
+                .map(|p| (0..400).step_by(p + 1).count().div_ceil(2))
+                .sum();
+            assert_eq!(order.len(), want, "{parties} parties");
         }
     }
 
+    /// A panicking party's poison reaches a party parked waiting for it.
     #[test]
-    fn an_abort_reaches_every_party() {
-        let meeting = Meeting::new(3);
-        let aborts: Vec<bool> = std::thread::scope(|s| {
-            let hs: Vec<_> = (0..3)
-                .map(|p| {
-                    let meeting = &meeting;
-                    s.spawn(move || {
-                        meeting.join(p);
-                        let (_, a0) = meeting.meet(0, 1, false);
-                        assert!(!a0);
-                        meeting.meet(1, 1, p == 2).1
-                    })
-                })
-                .collect();
-            hs.into_iter().map(|h| h.join().unwrap()).collect()
+    fn poison_wakes_a_waiting_party() {
+        let f = Frontiers::new(2);
+        let r = std::thread::scope(|s| {
+            let h = s.spawn(|| {
+                f.join(1);
+                f.publish(1, 5);
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| f.wait_turn(1, 5)))
+            });
+            f.join(0);
+            std::thread::sleep(std::time::Duration::from_millis(20));
+            f.poison();
+            h.join().unwrap()
         });
-        assert_eq!(aborts, vec![true; 3]);
+        assert!(r.is_err());
+    }
+
+    /// The earliest failure wins.
+    #[test]
+    fn the_earliest_failure_is_kept() {
+        let f = Frontiers::new(3);
+        assert_eq!(f.failed(), u64::MAX);
+        f.fail(9);
+        f.fail(4);
+        f.fail(7);
+        assert_eq!(f.failed(), 4);
     }
 }
