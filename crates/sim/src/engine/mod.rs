@@ -370,3 +370,129 @@ fn drive<L: Lane>(
         error,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SimConfig;
+
+    /// A toy thread model: each thread steps once a cycle until cycle 200, asks for the
+    /// commit phase every third cycle, and the threads of `fails` fail at their cycle (in
+    /// the local phase for even TMs, in the commit phase for odd ones), naming their TM.
+    struct Toy {
+        tms: Range<usize>,
+        per_tm: usize,
+        fails: Vec<(usize, u64)>,
+    }
+
+    impl Toy {
+        fn fails_now(&self, id: usize, now: Cycle, commit: bool) -> Option<usize> {
+            let tm = self.tms.start + id / self.per_tm;
+            let at = self.fails.iter().find(|&&(t, _)| t == tm)?.1;
+            (at == now.get() && (tm % 2 == 1) == commit).then_some(tm)
+        }
+    }
+
+    impl Lane for Toy {
+        type Error = (u64, usize);
+        type Shared = Vec<(u64, usize)>;
+
+        fn count(&self) -> usize {
+            self.tms.len() * self.per_tm
+        }
+
+        fn tms(&self) -> Range<usize> {
+            self.tms.clone()
+        }
+
+        fn tm_of(&self, id: usize) -> usize {
+            id / self.per_tm
+        }
+
+        fn step(
+            &mut self,
+            id: usize,
+            _: &mut Tm,
+            _: &mut Stalls,
+            now: Cycle,
+        ) -> Result<Wake, (u64, usize)> {
+            if let Some(tm) = self.fails_now(id, now, false) {
+                return Err((now.get(), tm));
+            }
+            Ok(match now.get() {
+                200.. => Wake::Done(now),
+                c if c % 3 == 0 => Wake::Commit,
+                _ => Wake::At(now + 1),
+            })
+        }
+
+        fn commit(
+            &mut self,
+            id: usize,
+            _: &mut Tm,
+            _: &mut Stalls,
+            shared: Commit<'_, Self::Shared>,
+            now: Cycle,
+        ) -> Result<Wake, (u64, usize)> {
+            let tm = self.tms.start + id / self.per_tm;
+            shared.model.push((now.get(), tm));
+            if let Some(tm) = self.fails_now(id, now, true) {
+                return Err((now.get(), tm));
+            }
+            Ok(Wake::At(now + 1))
+        }
+    }
+
+    /// A toy run's result, and the (cycle, TM) of each commit in the order the shared state
+    /// saw them.
+    type ToyRun = (Result<Cycle, (u64, usize)>, Vec<(u64, usize)>);
+
+    /// Runs the toy on `lanes` host threads.
+    fn toy(lanes: usize, fails: &[(usize, u64)]) -> ToyRun {
+        let mut cfg = SimConfig::lin2020();
+        cfg.tms = 8;
+        let mut chip = Chip::new(&cfg, 1);
+        let mut toys: Vec<Toy> = groups(8, lanes)
+            .into_iter()
+            .map(|tms| Toy {
+                tms,
+                per_tm: 3,
+                fails: fails.to_vec(),
+            })
+            .collect();
+        let mut seen = Vec::new();
+        let r = run(&mut chip, &mut toys, &mut seen);
+        (r, seen)
+    }
+
+    /// Commits reach the shared state in (cycle, TM) order, and a run ends with the same
+    /// result, on any number of host threads.
+    #[test]
+    fn commits_are_ordered_and_results_equal_on_any_thread_count() {
+        let (one, seen) = toy(1, &[]);
+        assert_eq!(one, Ok(Cycle(200)));
+        let mut sorted = seen.clone();
+        sorted.sort();
+        assert_eq!(seen, sorted);
+        for lanes in [2, 3, 8] {
+            assert_eq!(toy(lanes, &[]), (one, seen.clone()), "{lanes} lanes");
+        }
+    }
+
+    /// The error of the lowest TM in the first cycle with errors is returned, whichever
+    /// lane it is in and whichever phase it comes from, on any number of host threads.
+    #[test]
+    fn the_first_cycles_lowest_tm_error_wins_on_any_thread_count() {
+        for (fails, want) in [
+            (vec![(6, 40), (2, 40), (7, 90)], (40, 2)),
+            (vec![(1, 61), (6, 60), (4, 60)], (60, 4)),
+            (vec![(7, 30), (5, 33), (0, 120)], (30, 7)),
+            (vec![(3, 150), (5, 150)], (150, 3)),
+        ] {
+            for lanes in [1, 2, 3, 8] {
+                let (r, _) = toy(lanes, &fails);
+                assert_eq!(r, Err(want), "{fails:?} on {lanes} lanes");
+            }
+        }
+    }
+}
