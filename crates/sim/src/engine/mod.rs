@@ -190,7 +190,6 @@ pub fn run<L: Lane>(
         model: shared,
     });
     let parties = lanes.len();
-    let frontiers = Frontiers::new(parties);
     let left: Vec<Left<L::Error>> = if parties == 1 {
         lanes
             .iter_mut()
@@ -198,6 +197,7 @@ pub fn run<L: Lane>(
             .map(|(lane, tms)| drive(lane, tms, &common, None))
             .collect()
     } else {
+        let frontiers = Frontiers::new(parties);
         let (frontiers, common) = (&frontiers, &common);
         std::thread::scope(|s| {
             let handles: Vec<_> = lanes
