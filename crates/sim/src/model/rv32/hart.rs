@@ -571,8 +571,9 @@ impl Hart {
         })
     }
 
-    /// Executes `ins` as [`Hart::exec`] does, returning only its memory access (a timing
-    /// model that has the instruction's [`Info`] needs nothing else).
+    /// Executes `ins`, an instruction [`Hart::exec_register`] does not run, as
+    /// [`Hart::exec`] does, returning only its memory access (a timing model that has the
+    /// instruction's [`Info`] needs nothing else).
     #[inline(never)]
     pub fn exec_access<M: Memory>(
         &mut self,
@@ -580,7 +581,7 @@ impl Hart {
         prog: &Program,
         mem: &mut M,
     ) -> Result<MemAccess, ExecError> {
-        self.execute(ins, prog, mem).map(|(acc, _)| acc)
+        self.execute_other(ins, prog, mem)
     }
 
     /// Executes `ins` when it is a register operation: integer and floating-point
@@ -739,6 +740,18 @@ impl Hart {
         if let Some(taken) = self.exec_register(ins) {
             return Ok((MemAccess::NONE, taken));
         }
+        self.execute_other(ins, prog, mem).map(|acc| (acc, false))
+    }
+
+    /// Executes `ins`, which is not a register operation ([`Hart::exec_register`] returned
+    /// `None` for it): a load, store, ray-tracing, latch or system instruction.
+    #[inline(always)]
+    fn execute_other<M: Memory>(
+        &mut self,
+        ins: &Instr,
+        prog: &Program,
+        mem: &mut M,
+    ) -> Result<MemAccess, ExecError> {
         let pc = self.pc;
         let (op, imm) = (ins.op, ins.imm);
         // Register numbers are read where used; `& 31` lets the compiler drop the register
@@ -986,7 +999,7 @@ impl Hart {
         }
         self.x[0] = 0;
         self.pc = next;
-        Ok((acc, false))
+        Ok(acc)
     }
 }
 
