@@ -571,11 +571,12 @@ impl Hart {
         })
     }
 
-    /// Executes `ins`, an instruction [`Hart::exec_register`] does not run, as
-    /// [`Hart::exec`] does, returning only its memory access (a timing model that has the
-    /// instruction's [`Info`] needs nothing else).
+    /// Executes `ins`, an instruction [`Hart::exec_register`] does not run (it returned
+    /// `None`), as [`Hart::exec`] does, returning only its memory access (a timing model
+    /// that has the instruction's [`Info`] needs nothing else). The TP's executor: it
+    /// dispatches on the op once, among those instructions only.
     #[inline(never)]
-    pub fn exec_access<M: Memory>(
+    pub(crate) fn exec_access<M: Memory>(
         &mut self,
         ins: &Instr,
         prog: &Program,

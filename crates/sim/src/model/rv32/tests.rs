@@ -334,6 +334,43 @@ fn retired_records_local_accesses_csr_and_fence() {
     assert_eq!(h.pc, BASE + 24);
 }
 
+/// The TP's executor, `Hart::exec_register` and, where it declines, `Hart::exec_access`,
+/// runs every instruction as `step` does.
+#[test]
+fn the_tps_executor_runs_every_instruction_as_step_does() {
+    let words = [
+        addi(1, 0, 7),        // a register operation
+        s(0x23, 2, 2, 1, -4), // sw x1, -4(sp)
+        i(0x03, 2, 3, 2, -4), // lw x3, -4(sp)
+        addi(4, 3, 1),
+        b(1, 4, 0, 8), // bne x4, x0, +8: taken
+        addi(5, 0, 1), // skipped
+        lui(6, 0x1234_5000),
+        EBREAK,
+    ];
+    let prog = Program::from_words(BASE, &words);
+    let image = MemoryImage::default();
+    let mut mem = FrameMemory::new(&image, &[], 0);
+    let (mut a, mut b) = (Hart::new(&prog, 64), Hart::new(&prog, 64));
+    let mut out_of_line = 0;
+    for _ in 0..7 {
+        let ins = *prog.fetch(b.pc).expect("in the text");
+        let acc = match b.exec_register(&ins) {
+            Some(_) => MemAccess::NONE,
+            None => {
+                out_of_line += 1;
+                b.exec_access(&ins, &prog, &mut mem).unwrap()
+            }
+        };
+        let r = a.step(&prog, &mut mem).unwrap();
+        assert_eq!(acc, r.mem);
+        assert_eq!((a.pc, a.x, a.f), (b.pc, b.x, b.f));
+    }
+    assert_eq!(out_of_line, 3, "sw, lw and ebreak");
+    assert_eq!((b.x[3], b.x[4], b.x[5], b.x[6]), (7, 8, 0, 0x1234_5000));
+    assert_eq!(b.pc, BASE + 28);
+}
+
 #[test]
 fn memory_regions_and_faults() {
     let image = MemoryImage::default();
