@@ -42,12 +42,12 @@ impl Fetch {
 /// The fetch counts of one TM's instruction caches.
 #[derive(Clone, Debug)]
 pub struct ICaches {
-    /// One row per bank, the banks of cache 0 first.
+    /// One row per bank, each cache's banks in a plane of their own: a thread reads only
+    /// its cache's counts, so each host cache line it loads holds more of the cycles it
+    /// fetches in.
     banks: Window,
     caches: usize,
     bank_mask: u32,
-    /// log2(banks per cache): the bank count is a power of two (`ranges.rs`).
-    bank_shift: u32,
     /// Fetches per bank per cycle; 0 = no limit.
     limit: u8,
 }
@@ -56,16 +56,15 @@ impl ICaches {
     /// Idle caches as `units` configures them.
     pub fn new(units: &UnitConfig) -> Self {
         let limit = units.icache_fetches.min(u8::MAX as u32) as u8;
-        let n = if limit == 0 {
-            0
+        let (planes, rows) = if limit == 0 {
+            (1, 0)
         } else {
-            (units.icaches * units.icache_banks) as usize
+            (units.icaches as usize, units.icache_banks as usize)
         };
         Self {
-            banks: Window::new(n),
+            banks: Window::with_planes(planes, rows),
             caches: units.icaches as usize,
             bank_mask: units.icache_banks - 1,
-            bank_shift: units.icache_banks.trailing_zeros(),
             limit,
         }
     }
@@ -78,7 +77,7 @@ impl ICaches {
     /// The bank of cache `cache` holding the instruction at byte address `pc`.
     #[inline]
     fn bank(&self, cache: usize, pc: u32) -> usize {
-        (cache << self.bank_shift) | ((pc >> 2) & self.bank_mask) as usize
+        self.banks.row(cache, ((pc >> 2) & self.bank_mask) as usize)
     }
 
     /// The fetch of a thread that may not issue the instruction yet: fetches the

@@ -9,7 +9,10 @@
 //!
 //! Host layout: one cycle's counts of every row lie side by side (`[cycle][row]`, one byte
 //! each), so a thread issuing at consecutive cycles reads consecutive bytes, and a TM's
-//! tables take `HISTORY × rows` bytes (rows rounded up to a power of two).
+//! tables take `HISTORY × rows` bytes (rows rounded up to a power of two). Rows that
+//! different threads use may be split into *planes* (`[plane][cycle][row]`; the TM's
+//! instruction caches, each read by its own threads): a host cache line then holds more
+//! cycles of the rows a thread reads.
 
 /// Cycles a window remembers: four times the `rv32` model's run-ahead (`tp::LOOKAHEAD`), so
 /// that the requests of threads running ahead and of threads at the event clock always lie
@@ -22,19 +25,36 @@ pub struct Window {
     base: u64,
     /// Bytes per cycle (`rows` rounded up to a power of two, so an index is a shift).
     shift: u32,
-    /// `HISTORY << shift` counts, cycle-major.
+    /// log2 of a plane's bytes (`HISTORY << shift`).
+    plane_shift: u32,
+    /// `planes · HISTORY << shift` counts, plane-major, then cycle-major.
     counts: Box<[u8]>,
 }
 
 impl Window {
     /// An empty window over `rows` resources (at least one).
     pub fn new(rows: usize) -> Self {
+        Self::with_planes(1, rows)
+    }
+
+    /// An empty window over `planes` planes of `rows` resources each; row `r` of plane `p`
+    /// is row [`Window::row`]`(p, r)`.
+    pub fn with_planes(planes: usize, rows: usize) -> Self {
         let shift = rows.max(1).next_power_of_two().trailing_zeros();
+        let plane_shift = HISTORY.trailing_zeros() + shift;
         Self {
             base: 0,
             shift,
-            counts: vec![0; (HISTORY as usize) << shift].into_boxed_slice(),
+            plane_shift,
+            counts: vec![0; planes.max(1) << plane_shift].into_boxed_slice(),
         }
+    }
+
+    /// The row number of row `r` of plane `p`: the plane's offset in the counts, so that
+    /// an index is the same one `or` for every row.
+    #[inline]
+    pub fn row(&self, p: usize, r: usize) -> usize {
+        (p << self.plane_shift) | r
     }
 
     #[inline(always)]
@@ -143,9 +163,11 @@ impl Window {
             let (from, rows) = ((fresh % HISTORY) as usize, self.shift);
             let end = from + n as usize;
             let len = HISTORY as usize;
-            self.counts[from << rows..end.min(len) << rows].fill(0);
-            if end > len {
-                self.counts[..(end - len) << rows].fill(0);
+            for plane in self.counts.chunks_exact_mut(1 << self.plane_shift) {
+                plane[from << rows..end.min(len) << rows].fill(0);
+                if end > len {
+                    plane[..(end - len) << rows].fill(0);
+                }
             }
         }
         self.base = base;
@@ -167,6 +189,25 @@ mod tests {
         assert_eq!(w.count(1, 5), 0);
         // An earlier cycle is still free.
         assert_eq!(w.reserve(0, 4, 2), 4);
+    }
+
+    #[test]
+    fn planes_count_apart_and_slide_together() {
+        let mut w = Window::with_planes(2, 3);
+        let (a, b) = (w.row(0, 1), w.row(1, 1));
+        assert_eq!(w.reserve(a, 5, 1), 5);
+        assert_eq!(w.reserve(b, 5, 1), 5);
+        assert_eq!(w.reserve(a, 5, 1), 6);
+        assert_eq!((w.count(b, 6), w.count(w.row(1, 0), 5)), (0, 0));
+        // Far ahead: both planes forget cycles 5 and 6.
+        let far = 5 + 5 * HISTORY;
+        assert_eq!(w.reserve(b, far, 1), far);
+        assert_eq!(w.reserve(a, far + HISTORY / 4, 1), far + HISTORY / 4);
+        for row in [a, b] {
+            assert_eq!(w.count(row, 5), 0);
+            assert_eq!(w.count(row, 5 + HISTORY * 5 + 1), 0);
+        }
+        assert_eq!(w.count(b, far), 1);
     }
 
     #[test]
