@@ -10,10 +10,11 @@
 //! measure is callgrind/cachegrind's host instructions per simulated instruction:
 //! `valgrind --tool=cachegrind --cache-sim=no <bench binary> --bench kernel_frame::Dst
 //! --sample-count 1 --sample-size 1`, then the `run_counting` lines of `cg_annotate` divided by
-//! the simulated instructions (two frames: the count run and one sample). At the commit
-//! that added this note: 46 host instructions per simulated instruction (7.76 M simulated
-//! instructions per DST frame); divan: int_loop ≈ 180–320 M instructions/s, kernel_frame
-//! ≈ 100–150 M/s (median–fastest, load average ≈ 2.3).
+//! the simulated instructions (two frames: the count run and one sample). At commit 26bcb2c:
+//! 90 host instructions per simulated instruction for either kernel (4.88 M simulated
+//! instructions per DST frame, 5.41 M per BVH2 frame); divan pinned to one core of a quiet
+//! host: int_loop 131–198 M instructions/s, kernel_frame 81–132 M/s (BVH2) and 116–146 M/s
+//! (DST), median–fastest (`docs/performance.md`, "What bounds it").
 
 use divan::counter::ItemsCount;
 use dualsplit_accel::{MemoryImage, Structures};
